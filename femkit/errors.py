@@ -1,0 +1,106 @@
+"""Every exception femkit raises on purpose.
+
+All derive from :class:`FemkitError`, so a caller can catch the whole family.
+The command line maps :class:`InputError` (and its subclasses) to exit code 2
+and prints the one-line message; anything else is a bug.
+
+Hierarchy::
+
+    FemkitError
+    ├── InputError                 bad input from the user (exit code 2)
+    │   ├── CaseFileError          case/scene/study file: schema, keys, types, paths
+    │   ├── ExpressionError        unsafe or malformed expression in a case file
+    │   ├── UnknownNameError       unknown solver / preconditioner / integrator / geometry name
+    │   └── MeshError              unreadable or invalid mesh
+    │       └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
+    ├── SolverError                a linear solver could not do what was asked
+    │   ├── NotSPDError            input to CG-type method is not symmetric positive definite
+    │   └── SingularSystemError    singular system (e.g. pure Neumann, inconsistent rhs)
+    └── InstabilityError           a time integrator blew up (method, step, time, energy ratio, dt_crit)
+"""
+
+from __future__ import annotations
+
+from typing import Iterable
+
+
+class FemkitError(Exception):
+    """Base class of all femkit errors."""
+
+
+class InputError(FemkitError):
+    """Bad input from the user: the command line exits with code 2."""
+
+
+class CaseFileError(InputError):
+    """A case, scene or study file is invalid (unknown key, wrong type, missing file ...)."""
+
+
+class ExpressionError(InputError):
+    """An expression in a case file is malformed or uses something outside the whitelist."""
+
+
+class UnknownNameError(InputError, KeyError):
+    """A name looked up in a registry does not exist.
+
+    The message names the kind of thing, the name asked for and the valid names.
+    """
+
+    def __init__(self, kind: str, name: str, valid: Iterable[str]):
+        self.kind = kind
+        self.name = name
+        self.valid = sorted(valid)
+        super().__init__(f"unknown {kind} {name!r}; valid {kind}s: {', '.join(self.valid)}")
+
+    def __str__(self) -> str:  # KeyError would otherwise repr() the message
+        return self.args[0]
+
+
+class MeshError(InputError):
+    """A mesh cannot be read or fails validation."""
+
+
+class DegenerateMeshError(MeshError):
+    """Triangles with zero or near-zero area; ``element_ids`` lists them."""
+
+    def __init__(self, message: str, element_ids=()):
+        self.element_ids = list(element_ids)
+        super().__init__(message)
+
+
+class SolverError(FemkitError):
+    """A linear solver was handed something it cannot solve."""
+
+
+class NotSPDError(SolverError):
+    """The matrix handed to a CG-type method is not symmetric positive definite."""
+
+
+class SingularSystemError(SolverError):
+    """The system is singular (e.g. pure Neumann with an inconsistent right-hand side)."""
+
+
+class InstabilityError(FemkitError):
+    """A time integration became unstable.
+
+    Attributes carry the facts: ``method``, ``step``, ``time``, ``energy_ratio``,
+    ``dt``, ``dt_crit`` (``None`` when unknown) and ``partial`` (the results up to
+    the last good step, if the caller kept them).
+    """
+
+    def __init__(self, method: str, step: int, time: float, energy_ratio: float,
+                 dt: float, dt_crit: float | None, reason: str = "", partial=None):
+        self.method = method
+        self.step = step
+        self.time = time
+        self.energy_ratio = energy_ratio
+        self.dt = dt
+        self.dt_crit = dt_crit
+        self.reason = reason
+        self.partial = partial
+        crit = f"{dt_crit:.3e}" if dt_crit is not None else "unknown"
+        super().__init__(
+            f"{method} became unstable at step {step} (t = {time:.6g}): "
+            f"{reason or 'energy grew'}; energy ratio {energy_ratio:.3e}, dt = {dt:.3e}, "
+            f"critical step {crit}"
+        )
