@@ -1,0 +1,444 @@
+"""Mesh generation with the gmsh Python API.
+
+gmsh is imported inside the functions only, so ``import femkit.mesh`` stays cheap and a case
+that reads a ``.msh`` file never loads it.
+
+Every geometry is a factory registered in :data:`GEOMETRIES`; call it through
+:func:`generate`::
+
+    generate("l_shape", h=0.1)
+    generate("annulus", h=0.05, r_inner=0.3, r_outer=1.0)
+
+Tag conventions (names go to :attr:`Mesh.tag_names`):
+
+* Every geometry tags its whole boundary as the edge group ``"boundary"`` **as well as** named
+  parts. An edge in several groups appears once per group in ``Mesh.boundary_edges`` (the same
+  node pair repeated with each tag), so ``boundary_edges[boundary_tags == mesh.tag("left")]`` and
+  ``boundary_edges[boundary_tags == mesh.tag("boundary")]`` both work.
+* Cell groups: single-region geometries tag every triangle ``"domain"``; multi-region geometries
+  (``checkerboard``, ``square_with_inclusion``) tag each triangle with its region instead (a
+  triangle carries exactly one cell tag).
+* Tag numbers are unique across edge and cell groups of a generated mesh.
+
+Generated meshes are deterministic: one gmsh thread, fixed algorithm, no random reseeding
+between runs; triangles are counter-clockwise.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+from typing import Callable, Iterator, Sequence
+
+import numpy as np
+
+from ..errors import InputError, MeshError
+from ..registry import Registry
+from .mesh import Mesh
+
+GEOMETRIES: Registry[Callable[..., Mesh]] = Registry("geometry")
+
+#: gmsh element type numbers
+_GMSH_LINE, _GMSH_TRIANGLE = 1, 2
+
+
+def _check_h(h) -> float:
+    try:
+        hv = float(h)
+    except (TypeError, ValueError):
+        raise InputError(f"mesh size h must be a positive number, got {h!r}") from None
+    if not (math.isfinite(hv) and hv > 0):
+        raise InputError(f"mesh size h must be a positive finite number, got {h!r}")
+    return hv
+
+
+def _positive(name: str, value) -> float:
+    v = float(value)
+    if not (math.isfinite(v) and v > 0):
+        raise InputError(f"{name} must be positive and finite, got {value!r}")
+    return v
+
+
+@contextlib.contextmanager
+def _gmsh_session(name: str) -> Iterator[object]:
+    """Initialise gmsh quietly (or reuse a live session), yield the module, clean up.
+
+    If gmsh was already initialised by the caller, a fresh model is added and removed again
+    and gmsh is left running; otherwise gmsh is finalised on exit, also on errors.
+    """
+    import gmsh
+
+    owner = not gmsh.isInitialized()
+    if owner:
+        gmsh.initialize(argv=[], readConfigFiles=False, run=False, interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("General.Verbosity", 0)
+        gmsh.option.setNumber("General.NumThreads", 1)
+        gmsh.option.setNumber("Mesh.MaxNumThreads2D", 1)
+        gmsh.option.setNumber("Mesh.RandomSeed", 1)
+        gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay
+        gmsh.option.setNumber("Mesh.ElementOrder", 1)
+        gmsh.model.add(name)
+        yield gmsh
+    finally:
+        if owner:
+            gmsh.finalize()
+        else:
+            with contextlib.suppress(Exception):
+                gmsh.model.remove()
+
+
+def _set_size(gmsh, h: float) -> None:
+    gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+
+
+def _mesh_from_gmsh(gmsh) -> Mesh:
+    """Turn the current gmsh model (already meshed in 2D) into a :class:`Mesh`.
+
+    Triangles: when the model has 2D physical groups, only triangles of surfaces in a physical
+    group are kept (gmsh's own rule when saving), each tagged with its group (the first group
+    when a surface is in several); otherwise all triangles, tag 0. Nodes not used by any kept
+    triangle are dropped (e.g. circle centres); node order follows gmsh's node tags.
+    """
+    model = gmsh.model
+    node_tags, coords, _ = model.mesh.getNodes(-1, -1, includeBoundary=True,
+                                               returnParametricCoord=False)
+    node_tags = np.asarray(node_tags, dtype=np.int64)
+    xyz = np.asarray(coords, dtype=np.float64).reshape(-1, 3)
+
+    tri_blocks, tag_blocks = [], []
+    names: dict[str, int] = {}
+    groups2 = model.getPhysicalGroups(2)
+    if groups2:
+        seen_entities: set[int] = set()
+        for dim, ptag in groups2:
+            name = model.getPhysicalName(dim, ptag)
+            if name:
+                names[name] = int(ptag)
+            for ent in model.getEntitiesForPhysicalGroup(dim, ptag):
+                if int(ent) in seen_entities:
+                    continue
+                seen_entities.add(int(ent))
+                types, _, enodes = model.mesh.getElements(2, int(ent))
+                for t, nodes in zip(types, enodes):
+                    if t == _GMSH_TRIANGLE:
+                        tri_blocks.append(np.asarray(nodes, np.int64).reshape(-1, 3))
+                        tag_blocks.append(np.full(len(tri_blocks[-1]), ptag, np.int32))
+    else:
+        for _, ent in model.getEntities(2):
+            types, _, enodes = model.mesh.getElements(2, ent)
+            for t, nodes in zip(types, enodes):
+                if t == _GMSH_TRIANGLE:
+                    tri_blocks.append(np.asarray(nodes, np.int64).reshape(-1, 3))
+                    tag_blocks.append(np.zeros(len(tri_blocks[-1]), np.int32))
+    if not tri_blocks:
+        found = sorted({gmsh.model.mesh.getElementProperties(int(t))[0]
+                        for t in model.mesh.getElementTypes(2)})
+        raise MeshError("gmsh produced no linear triangles"
+                        + (f" (found 2D element types: {', '.join(found)})" if found else ""))
+    tri_gmsh = np.concatenate(tri_blocks)
+    cell_tags = np.concatenate(tag_blocks)
+
+    edge_blocks, etag_blocks = [], []
+    for dim, ptag in model.getPhysicalGroups(1):
+        name = model.getPhysicalName(dim, ptag)
+        if name:
+            names[name] = int(ptag)
+        for ent in model.getEntitiesForPhysicalGroup(dim, ptag):
+            types, _, enodes = model.mesh.getElements(1, int(ent))
+            for t, nodes in zip(types, enodes):
+                if t == _GMSH_LINE:
+                    edge_blocks.append(np.asarray(nodes, np.int64).reshape(-1, 2))
+                    etag_blocks.append(np.full(len(edge_blocks[-1]), ptag, np.int32))
+    edges_gmsh = np.concatenate(edge_blocks) if edge_blocks else np.zeros((0, 2), np.int64)
+    edge_tags = np.concatenate(etag_blocks) if etag_blocks else np.zeros(0, np.int32)
+
+    # compact numbering: keep nodes used by triangles, in gmsh tag order
+    order = np.argsort(node_tags, kind="stable")
+    sorted_tags = node_tags[order]
+    used = np.unique(tri_gmsh)
+    pos = np.searchsorted(sorted_tags, used)
+    if np.any(pos >= len(sorted_tags)) or np.any(sorted_tags[np.minimum(pos, len(sorted_tags) - 1)] != used):
+        raise MeshError("gmsh returned triangles referring to unknown nodes")
+    points = xyz[order[pos], :2]
+
+    def renumber(arr: np.ndarray) -> np.ndarray:
+        idx = np.searchsorted(used, arr)
+        idx = np.minimum(idx, len(used) - 1)
+        ok = used[idx] == arr
+        return idx, ok
+
+    tri, ok = renumber(tri_gmsh)
+    e, eok = renumber(edges_gmsh)
+    keep = eok.all(axis=1) if len(e) else np.zeros(0, bool)
+    from .validate import orient_ccw
+
+    return orient_ccw(Mesh(points=points, triangles=tri, cell_tags=cell_tags,
+                           boundary_edges=e[keep], boundary_tags=edge_tags[keep],
+                           tag_names=names))
+
+
+def _group(gmsh, dim: int, entities: Sequence[int], name: str, tag: int) -> None:
+    gmsh.model.addPhysicalGroup(dim, list(entities), tag)
+    gmsh.model.setPhysicalName(dim, tag, name)
+
+
+def _side_groups(gmsh, left: list[int], right: list[int], bottom: list[int], top: list[int]) -> None:
+    """Edge groups 1..5 of a rectangle: left, right, bottom, top and boundary (all four)."""
+    for k, (name, lines) in enumerate((("left", left), ("right", right),
+                                       ("bottom", bottom), ("top", top)), start=1):
+        _group(gmsh, 1, lines, name, k)
+    _group(gmsh, 1, left + right + bottom + top, "boundary", 5)
+
+
+def _finish(gmsh, h: float) -> Mesh:
+    gmsh.model.geo.synchronize()
+    _set_size(gmsh, h)
+    gmsh.model.mesh.generate(2)
+    return _mesh_from_gmsh(gmsh)
+
+
+def _polygon(geo, xy: Sequence[tuple[float, float]], h: float) -> list[int]:
+    """Closed polygon through ``xy`` (CCW); returns the line tags, line i from xy[i] to xy[i+1]."""
+    pts = [geo.addPoint(x, y, 0.0, h) for x, y in xy]
+    return [geo.addLine(pts[i], pts[(i + 1) % len(pts)]) for i in range(len(pts))]
+
+
+def _circle(geo, cx: float, cy: float, r: float, h: float) -> list[int]:
+    """Circle as four arcs (CCW); returns the arc tags."""
+    c = geo.addPoint(cx, cy, 0.0, h)
+    p = [geo.addPoint(cx + r * math.cos(a), cy + r * math.sin(a), 0.0, h)
+         for a in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi)]
+    return [geo.addCircleArc(p[i], c, p[(i + 1) % 4]) for i in range(4)]
+
+
+@GEOMETRIES.register("rectangle")
+def rectangle(h: float, x0: float = 0.0, y0: float = 0.0, x1: float = 1.0, y1: float = 1.0) -> Mesh:
+    """Rectangle ``[x0, x1] x [y0, y1]``.
+
+    Edge tags: ``left`` (x = x0), ``right`` (x = x1), ``bottom`` (y = y0), ``top`` (y = y1),
+    ``boundary`` (all four). Cell tag: ``domain``.
+    """
+    h = _check_h(h)
+    x0, y0, x1, y1 = map(float, (x0, y0, x1, y1))
+    if not (x1 > x0 and y1 > y0):
+        raise InputError(f"rectangle needs x1 > x0 and y1 > y0, got ({x0}, {y0}, {x1}, {y1})")
+    with _gmsh_session("rectangle") as gmsh:
+        geo = gmsh.model.geo
+        bottom, right, top, left = _polygon(geo, [(x0, y0), (x1, y0), (x1, y1), (x0, y1)], h)
+        surf = geo.addPlaneSurface([geo.addCurveLoop([bottom, right, top, left])])
+        geo.synchronize()
+        _side_groups(gmsh, [left], [right], [bottom], [top])
+        _group(gmsh, 2, [surf], "domain", 6)
+        return _finish(gmsh, h)
+
+
+@GEOMETRIES.register("unit_square")
+def unit_square(h: float) -> Mesh:
+    """Unit square ``[0, 1]^2``; tags as :func:`rectangle` (left/right/bottom/top/boundary, domain)."""
+    return rectangle(h, 0.0, 0.0, 1.0, 1.0)
+
+
+@GEOMETRIES.register("l_shape")
+def l_shape(h: float) -> Mesh:
+    """L-shaped domain ``(-1, 1)^2`` minus the quadrant ``[0, 1] x [-1, 0]``.
+
+    The re-entrant corner is the origin (interior angle 3 pi / 2); with ``theta`` in
+    ``[0, 2 pi)`` the singular solution ``r^(2/3) sin(2 theta / 3)`` vanishes on both edges
+    meeting there. Edge tags: ``reentrant`` (the two edges meeting at the origin: x = 0,
+    -1 <= y <= 0 and y = 0, 0 <= x <= 1), ``outer`` (the other four edges), ``boundary`` (all).
+    Cell tag: ``domain``.
+    """
+    h = _check_h(h)
+    with _gmsh_session("l_shape") as gmsh:
+        geo = gmsh.model.geo
+        lines = _polygon(geo, [(-1, -1), (0, -1), (0, 0), (1, 0), (1, 1), (-1, 1)], h)
+        surf = geo.addPlaneSurface([geo.addCurveLoop(lines)])
+        geo.synchronize()
+        reentrant = [lines[1], lines[2]]  # (0,-1)->(0,0) and (0,0)->(1,0)
+        outer = [lines[0], lines[3], lines[4], lines[5]]
+        _group(gmsh, 1, reentrant, "reentrant", 1)
+        _group(gmsh, 1, outer, "outer", 2)
+        _group(gmsh, 1, lines, "boundary", 3)
+        _group(gmsh, 2, [surf], "domain", 4)
+        return _finish(gmsh, h)
+
+
+@GEOMETRIES.register("disk")
+def disk(h: float, centre: Sequence[float] = (0.0, 0.0), radius: float = 1.0) -> Mesh:
+    """Disk of ``radius`` about ``centre``.
+
+    Edge tags: ``outer`` (the circle) and ``boundary`` (the same edges). Cell tag: ``domain``.
+    """
+    h = _check_h(h)
+    r = _positive("radius", radius)
+    cx, cy = map(float, centre)
+    with _gmsh_session("disk") as gmsh:
+        geo = gmsh.model.geo
+        arcs = _circle(geo, cx, cy, r, h)
+        surf = geo.addPlaneSurface([geo.addCurveLoop(arcs)])
+        geo.synchronize()
+        _group(gmsh, 1, arcs, "outer", 1)
+        _group(gmsh, 1, arcs, "boundary", 2)
+        _group(gmsh, 2, [surf], "domain", 3)
+        return _finish(gmsh, h)
+
+
+@GEOMETRIES.register("annulus")
+def annulus(h: float, r_inner: float = 0.5, r_outer: float = 1.0,
+            centre: Sequence[float] = (0.0, 0.0)) -> Mesh:
+    """Annulus ``r_inner < |x - centre| < r_outer``.
+
+    Edge tags: ``inner``, ``outer``, ``boundary`` (both circles). Cell tag: ``domain``.
+    """
+    h = _check_h(h)
+    ri, ro = _positive("r_inner", r_inner), _positive("r_outer", r_outer)
+    if not ri < ro:
+        raise InputError(f"annulus needs r_inner < r_outer, got {ri} and {ro}")
+    cx, cy = map(float, centre)
+    with _gmsh_session("annulus") as gmsh:
+        geo = gmsh.model.geo
+        outer = _circle(geo, cx, cy, ro, h)
+        inner = _circle(geo, cx, cy, ri, h)
+        surf = geo.addPlaneSurface([geo.addCurveLoop(outer), geo.addCurveLoop(inner)])
+        geo.synchronize()
+        _group(gmsh, 1, inner, "inner", 1)
+        _group(gmsh, 1, outer, "outer", 2)
+        _group(gmsh, 1, outer + inner, "boundary", 3)
+        _group(gmsh, 2, [surf], "domain", 4)
+        return _finish(gmsh, h)
+
+
+@GEOMETRIES.register("checkerboard")
+def checkerboard(h: float, n: int = 4) -> Mesh:
+    """Unit square split into ``n x n`` equal squares tagged alternately ``high`` and ``low``.
+
+    Square ``(i, j)`` (column i, row j, from the origin) is ``high`` when ``i + j`` is even.
+    Every square boundary is a mesh line, so a per-region coefficient jumps exactly across
+    element edges. Edge tags: ``left``, ``right``, ``bottom``, ``top``, ``boundary``.
+    Cell tags: ``high``, ``low`` (no ``domain`` group).
+    """
+    h = _check_h(h)
+    if int(n) != n or n < 1:
+        raise InputError(f"checkerboard needs a positive integer n, got {n!r}")
+    n = int(n)
+    if n == 1:
+        raise InputError("checkerboard needs n >= 2 (n = 1 is unit_square)")
+    with _gmsh_session("checkerboard") as gmsh:
+        geo = gmsh.model.geo
+        t = np.linspace(0.0, 1.0, n + 1)
+        p = [[geo.addPoint(float(t[i]), float(t[j]), 0.0, h) for j in range(n + 1)]
+             for i in range(n + 1)]
+        hor = [[geo.addLine(p[i][j], p[i + 1][j]) for j in range(n + 1)] for i in range(n)]
+        ver = [[geo.addLine(p[i][j], p[i][j + 1]) for j in range(n)] for i in range(n + 1)]
+        high, low = [], []
+        for i in range(n):
+            for j in range(n):
+                loop = geo.addCurveLoop([hor[i][j], ver[i + 1][j], -hor[i][j + 1], -ver[i][j]])
+                (high if (i + j) % 2 == 0 else low).append(geo.addPlaneSurface([loop]))
+        geo.synchronize()
+        left = [ver[0][j] for j in range(n)]
+        right = [ver[n][j] for j in range(n)]
+        bottom = [hor[i][0] for i in range(n)]
+        top = [hor[i][n] for i in range(n)]
+        _side_groups(gmsh, left, right, bottom, top)
+        _group(gmsh, 2, high, "high", 6)
+        _group(gmsh, 2, low, "low", 7)
+        return _finish(gmsh, h)
+
+
+@GEOMETRIES.register("square_with_inclusion")
+def square_with_inclusion(h: float, centre: Sequence[float] = (0.5, 0.5), radius: float = 0.25,
+                          shape: str = "disk") -> Mesh:
+    """Unit square with a centred inclusion (a disk of ``radius`` or a square of half-side ``radius``).
+
+    The inclusion boundary is a mesh line (the two regions are conforming). Edge tags: ``left``,
+    ``right``, ``bottom``, ``top``, ``boundary`` (outer square only). Cell tags: ``matrix``
+    (outside) and ``inclusion`` (inside; no ``domain`` group).
+    """
+    h = _check_h(h)
+    r = _positive("radius", radius)
+    cx, cy = map(float, centre)
+    if shape not in ("disk", "square"):
+        raise InputError(f"inclusion shape must be 'disk' or 'square', got {shape!r}")
+    if not (cx - r > 0 and cx + r < 1 and cy - r > 0 and cy + r < 1):
+        raise InputError(f"inclusion (centre {centre}, radius {r}) must lie strictly inside the unit square")
+    with _gmsh_session("square_with_inclusion") as gmsh:
+        geo = gmsh.model.geo
+        bottom, right, top, left = _polygon(geo, [(0, 0), (1, 0), (1, 1), (0, 1)], h)
+        if shape == "disk":
+            inner = _circle(geo, cx, cy, r, h)
+        else:
+            inner = _polygon(geo, [(cx - r, cy - r), (cx + r, cy - r), (cx + r, cy + r),
+                                   (cx - r, cy + r)], h)
+        inner_loop = geo.addCurveLoop(inner)
+        matrix = geo.addPlaneSurface([geo.addCurveLoop([bottom, right, top, left]), inner_loop])
+        inclusion = geo.addPlaneSurface([inner_loop])
+        geo.synchronize()
+        _side_groups(gmsh, [left], [right], [bottom], [top])
+        _group(gmsh, 2, [matrix], "matrix", 6)
+        _group(gmsh, 2, [inclusion], "inclusion", 7)
+        return _finish(gmsh, h)
+
+
+def geo_file(path: str | os.PathLike, h: float | None = None) -> Mesh:
+    """Mesh a user ``.geo`` file in 2D with gmsh (physical groups become tags).
+
+    Parameters
+    ----------
+    path : path to the ``.geo`` (or any file gmsh can open)
+    h : optional maximal mesh size; ``None`` keeps the sizes the file sets.
+
+    Raises
+    ------
+    MeshError
+        The file is missing, gmsh cannot open it or produces no triangles.
+    """
+    p = os.fspath(path)
+    if not os.path.isfile(p):
+        raise MeshError(f"geometry file not found: {p}")
+    hv = None if h is None else _check_h(h)
+    with _gmsh_session("geo_file") as gmsh:
+        try:
+            gmsh.open(p)
+            if hv is not None:
+                gmsh.option.setNumber("Mesh.MeshSizeMax", hv)
+            gmsh.option.setNumber("Mesh.ElementOrder", 1)
+            gmsh.model.mesh.generate(2)
+        except Exception as exc:  # gmsh raises bare Exception with its last error
+            raise MeshError(f"gmsh could not mesh {p}: {exc}") from None
+        return _mesh_from_gmsh(gmsh)
+
+
+def generate(geometry: str, h: float, **params) -> Mesh:
+    """Generate a mesh of a named geometry from :data:`GEOMETRIES`.
+
+    Parameters
+    ----------
+    geometry : one of ``GEOMETRIES.names()`` (``annulus``, ``checkerboard``, ``disk``,
+        ``l_shape``, ``rectangle``, ``square_with_inclusion``, ``unit_square``)
+    h : target (maximal) element size
+    **params : geometry parameters (e.g. ``r_inner`` for ``annulus``)
+
+    Raises
+    ------
+    UnknownNameError
+        Unknown geometry (the message lists the valid ones).
+    InputError
+        Bad or unknown parameters.
+    """
+    factory = GEOMETRIES.get(geometry)
+    import inspect
+
+    sig = inspect.signature(factory)
+    try:
+        sig.bind(h, **params)
+    except TypeError as exc:
+        valid = [n for n in sig.parameters if n != "h"]
+        raise InputError(f"geometry {geometry!r}: {exc}; valid parameters: "
+                         f"{', '.join(valid) or '(none)'}") from None
+    return factory(h, **params)

@@ -1,0 +1,289 @@
+"""Read and write meshes through meshio (``.msh`` v2/v4, ``.vtu``, ``.xdmf``, ...).
+
+meshio is imported inside the functions; its gmsh reader is pure Python, so reading a ``.msh``
+file never imports gmsh.
+
+Tags are stored the gmsh way in every format: cell data ``gmsh:physical`` (and
+``gmsh:geometrical``) on the ``triangle`` and ``line`` blocks, names in ``field_data``
+(``{name: [tag, dim]}``). ``.msh`` 4.1 is written by femkit's own small ASCII writer (one
+entity per tag; an edge with several tags is repeated once per tag), ``.msh`` 2.2 and the other
+formats by meshio. Formats whose field data do not carry the names (``.vtu``, ``.xdmf``) get a
+sidecar ``<file>.tags.json`` (``{name: tag}``), which :func:`read_mesh` reads back.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import MeshError
+from .mesh import Mesh
+
+_SIDECAR = ".tags.json"
+
+
+def _sidecar(path: str) -> str:
+    return path + _SIDECAR
+
+
+def _block_tags(mesh_io, i: int, n: int) -> np.ndarray:
+    data = mesh_io.cell_data.get("gmsh:physical")
+    if data is None or i >= len(data) or data[i] is None:
+        return np.zeros(n, np.int32)
+    return np.asarray(data[i]).reshape(-1).astype(np.int32)
+
+
+def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
+    """Read a triangle mesh; physical tags and names become ``cell_tags``/``boundary_tags``/``tag_names``.
+
+    Parameters
+    ----------
+    path : mesh file; the format is taken from the extension (``.msh`` v2 or v4, ``.vtu``,
+        ``.xdmf`` and anything else meshio reads)
+    compact : drop nodes used by no triangle (e.g. geometry points such as circle centres that
+        gmsh writes) and renumber, keeping the order of the rest
+
+    Triangles are made counter-clockwise; a 3D point array whose z is zero is reduced to 2D.
+
+    Raises
+    ------
+    MeshError
+        Missing file (the path is named), a file meshio cannot read, no (linear) triangles
+        (the cell types found are named), mixed triangle/other 2D cells, or non-planar points.
+    """
+    p = os.fspath(path)
+    if not os.path.isfile(p):
+        raise MeshError(f"mesh file not found: {p}")
+    import meshio
+
+    try:
+        mio = meshio.read(p)
+    except Exception as exc:  # meshio raises ReadError, KeyError, ValueError ... on bad files
+        raise MeshError(f"cannot read mesh file {p}: {type(exc).__name__}: {exc}") from None
+
+    types = [c.type for c in mio.cells]
+    tri_blocks, tri_tags, line_blocks, line_tags = [], [], [], []
+    for i, block in enumerate(mio.cells):
+        data = np.asarray(block.data, dtype=np.int64)
+        if block.type == "triangle":
+            tri_blocks.append(data)
+            tri_tags.append(_block_tags(mio, i, len(data)))
+        elif block.type == "line":
+            tags = _block_tags(mio, i, len(data))
+            line_blocks.append(data)
+            line_tags.append(tags)
+            # msh 4.1: an entity in several physical groups -> meshio keeps only the first in
+            # gmsh:physical but records every membership in cell_sets; repeat those edges
+            for name, (t, dim) in _groups(mio).items():
+                idx = (mio.cell_sets.get(name) or [None] * (i + 1))[i]
+                if dim != 1 or idx is None or len(idx) == 0:
+                    continue
+                idx = np.asarray(idx, dtype=np.int64)
+                extra = idx[tags[idx] != t]
+                if len(extra):
+                    line_blocks.append(data[extra])
+                    line_tags.append(np.full(len(extra), t, np.int32))
+    if not tri_blocks:
+        found = ", ".join(sorted(set(types))) or "no cells at all"
+        raise MeshError(f"{p} holds no linear triangles (found cell types: {found}); "
+                        "femkit needs a P1 triangle mesh")
+    other2d = sorted(set(types) - {"triangle", "line", "vertex"})
+    if other2d:
+        raise MeshError(f"{p} mixes triangles with other cells ({', '.join(other2d)}); "
+                        "femkit needs a pure linear-triangle mesh")
+
+    pts = np.asarray(mio.points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] not in (2, 3):
+        raise MeshError(f"{p}: points have shape {pts.shape}, expected (n, 2) or (n, 3)")
+    if pts.shape[1] == 3:
+        z = pts[:, 2]
+        scale = max(float(np.abs(pts[:, :2]).max(initial=0.0)), 1.0)
+        if np.abs(z).max(initial=0.0) > 1e-12 * scale:
+            raise MeshError(f"{p}: points are not in the plane z = 0 "
+                            f"(|z| up to {np.abs(z).max():.3g}); femkit meshes are 2D")
+        pts = pts[:, :2]
+
+    names: dict[str, int] = {}
+    for name, val in (mio.field_data or {}).items():
+        arr = np.asarray(val).ravel()
+        if arr.size >= 1 and np.issubdtype(arr.dtype, np.number):
+            names[str(name)] = int(arr[0])
+    names.update(_read_extra_names(mio, p))
+
+    tri = np.concatenate(tri_blocks)
+    be = np.concatenate(line_blocks) if line_blocks else np.zeros((0, 2), np.int64)
+    bt = np.concatenate(line_tags) if line_tags else np.zeros(0, np.int32)
+    n = len(pts)
+    if tri.min(initial=0) < 0 or tri.max(initial=0) >= n:
+        raise MeshError(f"{p}: triangles refer to nodes outside 0..{n - 1}")
+    from .validate import orient_ccw, remove_unreferenced
+
+    mesh = Mesh(points=pts, triangles=tri, cell_tags=np.concatenate(tri_tags),
+                boundary_edges=be, boundary_tags=bt, tag_names=names)
+    if compact:
+        mesh = remove_unreferenced(mesh)
+    return orient_ccw(mesh)
+
+
+def _groups(mio) -> dict[str, tuple[int, int]]:
+    """Physical groups from meshio's field_data: ``{name: (tag, dim)}`` (only well-formed ones)."""
+    out = {}
+    for name, val in (mio.field_data or {}).items():
+        arr = np.asarray(val).ravel()
+        if arr.size == 2 and np.issubdtype(arr.dtype, np.number):
+            out[str(name)] = (int(arr[0]), int(arr[1]))
+    return out
+
+
+def _read_extra_names(mio, path: str) -> dict[str, int]:
+    if mio.field_data or not os.path.isfile(_sidecar(path)):
+        return {}
+    text = Path(_sidecar(path)).read_text()
+    try:
+        return {str(k): int(v) for k, v in json.loads(text).items()}
+    except (ValueError, AttributeError, TypeError) as exc:
+        raise MeshError(f"{path}: unreadable tag names ({exc})") from None
+
+
+def _tag_dims(mesh: Mesh) -> dict[str, int]:
+    cells = set(np.unique(mesh.cell_tags).tolist())
+    return {name: (2 if int(t) in cells else 1) for name, t in mesh.tag_names.items()}
+
+
+def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = None,
+               cell_data: dict | None = None, *, msh_version: str = "4.1",
+               binary: bool = False) -> None:
+    """Write a mesh (and optional data) in the format given by the extension.
+
+    Parameters
+    ----------
+    path : ``.msh`` (gmsh, ``msh_version`` ``"4.1"`` or ``"2.2"``, ASCII unless ``binary``),
+        ``.vtu``, ``.xdmf`` or any other meshio format
+    point_data : ``{name: (n,) or (n, k) array}``
+    cell_data : ``{name: (m,) or (m, k) array}`` on the triangles (tagged boundary edges get
+        zeros in the written file)
+
+    Physical tags go to ``gmsh:physical`` / ``gmsh:geometrical`` on the ``triangle`` and
+    ``line`` blocks and names to ``field_data`` (see the module notes), so :func:`read_mesh`
+    gives back the same points, triangles and tags.
+    """
+    import meshio
+
+    p = os.fspath(path)
+    ext = Path(p).suffix.lower()
+    m, k = mesh.n_triangles, len(mesh.boundary_edges)
+    cells = [("triangle", mesh.triangles)]
+    with_lines = k > 0
+    if with_lines:
+        cells.append(("line", mesh.boundary_edges))
+
+    def per_block(tri_vals, line_vals):
+        return [tri_vals, line_vals] if with_lines else [tri_vals]
+
+    cdata = {
+        "gmsh:physical": per_block(mesh.cell_tags.astype(np.int32), mesh.boundary_tags.astype(np.int32)),
+        "gmsh:geometrical": per_block(mesh.cell_tags.astype(np.int32), mesh.boundary_tags.astype(np.int32)),
+    }
+    for name, arr in (cell_data or {}).items():
+        a = np.asarray(arr)
+        if a.shape[0] != m:
+            raise MeshError(f"cell_data {name!r} has {a.shape[0]} rows, mesh has {m} triangles")
+        cdata[name] = per_block(a, np.zeros((k,) + a.shape[1:], a.dtype))
+    pdata = {}
+    for name, arr in (point_data or {}).items():
+        a = np.asarray(arr)
+        if a.shape[0] != mesh.n_points:
+            raise MeshError(f"point_data {name!r} has {a.shape[0]} rows, mesh has {mesh.n_points} points")
+        pdata[name] = a
+    Path(p).parent.mkdir(parents=True, exist_ok=True)
+    try:
+        if ext == ".msh" and msh_version == "4.1" and not binary:
+            _write_msh41(p, mesh, pdata, {k: v[0] for k, v in cdata.items()
+                                          if not k.startswith("gmsh:")})
+            return
+        if ext == ".msh" and msh_version not in ("4.1", "2.2"):
+            raise MeshError(f"msh_version must be '4.1' or '2.2', got {msh_version!r}")
+        dims = _tag_dims(mesh)
+        fdata = {name: np.array([int(t), dims[name]]) for name, t in mesh.tag_names.items()}
+        points = np.column_stack([mesh.points, np.zeros(mesh.n_points)])
+        out = meshio.Mesh(points, cells, point_data=pdata, cell_data=cdata, field_data=fdata)
+        if ext == ".msh":
+            if msh_version == "4.1":
+                raise MeshError("binary msh 4.1 is not supported; use binary=False or msh_version='2.2'")
+            meshio.write(p, out, file_format="gmsh22", binary=binary)
+        else:
+            meshio.write(p, out)
+            if mesh.tag_names:
+                Path(_sidecar(p)).write_text(json.dumps(mesh.tag_names, sort_keys=True))
+    except MeshError:
+        raise
+    except Exception as exc:
+        raise MeshError(f"cannot write mesh file {p}: {type(exc).__name__}: {exc}") from None
+
+
+def _fmt_rows(arr: np.ndarray, fmt: str) -> str:
+    if arr.size == 0:
+        return ""
+    return "\n".join(" ".join(fmt % v for v in row) for row in arr.tolist()) + "\n"
+
+
+def _write_msh41(path: str, mesh: Mesh, point_data: dict, cell_data: dict) -> None:
+    """ASCII gmsh 4.1 writer: one surface entity per cell tag, one curve entity per edge tag.
+
+    An edge carrying several tags is written once per tag (in each tag's curve entity), so
+    gmsh and meshio read the same repeated edges back. Nodes are tagged 1..n in mesh order,
+    triangles 1..m in mesh order, then the edges.
+    """
+    pts3 = np.column_stack([mesh.points, np.zeros(mesh.n_points)])
+    dims = _tag_dims(mesh)
+    cell_vals = np.unique(mesh.cell_tags)
+    edge_vals = np.unique(mesh.boundary_tags)
+    lo, hi = pts3.min(axis=0), pts3.max(axis=0)
+    box = " ".join(repr(float(v)) for v in (*lo, *hi))
+    out = ["$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"]
+    if mesh.tag_names:
+        out.append(f"$PhysicalNames\n{len(mesh.tag_names)}\n")
+        for name, t in sorted(mesh.tag_names.items(), key=lambda kv: (dims[kv[0]], kv[1])):
+            out.append(f'{dims[name]} {int(t)} "{name}"\n')
+        out.append("$EndPhysicalNames\n")
+    out.append(f"$Entities\n0 {len(edge_vals)} {len(cell_vals)} 0\n")
+    for i, t in enumerate(edge_vals, start=1):
+        phys = f"1 {int(t)}" if t != 0 else "0"
+        out.append(f"{i} {box} {phys} 0\n")
+    for i, t in enumerate(cell_vals, start=1):
+        phys = f"1 {int(t)}" if t != 0 else "0"
+        out.append(f"{i} {box} {phys} 0\n")
+    out.append("$EndEntities\n")
+    n = mesh.n_points
+    out.append(f"$Nodes\n1 {n} 1 {n}\n2 1 0 {n}\n")
+    out.append("\n".join(map(str, range(1, n + 1))) + "\n")
+    out.append(_fmt_rows(pts3, "%.17g"))
+    out.append("$EndNodes\n")
+    m, k = mesh.n_triangles, len(mesh.boundary_edges)
+    out.append(f"$Elements\n{len(cell_vals) + len(edge_vals)} {m + k} 1 {m + k}\n")
+    ids = np.arange(1, m + 1)
+    for i, t in enumerate(cell_vals, start=1):
+        sel = np.flatnonzero(mesh.cell_tags == t)
+        out.append(f"2 {i} 2 {len(sel)}\n")
+        out.append(_fmt_rows(np.column_stack([ids[sel], mesh.triangles[sel] + 1]), "%d"))
+    eids = np.arange(m + 1, m + k + 1)
+    for i, t in enumerate(edge_vals, start=1):
+        sel = np.flatnonzero(mesh.boundary_tags == t)
+        out.append(f"1 {i} 1 {len(sel)}\n")
+        out.append(_fmt_rows(np.column_stack([eids[sel], mesh.boundary_edges[sel] + 1]), "%d"))
+    out.append("$EndElements\n")
+    for name, a in point_data.items():
+        a2 = np.asarray(a, dtype=np.float64).reshape(n, -1)
+        out.append(f'$NodeData\n1\n"{name}"\n1\n0.0\n3\n0\n{a2.shape[1]}\n{n}\n')
+        out.append(_fmt_rows(np.column_stack([np.arange(1, n + 1), a2]), "%.17g"))
+        out.append("$EndNodeData\n")
+    for name, a in cell_data.items():
+        a2 = np.asarray(a, dtype=np.float64).reshape(m, -1)
+        a2 = np.vstack([a2, np.zeros((k, a2.shape[1]))])  # edges get zeros (meshio wants all)
+        out.append(f'$ElementData\n1\n"{name}"\n1\n0.0\n3\n0\n{a2.shape[1]}\n{m + k}\n')
+        out.append(_fmt_rows(np.column_stack([np.arange(1, m + k + 1), a2]), "%.17g"))
+        out.append("$EndElementData\n")
+    Path(path).write_text("".join(out))

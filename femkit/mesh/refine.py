@@ -1,0 +1,120 @@
+"""Edges, topological boundary and uniform red refinement.
+
+>>> import numpy as np
+>>> from femkit.mesh import Mesh
+>>> m = Mesh(points=np.array([[0., 0.], [1., 0.], [0., 1.]]), triangles=np.array([[0, 1, 2]]))
+>>> f = refine(m, levels=2)
+>>> f.n_triangles, f.n_points, float(f.areas().sum())
+(16, 15, 0.5)
+"""
+
+from __future__ import annotations
+
+from typing import Iterable
+
+import numpy as np
+
+from ..errors import MeshError
+from .mesh import Mesh
+
+
+def _local_edges(tri: np.ndarray) -> np.ndarray:
+    """(m, 3, 2) local edges; edge k is opposite vertex k: (v1, v2), (v2, v0), (v0, v1)."""
+    return tri[:, [[1, 2], [2, 0], [0, 1]]]
+
+
+def edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """Unique edges and the element -> edge map.
+
+    Returns
+    -------
+    edge_nodes : (E, 2) int64
+        Node pairs, each sorted ascending, rows sorted lexicographically.
+    tri_edges : (m, 3) int64
+        ``tri_edges[t, k]`` is the edge of triangle ``t`` opposite its local vertex ``k``.
+    """
+    n = max(mesh.n_points, 1)
+    loc = _local_edges(mesh.triangles).reshape(-1, 2)
+    lo, hi = loc.min(axis=1), loc.max(axis=1)
+    keys, inverse = np.unique(lo * n + hi, return_inverse=True)
+    edge_nodes = np.stack([keys // n, keys % n], axis=1)
+    return edge_nodes, inverse.reshape(-1, 3).astype(np.int64)
+
+
+def boundary_edges_topological(mesh: Mesh) -> np.ndarray:
+    """Edges used by exactly one triangle, oriented as in that triangle (domain on the left).
+
+    Found from the connectivity alone, independent of any tags.
+    """
+    loc = _local_edges(mesh.triangles).reshape(-1, 2)
+    _, tri_edges = edges(mesh)
+    counts = np.bincount(tri_edges.ravel(), minlength=int(tri_edges.max(initial=-1)) + 1)
+    once = counts[tri_edges.ravel()] == 1
+    return loc[once]
+
+
+def boundary_nodes(mesh: Mesh, tags: Iterable | str | int | None = None) -> np.ndarray:
+    """Sorted node ids on boundary edges carrying any of ``tags``.
+
+    ``tags=None`` finds the whole boundary topologically (edges of exactly one triangle).
+    Names and numbers are checked with :func:`femkit.mesh.validate.check_tags` (a missing tag
+    raises :class:`~femkit.errors.MeshError` listing the available ones).
+    """
+    if tags is None:
+        return np.unique(boundary_edges_topological(mesh))
+    from .validate import check_tags
+
+    nums = check_tags(mesh, tags, kind="boundary")
+    sel = np.isin(mesh.boundary_tags, nums)
+    return np.unique(mesh.boundary_edges[sel])
+
+
+def _refine_once(mesh: Mesh) -> Mesh:
+    n = mesh.n_points
+    edge_nodes, tri_edges = edges(mesh)
+    mid = mesh.points[edge_nodes].mean(axis=1)
+    points = np.vstack([mesh.points, mid])
+    t = mesh.triangles
+    m0, m1, m2 = (n + tri_edges[:, k] for k in range(3))
+    v0, v1, v2 = t[:, 0], t[:, 1], t[:, 2]
+    # children are counter-clockwise when the parent is; the four of a parent are contiguous
+    children = np.stack([
+        np.stack([v0, m2, m1], axis=1),
+        np.stack([m2, v1, m0], axis=1),
+        np.stack([m1, m0, v2], axis=1),
+        np.stack([m0, m1, m2], axis=1),
+    ], axis=1).reshape(-1, 3)
+    cell_tags = np.repeat(mesh.cell_tags, 4)
+
+    be = mesh.boundary_edges
+    if len(be):
+        keys = edge_nodes[:, 0] * n + edge_nodes[:, 1]
+        q = be.min(axis=1) * n + be.max(axis=1)
+        pos = np.minimum(np.searchsorted(keys, q), len(keys) - 1)
+        bad = np.flatnonzero(keys[pos] != q)
+        if len(bad):
+            raise MeshError(f"{len(bad)} tagged boundary edge(s) are not edges of any triangle "
+                            f"(edge ids {', '.join(map(str, bad[:10]))}); cannot refine")
+        bm = n + pos
+        new_be = np.stack([np.stack([be[:, 0], bm], axis=1),
+                           np.stack([bm, be[:, 1]], axis=1)], axis=1).reshape(-1, 2)
+        new_bt = np.repeat(mesh.boundary_tags, 2)
+    else:
+        new_be, new_bt = be, mesh.boundary_tags
+    return Mesh(points=points, triangles=children, cell_tags=cell_tags,
+                boundary_edges=new_be, boundary_tags=new_bt, tag_names=mesh.tag_names)
+
+
+def refine(mesh: Mesh, levels: int = 1) -> Mesh:
+    """Uniform red refinement: each triangle into four by its edge midpoints, ``levels`` times.
+
+    Nested: the coarse nodes are the first ``n`` nodes of the fine mesh (in the same order),
+    then one new node per coarse edge in :func:`edges` order. Children ``4t .. 4t+3`` come
+    from coarse triangle ``t`` and inherit its cell tag; each tagged boundary edge becomes two
+    edges (same direction) with its tag. Orientation is preserved.
+    """
+    if int(levels) != levels or levels < 0:
+        raise ValueError(f"levels must be a non-negative integer, got {levels!r}")
+    for _ in range(int(levels)):
+        mesh = _refine_once(mesh)
+    return mesh
