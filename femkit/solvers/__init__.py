@@ -1,1 +1,25 @@
-"""solvers"""
+"""Linear solvers: femkit's own Jacobi, steepest descent, CG and PCG, a SuperLU direct
+solver, and Jacobi / IC(0) / AMG preconditioners, selectable by name.
+
+>>> import numpy as np, scipy.sparse as sp
+>>> from femkit.solvers import solve
+>>> A = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(10, 10), format="csr")
+>>> solve(A, np.ones(10), method="cg").converged
+True
+
+Importing this package imports numpy and scipy only (pyamg and numba load on first use).
+"""
+
+from .cg import cg
+from .direct import Factor, direct, factorize
+from .jacobi import jacobi
+from .pcg import pcg
+from .registry import (PRECONDITIONERS, SOLVERS, get_preconditioner, get_solver, solve)
+from .result import REASONS, SolveResult
+from .steepest_descent import steepest_descent
+
+__all__ = [
+    "PRECONDITIONERS", "SOLVERS", "REASONS", "Factor", "SolveResult", "cg", "direct",
+    "factorize", "get_preconditioner", "get_solver", "jacobi", "pcg", "solve",
+    "steepest_descent",
+]
