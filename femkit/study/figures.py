@@ -1,0 +1,208 @@
+"""Study figures (matplotlib, Agg canvas, imported lazily).
+
+Every function takes plain data, writes one PNG (100 dpi by default) and returns its path.
+Figures are built with :class:`matplotlib.figure.Figure` and the Agg canvas directly, so no
+pyplot global state and no display is touched.
+
+Series are dicts ``{"label": str, "x": array, "y": array}`` with optional ``"reference": True``
+(drawn dashed in grey: e.g. scikit-fem on the same meshes) and ``"fit": RateFit``
+(its slope goes into the legend and the fitted line is drawn dotted). Points with non-finite or
+non-positive values are dropped from log axes, never plotted as garbage.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Iterable, Sequence
+
+import numpy as np
+
+__all__ = ["loglog_figure", "work_precision_figure", "energy_figure", "stability_map_figure"]
+
+DPI = 100
+_MARKERS = "osD^v<>ph*"
+
+
+def _figure(width: float = 7.0, height: float = 5.0):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _save(fig, path) -> str:
+    path = os.fspath(path)
+    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+    fig.savefig(path, dpi=DPI)
+    return path
+
+
+def _positive(x, y):
+    x = np.asarray(x, dtype=float).ravel()
+    y = np.asarray(y, dtype=float).ravel()
+    ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
+    return x[ok], y[ok]
+
+
+def _style(i: int, s: dict) -> dict:
+    if s.get("reference"):
+        return dict(color="0.35", linestyle="--", marker="x", markersize=7, linewidth=1.6)
+    import matplotlib as mpl
+
+    colours = mpl.rcParams["axes.prop_cycle"].by_key()["color"]
+    return dict(color=colours[i % len(colours)], linestyle="-", marker=_MARKERS[i % len(_MARKERS)],
+                markersize=5, linewidth=1.6)
+
+
+def _slope_triangle(ax, xs: np.ndarray, ys: np.ndarray, order: float, *, decreasing_x: bool) -> None:
+    """Reference triangle of slope ``order`` under the data, spanning a third of the x range (log)."""
+    lx0, lx1 = np.log10(xs.min()), np.log10(xs.max())
+    if lx1 - lx0 <= 0:
+        return
+    width = (lx1 - lx0) / 3.0
+    xa = 10 ** (lx0 + (lx1 - lx0) * 0.55)
+    xb = xa * 10 ** width
+    ya = ys.min() * 0.35 / (xb / xa) ** order if order > 0 else ys.min() * 0.35
+    yb = ya * (xb / xa) ** order
+    ax.plot([xa, xb, xb, xa], [ya, ya, yb, ya], color="k", linewidth=1.0)
+    ax.text(np.sqrt(xa * xb), ya * 0.8, "1", ha="center", va="top", fontsize=9)
+    ax.text(xb * 1.05, np.sqrt(ya * yb), f"{order:g}", ha="left", va="center", fontsize=9)
+    ax.text(np.sqrt(xa * xb), np.sqrt(ya * yb) * 1.6, f"slope {order:g}", ha="right", va="bottom",
+            fontsize=8, color="0.2")
+
+
+def loglog_figure(path, series: Sequence[dict], *, title: str, xlabel: str, ylabel: str,
+                  triangle: float | None = None, invert_x: bool = False, note: str | None = None) -> str:
+    """Log-log lines (e.g. error vs h, error vs dofs, iterations vs dofs).
+
+    ``triangle`` draws a reference slope triangle; ``invert_x`` puts large x on the left
+    (error vs h then reads left to right as "finer mesh").
+    """
+    fig = _figure()
+    ax = fig.add_subplot()
+    allx, ally = [], []
+    for i, s in enumerate(series):
+        x, y = _positive(s["x"], s["y"])
+        if x.size == 0:
+            continue
+        order = np.argsort(x)
+        label = s["label"]
+        fit = s.get("fit")
+        st = _style(i, s)
+        if fit is not None:
+            label += f"  (rate {fit.slope:.2f}, R² {fit.r2:.3f})"
+        ax.plot(x[order], y[order], label=label, **st)
+        if fit is not None:
+            ax.plot(x[order], fit.predict(x[order]), color=st["color"], linestyle=":", linewidth=1.0)
+        allx.append(x)
+        ally.append(y)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    if triangle is not None and allx:
+        _slope_triangle(ax, np.concatenate(allx), np.concatenate(ally), triangle, decreasing_x=invert_x)
+    if invert_x:
+        ax.invert_xaxis()
+    ax.set_title(title)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, which="both", alpha=0.3)
+    if note:
+        ax.text(0.01, 0.01, note, transform=ax.transAxes, fontsize=8, color="0.3", va="bottom")
+    if allx:
+        ax.legend(fontsize=8)
+    return _save(fig, path)
+
+
+def work_precision_figure(path, series: Sequence[dict], *, front: Iterable[tuple[float, float]] = (),
+                          title: str, xlabel: str = "run time [s]", ylabel: str = "error") -> str:
+    """Error against run time, one line per method; the Pareto front drawn as a thick band.
+
+    Lower-left wins: a point on the front is not beaten by any other run on both counts.
+    """
+    fig = _figure()
+    ax = fig.add_subplot()
+    front = [(t, e) for t, e in front if np.isfinite(t) and np.isfinite(e) and t > 0 and e > 0]
+    if front:
+        ft, fe = np.array(sorted(front)).T
+        ax.step(ft, fe, where="post", color="gold", linewidth=7, alpha=0.45, zorder=0, label="Pareto front")
+        ax.scatter(ft, fe, s=140, facecolors="none", edgecolors="darkorange", linewidths=1.8, zorder=3)
+    any_data = bool(front)
+    for i, s in enumerate(series):
+        x, y = _positive(s["x"], s["y"])
+        if x.size == 0:
+            continue
+        any_data = True
+        ax.plot(x, y, label=s["label"], **_style(i, s))
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_title(title)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.text(0.99, 0.99, "better: lower left", transform=ax.transAxes, ha="right", va="top", fontsize=8, color="0.3")
+    if any_data:
+        ax.legend(fontsize=8)
+    return _save(fig, path)
+
+
+def energy_figure(path, series: Sequence[dict], *, title: str, floor: float = 1e-16) -> str:
+    """Relative energy error ``|E(t) - E(0)| / |E(0)|`` against time, one line per integrator."""
+    fig = _figure()
+    ax = fig.add_subplot()
+    drawn = False
+    for i, s in enumerate(series):
+        t = np.asarray(s["x"], dtype=float)
+        e = np.asarray(s["y"], dtype=float)
+        ok = np.isfinite(t) & np.isfinite(e)
+        if not ok.any():
+            continue
+        st = _style(i, s)
+        st.update(marker=None)
+        ax.plot(t[ok], np.maximum(e[ok], floor), label=s["label"], **st)
+        drawn = True
+    ax.set_yscale("log")
+    ax.set_title(title)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("relative energy error |E(t) - E(0)| / |E(0)|")
+    ax.grid(True, which="both", alpha=0.3)
+    if drawn:
+        ax.legend(fontsize=8)
+    return _save(fig, path)
+
+
+def stability_map_figure(path, rows: Sequence[dict], *, title: str) -> str:
+    """Survived / unstable runs per method against ``dt * omega_max``.
+
+    ``rows``: dicts with ``method``, ``h_omega`` (dt * omega_max), ``stable`` (bool) and optional
+    ``bound`` (the theoretical limit of the method, drawn as a black bar on its row).
+    """
+    methods = list(dict.fromkeys(r["method"] for r in rows))
+    fig = _figure(7.0, max(2.5, 0.6 * len(methods) + 1.5))
+    ax = fig.add_subplot()
+    ypos = {m: i for i, m in enumerate(methods)}
+    hw = np.array([r["h_omega"] for r in rows], dtype=float)
+    ok = np.array([bool(r["stable"]) for r in rows])
+    yy = np.array([ypos[r["method"]] for r in rows], dtype=float)
+    if ok.any():
+        ax.scatter(hw[ok], yy[ok], marker="o", color="tab:green", s=40, label="survived", zorder=3)
+    if (~ok).any():
+        ax.scatter(hw[~ok], yy[~ok], marker="x", color="tab:red", s=50, label="unstable", zorder=3)
+    labelled = False
+    for r in rows:
+        b = r.get("bound")
+        if b is not None and np.isfinite(b):
+            y = ypos[r["method"]]
+            ax.plot([b, b], [y - 0.35, y + 0.35], color="k", linewidth=2.0,
+                    label=None if labelled else "theoretical limit", zorder=2)
+            labelled = True
+    ax.set_xscale("log")
+    ax.set_yticks(range(len(methods)), methods)
+    ax.set_ylim(-0.6, len(methods) - 0.4)
+    ax.set_xlabel("dt * omega_max  (dimensionless step)")
+    ax.set_title(title)
+    ax.grid(True, axis="x", which="both", alpha=0.3)
+    if rows:
+        ax.legend(fontsize=8, loc="best")
+    return _save(fig, path)

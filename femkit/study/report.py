@@ -1,0 +1,207 @@
+"""Report writing: ``report.md``, a self-contained ``report.html``, CSV and JSON data.
+
+A report is a list of blocks (headings, paragraphs, tables, figures) rendered twice:
+Markdown with relative links to the PNGs in ``figures/``, and HTML with every PNG embedded
+as a base64 ``data:image/png`` URI (the file can be mailed on its own).
+
+Writes are atomic at the directory level: :func:`staged_output` hands out a fresh temporary
+directory beside the target; only when the whole study succeeded is it renamed into place
+(the previous report, if any, is moved aside first and then deleted). A crashed or interrupted
+study leaves the previous report untouched and no half-written one.
+
+>>> r = Report("demo")
+>>> r.table(["a", "b"], [[1, 2.5e-3]])
+>>> print(r.to_markdown().splitlines()[-1])
+| 1 | 0.0025 |
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import csv
+import html
+import json
+import math
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any, Iterator, Sequence
+
+import numpy as np
+
+__all__ = ["Report", "staged_output", "write_csv", "write_json", "to_jsonable", "fmt"]
+
+
+def fmt(v: Any) -> str:
+    """Table cell text: floats with 4 significant digits, bools as yes/no, None as '-'."""
+    if v is None:
+        return "-"
+    if isinstance(v, (bool, np.bool_)):
+        return "yes" if v else "no"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        v = float(v)
+        if math.isnan(v):
+            return "-"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return f"{v:.4g}"
+    return str(v)
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Numpy scalars/arrays to Python, non-finite floats to None (strict JSON)."""
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        f = float(obj)
+        return f if math.isfinite(f) else None
+    if hasattr(obj, "as_dict"):
+        return to_jsonable(obj.as_dict())
+    if obj is None or isinstance(obj, str):
+        return obj
+    return str(obj)
+
+
+def write_json(path, obj: Any) -> None:
+    with open(path, "w", encoding="utf-8") as fh:
+        json.dump(to_jsonable(obj), fh, indent=1, allow_nan=False)
+        fh.write("\n")
+
+
+def write_csv(path, records: Sequence[dict]) -> None:
+    """One row per record; columns are the union of keys in first-seen order."""
+    cols: list[str] = []
+    for r in records:
+        for k in r:
+            if k not in cols:
+                cols.append(k)
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(cols)
+        for r in records:
+            row = []
+            for c in cols:
+                v = to_jsonable(r.get(c))
+                row.append("" if v is None else (json.dumps(v) if isinstance(v, (list, dict)) else v))
+            w.writerow(row)
+
+
+class Report:
+    """Blocks of a study report, rendered to Markdown and HTML."""
+
+    def __init__(self, title: str):
+        self.title = title
+        self.blocks: list[tuple[str, Any]] = []
+
+    def heading(self, text: str, level: int = 2) -> None:
+        self.blocks.append(("heading", (level, text)))
+
+    def paragraph(self, text: str) -> None:
+        self.blocks.append(("paragraph", text))
+
+    def table(self, columns: Sequence[str], rows: Sequence[Sequence[Any]], caption: str | None = None) -> None:
+        self.blocks.append(("table", (list(columns), [list(r) for r in rows], caption)))
+
+    def figure(self, relpath: str, caption: str) -> None:
+        self.blocks.append(("figure", (relpath, caption)))
+
+    @property
+    def figures(self) -> list[str]:
+        return [b[1][0] for b in self.blocks if b[0] == "figure"]
+
+    def to_markdown(self) -> str:
+        out = [f"# {self.title}", ""]
+        for kind, data in self.blocks:
+            if kind == "heading":
+                out += [f"{'#' * data[0]} {data[1]}", ""]
+            elif kind == "paragraph":
+                out += [data, ""]
+            elif kind == "table":
+                cols, rows, caption = data
+                if caption:
+                    out += [f"*{caption}*", ""]
+                out.append("| " + " | ".join(cols) + " |")
+                out.append("|" + "|".join("---" for _ in cols) + "|")
+                out += ["| " + " | ".join(fmt(v).replace("|", "\\|") for v in r) + " |" for r in rows]
+                out.append("")
+            elif kind == "figure":
+                rel, caption = data
+                out += [f"![{caption}]({rel})", "", f"*{caption}*", ""]
+        return "\n".join(out).rstrip() + "\n"
+
+    def to_html(self, base_dir) -> str:
+        """HTML with each figure read from ``base_dir/relpath`` and embedded as a data URI."""
+        e = html.escape
+        out = ["<!DOCTYPE html>", "<html><head><meta charset='utf-8'>", f"<title>{e(self.title)}</title>",
+               "<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;padding:0 1em}"
+               "table{border-collapse:collapse;margin:1em 0;font-size:0.9em}"
+               "td,th{border:1px solid #bbb;padding:2px 8px;text-align:right}th{background:#eee}"
+               "td:first-child,th:first-child{text-align:left}img{max-width:100%}"
+               "figcaption{font-style:italic;color:#444}</style>",
+               "</head><body>", f"<h1>{e(self.title)}</h1>"]
+        for kind, data in self.blocks:
+            if kind == "heading":
+                out.append(f"<h{data[0]}>{e(data[1])}</h{data[0]}>")
+            elif kind == "paragraph":
+                out.append(f"<p>{e(data)}</p>")
+            elif kind == "table":
+                cols, rows, caption = data
+                out.append("<table>")
+                if caption:
+                    out.append(f"<caption>{e(caption)}</caption>")
+                out.append("<tr>" + "".join(f"<th>{e(c)}</th>" for c in cols) + "</tr>")
+                for r in rows:
+                    out.append("<tr>" + "".join(f"<td>{e(fmt(v))}</td>" for v in r) + "</tr>")
+                out.append("</table>")
+            elif kind == "figure":
+                rel, caption = data
+                with open(os.path.join(base_dir, rel), "rb") as fh:
+                    b64 = base64.b64encode(fh.read()).decode("ascii")
+                out.append(f"<figure><img alt='{e(caption)}' src='data:image/png;base64,{b64}'>"
+                           f"<figcaption>{e(caption)}</figcaption></figure>")
+        out.append("</body></html>")
+        return "\n".join(out) + "\n"
+
+    def write(self, directory) -> None:
+        """Write ``report.md`` and ``report.html`` into ``directory`` (figures must already be there)."""
+        directory = os.fspath(directory)
+        with open(os.path.join(directory, "report.md"), "w", encoding="utf-8") as fh:
+            fh.write(self.to_markdown())
+        with open(os.path.join(directory, "report.html"), "w", encoding="utf-8") as fh:
+            fh.write(self.to_html(directory))
+
+
+@contextlib.contextmanager
+def staged_output(output_dir) -> Iterator[Path]:
+    """Yield a temporary directory that replaces ``output_dir`` when the block succeeds.
+
+    On an exception the temporary directory is removed and ``output_dir`` is untouched.
+    """
+    target = Path(output_dir).resolve()
+    target.parent.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=target.parent))
+    os.chmod(stage, 0o755)
+    try:
+        yield stage
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+    old = None
+    if target.exists():
+        old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
+        os.rename(target, old / "report")
+    os.rename(stage, target)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
