@@ -1,0 +1,386 @@
+"""The mass-spring system: particles, springs, declared forces, Jacobians and energies.
+
+State arrays are node-major ``(n, d)`` float64 (``d`` = 2 or 3); the flat dof index is
+``i*d + c`` (``x.reshape(-1)``). See ``docs/architecture.md`` and the dynamics contract.
+
+Pinned nodes
+------------
+:meth:`MassSpringSystem.force`, :meth:`~MassSpringSystem.acceleration` and
+:meth:`~MassSpringSystem.potential_gradient` have zero rows on pinned nodes. The matrices
+(:meth:`~MassSpringSystem.stiffness_matrix`, :meth:`~MassSpringSystem.damping_matrix`,
+:meth:`~MassSpringSystem.hessian_product`, :meth:`~MassSpringSystem.spring_laplacian`) are the
+full, unconstrained Jacobians; an integrator restricts them to ``free_dofs``
+(:meth:`~MassSpringSystem.free_block` does ``A[free][:, free]``).
+
+Example: one spring stretched from rest length 1 to 2 pulls its ends together.
+
+>>> import numpy as np
+>>> s = MassSpringSystem(np.array([[0., 0.], [2., 0.]]), 1.0, [[0, 1]], k=3.0, rest=1.0)
+>>> s.force(s.x0, s.v0).tolist()
+[[3.0, 0.0], [-3.0, 0.0]]
+>>> s.energies(s.x0, s.v0)["spring"]
+1.5
+"""
+
+from __future__ import annotations
+
+from typing import Iterable, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import InputError, UnknownNameError
+from .forces.base import Force
+from .forces.rayleigh import RayleighDamping
+from .forces.springs import dashpot_forces, hooke_forces, spring_energy, spring_geometry
+from .jacobian import (
+    FIXES,
+    SpringPattern,
+    dashpot_blocks,
+    regularization_shift,
+    spring_block_product,
+    spring_blocks,
+)
+
+__all__ = ["MassSpringSystem"]
+
+
+def _per_item(value, count: int, name: str, *, positive: bool = False) -> np.ndarray:
+    a = np.asarray(value, dtype=float)
+    if a.ndim == 0:
+        a = np.full(count, float(a))
+    if a.shape != (count,):
+        raise InputError(f"{name} must be a scalar or have {count} entries, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise InputError(f"{name} must be finite")
+    if positive and np.any(a <= 0.0):
+        bad = np.flatnonzero(a <= 0.0)[:5].tolist()
+        raise InputError(f"{name} must be > 0 (offending entries {bad})")
+    if not positive and np.any(a < 0.0):
+        bad = np.flatnonzero(a < 0.0)[:5].tolist()
+        raise InputError(f"{name} must be >= 0 (offending entries {bad})")
+    return np.ascontiguousarray(a)
+
+
+class MassSpringSystem:
+    """Particles connected by Hooke springs (with optional dashpots) plus declared forces.
+
+    Parameters
+    ----------
+    x0 : (n, d) array
+        Initial positions, ``d`` = 2 or 3.
+    mass : float or (n,) array
+        Particle masses (> 0).
+    springs : (s, 2) int array
+        Spring end indices ``(i, j)``, ``i != j``.
+    k : float or (s,) array
+        Spring stiffnesses (>= 0).
+    rest : float or (s,) array, optional
+        Rest lengths; default the initial lengths ``|x0_j - x0_i|`` (which must be > 0).
+    damping : float or (s,) array
+        Dashpot coefficient along each spring; dashpots are evaluated only when non-zero.
+    v0 : (n, d) array, optional
+        Initial velocities (default zero; pinned rows are set to zero).
+    pinned : index list or (n,) bool mask, optional
+        Particles held fixed.
+    forces : iterable of :class:`~femkit.dynamics.forces.base.Force`
+        Declared extra forces (Gravity, ViscousDamping, RayleighDamping, GroundContact,
+        SphereContact). Nothing undeclared is computed.
+    family : (s,) int array, optional
+        Spring family code per spring (see :mod:`femkit.dynamics.topology`), kept for output.
+
+    Raises
+    ------
+    InputError
+        Wrong shapes, non-finite values, masses <= 0, negative stiffness/rest/damping,
+        out-of-range or self-connected springs, zero default rest length.
+    """
+
+    def __init__(self, x0, mass, springs, k, rest=None, damping=0.0, *, v0=None, pinned=None,
+                 forces: Iterable[Force] = (), family=None):
+        x0 = np.array(x0, dtype=float)
+        if x0.ndim != 2 or x0.shape[1] not in (2, 3) or x0.shape[0] == 0:
+            raise InputError(f"x0 must have shape (n, 2) or (n, 3) with n >= 1, got {x0.shape}")
+        if not np.all(np.isfinite(x0)):
+            raise InputError("x0 must be finite")
+        n, d = x0.shape
+        self.n, self.dim, self.ndof = n, d, n * d
+        self.x0 = x0
+        self.mass = _per_item(mass, n, "mass", positive=True)
+
+        sp_arr = np.asarray(springs)
+        if sp_arr.size == 0:
+            sp_arr = np.zeros((0, 2), dtype=np.intp)
+        if sp_arr.ndim != 2 or sp_arr.shape[1] != 2 or not np.issubdtype(sp_arr.dtype, np.integer):
+            raise InputError(f"springs must be an (s, 2) integer array, got shape {sp_arr.shape}, dtype {sp_arr.dtype}")
+        sp_arr = sp_arr.astype(np.intp)
+        if sp_arr.size and (sp_arr.min() < 0 or sp_arr.max() >= n):
+            raise InputError(f"spring indices must lie in [0, {n - 1}]")
+        selfc = np.flatnonzero(sp_arr[:, 0] == sp_arr[:, 1])
+        if len(selfc):
+            raise InputError(f"springs connect a node to itself (springs {selfc[:5].tolist()})")
+        self.springs = np.ascontiguousarray(sp_arr)
+        s = len(sp_arr)
+        self.n_springs = s
+        self._i = np.ascontiguousarray(sp_arr[:, 0])
+        self._j = np.ascontiguousarray(sp_arr[:, 1])
+        self.k = _per_item(k, s, "spring stiffness k")
+        if rest is None:
+            _, l0, _ = spring_geometry(x0, self._i, self._j)
+            zero = np.flatnonzero(l0 == 0.0)
+            if len(zero):
+                raise InputError(
+                    f"springs {zero[:5].tolist()} have coincident endpoints in x0, so their default "
+                    "rest length would be 0: give rest lengths explicitly or fix the positions")
+            rest = l0
+        self.rest = _per_item(rest, s, "spring rest length")
+        self.damping = _per_item(damping, s, "spring damping")
+        self._has_dashpots = bool(np.any(self.damping > 0.0))
+        self.family = None if family is None else np.asarray(family)
+        scale = max(float(self.rest.max()) if s else 0.0, float(np.ptp(x0, axis=0).max()), 1e-300)
+        self.length_floor = 1e-12 * scale
+
+        mask = np.zeros(n, dtype=bool)
+        if pinned is not None:
+            p = np.asarray(pinned)
+            if p.dtype == bool:
+                if p.shape != (n,):
+                    raise InputError(f"pinned mask must have shape ({n},), got {p.shape}")
+                mask = p.copy()
+            elif p.size:
+                if not np.issubdtype(p.dtype, np.integer):
+                    raise InputError("pinned must be node indices or a boolean mask")
+                if p.min() < -n or p.max() >= n:
+                    raise InputError(f"pinned node indices must lie in [0, {n - 1}]")
+                mask[p.ravel()] = True
+        self.pinned = mask
+        self.free_dofs = np.flatnonzero(np.repeat(~mask, d))
+
+        if v0 is None:
+            v = np.zeros_like(x0)
+        else:
+            v = np.array(v0, dtype=float)
+            if v.shape != x0.shape or not np.all(np.isfinite(v)):
+                raise InputError(f"v0 must be finite with shape {x0.shape}")
+            v[mask] = 0.0
+        self.v0 = v
+
+        # flat scatter indices: per-spring force on i goes to i*d + c, its negative to j*d + c
+        c = np.arange(d)
+        self._scatter = np.concatenate([(self._i[:, None] * d + c).ravel(),
+                                        (self._j[:, None] * d + c).ravel()])
+        self._pattern = None
+        self.last_shift = 0.0
+
+        self.forces = tuple(forces)
+        for f in self.forces:
+            if not isinstance(f, Force):
+                raise InputError(f"forces must be femkit force objects, got {f!r}")
+            f.bind(self)
+        self._rayleigh = tuple(f for f in self.forces if isinstance(f, RayleighDamping))
+        self._conservative = tuple(f for f in self.forces if f.kind is not None)
+
+    # ------------------------------------------------------------------ helpers
+    def __repr__(self) -> str:
+        return (f"MassSpringSystem(n={self.n}, dim={self.dim}, springs={self.n_springs}, "
+                f"pinned={int(self.pinned.sum())}, forces={list(self.forces)})")
+
+    @property
+    def pattern(self) -> SpringPattern:
+        """Sparsity pattern and scatter map of the spring matrices (built once, cached)."""
+        if self._pattern is None:
+            self._pattern = SpringPattern(self.n, self.dim, self._i, self._j)
+        return self._pattern
+
+    @property
+    def rayleigh(self) -> tuple[float, float]:
+        """``(alpha_mass, beta_stiffness)`` of the declared Rayleigh damping, ``(0, 0)`` if none."""
+        return (float(sum(f.alpha for f in self._rayleigh)), float(sum(f.beta for f in self._rayleigh)))
+
+    def _state(self, x, name="x") -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        if x.shape != (self.n, self.dim):
+            if x.shape == (self.ndof,):
+                return x.reshape(self.n, self.dim)
+            raise InputError(f"{name} must have shape ({self.n}, {self.dim}), got {x.shape}")
+        return x
+
+    def _geometry(self, x):
+        return spring_geometry(x, self._i, self._j, self.length_floor)
+
+    def _scatter_springs(self, fs: np.ndarray) -> np.ndarray:
+        """(s, d) per-spring values on end i (end j gets the negative) -> (n, d)."""
+        flat = fs.ravel()
+        w = np.concatenate([flat, -flat])
+        return np.bincount(self._scatter, weights=w, minlength=self.ndof).reshape(self.n, self.dim)
+
+    def free_block(self, A):
+        """``A[free][:, free]`` of an ``ndof x ndof`` matrix (pinned dofs removed)."""
+        f = self.free_dofs
+        return A[f][:, f]
+
+    # ------------------------------------------------------------------ forces
+    def spring_forces(self, x, v=None) -> np.ndarray:
+        """Hooke (+ dashpot when ``v`` is given and damping is non-zero) forces, ``(n, d)``, pins not zeroed."""
+        x = self._state(x)
+        _, l, u = self._geometry(x)
+        fs = hooke_forces(l, u, self.k, self.rest)
+        if v is not None and self._has_dashpots:
+            v = self._state(v, "v")
+            fs += dashpot_forces(np.take(v, self._i, axis=0), np.take(v, self._j, axis=0), u, self.damping)
+        return self._scatter_springs(fs)
+
+    def force(self, x, v, t: float = 0.0, *, rayleigh: bool = True) -> np.ndarray:
+        """Total force ``(n, d)``; zero rows on pinned nodes.
+
+        ``rayleigh=False`` omits the Rayleigh term (for implicit methods that put
+        ``alpha M + beta K`` into their matrix).
+        """
+        x = self._state(x)
+        v = self._state(v, "v")
+        out = self.spring_forces(x, v)
+        for f in self.forces:
+            if rayleigh or not isinstance(f, RayleighDamping):
+                f.add_force(x, v, t, out)
+        out[self.pinned] = 0.0
+        return out
+
+    def acceleration(self, x, v, t: float = 0.0, *, rayleigh: bool = True) -> np.ndarray:
+        """``force / mass``, zero on pinned nodes."""
+        return self.force(x, v, t, rayleigh=rayleigh) / self.mass[:, None]
+
+    def potential_gradient(self, x) -> np.ndarray:
+        """Gradient of :meth:`potential_energy` = minus the conservative force (springs,
+        gravity, contact); zero rows on pinned nodes."""
+        x = self._state(x)
+        out = self.spring_forces(x)
+        zero_v = np.zeros_like(x)
+        for f in self._conservative:
+            f.add_force(x, zero_v, 0.0, out)
+        out[self.pinned] = 0.0
+        return -out
+
+    # ------------------------------------------------------------------ energies
+    def potential_energy(self, x) -> float:
+        """Spring + gravity + contact energy."""
+        e = self.energies(x, None)
+        return e["spring"] + e["gravity"] + e["contact"]
+
+    def energies(self, x, v) -> dict:
+        """``dict(kinetic, spring, gravity, contact, total)`` (``v=None`` gives kinetic 0)."""
+        x = self._state(x)
+        _, l, _ = self._geometry(x)
+        out = {"kinetic": 0.0, "spring": spring_energy(l, self.k, self.rest), "gravity": 0.0, "contact": 0.0}
+        if v is not None:
+            v = self._state(v, "v")
+            out["kinetic"] = float(0.5 * np.einsum("n,nd,nd->", self.mass, v, v))
+        for f in self._conservative:
+            out[f.kind] += f.energy(x)
+        out["total"] = out["kinetic"] + out["spring"] + out["gravity"] + out["contact"]
+        return out
+
+    def momentum(self, v) -> np.ndarray:
+        """Linear momentum ``sum_i m_i v_i``, shape ``(d,)``."""
+        v = self._state(v, "v")
+        return self.mass @ v
+
+    # ------------------------------------------------------------------ matrices
+    def _check_fix(self, fix):
+        if fix not in FIXES:
+            raise UnknownNameError("definiteness fix", str(fix), [f for f in FIXES if f])
+
+    def regularization_shift(self, x) -> float:
+        """The ``mu`` of ``fix="regularize"`` at ``x`` (see :func:`femkit.dynamics.jacobian.regularization_shift`)."""
+        x = self._state(x)
+        _, l, _ = self._geometry(x)
+        extra = None
+        for f in self.forces:
+            e = f.negative_bound(x)
+            if e is not None:
+                extra = e if extra is None else extra + e
+        return regularization_shift(self.n, self._i, self._j, l, self.rest, self.k, extra)
+
+    def stiffness_matrix(self, x, *, fix: str | None = None) -> sp.csr_matrix:
+        """``K = -df/dx`` of springs and contacts (full, pins not removed), CSR ``ndof x ndof``.
+
+        ``fix``: ``None``; ``"clamp"`` (per-spring/per-contact eigenvalue clamp, PSD result);
+        ``"regularize"`` (``K + mu I`` with the analytic shift :meth:`regularization_shift`,
+        stored in ``self.last_shift``). Dashpots' position derivative is not included.
+        """
+        self._check_fix(fix)
+        x = self._state(x)
+        _, l, u = self._geometry(x)
+        H = spring_blocks(l, u, self.k, self.rest, "clamp" if fix == "clamp" else None)
+        mu = self.regularization_shift(x) if fix == "regularize" else 0.0
+        self.last_shift = mu
+        K = self.pattern.assemble(H, mu if mu else None)
+        for f in self.forces:
+            Kf = f.stiffness(x, "clamp" if fix == "clamp" else None)
+            if Kf is not None:
+                K = K + Kf
+        return K.tocsr()
+
+    def hessian_product(self, x, d, *, fix: str | None = None) -> np.ndarray:
+        """Matrix-free ``K d`` (seed 001: ``A d = M d + h^2 sum_j H_j d``), equal to
+        ``stiffness_matrix(x, fix=fix) @ d`` with ``d`` of shape ``(n, d)`` or flat."""
+        self._check_fix(fix)
+        x = self._state(x)
+        dd = self._state(d, "d")
+        _, l, u = self._geometry(x)
+        diff = np.take(dd, self._j, axis=0) - np.take(dd, self._i, axis=0)
+        y = spring_block_product(l, u, self.k, self.rest, diff, "clamp" if fix == "clamp" else None)
+        out = self._scatter_springs(-y)
+        for f in self.forces:
+            p = f.stiffness_product(x, dd, "clamp" if fix == "clamp" else None)
+            if p is not None:
+                out += p
+        if fix == "regularize":
+            out += self.regularization_shift(x) * dd
+        return out
+
+    def damping_matrix(self, x) -> sp.csr_matrix:
+        """``D = -df/dv`` of the dashpots (``c u u^T`` blocks) and viscous damping (not Rayleigh)."""
+        x = self._state(x)
+        if self._has_dashpots:
+            _, _, u = self._geometry(x)
+            D = self.pattern.assemble(dashpot_blocks(u, self.damping))
+        else:
+            D = sp.csr_matrix((self.ndof, self.ndof))
+        for f in self.forces:
+            Df = f.damping(x)
+            if Df is not None:
+                D = D + Df
+        return D.tocsr()
+
+    def mass_matrix(self) -> sp.csr_matrix:
+        """Lumped mass matrix: masses repeated ``d`` times on the diagonal."""
+        return sp.diags(np.repeat(self.mass, self.dim), format="csr")
+
+    def spring_laplacian(self) -> sp.csr_matrix:
+        """``L = sum_s k_s A_s A_s^T`` (``n x n``, Liu et al. 2013), ``A_s = e_i - e_j``.
+
+        Liu's global step is ``(M_n + h^2 L) x = M_n y + h^2 J d`` per coordinate, with
+        :meth:`spring_J` and :meth:`spring_directions`; pins are handled by the integrator.
+        """
+        pat = SpringPattern(self.n, 1, self._i, self._j)
+        return pat.assemble(self.k.reshape(-1, 1, 1))
+
+    def spring_J(self) -> sp.csr_matrix:
+        """``J = sum_s k_s A_s S_s^T`` (``n x s``): ``J[i, s] = k_s``, ``J[j, s] = -k_s``."""
+        s = self.n_springs
+        cols = np.concatenate([np.arange(s), np.arange(s)])
+        rows = np.concatenate([self._i, self._j])
+        return sp.csr_matrix((np.concatenate([self.k, -self.k]), (rows, cols)), shape=(self.n, s))
+
+    def spring_directions(self, x) -> np.ndarray:
+        """Liu's local step: ``d_s = L_s (x_i - x_j) / |x_i - x_j|``, shape ``(s, d)``
+        (the minimiser of ``|(x_i - x_j) - d|`` over ``|d| = L_s``)."""
+        x = self._state(x)
+        _, _, u = self._geometry(x)
+        return -self.rest[:, None] * u
+
+    def omega_max(self, x=None, **options) -> float:
+        """Largest angular frequency of the linearisation at ``x`` (see :mod:`.stability`)."""
+        from .stability import estimate_omega_max
+
+        return estimate_omega_max(self, x, **options)
