@@ -1,0 +1,62 @@
+"""Shared helpers of the assembly routines: element subsets and triangle geometry."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import DegenerateMeshError, InputError
+
+
+def select_elements(mesh, elements) -> np.ndarray | None:
+    """Normalise ``elements`` (None, index array or boolean mask) to an index array or None.
+
+    ``None`` means every element.  Raises :class:`~femkit.errors.InputError` for a mask of
+    the wrong length or indices out of range.
+    """
+    if elements is None:
+        return None
+    m = mesh.n_triangles
+    sel = np.asarray(elements)
+    if sel.dtype == bool:
+        if sel.shape != (m,):
+            raise InputError(f"element mask must have shape ({m},), got {sel.shape}")
+        return np.flatnonzero(sel)
+    if sel.size == 0:
+        return np.zeros(0, dtype=np.intp)
+    if not np.issubdtype(sel.dtype, np.integer):
+        raise InputError(f"elements must be an integer index array or a boolean mask, got dtype {sel.dtype}")
+    sel = sel.ravel().astype(np.intp, copy=False)
+    if sel.min() < -m or sel.max() >= m:
+        raise InputError(f"element indices out of range for a mesh of {m} triangles")
+    return np.where(sel < 0, sel + m, sel)
+
+
+def triangle_geometry(mesh, idx: np.ndarray | None):
+    """Edge vectors opposite each vertex and areas of the selected triangles.
+
+    Returns ``(e, area)`` with ``e`` of shape (m, 3, 2), ``e[:, a]`` the edge opposite vertex ``a``
+    (from vertex a+1 to a+2), so that ``grad N_a = rot(e_a) / (2 A_signed)``.
+    """
+    tri = mesh.triangles if idx is None else mesh.triangles[idx]
+    p = mesh.points
+    p0, p1, p2 = p[tri[:, 0]], p[tri[:, 1]], p[tri[:, 2]]
+    e = np.empty((len(tri), 3, 2))
+    np.subtract(p2, p1, out=e[:, 0])
+    np.subtract(p0, p2, out=e[:, 1])
+    np.subtract(p1, p0, out=e[:, 2])
+    signed = 0.5 * (e[:, 2, 0] * (-e[:, 1, 1]) - e[:, 2, 1] * (-e[:, 1, 0]))
+    area = np.abs(signed)
+    check_areas(area, idx)
+    return e, area, signed, tri
+
+
+def check_areas(area: np.ndarray, idx: np.ndarray | None) -> None:
+    """Raise :class:`DegenerateMeshError` naming zero-area (or non-finite) triangles."""
+    bad = ~(area > 0) | ~np.isfinite(area)
+    if bad.any():
+        local = np.flatnonzero(bad)
+        ids = local if idx is None else idx[local]
+        raise DegenerateMeshError(
+            f"{len(ids)} triangle(s) with zero or non-finite area, first ids: {ids[:10].tolist()}",
+            element_ids=ids.tolist(),
+        )
