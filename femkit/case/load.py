@@ -1,0 +1,172 @@
+"""Load a case file: read YAML, apply overrides, validate, fill defaults, prepare.
+
+>>> import tempfile, pathlib
+>>> d = pathlib.Path(tempfile.mkdtemp())
+>>> _ = (d / "c.yaml").write_text('''
+... problem: poisson
+... mesh: {geometry: unit_square, h: 0.5}
+... source: "1"
+... boundary: {dirichlet: [{tags: [boundary]}]}
+... solver: {method: direct}
+... ''')
+>>> case = load_case(d / "c.yaml", mesh={"h": 0.25})
+>>> case.name, case.data["mesh"]["h"], case.data["solver"]["preconditioner"]
+('c', 0.25, 'none')
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+from ..errors import CaseFileError, UnknownNameError
+from .problems import get_problem
+from .schema import fill_defaults, validate_against
+
+__all__ = ["Case", "load_case", "case_from_dict", "read_yaml", "apply_overrides"]
+
+
+@dataclass
+class Case:
+    """A validated case: the data (defaults filled, paths absolute) and its compiled pieces.
+
+    Attributes
+    ----------
+    data : dict
+        The validated case, defaults filled, relative paths resolved against ``base_dir``.
+    problem : str
+        The ``problem`` key (dispatch key of :data:`femkit.case.problems.PROBLEMS`).
+    name : str
+        ``name`` key, else the file stem.
+    base_dir : Path
+        Directory relative paths in the case are resolved against.
+    path : Path or None
+        The case file (None for a case built from a dict).
+    functions : dict
+        Compiled callables keyed by their key path (``"source"``, ``"exact.u"`` ...),
+        each with ``.source`` holding its text. Replace an entry to swap a piece.
+    """
+
+    data: dict
+    problem: str
+    name: str
+    base_dir: Path
+    path: Path | None = None
+    functions: dict = field(default_factory=dict)
+    extras: dict = field(default_factory=dict)
+
+    def run(self, output_dir: str | os.PathLike | None = None, quiet: bool = True,
+            write: bool = True, echo=None):
+        """Run the case; returns the problem's result object (CaseResult for Poisson).
+
+        Parameters
+        ----------
+        output_dir : overrides ``output.dir``.
+        quiet : when False, print the stage-by-stage summary.
+        write : when False, nothing is written to disk.
+        echo : callable used for printing (default :func:`print`).
+        """
+        run = get_problem(self.problem).get_run()
+        return run(self, output_dir=output_dir, quiet=quiet, write=write, echo=echo)
+
+
+def read_yaml(path: str | os.PathLike) -> Any:
+    """Parse a YAML file; CaseFileError with the file and line number on any problem."""
+    import yaml
+
+    p = Path(path)
+    if not p.is_file():
+        what = "is a directory" if p.is_dir() else "not found"
+        raise CaseFileError(f"case file {what}: {p.resolve()}")
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CaseFileError(f"cannot read case file {p}: {exc}") from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise CaseFileError(f"{p}:{where}: invalid YAML: {problem}") from None
+
+
+def apply_overrides(data: dict, overrides: Mapping[str, Any]) -> dict:
+    """Deep-merge ``overrides`` into a copy of ``data``.
+
+    A mapping merges key by key (``mesh={"h": 0.1}`` changes only ``mesh.h``); a key with
+    double underscores is a path (``mesh__h=0.1`` is the same); anything else replaces.
+    """
+    out = copy.deepcopy(data)
+    for key, value in overrides.items():
+        parts = key.split("__")
+        node = out
+        for part in parts[:-1]:
+            if not isinstance(node.get(part), dict):
+                node[part] = {}
+            node = node[part]
+        _merge(node, parts[-1], value)
+    return out
+
+
+def _merge(node: dict, key: str, value: Any) -> None:
+    if isinstance(value, Mapping) and isinstance(node.get(key), dict):
+        for k, v in value.items():
+            _merge(node[key], k, v)
+    else:
+        node[key] = copy.deepcopy(value)
+
+
+def case_from_dict(data: Mapping, base_dir: str | os.PathLike = ".", *, name: str | None = None,
+                   path: str | os.PathLike | None = None, **overrides) -> Case:
+    """Validate and prepare a case given as a mapping (what :func:`load_case` does after parsing)."""
+    if not isinstance(data, Mapping):
+        raise CaseFileError(f"a case file must be a mapping of keys, got {type(data).__name__}")
+    data = apply_overrides(dict(data), overrides)
+    if "problem" not in data:
+        raise CaseFileError("(top level): missing required key 'problem' "
+                            "(e.g. 'problem: poisson')")
+    try:
+        ptype = get_problem(data["problem"])
+    except UnknownNameError as exc:
+        raise CaseFileError(f"problem: {exc}") from None
+    schema = ptype.get_schema()
+    validate_against(data, schema)
+    full = fill_defaults(data, schema)
+    base = Path(base_dir).resolve()
+    case_name = full.get("name") or name or "case"
+    case = Case(data=full, problem=str(full["problem"]), name=case_name, base_dir=base,
+                path=Path(path).resolve() if path is not None else None)
+    ptype.get_prepare()(case)
+    return case
+
+
+def load_case(path: str | os.PathLike, **overrides) -> Case:
+    """Load, validate and prepare the case file at ``path``.
+
+    Parameters
+    ----------
+    path : the YAML case file.
+    **overrides : values merged into the file's content before validation
+        (``mesh={"h": 0.1}`` or ``mesh__h=0.1``; ``solver={"method": "direct"}``).
+
+    Returns
+    -------
+    Case
+
+    Raises
+    ------
+    CaseFileError
+        Unreadable file, invalid YAML (with line number), schema violation (one line: key
+        path, what is wrong, valid keys), missing mesh file.
+    ExpressionError, UnknownNameError
+        Unsafe expression; unknown geometry/solver/preconditioner/quadrature name.
+    """
+    p = Path(path)
+    data = read_yaml(p)
+    if data is None:
+        raise CaseFileError(f"case file is empty: {p.resolve()}")
+    return case_from_dict(data, p.resolve().parent, name=p.stem, path=p, **overrides)

@@ -1,0 +1,157 @@
+"""The ``femkit`` command line: ``femkit solve CASE``, ``femkit check CASE``.
+
+This module imports only the standard library at module level, so ``femkit --help`` is
+instant; each subcommand imports what it needs when it runs.
+
+Exit codes (every subcommand):
+  0  success
+  1  the computation ran but failed its goal (solver did not converge; a cross-check
+     exceeded its tolerance; a solver/integrator error)
+  2  bad input (case file, expression, name, mesh); one line on stderr, nothing written
+
+Adding a subcommand: write ``_add_<name>(sub)`` that declares its parser and sets
+``handler`` (a function ``args -> int``), then append it to :data:`SUBCOMMANDS`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Callable, Sequence
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+
+_EPILOG = """\
+exit codes:
+  0  success
+  1  ran, but did not reach its goal (solver not converged, check out of tolerance)
+  2  bad input (case file, expression, solver name, mesh); a one-line message on
+     stderr and no output written
+
+examples:
+  femkit solve cases/poisson_unit_square.yaml
+  femkit solve cases/poisson_lshape.yaml --output runs/lshape --quiet
+  femkit check cases/poisson_unit_square.yaml
+
+Case-file reference: docs/case-files.md; command line: docs/cli.md.
+"""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but usage errors exit with code 2 and one line (no usage dump)."""
+
+    def error(self, message: str):  # noqa: D401 - argparse API
+        self.exit(EXIT_BAD_INPUT, f"femkit: error: {message} (see '{self.prog} --help')\n")
+
+
+# ----------------------------------------------------------------------------- solve
+
+def _add_solve(sub) -> None:
+    p = sub.add_parser(
+        "solve", help="run a case file and write its results",
+        description=(
+            "Load CASE (YAML), validate it completely (schema, names, expressions, mesh file), "
+            "build and check the mesh, assemble, solve, and write result.json plus the "
+            "requested outputs (solution.vtu, solution.xdmf, solution.png) into the output "
+            "directory, which appears only when the run finishes (atomically). Prints a short "
+            "summary: mesh size, dofs, solver and iterations, true residual, error norms "
+            "when the case gives an exact solution, and the time of each stage."),
+        epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("case", metavar="CASE", help="case file (.yaml), e.g. cases/poisson_lshape.yaml")
+    p.add_argument("-o", "--output", metavar="DIR",
+                   help="output directory (default: output.dir of the case, resolved against "
+                        "the case file's directory)")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
+    p.set_defaults(handler=_run_solve)
+
+
+def _run_solve(args) -> int:
+    from .case import load_case
+
+    case = load_case(args.case)
+    result = case.run(output_dir=args.output, quiet=args.quiet)
+    converged = bool(getattr(result, "converged", True))
+    if not converged:
+        where = getattr(result, "output_dir", None)
+        print(f"femkit: solver did not converge; results written to {where} "
+              f"(marked converged: false)", file=sys.stderr)
+        return EXIT_FAILED
+    return EXIT_OK
+
+
+# ----------------------------------------------------------------------------- check
+
+def _add_check(sub) -> None:
+    p = sub.add_parser(
+        "check", help="cross-check a Poisson case against scikit-fem and pyamg",
+        description=(
+            "Build the case's mesh and compare, on that same mesh: femkit's stiffness matrix "
+            "and one-point (barycentric) load vector with scikit-fem's (intorder=1), "
+            "femkit's solution with scikit-fem's (condense + direct solve), and the reduced "
+            "system solved with pyamg's own smoothed-aggregation solver (accel='cg'). "
+            "Prints each relative difference next to its tolerance; nothing is written. "
+            "Tolerances: K and F 1e-12 relative; solutions 10*rtol relative (at least 1e-10)."),
+        epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("case", metavar="CASE", help="Poisson case file (.yaml)")
+    p.add_argument("-q", "--quiet", action="store_true", help="print only failures")
+    p.set_defaults(handler=_run_check)
+
+
+def _run_check(args) -> int:
+    from .case import load_case
+    from .case.check import cross_check, format_table
+
+    case = load_case(args.case)
+    rows = cross_check(case)
+    ok = all(r.passed for r in rows)
+    if not args.quiet or not ok:
+        print(format_table(rows))
+    return EXIT_OK if ok else EXIT_FAILED
+
+
+#: Subcommands, in help order: each adds its parser to the subparsers object.
+SUBCOMMANDS: list[Callable] = [_add_solve, _add_check]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``femkit`` argument parser (no heavy import happens here)."""
+    parser = _Parser(
+        prog="femkit",
+        description=("femkit: P1 finite elements for Poisson problems (and mass-spring "
+                     "dynamics), every result reported with its error and its cost."),
+        epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    from . import __version__
+
+    parser.add_argument("--version", action="version", version=f"femkit {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for add in SUBCOMMANDS:
+        add(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``femkit`` command; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    from .errors import FemkitError, InputError
+
+    try:
+        return int(args.handler(args))
+    except InputError as exc:
+        print(f"femkit: error: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except FemkitError as exc:
+        print(f"femkit: failed: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_FAILED
+    except KeyboardInterrupt:
+        print("femkit: interrupted", file=sys.stderr)
+        return 130
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

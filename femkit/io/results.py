@@ -1,0 +1,93 @@
+"""Outputs of a Poisson run: ``result.json``, the solution as ``.vtu`` / ``.xdmf``, a PNG plot.
+
+Every file is written atomically (see :mod:`femkit.io.atomic`). The keys of ``result.json``
+are documented in docs/case-files.md ("Outputs").
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .atomic import atomic_path, atomic_write_text
+
+__all__ = ["to_jsonable", "write_json", "write_solution", "write_plot", "RESULT_KEYS"]
+
+#: Top-level keys of result.json.
+RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs", "nnz",
+               "solver", "converged", "errors", "timings", "expressions", "files")
+
+
+def to_jsonable(value: Any) -> Any:
+    """Convert numpy scalars/arrays and paths to JSON types; non-finite floats become null."""
+    if isinstance(value, dict):
+        return {str(k): to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return to_jsonable(value.tolist())
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        return v if math.isfinite(v) else None
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    return value
+
+
+def write_json(path: str | os.PathLike, data: dict) -> Path:
+    """Write ``data`` as indented JSON (atomically)."""
+    return atomic_write_text(path, json.dumps(to_jsonable(data), indent=2, allow_nan=False) + "\n")
+
+
+def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarray | None = None,
+                   extra_point_data: dict | None = None) -> Path:
+    """Write the mesh with point data ``u`` and cell data ``kappa`` and ``tag`` (vtu/xdmf by extension)."""
+    from ..mesh import write_mesh
+
+    point_data = {"u": np.asarray(u, dtype=np.float64)}
+    point_data.update(extra_point_data or {})
+    cell_data = {"tag": np.asarray(mesh.cell_tags, dtype=np.int32)}
+    if kappa is not None:
+        cell_data["kappa"] = np.asarray(kappa, dtype=np.float64)
+    target = Path(path)
+    if target.suffix.lower() == ".xdmf":
+        # XDMF keeps its heavy data in a sibling .h5 named after the file: write in place.
+        write_mesh(target, mesh, point_data=point_data, cell_data=cell_data)
+        return target
+    with atomic_path(target) as tmp:
+        write_mesh(tmp, mesh, point_data=point_data, cell_data=cell_data)
+    return target
+
+
+def write_plot(path: str | os.PathLike, mesh, u: np.ndarray, title: str = "") -> Path:
+    """Save a filled-contour PNG of ``u`` with a colour bar (matplotlib, Agg backend)."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+    from matplotlib.tri import Triangulation
+
+    tri = Triangulation(mesh.points[:, 0], mesh.points[:, 1], mesh.triangles)
+    fig, ax = plt.subplots(figsize=(6, 5), dpi=120)
+    try:
+        art = ax.tripcolor(tri, np.asarray(u, dtype=np.float64), shading="gouraud", cmap="viridis")
+        fig.colorbar(art, ax=ax, label="u")
+        ax.set_aspect("equal")
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.set_title(title, fontsize=9)
+        fig.tight_layout()
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, format="png")
+    finally:
+        plt.close(fig)
+    return Path(path)
