@@ -59,9 +59,11 @@ def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
         raise MeshError(f"mesh file not found: {p}")
     import meshio
 
+    fmt = "gmsh" if p.lower().endswith(".msh") else None
     try:
-        mio = meshio.read(p)
-    except Exception as exc:  # meshio raises ReadError, KeyError, ValueError ... on bad files
+        mio = meshio.read(p, file_format=fmt)
+    except (Exception, SystemExit) as exc:  # meshio raises ReadError, KeyError, ValueError ...
+        # (and sys.exit() when several readers fail), so catch all of them here
         raise MeshError(f"cannot read mesh file {p}: {type(exc).__name__}: {exc}") from None
 
     types = [c.type for c in mio.cells]
@@ -160,7 +162,8 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = No
 
     Parameters
     ----------
-    path : ``.msh`` (gmsh, ``msh_version`` ``"4.1"`` or ``"2.2"``, ASCII unless ``binary``),
+    path : ``.msh`` (gmsh, ``msh_version`` ``"4.1"`` (ASCII) or ``"2.2"`` (ASCII unless
+        ``binary``; mesh and tags only, no data)),
         ``.vtu``, ``.xdmf`` or any other meshio format
     point_data : ``{name: (n,) or (n, k) array}``
     cell_data : ``{name: (m,) or (m, k) array}`` on the triangles (tagged boundary edges get
@@ -213,6 +216,9 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = No
         if ext == ".msh":
             if msh_version == "4.1":
                 raise MeshError("binary msh 4.1 is not supported; use binary=False or msh_version='2.2'")
+            if pdata or cell_data:
+                raise MeshError("point/cell data are written to msh 4.1 (the default), .vtu or "
+                                ".xdmf, not to msh 2.2")
             meshio.write(p, out, file_format="gmsh22", binary=binary)
         else:
             meshio.write(p, out)
@@ -275,6 +281,14 @@ def _write_msh41(path: str, mesh: Mesh, point_data: dict, cell_data: dict) -> No
         out.append(f"1 {i} 1 {len(sel)}\n")
         out.append(_fmt_rows(np.column_stack([eids[sel], mesh.boundary_edges[sel] + 1]), "%d"))
     out.append("$EndElements\n")
+    out.append(_data_sections(mesh, point_data, cell_data))
+    Path(path).write_text("".join(out))
+
+
+def _data_sections(mesh: Mesh, point_data: dict, cell_data: dict) -> str:
+    """ASCII ``$NodeData`` / ``$ElementData`` blocks (elements numbered triangles first, then edges)."""
+    n, m, k = mesh.n_points, mesh.n_triangles, len(mesh.boundary_edges)
+    out = []
     for name, a in point_data.items():
         a2 = np.asarray(a, dtype=np.float64).reshape(n, -1)
         out.append(f'$NodeData\n1\n"{name}"\n1\n0.0\n3\n0\n{a2.shape[1]}\n{n}\n')
@@ -286,4 +300,4 @@ def _write_msh41(path: str, mesh: Mesh, point_data: dict, cell_data: dict) -> No
         out.append(f'$ElementData\n1\n"{name}"\n1\n0.0\n3\n0\n{a2.shape[1]}\n{m + k}\n')
         out.append(_fmt_rows(np.column_stack([np.arange(1, m + k + 1), a2]), "%.17g"))
         out.append("$EndElementData\n")
-    Path(path).write_text("".join(out))
+    return "".join(out)
