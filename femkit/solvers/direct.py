@@ -120,7 +120,7 @@ def direct(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter=None
     """Solve ``A x = b`` with a sparse LU factorisation (see :func:`factorize`).
 
     ``x0``, ``maxiter``, ``M`` and ``callback`` are accepted for signature uniformity and
-    ignored (``callback`` is never called: there are no iterations). The stopping rule
+    ignored (``maxiter`` is still validated) (``callback`` is never called: there are no iterations). The stopping rule
     ``||b - A x|| <= max(rtol ||b||, atol)`` is applied to the true residual of the
     returned ``x``: ``converged`` is False (with the residual in ``message``) for a
     numerically singular matrix. ``reason`` is ``"direct"`` either way.
@@ -138,7 +138,7 @@ def direct(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter=None
     SingularSystemError
         Exactly singular matrix.
     """
-    prob = prepare(A, b, None, rtol=rtol, atol=atol, maxiter=0, method="direct")
+    prob = prepare(A, b, None, rtol=rtol, atol=atol, maxiter=maxiter, method="direct")
     if isinstance(prob.A, LinearOperator):
         raise InputError("the direct solver needs an explicit matrix, not a LinearOperator")
     if prob.rhs_norm == 0.0:

@@ -72,8 +72,9 @@ def jacobi(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int
     while reason == "maxiter" and k < prob.maxiter:
         step = apply_M(r)
         x_new = x + step if scale == 1.0 else x + scale * step
-        r_new = b - matvec(x_new)
-        res = float(np.linalg.norm(r_new))
+        with np.errstate(over="ignore", invalid="ignore"):
+            r_new = b - matvec(x_new)
+            res = float(np.linalg.norm(r_new))
         if not math.isfinite(res):
             reason = "non-finite"
             message = (f"jacobi diverged: the residual overflowed at iteration {k + 1} "
