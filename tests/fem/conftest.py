@@ -60,3 +60,9 @@ def sk_mesh():
     p[:, interior] += 0.01 * rng.standard_normal((2, interior.sum()))
     sk = skfem.MeshTri(p, m.t)
     return sk, from_skfem(sk)
+
+
+@pytest.fixture
+def make_square():
+    """The :func:`unit_square` factory (test modules cannot import conftest in importlib mode)."""
+    return unit_square
