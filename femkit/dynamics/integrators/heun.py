@@ -1,0 +1,21 @@
+"""Heun's method (explicit trapezoid, RK2): average of the slopes at ``t`` and at an Euler predictor.
+
+Second order; Dahlquist real interval ``[-2, 0]``; never stable on the undamped oscillator
+(energy grows as ``1 + (h omega)^4 / 4`` per step).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .registry import INTEGRATORS
+from .tableau import ButcherTableau, ExplicitRungeKutta
+
+
+@INTEGRATORS.register("heun")
+@dataclass(frozen=True)
+class Heun(ExplicitRungeKutta):
+    name = "heun"
+    order = 2
+    stability_bound = 2.0
+    tableau = ButcherTableau(((0.0, 0.0), (1.0, 0.0)), (0.5, 0.5), (0.0, 1.0))

@@ -1,0 +1,22 @@
+"""Explicit midpoint (SOFA's RungeKutta2): slope at an Euler half step.
+
+``x+ = x + h v_{1/2}``, ``v+ = v + h a(x_{1/2}, v_{1/2})`` with ``x_{1/2} = x + h/2 v``,
+``v_{1/2} = v + h/2 a``. Second order; Dahlquist real interval ``[-2, 0]``; never stable on
+the undamped oscillator (same amplification as Heun on linear problems).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .registry import INTEGRATORS
+from .tableau import ButcherTableau, ExplicitRungeKutta
+
+
+@INTEGRATORS.register("midpoint")
+@dataclass(frozen=True)
+class Midpoint(ExplicitRungeKutta):
+    name = "midpoint"
+    order = 2
+    stability_bound = 2.0
+    tableau = ButcherTableau(((0.0, 0.0), (0.5, 0.0)), (0.0, 1.0), (0.0, 0.5))

@@ -1,0 +1,42 @@
+"""Small systems shared by the integrator tests (SOFA's one-spring scene, a unit oscillator)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from femkit.dynamics.forces import Gravity, RayleighDamping
+from femkit.dynamics.integrators import StepContext
+from femkit.dynamics.system import MassSpringSystem
+
+
+def sofa_spring(K=100.0, m=10.0, g=10.0, rm=0.0, rk=0.0):
+    """SOFA's ODE-solver test scene: fixed node at y = 2, rest length 1, mass at y = 1, gravity -g.
+
+    With ``g = K/m`` the free node follows ``y(t) = cos(sqrt(K/m) t)`` exactly.
+    """
+    forces = [Gravity(g)]
+    if rm or rk:
+        forces.append(RayleighDamping(rm, rk))
+    return MassSpringSystem(np.array([[0.0, 2.0], [0.0, 1.0]]), m, [[0, 1]], K, rest=1.0,
+                            pinned=[0], forces=forces)
+
+
+def unit_oscillator(omega=1.0, amplitude=1.0):
+    """``y'' = -omega^2 y`` for the free node's displacement along x (no gravity); y(0) = amplitude."""
+    sys = MassSpringSystem(np.array([[0.0, 0.0], [1.0, 0.0]]), 1.0, [[0, 1]], omega ** 2,
+                           rest=1.0, pinned=[0])
+    x0 = sys.x0.copy()
+    x0[1, 0] += amplitude
+    return sys, x0
+
+
+def run(integrator, system, x0, v0, dt, steps, ctx=None):
+    """Positions and velocities of the free node 1 at every step (including the start)."""
+    ctx = ctx or StepContext()
+    state = integrator.start(system, x0, v0, 0.0, dt, ctx)
+    xs, vs = [state.x[1].copy()], [state.v[1].copy()]
+    for _ in range(steps):
+        state = integrator.step(system, state, dt, ctx)
+        xs.append(state.x[1].copy())
+        vs.append(state.v[1].copy())
+    return np.array(xs), np.array(vs), ctx
