@@ -73,6 +73,26 @@ class Case:
         return run(self, output_dir=output_dir, quiet=quiet, write=write, echo=echo)
 
 
+def _loader():
+    """PyYAML's SafeLoader, plus YAML 1.2 floats (``1e6``, ``1.0e-8`` are numbers, not strings)."""
+    import re
+
+    import yaml
+
+    class Loader(yaml.SafeLoader):
+        pass
+
+    Loader.add_implicit_resolver(
+        "tag:yaml.org,2002:float",
+        re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
+                    |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
+                    |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
+                    |[-+]?\.(?:inf|Inf|INF)
+                    |\.(?:nan|NaN|NAN))$""", re.X),
+        list("-+0123456789."))
+    return Loader
+
+
 def read_yaml(path: str | os.PathLike) -> Any:
     """Parse a YAML file; CaseFileError with the file and line number on any problem."""
     import yaml
@@ -86,7 +106,7 @@ def read_yaml(path: str | os.PathLike) -> Any:
     except (OSError, UnicodeDecodeError) as exc:
         raise CaseFileError(f"cannot read case file {p}: {exc}") from None
     try:
-        return yaml.safe_load(text)
+        return yaml.load(text, Loader=_loader())  # a SafeLoader subclass
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""

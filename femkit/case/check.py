@@ -1,0 +1,139 @@
+"""``femkit check``: cross-check a Poisson case against scikit-fem and pyamg on the same mesh.
+
+Compared quantities and their documented tolerances (docs/cli.md):
+
+- stiffness K: ``||K - K_skfem||_F / ||K_skfem||_F`` <= 1e-12;
+- load F (one-point rule, skfem given the same centroid rule): ``||F - F_skfem|| / ||F_skfem||``
+  <= 1e-12;
+- solution vs skfem (condense + direct solve): ``||u - u_skfem|| / ||u_skfem||`` <=
+  ``SOLUTION_FACTOR * rtol``;
+- solution vs pyamg (its own SA solver, ``accel='cg'``, same rtol) on the reduced system:
+  ``||u - u_pyamg|| / ||u_pyamg||`` <= ``SOLUTION_FACTOR * rtol``.
+
+Both iterative solutions satisfy a relative residual of ``rtol``; their difference is bounded
+by ``cond(A) * rtol`` in theory, and observed far below ``10 * rtol`` on the bundled cases.
+Solution tolerances are never tighter than ``1e-10`` (round-off of a direct solve).
+The load row uses the source term only (femkit's one-point rule against skfem's
+one-point rule); Neumann terms, when present, are femkit's in both solution rows.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .load import Case
+
+__all__ = ["CheckRow", "cross_check", "format_table", "MATRIX_TOL", "SOLUTION_FACTOR"]
+
+#: Relative tolerance of the stiffness matrix and one-point load comparisons.
+MATRIX_TOL = 1e-12
+#: Solution tolerance = SOLUTION_FACTOR * solver.rtol (at least SOLUTION_FLOOR).
+SOLUTION_FACTOR = 10.0
+SOLUTION_FLOOR = 1e-10
+
+
+@dataclass
+class CheckRow:
+    """One compared quantity: its relative difference and the tolerance it must meet."""
+
+    name: str
+    difference: float
+    tolerance: float
+    detail: str = ""
+
+    @property
+    def passed(self) -> bool:
+        return bool(np.isfinite(self.difference) and self.difference <= self.tolerance)
+
+
+def _rel(a, b) -> float:
+    den = float(np.linalg.norm(b))
+    num = float(np.linalg.norm(a - b))
+    return num / den if den > 0 else num
+
+
+def cross_check(case: Case) -> list[CheckRow]:
+    """Run the comparisons of the module docstring; returns the rows (nothing written)."""
+    if case.problem != "poisson":
+        from ..errors import CaseFileError
+
+        raise CaseFileError(f"femkit check handles 'poisson' cases, not {case.problem!r}")
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+    import skfem
+    from skfem import Basis, BilinearForm, ElementTriP1, LinearForm, MeshTri, condense
+    from skfem.helpers import dot, grad
+
+    from ..fem import assemble_load
+    from .run import assemble_system, build_mesh, dirichlet_data, dirichlet_system, solve_system
+
+    mesh = build_mesh(case)
+    K, F, kappa = assemble_system(case, mesh)
+    F_source = assemble_load(mesh, case.functions["source"], rule="barycentric")
+    neumann = F - assemble_load(mesh, case.functions["source"],
+                                rule=case.data["quadrature"]["load"])
+
+    m = MeshTri(mesh.points.T.copy(), mesh.triangles.T.copy(), sort_t=False)
+    # skfem's intorder=1 picks a 3-point rule on triangles; pass the centroid rule itself
+    # (reference triangle area 1/2) so both codes use the same one-point quadrature.
+    basis = Basis(m, ElementTriP1(), quadrature=(np.array([[1 / 3], [1 / 3]]), np.array([0.5])))
+    nqp = basis.X.shape[1]
+
+    @BilinearForm
+    def stiffness(u, v, w):
+        return w.kappa * dot(grad(u), grad(v))
+
+    f = case.functions["source"]
+
+    @LinearForm
+    def load(v, w):
+        return f(w.x[0], w.x[1]) * v
+
+    K_sk = stiffness.assemble(basis, kappa=np.repeat(kappa[:, None], nqp, axis=1)).tocsr()
+    F_sk = load.assemble(basis)
+    rows = [
+        CheckRow("stiffness K vs scikit-fem", float(spla.norm(K - K_sk) / spla.norm(K_sk)),
+                 MATRIX_TOL, f"{K.shape[0]}x{K.shape[1]}, nnz {K.nnz}"),
+        CheckRow("load F (one-point) vs scikit-fem", _rel(F_source, F_sk), MATRIX_TOL,
+                 f"skfem centroid rule ({nqp} point)"),
+    ]
+
+    # Our solution with the case's solver.
+    system = dirichlet_system(case, mesh, K, F)
+    res = solve_system(case, system.A, system.b)
+    u = system.expand(res.x)
+    s = case.data["solver"]
+    sol_tol = max(SOLUTION_FACTOR * s["rtol"], SOLUTION_FLOOR)
+
+    nodes, values = dirichlet_data(case, mesh)
+    x_d = np.zeros(mesh.n_points)
+    x_d[nodes] = values
+    u_sk = skfem.solve(*condense(sp.csr_matrix(K_sk), F_sk + neumann, x=x_d, D=nodes))
+    rows.append(CheckRow("solution vs scikit-fem", _rel(u, u_sk), sol_tol,
+                         f"femkit {res.method}+{res.preconditioner}, {res.iterations} it; "
+                         "skfem condense + direct"))
+
+    import pyamg
+
+    ml = pyamg.smoothed_aggregation_solver(system.A.tocsr())
+    pyres: list[float] = []
+    x_amg = ml.solve(system.b, tol=s["rtol"], accel="cg", maxiter=s["maxiter"],
+                     residuals=pyres)
+    x_amg = np.asarray(x_amg).ravel()
+    rows.append(CheckRow("solution vs pyamg SA (accel=cg)", _rel(res.x, x_amg), sol_tol,
+                         f"pyamg {max(len(pyres) - 1, 0)} it, femkit {res.iterations} it"))
+    return rows
+
+
+def format_table(rows: list[CheckRow]) -> str:
+    """Fixed-width table: quantity, relative difference, tolerance, verdict, detail."""
+    width = max(len(r.name) for r in rows)
+    lines = [f"{'quantity':<{width}}  {'rel. diff':>10}  {'tolerance':>10}  result  detail"]
+    for r in rows:
+        lines.append(f"{r.name:<{width}}  {r.difference:10.3e}  {r.tolerance:10.3e}  "
+                     f"{'ok' if r.passed else 'FAIL':<6}  {r.detail}")
+    n_bad = sum(not r.passed for r in rows)
+    lines.append("all within tolerance" if n_bad == 0 else f"{n_bad} check(s) out of tolerance")
+    return "\n".join(lines)
