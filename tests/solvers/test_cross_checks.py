@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from femkit.solvers import cg, pcg, solve
+from femkit.solvers import cg, get_preconditioner, pcg, solve
 from femkit.solvers.preconditioners import ic0
 
 
@@ -112,3 +112,15 @@ def test_ic0_breakdown_is_shifted_and_reported():
     assert M.info["shift"] > 0 and M.info["tries"] > 1
     res = solve(A, np.ones(4), method="pcg", preconditioner="ic0")
     assert res.converged and res.info["preconditioner_info"]["shift"] > 0
+
+
+@pytest.mark.parametrize("flavour", ["amg_sa", "amg_rs"])
+@pytest.mark.parametrize("cycle", ["V", "W"])
+def test_amg_application_equals_pyamg_preconditioner(flavour, cycle, builders):
+    A = builders["aniso"](30)
+    M = get_preconditioner(flavour)(A, cycle=cycle)
+    ref = M.info["hierarchy"].aspreconditioner(cycle=cycle)
+    r = _rhs(A.shape[0], 4)
+    np.testing.assert_allclose(M(r), ref.matvec(r), rtol=1e-12, atol=1e-14 * np.abs(ref.matvec(r)).max())
+    u, v = _rhs(A.shape[0], 5), _rhs(A.shape[0], 6)
+    assert u @ M(v) == pytest.approx(v @ M(u), rel=1e-8)  # symmetric V-cycle -> SPD for CG

@@ -42,16 +42,18 @@ def ic0_factor(indptr, indices, data, n):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def ic0_solve(indptr, indices, data, r, z):  # pragma: no cover - compiled
-    """``z = (L L^T)^-1 r``: forward substitution with ``L``, then a column sweep with ``L^T``."""
+def ic0_solve(lp, li, lx, up, ui, ux, inv_d, r, z):  # pragma: no cover - compiled
+    """``z = (L L^T)^-1 r`` with ``L = strict lower (lp, li, lx) + diag(1 / inv_d)`` and
+    ``L^T``'s strict upper part as CSR ``(up, ui, ux)``: two row-oriented substitutions
+    (gathers only, multiplications by the inverse diagonal)."""
     n = r.shape[0]
     for i in range(n):
         acc = r[i]
-        for t in range(indptr[i], indptr[i + 1] - 1):
-            acc -= data[t] * z[indices[t]]
-        z[i] = acc / data[indptr[i + 1] - 1]
+        for t in range(lp[i], lp[i + 1]):
+            acc -= lx[t] * z[li[t]]
+        z[i] = acc * inv_d[i]
     for i in range(n - 1, -1, -1):
-        zi = z[i] / data[indptr[i + 1] - 1]
-        z[i] = zi
-        for t in range(indptr[i], indptr[i + 1] - 1):
-            z[indices[t]] -= data[t] * zi
+        acc = z[i]
+        for t in range(up[i], up[i + 1]):
+            acc -= ux[t] * z[ui[t]]
+        z[i] = acc * inv_d[i]

@@ -91,12 +91,17 @@ def build(A, *, shift: float = 0.0, max_shift_tries: int = 8) -> Preconditioner:
 
     t0 = time.perf_counter()
     L, alpha, tries = lower_factor(A, shift=shift, max_shift_tries=max_shift_tries)
-    indptr, indices, data = L.indptr, L.indices, L.data
+    inv_d = 1.0 / L.diagonal()
+    Ls = sp.tril(L, -1, format="csr")
+    Us = Ls.T.tocsr()
+    Us.sort_indices()
+    lp, li, lx = Ls.indptr, Ls.indices, Ls.data
+    up, ui, ux = Us.indptr, Us.indices, Us.data
 
     def apply(r):
         r = np.ascontiguousarray(r, dtype=np.float64)
         z = np.empty_like(r)
-        ic0_solve(indptr, indices, data, r, z)
+        ic0_solve(lp, li, lx, up, ui, ux, inv_d, r, z)
         return z
 
     info = {"shift": float(alpha), "tries": tries, "nnz_L": int(L.nnz), "factor": L}
