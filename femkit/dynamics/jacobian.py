@@ -159,7 +159,7 @@ class SpringPattern:
 
     def assemble(self, blocks: np.ndarray, diagonal: np.ndarray | float | None = None) -> sp.csr_matrix:
         """CSR matrix from per-spring blocks ``(s, d, d)`` (+ an optional added diagonal)."""
-        b = blocks.reshape(len(blocks), -1)
+        b = blocks.reshape(len(blocks), self.dim * self.dim)
         tail = self._zero_tail if diagonal is None else np.broadcast_to(diagonal, (self.ndof,))
         w = np.concatenate([b.ravel(), b.ravel(), -b.ravel(), -b.ravel(), tail])
         data = np.bincount(self._inv, weights=w, minlength=self.nnz)

@@ -126,7 +126,8 @@ class MassSpringSystem:
         self._j = np.ascontiguousarray(sp_arr[:, 1])
         self.k = _per_item(k, s, "spring stiffness k")
         if rest is None:
-            _, l0, _ = spring_geometry(x0, self._i, self._j)
+            d0 = np.take(x0, self._j, axis=0) - np.take(x0, self._i, axis=0)
+            l0 = np.sqrt(np.einsum("sd,sd->s", d0, d0))
             zero = np.flatnonzero(l0 == 0.0)
             if len(zero):
                 raise InputError(
@@ -210,6 +211,8 @@ class MassSpringSystem:
 
     def _scatter_springs(self, fs: np.ndarray) -> np.ndarray:
         """(s, d) per-spring values on end i (end j gets the negative) -> (n, d)."""
+        if not self.n_springs:  # np.bincount of nothing is an int array
+            return np.zeros((self.n, self.dim))
         flat = fs.ravel()
         w = np.concatenate([flat, -flat])
         return np.bincount(self._scatter, weights=w, minlength=self.ndof).reshape(self.n, self.dim)
