@@ -50,11 +50,15 @@ def bench_cg_iteration(A, b, iters, repeat):
 
     from femkit.solvers import cg
 
-    # rtol tiny so both run exactly `iters` iterations
-    t_ours, res = median_time(lambda: cg(A, b, rtol=1e-30, maxiter=iters,
-                                         stagnation_window=10 * iters), repeat)
-    assert res.iterations == iters, res.iterations
-    t_sp, _ = median_time(lambda: scipy_cg(A, b, rtol=1e-30, maxiter=iters), repeat)
+    # rtol tiny so both run exactly `iters` iterations; interleaved repeats
+    t_ours, t_sp = [], []
+    for _ in range(repeat):
+        t, res = median_time(lambda: cg(A, b, rtol=1e-30, maxiter=iters,
+                                        stagnation_window=10 * iters), 1)
+        assert res.iterations == iters, res.iterations
+        t_ours.append(t)
+        t_sp.append(median_time(lambda: scipy_cg(A, b, rtol=1e-30, maxiter=iters), 1)[0])
+    t_ours, t_sp = statistics.median(t_ours), statistics.median(t_sp)
     spmv, _ = median_time(lambda: A @ b, max(repeat, 5))
     return t_ours / iters, t_sp / iters, spmv
 
@@ -80,12 +84,19 @@ def bench_amg(A, b, flavour, repeat):
         assert r.converged, r.message
         return r.setup_time, r.solve_time, r.iterations, r.relative_residual
 
+    # interleave the two (alternating which goes first) so load drift hits both alike
+    runs = {"pyamg": [], "femkit": []}
+    for i in range(repeat):
+        order = (("pyamg", peer), ("femkit", ours)) if i % 2 == 0 else (("femkit", ours), ("pyamg", peer))
+        for label, fn in order:
+            runs[label].append(fn())
     rows = {}
-    for label, fn in (("pyamg", peer), ("femkit", ours)):
-        runs = [fn() for _ in range(repeat)]
-        tot = [s + t for s, t, _, _ in runs]
+    for label, rs in runs.items():
+        tot = [s + t for s, t, _, _ in rs]
         k = int(np.argsort(tot)[len(tot) // 2])
-        rows[label] = runs[k] + (statistics.median(tot),)
+        rows[label] = rs[k] + (statistics.median(tot),)
+    pair = [(a[0] + a[1]) / (p[0] + p[1]) for a, p in zip(runs["femkit"], runs["pyamg"])]
+    rows["pair_ratio"] = statistics.median(pair)
     return rows
 
 
@@ -120,8 +131,9 @@ def main(argv=None):
                 s, t, it, rr, tot = rows[label]
                 print(f"PCG+{flavour} {label:6s}: setup {s:.3f} s + solve {t:.3f} s = "
                       f"{tot:.3f} s, {it} it, true relres {rr:.1e}")
-            print(f"PCG+{flavour} ratio femkit/pyamg (setup+solve): "
-                  f"{rows['femkit'][4] / rows['pyamg'][4]:.3f} (target <= 1.2)")
+            print(f"PCG+{flavour} ratio femkit/pyamg (setup+solve): medians "
+                  f"{rows['femkit'][4] / rows['pyamg'][4]:.3f}, median of paired runs "
+                  f"{rows['pair_ratio']:.3f} (target <= 1.2)")
         runs = [solve(A, b, method="pcg", preconditioner="ic0", rtol=1e-8) for _ in range(args.repeat)]
         r = sorted(runs, key=lambda r: r.setup_time + r.solve_time)[len(runs) // 2]
         print(f"PCG+ic0: setup {r.setup_time:.3f} s + solve {r.solve_time:.3f} s, "
