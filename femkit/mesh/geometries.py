@@ -393,6 +393,10 @@ def geo_file(path: str | os.PathLike, h: float | None = None) -> Mesh:
     path : path to the ``.geo`` (or any file gmsh can open)
     h : optional maximal mesh size; ``None`` keeps the sizes the file sets.
 
+    Tags come only from the file's physical groups (no ``"boundary"`` group is added): with
+    2D physical groups only their triangles are kept (gmsh's saving rule), without any all
+    triangles are kept with cell tag 0.
+
     Raises
     ------
     MeshError

@@ -158,3 +158,11 @@ def test_reuses_a_running_gmsh_session():
         assert gmsh.isInitialized()
     finally:
         gmsh.finalize()
+
+
+def test_disk_area_error_is_second_order():
+    hs = np.array([0.2, 0.1, 0.05])
+    err = [math.pi - generate("disk", h).areas().sum() for h in hs]
+    assert all(e > 0 for e in err)  # inscribed polygon
+    slope = np.polyfit(np.log(hs), np.log(err), 1)[0]
+    assert abs(slope - 2) < 0.15, slope
