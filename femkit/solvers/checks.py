@@ -249,3 +249,12 @@ def zero_rhs_result(prob: Problem, *, method: str) -> SolveResult:
         message="zero right-hand side: x = 0", true_residual=0.0, rhs_norm=0.0,
         tolerance=prob.tolerance, method=method,
     )
+
+
+def record_iteration(residuals: list, res: float, x: np.ndarray, callback, k: int) -> str:
+    """Append ``res`` to the history and call ``callback(x)``; return a non-finite message
+    (empty string when ``res`` is finite)."""
+    residuals.append(res)
+    if callback is not None:
+        callback(x)
+    return "" if np.isfinite(res) else f"residual became {res} at iteration {k}"

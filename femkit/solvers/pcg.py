@@ -21,7 +21,7 @@ from typing import Callable
 import numpy as np
 from scipy.linalg.blas import daxpy
 
-from .checks import Problem, as_apply, finish, prepare, zero_rhs_result
+from .checks import Problem, as_apply, finish, prepare, record_iteration, zero_rhs_result
 from .result import SolveResult
 
 #: Iterations without a new best residual after which the iteration is declared stagnant.
@@ -78,11 +78,9 @@ def _krylov_loop(prob: Problem, apply_M: Callable | None, *, method: str, callba
             rr = float(np.dot(r, r))
         k += 1
         res = math.sqrt(rr) if rr >= 0 else float("nan")
-        residuals.append(res)
-        if callback is not None:
-            callback(x)
-        if not math.isfinite(res):
-            reason, message = "non-finite", f"residual became {res} at iteration {k}"
+        bad = record_iteration(residuals, res, x, callback, k)
+        if bad:
+            reason, message = "non-finite", bad
             break
         if res <= tol:
             reason, recursive_met = "converged", True

@@ -12,7 +12,7 @@ import math
 import numpy as np
 from scipy.linalg.blas import daxpy
 
-from .checks import as_apply, finish, prepare, zero_rhs_result
+from .checks import as_apply, finish, prepare, record_iteration, zero_rhs_result
 from .result import SolveResult
 
 
@@ -58,11 +58,9 @@ def steepest_descent(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0,
         daxpy(q, r, a=-alpha)
         k += 1
         res = float(np.linalg.norm(r))
-        residuals.append(res)
-        if callback is not None:
-            callback(x)
-        if not math.isfinite(res):
-            reason, message = "non-finite", f"residual became {res} at iteration {k}"
+        bad = record_iteration(residuals, res, x, callback, k)
+        if bad:
+            reason, message = "non-finite", bad
             break
         if res <= tol:
             reason, met = "converged", True

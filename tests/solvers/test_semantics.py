@@ -232,3 +232,30 @@ def test_direct_factor_reuse_and_singular(poisson):
     S = sp.csr_matrix(np.array([[1.0, 1.0], [1.0, 1.0]]))
     with pytest.raises(SingularSystemError):
         direct(S, np.ones(2))
+
+
+def test_stagnation_window(builders):
+    # plain CG on the 1e6-contrast checkerboard: the residual is far from monotone, so a
+    # 3-iteration window without a new minimum is met early
+    A = builders["contrast"](20)
+    b = np.random.default_rng(0).standard_normal(A.shape[0])
+    res = cg(A, b, stagnation_window=3)
+    assert res.reason == "stagnation" and not res.converged
+    assert "no residual decrease for 3 iterations" in res.message
+    k_best = int(np.argmin(res.residuals))
+    assert res.iterations - k_best == 3
+    assert cg(A, b).converged  # the default window lets it finish
+
+
+def test_inexact_operator_true_residual_refused(builders):
+    # a matrix-free operator accurate to float32 only: CG's recursive residual reaches 1e-14,
+    # the true residual cannot go below ~1e-7 relative
+    A = builders["poisson"](12)
+    op = LinearOperator(A.shape, dtype=np.float64,
+                        matvec=lambda x: (A @ x).astype(np.float32).astype(np.float64))
+    b = np.random.default_rng(0).standard_normal(A.shape[0])
+    res = cg(op, b, rtol=1e-14)
+    assert not res.converged and res.reason == "stagnation"
+    assert res.residuals[-1] <= 1e-14 * np.linalg.norm(b)
+    assert np.linalg.norm(b - op @ res.x) == pytest.approx(res.true_residual)
+    assert res.relative_residual > 1e-10
