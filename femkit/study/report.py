@@ -18,16 +18,12 @@ study leaves the previous report untouched and no half-written one.
 from __future__ import annotations
 
 import base64
-import contextlib
 import csv
 import html
 import json
 import math
 import os
-import shutil
-import tempfile
-from pathlib import Path
-from typing import Any, Iterator, Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -183,25 +179,12 @@ class Report:
             fh.write(self.to_html(directory))
 
 
-@contextlib.contextmanager
-def staged_output(output_dir) -> Iterator[Path]:
-    """Yield a temporary directory that replaces ``output_dir`` when the block succeeds.
+def staged_output(output_dir):
+    """Context manager yielding a temporary directory that replaces ``output_dir`` on success.
 
-    On an exception the temporary directory is removed and ``output_dir`` is untouched.
+    The study-side name of :func:`femkit.io.atomic.atomic_directory`: on an exception the
+    temporary directory is removed and ``output_dir`` (an earlier report) is untouched.
     """
-    target = Path(output_dir).resolve()
-    target.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=target.parent))
-    os.chmod(stage, 0o755)
-    try:
-        yield stage
-    except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
-        raise
-    old = None
-    if target.exists():
-        old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
-        os.rename(target, old / "report")
-    os.rename(stage, target)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
+    from ..io.atomic import atomic_directory
+
+    return atomic_directory(output_dir)

@@ -1,0 +1,141 @@
+"""JSON schemas of study files (one per ``kind``), validated with jsonschema.
+
+Every object has ``additionalProperties: false``: a misspelled key is an error naming its key
+path, the valid keys and the closest match (the machinery of :mod:`femkit.case.schema`).
+A ``quick:`` block takes any subset of the kind's own keys and is merged over the file when the
+study runs in quick (small) mode: that is how the test suite runs every bundled study small.
+"""
+
+from __future__ import annotations
+
+import copy
+
+POS = {"type": "number", "exclusiveMinimum": 0}
+POSINT = {"type": "integer", "minimum": 1}
+EXPR = {"oneOf": [{"type": "string", "minLength": 1}, {"type": "number"}],
+        "x-message": "must be a number or an expression of x and y"}
+
+
+def _obj(props: dict, required=(), **extra) -> dict:
+    d = {"type": "object", "additionalProperties": False, "properties": props}
+    if required:
+        d["required"] = list(required)
+    d.update(extra)
+    return d
+
+
+COMMON = {
+    "kind": {"type": "string"},
+    "title": {"type": "string"},
+    "description": {"type": "string"},
+    "output": {"type": "string", "description": "report directory (relative to the study file)"},
+    "repeats": {**POSINT, "default": 1, "description": "timed repetitions; the minimum is reported"},
+    "warmup": {"type": "integer", "minimum": 0, "default": 1, "description": "untimed warm-up runs"},
+}
+
+SOLVER = _obj({
+    "method": {"type": "string"},
+    "preconditioner": {"type": "string"},
+    "rtol": {**POS, "default": 1e-10},
+    "atol": {"type": "number", "minimum": 0, "default": 0.0},
+    "maxiter": POSINT,
+    "label": {"type": "string"},
+}, required=["method"])
+
+PROBLEM = _obj({
+    "geometry": {"type": "string", "default": "unit_square"},
+    "geometry_params": {"type": "object"},
+    "exact": EXPR,
+    "grad_exact": {"type": "array", "items": EXPR, "minItems": 2, "maxItems": 2},
+    "source": EXPR,
+    "kappa": EXPR,
+    "dirichlet": EXPR,
+}, required=["exact", "source"])
+
+POISSON = {
+    "problem": PROBLEM,
+    "base_case": {"type": "string"},
+    "levels": _obj({
+        "h0": POS,
+        "count": {**POSINT, "minimum": 2},
+        "h": {"type": "array", "items": POS, "minItems": 2},
+        "max_level": {"type": "integer", "minimum": 1},
+    }),
+    "solvers": {"type": "array", "items": SOLVER, "minItems": 1,
+                "default": [{"method": "pcg", "preconditioner": "amg", "rtol": 1e-10}]},
+    "quadrature": {"type": "array", "items": {"type": "string"}, "minItems": 1, "default": ["barycentric"]},
+    "error_order": {**POSINT, "default": 5},
+    "reference": {"enum": ["none", "scikit-fem"], "default": "none"},
+    "stop_at_discretisation_error": _obj({"fraction": {**POS, "default": 0.1}}),
+}
+
+SCENE = _obj({
+    "type": {"enum": ["harmonic_oscillator", "single_spring", "rope", "cloth"]},
+    "k": {**POS, "default": 100.0},
+    "mass": {**POS, "default": 1.0},
+    "amplitude": {**POS, "default": 0.1},
+    "rest": {**POS, "default": 1.0},
+    "n": {"type": "integer", "minimum": 2, "default": 8},
+    "gravity": {"type": "number", "default": 0.0},
+    "t_end": {**POS, "default": 1.0},
+}, required=["type"])
+
+INTEGRATOR = {"oneOf": [{"type": "string"},
+                        _obj({"name": {"type": "string"}, "options": {"type": "object"},
+                              "label": {"type": "string"}}, required=["name"])],
+              "x-message": "must be an integrator name or {name:, options:}"}
+
+DYNAMICS = {
+    "scene": SCENE,
+    "integrators": {"type": "array", "items": INTEGRATOR, "minItems": 1},
+    "dt": _obj({"k_min": {"type": "integer"}, "k_max": {"type": "integer"},
+                "values": {"type": "array", "items": POS, "minItems": 2}}),
+    "reference": _obj({"integrator": {"type": "string", "default": "rk4"},
+                       "dt": POS, "analytic": {"type": "boolean", "default": True}}),
+    "energy_growth_limit": {**POS, "default": 10.0},
+}
+
+STRESS_CASE = _obj({
+    "name": {"type": "string"},
+    "type": {"enum": ["poisson_contrast", "poisson_anisotropic", "poisson_scaled", "poisson_degenerate",
+                      "poisson_fine", "poisson_neumann", "cg_residual_drift", "jacobi_divergence",
+                      "dynamics_stiffness"]},
+    "values": {"type": "array", "minItems": 1,
+               "description": "the swept parameter: contrast, aspect ratio, scale, degeneracy, ..."},
+    "n": {"type": "integer", "minimum": 2},
+    "dofs": POSINT,
+    "mass_ratio": {"type": "array", "items": POS},
+    "dt_factors": {"type": "array", "items": POS},
+    "t_end": POS,
+    "maxiter": POSINT,
+    "description": {"type": "string"},
+}, required=["type"])
+
+STABILITY = {
+    "cases": {"type": "array", "minItems": 1,
+              "items": {"oneOf": [{"type": "string"}, STRESS_CASE],
+                        "x-message": "must be a stress case file path or an inline stress case"}},
+    "solvers": {"type": "array", "items": SOLVER, "minItems": 1,
+                "default": [{"method": "pcg", "preconditioner": "amg_sa", "rtol": 1e-8},
+                            {"method": "pcg", "preconditioner": "amg_rs", "rtol": 1e-8},
+                            {"method": "pcg", "preconditioner": "jacobi", "rtol": 1e-8},
+                            {"method": "cg", "rtol": 1e-8}]},
+    "integrators": {"type": "array", "items": INTEGRATOR, "minItems": 1,
+                    "default": ["explicit_euler", "symplectic_euler", "verlet", "rk4"]},
+    "case_overrides": {"type": "object", "description": "per case name: keys merged over that case"},
+}
+
+KINDS = {"poisson_convergence": POISSON, "dynamics_work_precision": DYNAMICS, "stability": STABILITY}
+
+
+def schema_for(kind: str) -> dict:
+    """The full schema of a study of ``kind`` (with its ``quick:`` block)."""
+    props = {**copy.deepcopy(COMMON), **copy.deepcopy(KINDS[kind])}
+    quick = _obj({k: copy.deepcopy(v) for k, v in props.items() if k != "kind"})
+    for v in quick["properties"].values():
+        v.pop("default", None)
+    props["quick"] = quick
+    return _obj(props, required=["kind"])
+
+
+STRESS_CASE_SCHEMA = STRESS_CASE

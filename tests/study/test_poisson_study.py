@@ -1,0 +1,130 @@
+"""A generated convergence study: rates match P1 theory, data monotone, report renders."""
+
+from __future__ import annotations
+
+import base64
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from femkit.errors import CaseFileError, ExpressionError
+from femkit.study import load_study, run_study, study_from_dict
+from femkit.study.poisson import interpolate_nested
+
+ROOT = Path(__file__).resolve().parents[2]
+PNG = b"\x89PNG\r\n\x1a\n"
+
+SMOOTH = {
+    "kind": "poisson_convergence",
+    "problem": {"geometry": "unit_square", "exact": "sin(pi*x)*sin(pi*y)",
+                "grad_exact": ["pi*cos(pi*x)*sin(pi*y)", "pi*sin(pi*x)*cos(pi*y)"],
+                "source": "2*pi**2*sin(pi*x)*sin(pi*y)"},
+    "levels": {"h0": 0.2, "count": 4},
+    "solvers": [{"method": "pcg", "preconditioner": "amg", "rtol": 1e-10}, {"method": "cg", "rtol": 1e-10},
+                {"method": "direct"}],
+    "quadrature": ["barycentric", "gauss3"],
+    "reference": "scikit-fem",
+    "stop_at_discretisation_error": {"fraction": 0.1},
+    "warmup": 0,
+}
+
+
+@pytest.fixture(scope="module")
+def smooth(tmp_path_factory):
+    out = tmp_path_factory.mktemp("smooth") / "report"
+    return run_study(study_from_dict(SMOOTH, name="smooth"), out)
+
+
+@pytest.mark.parametrize("norm, theory", [("L2", 2.0), ("H1_semi", 1.0)], ids=["L2", "H1"])
+@pytest.mark.parametrize("rule", ["barycentric", "gauss3"])
+def test_fitted_rates_match_p1_theory(smooth, norm, theory, rule):
+    fit = smooth.fit(source="femkit", solver="direct", quadrature=rule, norm=norm)
+    assert abs(fit["slope"] - theory) < 0.1
+    assert fit["r2"] > 0.99 and fit["n"] == 4
+
+
+def test_reference_line_agrees_with_femkit(smooth):
+    # same meshes, same P1 space: scikit-fem's 3-point load and femkit's gauss3 give the same errors
+    ours = smooth.column("L2", source="femkit", solver="direct", quadrature="gauss3")
+    ref = smooth.column("L2", source="scikit-fem")
+    np.testing.assert_allclose(ref, ours, rtol=1e-6)
+
+
+@pytest.mark.parametrize("key", ["L2", "H1_semi", "max_nodal", "h"])
+def test_finer_mesh_smaller_error(smooth, key):
+    for solver in ("pcg+amg", "cg", "direct"):
+        v = smooth.column(key, source="femkit", solver=solver, quadrature="barycentric")
+        assert np.all(np.diff(v) < 0), (solver, v)
+    dofs = smooth.column("dofs", source="femkit", solver="direct", quadrature="barycentric")
+    assert np.all(np.diff(dofs) > 0)
+
+
+def test_iterations_amg_flat_cg_grows(smooth):
+    amg = smooth.column("iterations", source="femkit", solver="pcg+amg", quadrature="barycentric")
+    cg = smooth.column("iterations", source="femkit", solver="cg", quadrature="barycentric")
+    assert amg.max() <= 25
+    assert np.all(np.diff(cg) > 0) and cg[-1] / cg[0] > 4  # O(h^-1): x2 per level
+
+
+def test_every_run_reaches_its_true_residual(smooth):
+    for r in smooth.records:
+        if r["source"] == "femkit" and r["method"] != "direct":
+            assert r["converged"] and r["relative_residual"] <= 1e-10 * (1 + 1e-9)
+
+
+def test_nested_iteration_saves_and_keeps_accuracy(smooth):
+    rows = [n for n in smooth.tables["nested"] if n["solver"] == "pcg+amg" and n["level"] > 0]
+    assert sum(n["iterations_nested"] for n in rows) < sum(n["iterations_fixed"] for n in rows)
+    for n in rows:
+        assert n["algebraic_over_discretisation"] <= 0.1 * 1.5
+        assert n["L2_nested"] <= 1.1 * n["L2_fixed"]
+
+
+def test_interpolation_to_refined_mesh_exact_for_linear():
+    from femkit.mesh import Mesh, refine
+
+    m = Mesh(points=np.array([[0., 0.], [1., 0.], [1., 1.], [0., 1.]]), triangles=np.array([[0, 1, 2], [0, 2, 3]]))
+    f = refine(m, 1)
+    lin = lambda p: 2 * p[:, 0] - 3 * p[:, 1] + 1  # noqa: E731
+    np.testing.assert_allclose(interpolate_nested(m, f, lin(m.points)), lin(f.points), atol=1e-14)
+
+
+def test_report_files(smooth):
+    out = smooth.output_dir
+    for name in ("report.md", "report.html", "runs.csv", "results.json", "nested.csv"):
+        assert (out / name).stat().st_size > 0
+    names = {"error_vs_h.png", "error_vs_dofs.png", "iterations_vs_dofs.png", "work_precision.png"}
+    assert {Path(f).name for f in smooth.figures} == names
+    html = (out / "report.html").read_text()
+    embedded = [base64.b64decode(s) for s in re.findall(r"data:image/png;base64,([A-Za-z0-9+/=]+)", html)]
+    assert len(embedded) == 4
+    for f in smooth.figures:
+        data = (out / f).read_bytes()
+        assert data.startswith(PNG) and data in embedded
+        import matplotlib.image as mpimg
+
+        img = mpimg.imread(out / f)
+        assert img.shape[0] >= 300 and img.shape[1] >= 500 and img.std() > 0.01
+    assert any(r["pareto"] for r in smooth.records)
+
+
+@pytest.mark.parametrize("patch, exc, text", [
+    ({"levels": {"h0": 0.2, "cont": 3}}, CaseFileError, "levels.cont: unknown key"),
+    ({"solvers": [{"method": "cg", "rtl": 1}]}, CaseFileError, "solvers[0].rtl"),
+    ({"reference": "fenics"}, CaseFileError, "reference"),
+    ({"problem": {**SMOOTH["problem"], "exact": "__import__('os')"}}, ExpressionError, "problem.exact"),
+], ids=["levels-typo", "solver-typo", "bad-reference", "unsafe-expression"])
+def test_bad_study_files(patch, exc, text, tmp_path):
+    with pytest.raises(exc, match=re.escape(text)):
+        s = study_from_dict({**SMOOTH, **patch})
+        run_study(s, tmp_path / "r")
+    assert not (tmp_path / "r").exists()
+
+
+def test_bundled_poisson_study_quick(tmp_path):
+    res = load_study(ROOT / "studies" / "poisson_convergence.yaml", quick=True).run(tmp_path / "r")
+    fit = res.fit(source="femkit", solver="direct", quadrature="barycentric", norm="H1_semi")
+    assert abs(fit["slope"] - 1.0) < 0.15
+    assert (tmp_path / "r" / "report.html").exists()
