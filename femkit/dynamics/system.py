@@ -24,7 +24,8 @@ Example: one spring stretched from rest length 1 to 2 pulls its ends together.
 
 from __future__ import annotations
 
-from typing import Iterable, Sequence
+import copy
+from typing import Iterable
 
 import numpy as np
 import scipy.sparse as sp
@@ -173,10 +174,12 @@ class MassSpringSystem:
         self._pattern = None
         self.last_shift = 0.0
 
-        self.forces = tuple(forces)
-        for f in self.forces:
+        # each system binds its own shallow copies, so one force object may serve many systems
+        for f in forces:
             if not isinstance(f, Force):
                 raise InputError(f"forces must be femkit force objects, got {f!r}")
+        self.forces = tuple(copy.copy(f) for f in forces)
+        for f in self.forces:
             f.bind(self)
         self._rayleigh = tuple(f for f in self.forces if isinstance(f, RayleighDamping))
         self._conservative = tuple(f for f in self.forces if f.kind is not None)

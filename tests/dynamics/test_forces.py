@@ -107,3 +107,11 @@ def test_sphere_centre_particle_is_finite():
 def test_bad_force_parameters(make, match):
     with pytest.raises(InputError, match=match):
         make()
+
+
+def test_one_force_object_serves_two_systems():
+    g = Gravity(10.0)
+    a = free_particles([[0.0, 0.0]], mass=1.0, forces=[g])
+    b = free_particles([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]], mass=2.0, forces=[g])
+    assert np.allclose(a.force(a.x0, a.v0), [[0.0, -10.0]])
+    assert np.allclose(b.force(b.x0, b.v0), [[0.0, -20.0]] * 3)
