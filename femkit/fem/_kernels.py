@@ -101,3 +101,38 @@ def _pattern(tri, n):  # pragma: no cover - compiled
 def pattern_kernel(tri: np.ndarray, n: int):
     """CSR ``indptr``, ``indices`` and the (m, 9) slot map of the P1 pattern (compiled)."""
     return _pattern(np.ascontiguousarray(tri, dtype=np.int64), int(n))
+
+
+@numba.njit(cache=True)
+def _stiffness(tri, points, idx, kappa, slots, nnz):  # pragma: no cover - compiled
+    """Fused local stiffness + scatter into CSR data; returns (data, number of bad areas)."""
+    data = np.zeros(nnz)
+    ex = np.empty(3)
+    ey = np.empty(3)
+    bad = 0
+    for k in range(idx.shape[0]):
+        e = idx[k]
+        i0, i1, i2 = tri[e, 0], tri[e, 1], tri[e, 2]
+        ex[0] = points[i2, 0] - points[i1, 0]
+        ey[0] = points[i2, 1] - points[i1, 1]
+        ex[1] = points[i0, 0] - points[i2, 0]
+        ey[1] = points[i0, 1] - points[i2, 1]
+        ex[2] = points[i1, 0] - points[i0, 0]
+        ey[2] = points[i1, 1] - points[i0, 1]
+        area = 0.5 * abs(ex[2] * ey[0] - ey[2] * ex[0])
+        if not area > 0.0:
+            bad += 1
+            continue
+        s = kappa[k] / (4.0 * area)
+        for a in range(3):
+            for b in range(3):
+                data[slots[e, 3 * a + b]] += s * (ex[a] * ex[b] + ey[a] * ey[b])
+    return data, bad
+
+
+def stiffness_kernel(mesh, idx, kappa, pattern):
+    """CSR data of the stiffness of elements ``idx`` (kappa per selected element), or None if
+    some triangle is degenerate (the caller's numpy path then raises with the ids)."""
+    data, bad = _stiffness(mesh.triangles, mesh.points, idx, np.ascontiguousarray(kappa, dtype=np.float64),
+                           pattern.slots, pattern.nnz)
+    return None if bad else data

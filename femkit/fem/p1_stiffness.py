@@ -16,9 +16,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ._elements import select_elements, triangle_geometry
+from ._elements import check_areas, select_elements
 from .coefficients import Coefficient, element_coefficient
-from .sparsity import SparsityPattern
+from ..errors import InputError
+from .sparsity import NUMBA_THRESHOLD, SparsityPattern
 
 
 def local_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None) -> np.ndarray:
@@ -28,19 +29,35 @@ def local_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None) -> np.ndar
     :class:`~femkit.errors.DegenerateMeshError` for zero-area triangles.
     """
     idx = select_elements(mesh, elements)
-    e, area, _, _ = triangle_geometry(mesh, idx)
-    kap = element_coefficient(mesh, kappa, idx)
-    scale = kap / (4.0 * area)
-    ex, ey = e[:, :, 0], e[:, :, 1]
-    # (k,3,1)*(k,1,3): all 9 dot products e_a . e_b, scaled per element
-    local = ex[:, :, None] * ex[:, None, :]
-    local += ey[:, :, None] * ey[:, None, :]
-    local *= scale[:, None, None]
+    ex, ey, area = edge_components(mesh, idx)
+    scale = element_coefficient(mesh, kappa, idx) / (4.0 * area)
+    local = np.empty((len(area), 3, 3))
+    for a in range(3):  # 6 distinct dot products e_a . e_b per element, each an (m,) array
+        for b in range(a, 3):
+            v = ex[a] * ex[b]
+            v += ey[a] * ey[b]
+            v *= scale
+            local[:, a, b] = v
+            if b != a:
+                local[:, b, a] = v
     return local
 
 
+def edge_components(mesh, idx):
+    """x and y components of the edges opposite each vertex (3 arrays each) and the areas."""
+    tri = mesh.triangles if idx is None else mesh.triangles[idx]
+    px, py = mesh.points[:, 0].copy(), mesh.points[:, 1].copy()
+    x = [np.take(px, tri[:, a]) for a in range(3)]
+    y = [np.take(py, tri[:, a]) for a in range(3)]
+    ex = [x[2] - x[1], x[0] - x[2], x[1] - x[0]]
+    ey = [y[2] - y[1], y[0] - y[2], y[1] - y[0]]
+    area = 0.5 * np.abs(ex[2] * ey[0] - ey[2] * ex[0])
+    check_areas(area, idx)
+    return ex, ey, area
+
+
 def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
-                       pattern: SparsityPattern | None = None) -> sp.csr_matrix:
+                       pattern: SparsityPattern | None = None, backend: str = "auto") -> sp.csr_matrix:
     """Assemble the global P1 stiffness matrix of ``-div(kappa grad u)``.
 
     Parameters
@@ -53,6 +70,10 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
         matrices of a partition of the elements sum to the full matrix.
     pattern : SparsityPattern, optional
         A pattern built for this mesh; by default the mesh's cached pattern is used.
+    backend : {"auto", "numpy", "numba"}
+        ``numpy``: (m, 3, 3) local matrices + ``np.bincount``; ``numba``: one fused compiled
+        loop (imported lazily, cached on disk); ``auto``: numba from
+        :data:`~femkit.fem.sparsity.NUMBA_THRESHOLD` selected elements on.
 
     Returns
     -------
@@ -64,5 +85,17 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
     else:
         pattern.check(mesh)
     idx = select_elements(mesh, elements)
+    count = mesh.n_triangles if idx is None else len(idx)
+    if backend == "auto":
+        backend = "numba" if count >= NUMBA_THRESHOLD else "numpy"
+    if backend == "numba":
+        from ._kernels import stiffness_kernel
+
+        kap = element_coefficient(mesh, kappa, idx)
+        data = stiffness_kernel(mesh, np.arange(count) if idx is None else idx, kap, pattern)
+        if data is not None:
+            return pattern.matrix(data)
+    elif backend != "numpy":
+        raise InputError(f"unknown assembly backend {backend!r}; valid: auto, numba, numpy")
     local = local_stiffness(mesh, kappa, elements=idx)
     return pattern.assemble(local, elements=idx)

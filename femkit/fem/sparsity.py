@@ -118,7 +118,10 @@ class SparsityPattern:
         idx = None if elements is None else _normalise(self, elements)
         slots = self.slots if idx is None else self.slots[idx]
         local = np.asarray(local, dtype=np.float64).reshape(len(slots), 9)
-        data = np.bincount(slots.ravel(), weights=local.ravel(), minlength=self.nnz)
+        return self.matrix(np.bincount(slots.ravel(), weights=local.ravel(), minlength=self.nnz))
+
+    def matrix(self, data: np.ndarray) -> sp.csr_matrix:
+        """A CSR matrix with this pattern and ``data`` (index arrays copied, so it owns them)."""
         mat = sp.csr_matrix((data, self.indices.copy(), self.indptr.copy()),
                             shape=(self.n, self.n), copy=False)
         mat.has_sorted_indices = True

@@ -25,10 +25,11 @@ def rel(a, b):
     return num / den
 
 
-def test_stiffness_constant_kappa(sk_mesh):
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_stiffness_constant_kappa(sk_mesh, backend):
     sk, mesh = sk_mesh
     K_ref = asm(laplace, Basis(sk, ElementTriP1()))
-    K = assemble_stiffness(mesh)
+    K = assemble_stiffness(mesh, backend=backend)
     assert rel(K, K_ref) < 1e-12
     assert abs(K - K.T).max() < 1e-14
 
@@ -41,11 +42,12 @@ def _skfem_kappa_form(kappa_fn):
     return form
 
 
-def test_stiffness_variable_kappa_at_barycentres(sk_mesh):
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_stiffness_variable_kappa_at_barycentres(sk_mesh, backend):
     sk, mesh = sk_mesh
     kappa = lambda x, y: 1.0 + x**2 + np.sin(3 * y)  # noqa: E731
     K_ref = asm(_skfem_kappa_form(kappa), Basis(sk, ElementTriP1(), quadrature=CENTROID))
-    assert rel(assemble_stiffness(mesh, kappa), K_ref) < 1e-12
+    assert rel(assemble_stiffness(mesh, kappa, backend=backend), K_ref) < 1e-12
 
 
 @pytest.mark.parametrize("table", [{1: 2.0, 2: 1e6}, {"west": 2.0, "east": 1e6}], ids=["tag-ids", "tag-names"])

@@ -7,8 +7,9 @@ from femkit.errors import InputError
 from femkit.fem import assemble_load, assemble_stiffness
 
 
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
 @pytest.mark.parametrize("parts", [2, 3, 7])
-def test_partition_sums_to_full(square8, parts):
+def test_partition_sums_to_full(square8, parts, backend):
     mesh = square8
     rng = np.random.default_rng(parts)
     owner = rng.integers(0, parts, mesh.n_triangles)
@@ -16,7 +17,7 @@ def test_partition_sums_to_full(square8, parts):
     f = lambda x, y: np.sin(x) + y  # noqa: E731
     K_full = assemble_stiffness(mesh, kappa)
     F_full = assemble_load(mesh, f, rule="gauss6")
-    K_sum = sum(assemble_stiffness(mesh, kappa, elements=owner == p) for p in range(parts))
+    K_sum = sum(assemble_stiffness(mesh, kappa, elements=owner == p, backend=backend) for p in range(parts))
     F_sum = sum(assemble_load(mesh, f, rule="gauss6", elements=np.flatnonzero(owner == p)) for p in range(parts))
     assert K_sum.shape == K_full.shape
     assert abs(K_sum - K_full).max() <= 1e-13 * abs(K_full).max()

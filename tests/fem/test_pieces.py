@@ -60,10 +60,11 @@ def test_bad_kappa_tables_and_arrays(square8, kappa):
         assemble_stiffness(square8, kappa)
 
 
-def test_degenerate_triangle_named():
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_degenerate_triangle_named(backend):
     mesh = Mesh(np.array([[0, 0], [1, 0], [0, 1], [2, 0]], float), [[0, 1, 2], [0, 1, 3]])
     with pytest.raises(DegenerateMeshError) as info:
-        assemble_stiffness(mesh)
+        assemble_stiffness(mesh, backend=backend)
     assert info.value.element_ids == [1]
 
 
