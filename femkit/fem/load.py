@@ -56,16 +56,17 @@ def assemble_load(mesh, f: Source, *, rule: str = "barycentric", elements=None) 
         # local[e, a] = |T_e| sum_q w_q f(x_q) lambda_a(x_q)
         local = (fq * quad.weights) @ quad.points
         local *= area[:, None]
-    else:
-        val = _scalar(f)
-        local = np.repeat((area * (val / 3.0))[:, None], 3, axis=1)
-    return np.bincount(tri.ravel(), weights=local.ravel(), minlength=mesh.n_points)
+        return np.bincount(tri.ravel(), weights=local.ravel(), minlength=mesh.n_points)
+    w = area * (_scalar(f) / 3.0)  # the same share for the three vertices
+    n = mesh.n_points
+    return sum(np.bincount(tri[:, a], weights=w, minlength=n) for a in range(3))
 
 
 def _areas(mesh, tri):
-    p = mesh.points
-    a, b, c = p[tri[:, 0]], p[tri[:, 1]], p[tri[:, 2]]
-    return 0.5 * np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+    px, py = mesh.points[:, 0].copy(), mesh.points[:, 1].copy()
+    x = [np.take(px, tri[:, a]) for a in range(3)]
+    y = [np.take(py, tri[:, a]) for a in range(3)]
+    return 0.5 * np.abs((x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]))
 
 
 def _scalar(f) -> float:
