@@ -10,16 +10,19 @@ True
 Importing this package imports numpy and scipy only (pyamg and numba load on first use).
 """
 
+from .backend import FemkitBackend, LinearSolverBackend
 from .cg import cg
 from .direct import Factor, direct, factorize
 from .jacobi import jacobi
 from .pcg import pcg
+from .preconditioners.base import Preconditioner
 from .registry import (PRECONDITIONERS, SOLVERS, get_preconditioner, get_solver, solve)
 from .result import REASONS, SolveResult
 from .steepest_descent import steepest_descent
 
 __all__ = [
-    "PRECONDITIONERS", "SOLVERS", "REASONS", "Factor", "SolveResult", "cg", "direct",
+    "PRECONDITIONERS", "SOLVERS", "REASONS", "Factor", "FemkitBackend", "LinearSolverBackend",
+    "Preconditioner", "SolveResult", "cg", "direct",
     "factorize", "get_preconditioner", "get_solver", "jacobi", "pcg", "solve",
     "steepest_descent",
 ]

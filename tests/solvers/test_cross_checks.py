@@ -55,12 +55,22 @@ def test_cg_matches_scipy_iteration_count(builders):
     np.testing.assert_allclose(ours.x, x_sp, rtol=1e-6 * np.linalg.norm(x_sp) / np.abs(x_sp).min())
 
 
+_CONDS: dict = {}
+
+
+def _cond(case, A):
+    if case not in _CONDS:
+        ev = np.linalg.eigvalsh(A.toarray())
+        _CONDS[case] = ev[-1] / ev[0]
+    return _CONDS[case]
+
+
 @pytest.mark.parametrize("flavour", ["amg_sa", "amg_rs"])
 @pytest.mark.parametrize("case", ["poisson", "contrast"])
 def test_amg_pcg_matches_pyamg_own_solve(flavour, case, builders):
     import pyamg
 
-    A = builders[case](40)
+    A = builders[case](30)
     b = _rhs(A.shape[0], 11)
     build = pyamg.smoothed_aggregation_solver if flavour == "amg_sa" else pyamg.ruge_stuben_solver
     ml = build(A)
@@ -70,7 +80,7 @@ def test_amg_pcg_matches_pyamg_own_solve(flavour, case, builders):
     assert ours.converged
     assert abs(ours.iterations - (len(hist) - 1)) <= 2, (ours.iterations, len(hist) - 1)
     rel = np.linalg.norm(ours.x - x_py) / np.linalg.norm(x_py)
-    cond_bound = 1e-8 * np.linalg.cond(A.toarray())
+    cond_bound = 1e-8 * _cond(case, A)
     assert rel <= 2 * cond_bound
     assert rel <= 1e-5
 
