@@ -271,7 +271,8 @@ def _build(node, text, variables, names, constants, used) -> Callable[[dict], ob
                 hint = f" (did you mean {close[0]!r}?)" if close else ""
                 raise _fail(text, node, f"call of unknown function {fname!r}{hint}",
                             variables, constants)
-            raise _fail(text, node, "call", variables, constants)
+            what = _DESCRIBE.get(type(func), "call of a computed function")
+            raise _fail(text, func, what, variables, constants)
         if node.keywords:
             raise _fail(text, node, "keyword argument in", variables, constants)
         f, arity = FUNCTIONS[func.id]

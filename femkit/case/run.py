@@ -37,12 +37,6 @@ __all__ = ["prepare_poisson", "run_poisson", "build_mesh", "element_kappa", "ass
 
 # ----------------------------------------------------------------------------- prepare
 
-def _prefixed(exc: UnknownNameError, where: str) -> UnknownNameError:
-    new = UnknownNameError(exc.kind, exc.name, exc.valid)
-    new.args = (f"{where}: {exc}",)
-    return new
-
-
 def _compile(case: Case, key: str, text, *, check_finite: bool = True):
     try:
         fn = compile_expression(text, ("x", "y"), case.data.get("constants") or {},
@@ -78,7 +72,7 @@ def prepare_poisson(case: Case) -> None:
         try:
             factory = GEOMETRIES.get(mesh["geometry"])
         except UnknownNameError as exc:
-            raise _prefixed(exc, "mesh.geometry") from None
+            raise _with_prefix(exc, "mesh.geometry") from None
         params = mesh.get("params") or {}
         try:
             inspect.signature(factory).bind(mesh["h"], **params)
@@ -94,13 +88,13 @@ def prepare_poisson(case: Case) -> None:
     try:
         SOLVERS.get(solver["method"])
     except UnknownNameError as exc:
-        raise _prefixed(exc, "solver.method") from None
+        raise _with_prefix(exc, "solver.method") from None
     if solver.get("preconditioner") is None:
         solver["preconditioner"] = "amg" if solver["method"] == "pcg" else "none"
     try:
         PRECONDITIONERS.get(solver["preconditioner"])
     except UnknownNameError as exc:
-        raise _prefixed(exc, "solver.preconditioner") from None
+        raise _with_prefix(exc, "solver.preconditioner") from None
     if solver["preconditioner"] != "none" and solver["method"] != "pcg":
         raise CaseFileError(f"solver.preconditioner: {solver['preconditioner']!r} needs method "
                             f"'pcg', not {solver['method']!r} (drop it or use method: pcg)")
@@ -110,7 +104,7 @@ def prepare_poisson(case: Case) -> None:
     try:
         QUADRATURE.get(d["quadrature"]["load"])
     except UnknownNameError as exc:
-        raise _prefixed(exc, "quadrature.load") from None
+        raise _with_prefix(exc, "quadrature.load") from None
 
     coef = d["coefficient"]
     if isinstance(coef, str):
@@ -138,11 +132,15 @@ def build_mesh(case: Case):
     from ..mesh import check_tags, generate, read_mesh, refine, validate
 
     spec = case.data["mesh"]
-    if "file" in spec:
-        mesh = read_mesh(spec["file"])
-    else:
-        mesh = generate(spec["geometry"], spec["h"], **(spec.get("params") or {}))
-    mesh = validate(mesh)
+    where = f"mesh.file {spec['file']}" if "file" in spec else f"mesh.geometry {spec['geometry']}"
+    try:
+        if "file" in spec:
+            mesh = read_mesh(spec["file"])
+        else:
+            mesh = generate(spec["geometry"], spec["h"], **(spec.get("params") or {}))
+        mesh = validate(mesh)
+    except InputError as exc:
+        raise _with_prefix(exc, where) from None
     if spec.get("refine"):
         mesh = refine(mesh, spec["refine"])
     bnd = case.data["boundary"]
@@ -153,14 +151,23 @@ def build_mesh(case: Case):
                 try:
                     check_tags(mesh, tags, kind="boundary")
                 except InputError as exc:
-                    raise type(exc)(f"boundary.{kind}[{i}].tags: {exc}") from None
+                    raise _with_prefix(exc, f"boundary.{kind}[{i}].tags") from None
     coef = case.data["coefficient"]
     if isinstance(coef, dict):
         try:
             check_tags(mesh, list(coef["regions"]), kind="cell")
         except InputError as exc:
-            raise type(exc)(f"coefficient.regions: {exc}") from None
+            raise _with_prefix(exc, "coefficient.regions") from None
     return mesh
+
+
+def _with_prefix(exc: InputError, where: str) -> InputError:
+    """The same exception (type and attributes kept) with ``where: `` before its message."""
+    cls = type(exc)
+    new = cls.__new__(cls)
+    new.__dict__.update(exc.__dict__)
+    new.args = (f"{where}: {exc}",)
+    return new
 
 
 def _is_whole_boundary(mesh, tag) -> bool:
