@@ -10,7 +10,7 @@ Exit codes (every subcommand):
   2  bad input (case file, expression, name, mesh); one line on stderr, nothing written
 
 Adding a subcommand: write ``_add_<name>(sub)`` that declares its parser and sets
-``handler`` (a function ``args -> int``), then append it to :data:`SUBCOMMANDS`.
+``handler`` (or ``func``; a function ``args -> int``), then append it to :data:`SUBCOMMANDS`.
 """
 
 from __future__ import annotations
@@ -136,8 +136,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     from .errors import FemkitError, InputError
 
+    handler = getattr(args, "handler", None) or getattr(args, "func")  # func: femkit.study.cli style
     try:
-        return int(args.handler(args))
+        return int(handler(args))
     except InputError as exc:
         print(f"femkit: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -58,7 +58,7 @@ class Case:
     functions: dict = field(default_factory=dict)
     extras: dict = field(default_factory=dict)
 
-    def run(self, output_dir: str | os.PathLike | None = None, quiet: bool = True,
+    def run(self, output_dir: str | os.PathLike | None = None, quiet: bool = False,
             write: bool = True, echo=None):
         """Run the case; returns the problem's result object (CaseResult for Poisson).
 

@@ -63,6 +63,11 @@ PROBLEMS: dict[str, ProblemType] = {
         prepare="femkit.case.run:prepare_poisson",
         run="femkit.case.run:run_poisson",
     ),
+    "mass_spring": ProblemType(
+        schema="femkit.dynamics.scene_schema:SCENE_SCHEMA",
+        prepare="femkit.dynamics.scene:prepare_scene",
+        run="femkit.dynamics.scene:run_scene",
+    ),
 }
 
 

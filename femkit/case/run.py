@@ -370,7 +370,7 @@ class _Stages:
             self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - t0
 
 
-def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: bool = True,
+def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: bool = False,
                 write: bool = True, echo: Callable[[str], Any] | None = None) -> CaseResult:
     """Run a prepared Poisson case; see the module docstring for the stages.
 
@@ -378,7 +378,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     ----------
     case : a :class:`Case` from :func:`femkit.case.load_case`.
     output_dir : overrides ``output.dir``.
-    quiet : print nothing when true, else the summary.
+    quiet : print nothing when true, else the summary (default).
     write : write ``result.json`` and the requested files (atomically) when true.
     echo : printing function (default :func:`print`).
 
@@ -409,8 +409,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
                         n_dirichlet=int(mesh.n_points - system.A.shape[0]),
                         nnz=int(system.A.nnz))
     if write:
-        with stage("output"):
-            write_outputs(result, output_dir or case.data["output"]["dir"])
+        write_outputs(result, output_dir or case.data["output"]["dir"])
     if not quiet:
         out = echo or print
         for line in result.summary_lines():
@@ -424,16 +423,9 @@ def write_outputs(result: CaseResult, directory: str | os.PathLike) -> Path:
     from ..io.results import write_json, write_plot, write_solution
 
     opts = result.case.data["output"]
-    files = ["result.json"]
-    if opts["vtu"]:
-        files.append("solution.vtu")
-    if opts["xdmf"]:
-        files += ["solution.xdmf", "solution.h5"]
-    if opts["plot"]:
-        files.append("solution.png")
-    result.files = files
     final = Path(directory).resolve()
     result.output_dir = final
+    t0 = time.perf_counter()
     with atomic_directory(final) as tmp:
         if opts["vtu"]:
             write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa)
@@ -443,5 +435,8 @@ def write_outputs(result: CaseResult, directory: str | os.PathLike) -> Path:
             title = (f"{result.case.name}: {result.mesh.n_triangles} triangles, "
                      f"h_max = {result.quality.get('h_max', float('nan')):.3g}")
             write_plot(tmp / "solution.png", result.mesh, result.u, title)
+        result.files = sorted({p.name for p in tmp.iterdir()} | {"result.json"})
+        result.timings["output"] = time.perf_counter() - t0  # up to result.json itself
         write_json(tmp / "result.json", result.to_dict())
+    result.timings["output"] = time.perf_counter() - t0
     return final

@@ -50,7 +50,11 @@ def write_json(path: str | os.PathLike, data: dict) -> Path:
 
 def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarray | None = None,
                    extra_point_data: dict | None = None) -> Path:
-    """Write the mesh with point data ``u`` and cell data ``kappa`` and ``tag`` (vtu/xdmf by extension)."""
+    """Write the mesh with point data ``u`` and cell data ``kappa`` and ``tag`` (vtu/xdmf by extension).
+
+    Not atomic by itself (meshio may write sibling files); use it inside
+    :func:`femkit.io.atomic.atomic_directory`.
+    """
     from ..mesh import write_mesh
 
     point_data = {"u": np.asarray(u, dtype=np.float64)}
@@ -58,13 +62,10 @@ def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarr
     cell_data = {"tag": np.asarray(mesh.cell_tags, dtype=np.int32)}
     if kappa is not None:
         cell_data["kappa"] = np.asarray(kappa, dtype=np.float64)
+    # Written in place: sibling files (XDMF's .h5, a tag-name sidecar) are named after the
+    # file, so a temporary name would orphan them. Callers write into an atomic directory.
     target = Path(path)
-    if target.suffix.lower() == ".xdmf":
-        # XDMF keeps its heavy data in a sibling .h5 named after the file: write in place.
-        write_mesh(target, mesh, point_data=point_data, cell_data=cell_data)
-        return target
-    with atomic_path(target) as tmp:
-        write_mesh(tmp, mesh, point_data=point_data, cell_data=cell_data)
+    write_mesh(target, mesh, point_data=point_data, cell_data=cell_data)
     return target
 
 

@@ -103,7 +103,7 @@ def test_normal_run_writes_result_json_and_vtu(tmp_path, capsys):
         assert key in res
     assert res["converged"] is True and res["solver"]["converged"] is True
     assert res["errors"]["L2"] < 0.1 and res["errors"]["H1_semi"] < 1.0
-    assert set(res["timings"]) >= {"mesh", "assembly", "boundary", "solve", "errors"}
+    assert set(res["timings"]) == {"mesh", "assembly", "boundary", "solve", "errors", "output"}
     assert res["mesh"]["n_triangles"] > 0 and res["mesh"]["h_max"] > 0
     assert res["solver"]["residuals"][0] > res["solver"]["true_residual"]
     import meshio
@@ -133,6 +133,8 @@ def test_plot_and_xdmf_when_asked(tmp_path):
     from femkit.mesh import read_mesh
 
     assert read_mesh(tmp_path / "out" / "solution.xdmf").n_points > 0
+    listed = json.loads((tmp_path / "out" / "result.json").read_text())["files"]
+    assert sorted(listed) == sorted(p.name for p in (tmp_path / "out").iterdir())
 
 
 def test_not_converged_exit_1_results_marked(tmp_path, capsys):
