@@ -189,14 +189,15 @@ def stability_map_figure(path, rows: Sequence[dict], *, title: str) -> str:
         ax.scatter(hw[ok], yy[ok], marker="o", color="tab:green", s=40, label="survived", zorder=3)
     if (~ok).any():
         ax.scatter(hw[~ok], yy[~ok], marker="x", color="tab:red", s=50, label="unstable", zorder=3)
-    labelled = False
+    bounds = {}
     for r in rows:
         b = r.get("bound")
         if b is not None and np.isfinite(b):
-            y = ypos[r["method"]]
-            ax.plot([b, b], [y - 0.35, y + 0.35], color="k", linewidth=2.0,
-                    label=None if labelled else "theoretical limit", zorder=2)
-            labelled = True
+            bounds[r["method"]] = float(b)
+    for j, (m, b) in enumerate(bounds.items()):
+        y = ypos[m]
+        ax.plot([b, b], [y - 0.35, y + 0.35], color="k", linewidth=2.5,
+                label="theoretical limit" if j == 0 else None, zorder=2)
     ax.set_xscale("log")
     ax.set_yticks(range(len(methods)), methods)
     ax.set_ylim(-0.6, len(methods) - 0.4)

@@ -70,7 +70,7 @@ POISSON = {
 }
 
 SCENE = _obj({
-    "type": {"enum": ["harmonic_oscillator", "single_spring", "rope", "cloth"]},
+    "type": {"enum": ["harmonic_oscillator", "single_spring", "rope"]},
     "k": {**POS, "default": 100.0},
     "mass": {**POS, "default": 1.0},
     "amplitude": {**POS, "default": 0.1},
@@ -128,12 +128,20 @@ STABILITY = {
 KINDS = {"poisson_convergence": POISSON, "dynamics_work_precision": DYNAMICS, "stability": STABILITY}
 
 
+def _partial(node: dict) -> None:
+    """A ``quick:`` value may give part of an object: no defaults, no required keys (lists stay whole)."""
+    node.pop("default", None)
+    node.pop("required", None)
+    for v in (node.get("properties") or {}).values():
+        _partial(v)
+
+
 def schema_for(kind: str) -> dict:
     """The full schema of a study of ``kind`` (with its ``quick:`` block)."""
     props = {**copy.deepcopy(COMMON), **copy.deepcopy(KINDS[kind])}
     quick = _obj({k: copy.deepcopy(v) for k, v in props.items() if k != "kind"})
     for v in quick["properties"].values():
-        v.pop("default", None)
+        _partial(v)
     props["quick"] = quick
     return _obj(props, required=["kind"])
 

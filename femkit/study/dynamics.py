@@ -1,0 +1,152 @@
+"""``kind: dynamics_work_precision``: integrators x dt = 2^-k on a scene with a reference.
+
+Scenes: ``harmonic_oscillator`` / ``single_spring`` (node 0 pinned, node 1 of mass ``m`` on a spring
+of stiffness ``k``, started ``amplitude`` below its equilibrium, optional gravity along -y): the
+analytic solution ``y(t) = y_eq + (y0 - y_eq) cos(sqrt(k/m) t)`` is the reference. ``rope`` (``n``
+nodes, first pinned, falling under gravity): a converged reference run by ``reference.integrator``
+(default RK4) at ``reference.dt`` (default the smallest swept dt / 16), stated in the report.
+
+Per run: error at the end time and the maximum over the trajectory (2-norm of all position
+errors at the common times, multiples of the largest dt), relative energy drift and its maximum,
+steps, wall time (minimum over repeats after a warm-up). A run that raises
+:class:`~femkit.errors.InstabilityError` is recorded as unstable (step, time, reason), never a crash.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from ..errors import InstabilityError
+from .fit import fit_rate
+from .progress import progress
+from .timing import time_call
+
+
+def integrator_spec(item) -> tuple[str, dict, str]:
+    if isinstance(item, str):
+        return item, {}, item
+    opts = dict(item.get("options") or {})
+    label = item.get("label") or (item["name"] + ("" if not opts else " " + ",".join(f"{k}={v}" for k, v in opts.items())))
+    return item["name"], opts, label
+
+
+def build_scene(scene: dict):
+    """(system, x0, v0, exact) with ``exact(times) -> (m, n, d)`` positions or None."""
+    from ..dynamics import rope, single_spring
+    from ..dynamics.forces import Gravity
+
+    kind = scene["type"]
+    k, m, g = scene["k"], scene["mass"], scene.get("gravity", 0.0)
+    if kind in ("harmonic_oscillator", "single_spring"):
+        sys_ = single_spring(k=k, m=m, rest=scene["rest"], gravity=g or None)
+        x0 = sys_.x0.copy()
+        y_eq = x0[0, 1] - scene["rest"] - m * g / k
+        y0 = y_eq - scene["amplitude"]
+        x0[1, 1] = y0
+        w = np.sqrt(k / m)
+
+        def exact(t):
+            t = np.asarray(t, float)
+            out = np.broadcast_to(x0, (t.size,) + x0.shape).copy()
+            out[:, 1, 1] = y_eq + (y0 - y_eq) * np.cos(w * t)
+            return out
+
+        return sys_, x0, np.zeros_like(x0), exact
+    n = scene["n"]
+    forces = [Gravity(g)] if g else []
+    sys_ = rope(n, scene["rest"] * (n - 1), k=k, mass=m, pinned="first", forces=forces)
+    return sys_, sys_.x0.copy(), np.zeros_like(sys_.x0), None
+
+
+def _simulate(system, name, opts, dt, t_end, x0, v0, every, limit):
+    from ..dynamics.simulate import simulate
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the sweep crosses critical steps on purpose
+        return simulate(system, name, dt, t_end, x0=x0, v0=v0, record_every=every,
+                        energy_growth_limit=limit, **opts)
+
+
+def dt_values(d: dict) -> list[float]:
+    if "values" in d:
+        return sorted(float(v) for v in d["values"])[::-1]
+    return [2.0 ** (-k) for k in range(d["k_min"], d["k_max"] + 1)]
+
+
+def run_dynamics_study(study, *, progress_enabled=None) -> dict:
+    d = study.data
+    scene = d["scene"]
+    system, x0, v0, exact = build_scene(scene)
+    t_end = scene["t_end"]
+    dts = dt_values(d["dt"])
+    dt_big = max(dts)
+    ratios = [dt_big / dt for dt in dts]
+    if not all(abs(r - round(r)) < 1e-9 for r in ratios) or abs(t_end / dt_big - round(t_end / dt_big)) > 1e-9:
+        from ..errors import CaseFileError
+
+        raise CaseFileError("dt: every dt must divide the largest one, and the largest must divide scene.t_end "
+                            "(errors are compared at common times)")
+    n_common = int(round(t_end / dt_big))
+    t_common = np.arange(n_common + 1) * dt_big
+    notes = []
+    ref = d.get("reference") or {}
+    if exact is not None and ref.get("analytic", True):
+        ref_x = exact(t_common)
+        notes.append(f"Reference: the analytic solution y(t) = y_eq + (y0 - y_eq) cos(sqrt(k/m) t), k = {scene['k']:g}, "
+                     f"m = {scene['mass']:g}.")
+    else:
+        rname = ref.get("integrator", "rk4")
+        rdt = ref.get("dt", min(dts) / 16)
+        every = int(round(dt_big / rdt))
+        rtraj = _simulate(system, rname, {}, dt_big / every, t_end, x0, v0, every, np.inf)
+        ref_x = rtraj.x
+        notes.append(f"Reference: a {rname} run at dt = {dt_big / every:.3g} ({every} steps per largest dt; "
+                     f"{rtraj.steps} steps, {rtraj.wall_time:.2f} s).")
+    free = ~system.pinned
+    records, energy_series = [], {}
+    integrators = [integrator_spec(i) for i in d["integrators"]]
+    if d["warmup"]:
+        for name, opts, _ in integrators:
+            try:
+                _simulate(system, name, opts, dts[-1], min(t_end, 20 * dts[-1]), x0, v0, 1, np.inf)
+            except InstabilityError:
+                pass
+    jobs = [(i, dt) for i in integrators for dt in dts]
+    for (name, opts, label), dt in progress(jobs, total=len(jobs), desc=study.name, enabled=progress_enabled):
+        every = int(round(dt_big / dt))
+        rec = {"integrator": label, "name": name, "dt": dt, "k": -np.log2(dt), "steps": int(round(t_end / dt))}
+        try:
+            timing = time_call(lambda: _simulate(system, name, opts, dt, t_end, x0, v0, every, d["energy_growth_limit"]),
+                               repeats=d["repeats"], warmup=0)
+            traj = timing.value
+            diff = (traj.x - ref_x)[:, free]
+            err_t = np.sqrt(np.sum(diff.reshape(len(diff), -1) ** 2, axis=1))
+            e = traj.energies["total"]
+            rel = np.abs(e - e[0]) / traj.energy_scale
+            rec.update(stable=True, error_end=float(err_t[-1]), error_max=float(err_t.max()),
+                       energy_drift=float(traj.energy_drift), energy_drift_max=float(rel.max()),
+                       wall_time=timing.min, wall_time_median=timing.median, omega_max=traj.omega_max,
+                       dt_crit=traj.dt_crit, reason="")
+            energy_series.setdefault(label, {})[dt] = (traj.times, rel)
+        except InstabilityError as exc:
+            rec.update(stable=False, error_end=None, error_max=None, energy_drift=exc.energy_ratio,
+                       energy_drift_max=None, wall_time=None, wall_time_median=None,
+                       omega_max=getattr(exc.partial, "omega_max", None), dt_crit=exc.dt_crit,
+                       reason=f"{exc.reason or 'energy grew'} at step {exc.step} (t = {exc.time:.4g})")
+        rec["h_omega"] = dt * rec["omega_max"] if rec.get("omega_max") else None
+        records.append(rec)
+    fits = []
+    for name, opts, label in integrators:
+        rows = [r for r in records if r["integrator"] == label and r["stable"] and r["error_end"]]
+        # drop the round-off floor: errors below 1e-11 of the motion's scale no longer follow dt^p
+        scale = float(np.abs(ref_x[:, free] - ref_x[0, free]).max()) or 1.0
+        pts = [(r["dt"], r["error_max"]) for r in rows if r["error_max"] > 1e-11 * scale]
+        if len(pts) >= 2:
+            f = fit_rate(*np.array(pts).T)
+            from ..dynamics.integrators import get_integrator
+
+            fits.append({"integrator": label, "error": "max over trajectory", "declared_order": get_integrator(name, **opts).order,
+                         **f.as_dict(), "fit": f})
+    return {"records": records, "fits": fits, "notes": notes, "energy": energy_series, "dts": dts}

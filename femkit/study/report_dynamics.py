@@ -1,0 +1,91 @@
+"""Report of a ``dynamics_work_precision`` study: orders, runs, four figures."""
+
+from __future__ import annotations
+
+from . import figures as F
+from .pareto import pareto_front
+
+
+def build_dynamics_report(report, study, result, data, stage) -> None:
+    recs = result.records
+    scene = study.data["scene"]
+    labels = list(dict.fromkeys(r["integrator"] for r in recs))
+    fits = {f["integrator"]: f for f in result.fits}
+    report.paragraph(f"Scene: {scene['type']} (k = {scene['k']:g}, m = {scene['mass']:g}, t_end = {scene['t_end']:g}); "
+                     f"dt = {', '.join(f'{dt:.4g}' for dt in data['dts'])}.")
+    report.heading("Fitted orders")
+    report.paragraph("Least-squares slope of log(max position error over the trajectory) against log(dt), over the "
+                     "stable runs above the round-off floor; the declared order is the integrator's own.")
+    report.table(["integrator", "declared order", "fitted order", "std. error", "R²", "points"],
+                 [[f["integrator"], f["declared_order"], f["slope"], f["slope_stderr"], f["r2"], f["n"]]
+                  for f in result.fits])
+    unstable = [r for r in recs if not r["stable"]]
+    report.heading("Unstable runs")
+    if unstable:
+        report.table(["integrator", "dt", "dt * omega_max", "critical dt", "what happened"],
+                     [[r["integrator"], r["dt"], r["h_omega"], r["dt_crit"], r["reason"]] for r in unstable])
+    else:
+        report.paragraph("None: every run completed within the energy-growth limit.")
+
+    report.heading("Figures")
+    series = []
+    for lab in labels:
+        rows = [r for r in recs if r["integrator"] == lab and r["stable"]]
+        series.append({"label": lab, "x": [r["dt"] for r in rows], "y": [r["error_max"] for r in rows],
+                       "fit": fits.get(lab, {}).get("fit")})
+    F.loglog_figure(stage / "figures" / "error_vs_dt.png", series, title=f"{study.title}: error vs time step",
+                    xlabel="time step dt [s]", ylabel="max position error over the trajectory [length]",
+                    triangle=2, note="dotted: fitted order; triangle: slope 2")
+    report.figure("figures/error_vs_dt.png", "Error against dt, fitted orders in the legend (unstable runs omitted)")
+
+    wp, t_all, e_all, idx = [], [], [], []
+    for lab in labels:
+        rows = [r for r in recs if r["integrator"] == lab and r["stable"]]
+        wp.append({"label": lab, "x": [r["wall_time"] for r in rows], "y": [r["error_max"] for r in rows]})
+        for r in rows:
+            t_all.append(r["wall_time"])
+            e_all.append(r["error_max"])
+            idx.append(recs.index(r))
+    front = pareto_front(t_all, e_all)
+    F.work_precision_figure(stage / "figures" / "work_precision.png", wp, front=[(t_all[i], e_all[i]) for i in front],
+                            title=f"{study.title}: error vs run time",
+                            xlabel="wall time [s] (min over repeats)", ylabel="max position error [length]")
+    report.figure("figures/work_precision.png", "Work-precision: error against wall time, Pareto front highlighted")
+    on_front = {idx[i] for i in front}
+    for i, r in enumerate(recs):
+        r["pareto"] = i in on_front
+
+    dts = data["dts"]
+    mid = dts[len(dts) // 2]
+    es = []
+    for lab in labels:
+        e = data["energy"].get(lab, {}).get(mid)
+        if e is not None:
+            es.append({"label": lab, "x": e[0], "y": e[1]})
+    F.energy_figure(stage / "figures" / "energy_vs_time.png", es,
+                    title=f"{study.title}: energy error, dt = {mid:.4g}")
+    report.figure("figures/energy_vs_time.png",
+                  f"Relative energy error against time at dt = {mid:.4g} (symplectic methods stay bounded)")
+
+    rows = [{"method": r["integrator"], "h_omega": r["h_omega"], "stable": r["stable"],
+             "bound": None} for r in recs if r.get("h_omega")]
+    if rows:
+        from ..dynamics.integrators import get_integrator
+        from .dynamics import integrator_spec
+
+        bounds = {}
+        for item in study.data["integrators"]:
+            name, opts, lab = integrator_spec(item)
+            bounds[lab] = get_integrator(name, **opts).stability_bound
+        for r in rows:
+            r["bound"] = bounds.get(r["method"])
+        F.stability_map_figure(stage / "figures" / "stability.png", rows,
+                               title=f"{study.title}: which runs survived")
+        report.figure("figures/stability.png", "Survived (o) and unstable (x) runs against dt * omega_max; "
+                      "black bars: the method's theoretical limit")
+
+    report.heading("Runs")
+    cols = ["integrator", "dt", "steps", "stable", "error_end", "error_max", "energy_drift", "energy_drift_max",
+            "wall_time", "h_omega", "pareto"]
+    report.table(cols, [[r.get(c) for c in cols] for r in recs],
+                 caption="errors: 2-norm of all position errors [length]; energy drift relative to the energy scale")
