@@ -1,0 +1,236 @@
+"""Outputs of a mass-spring scene: frames (.vtu + .pvd, or XDMF), energy.csv, result.json, PNG, GIF.
+
+:func:`write_scene_outputs` builds the whole output directory under a temporary name and moves
+it into place only when every file is written (:func:`femkit.io.atomic.atomic_directory`).
+
+Frames: one ``frames/frame_NNNNN.vtu`` per recorded step (points padded to 3D; cells are the
+springs as ``line`` cells, plus the ``triangle`` cells of cloth and mesh systems; point data
+``velocity`` (3D) and ``pinned``; cell data ``stretch`` = length / rest - 1 on springs, 0 on
+triangles) and ``scene.pvd`` listing them with their times (ParaView opens the ``.pvd`` as a
+time series). ``xdmf: true`` writes ``scene.xdmf`` + ``scene.h5`` (meshio's time-series writer).
+
+Matplotlib and imageio are imported only when a PNG or GIF is asked for; meshio only when
+frames are written.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Sequence
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from ..io.atomic import atomic_directory, atomic_write_text
+
+__all__ = ["write_scene_outputs", "write_frames_vtu", "write_frames_xdmf", "write_pvd",
+           "write_energy_csv", "energy_columns", "write_final_png", "write_gif", "RESULT_KEYS"]
+
+#: Top-level keys of a scene's result.json.
+RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "system", "integrator",
+               "linear_solver", "dt", "t_end", "steps", "steps_planned", "t_reached", "frames",
+               "output_every", "wall_time", "step_time", "energy", "final_state",
+               "momentum_final", "stability", "converged", "warnings", "timings", "files")
+
+
+def _pad3(a: np.ndarray) -> np.ndarray:
+    a = np.asarray(a, dtype=np.float64)
+    if a.shape[1] == 3:
+        return a
+    return np.concatenate([a, np.zeros((a.shape[0], 3 - a.shape[1]))], axis=1)
+
+
+def _frame_mesh(system, x, v, triangles):
+    import meshio
+
+    cells = [("line", np.asarray(system.springs, dtype=np.int64))]
+    i, j = system.springs[:, 0], system.springs[:, 1]
+    length = np.linalg.norm(x[j] - x[i], axis=1)
+    stretch = [length / system.rest - 1.0]
+    if triangles is not None and len(triangles):
+        cells.append(("triangle", np.asarray(triangles, dtype=np.int64)))
+        stretch.append(np.zeros(len(triangles)))
+    return meshio.Mesh(_pad3(x), cells,
+                       point_data={"velocity": _pad3(v),
+                                   "pinned": system.pinned.astype(np.int32)},
+                       cell_data={"stretch": stretch})
+
+
+def write_frames_vtu(directory: str | os.PathLike, system, traj, triangles=None,
+                     subdir: str = "frames") -> list[str]:
+    """One ``.vtu`` per recorded frame in ``directory/subdir``; returns their relative names."""
+    d = Path(directory)
+    (d / subdir).mkdir(parents=True, exist_ok=True)
+    names = []
+    for k in range(len(traj.times)):
+        name = f"{subdir}/frame_{k:05d}.vtu"
+        _frame_mesh(system, traj.x[k], traj.v[k], triangles).write(d / name)
+        names.append(name)
+    return names
+
+
+def write_pvd(path: str | os.PathLike, times: Sequence[float], files: Sequence[str]) -> Path:
+    """A ParaView collection listing ``files`` at ``times``."""
+    rows = "\n".join(f'    <DataSet timestep="{float(t)!r}" group="" part="0" file={quoteattr(f)}/>'
+                     for t, f in zip(times, files))
+    text = ('<?xml version="1.0"?>\n'
+            '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
+            f'  <Collection>\n{rows}\n  </Collection>\n</VTKFile>\n')
+    return atomic_write_text(path, text)
+
+
+def write_frames_xdmf(path: str | os.PathLike, system, traj, triangles=None) -> Path:
+    """An XDMF time series (``.xdmf`` + ``.h5``): the first frame's mesh, positions per step.
+
+    Point data per time: ``position`` (3D), ``displacement`` from the first frame and
+    ``velocity`` (ParaView's "Warp By Vector" on ``displacement`` animates it).
+    """
+    import meshio
+
+    m0 = _frame_mesh(system, traj.x[0], traj.v[0], triangles)
+    x0 = _pad3(traj.x[0])
+    with meshio.xdmf.TimeSeriesWriter(str(path)) as w:
+        w.write_points_cells(m0.points, m0.cells)
+        for k, t in enumerate(traj.times):
+            x = _pad3(traj.x[k])
+            w.write_data(float(t), point_data={"position": x, "displacement": x - x0,
+                                               "velocity": _pad3(traj.v[k])})
+    return Path(path)
+
+
+def energy_columns(dim: int) -> list[str]:
+    """Header of energy.csv."""
+    return (["t", "kinetic", "spring", "gravity", "contact", "total"]
+            + [f"momentum_{c}" for c in "xyz"[:dim]])
+
+
+def write_energy_csv(path: str | os.PathLike, traj) -> Path:
+    """``energy.csv``: one row per recorded frame (see :func:`energy_columns`)."""
+    dim = traj.momentum.shape[1]
+    e = traj.energies
+    table = np.column_stack([traj.times] + [e[k] for k in ("kinetic", "spring", "gravity",
+                                                           "contact", "total")]
+                            + [traj.momentum[:, c] for c in range(dim)])
+    lines = [",".join(energy_columns(dim))]
+    lines += [",".join(f"{v:.17g}" for v in row) for row in table]
+    return atomic_write_text(path, "\n".join(lines) + "\n")
+
+
+# ----------------------------------------------------------------------------- pictures
+
+def _view_axes(traj) -> tuple[int, int]:
+    """The two coordinate axes with the largest extent over the run (x, last axis for ties)."""
+    d = traj.x.shape[2]
+    if d == 2:
+        return 0, 1
+    ext = traj.x.max(axis=(0, 1)) - traj.x.min(axis=(0, 1))
+    order = sorted(range(3), key=lambda c: (-ext[c], -c))
+    a, b = sorted(order[:2])
+    return a, b
+
+
+def _limits(traj, axes):
+    lo = traj.x[..., list(axes)].min(axis=(0, 1))
+    hi = traj.x[..., list(axes)].max(axis=(0, 1))
+    pad = 0.05 * max(float(np.max(hi - lo)), 1e-12)
+    return lo - pad, hi + pad
+
+
+def _draw(ax, system, x, axes, lo, hi, title):
+    from matplotlib.collections import LineCollection
+
+    a, b = axes
+    seg = np.stack([x[system.springs[:, 0]][:, [a, b]], x[system.springs[:, 1]][:, [a, b]]], 1)
+    ax.add_collection(LineCollection(seg, linewidths=0.5, colors="tab:blue"))
+    free = ~system.pinned
+    ax.plot(x[free, a], x[free, b], ".", ms=2, color="k")
+    ax.plot(x[~free, a], x[~free, b], "s", ms=4, color="tab:red")
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.set_xlabel("xyz"[a])
+    ax.set_ylabel("xyz"[b])
+    ax.set_title(title, fontsize=9)
+
+
+def _figure():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    from matplotlib.figure import Figure
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig = Figure(figsize=(5, 5), dpi=80)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def write_final_png(path: str | os.PathLike, system, traj, name: str) -> Path:
+    """The springs of the last frame (projected on the two widest axes) as a PNG."""
+    from ..io.atomic import atomic_path
+
+    axes = _view_axes(traj)
+    lo, hi = _limits(traj, axes)
+    fig = _figure()
+    ax = fig.add_subplot(1, 1, 1)
+    _draw(ax, system, traj.x[-1], axes, lo, hi, f"{name}: t = {traj.times[-1]:.4g}")
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png")
+    return Path(path)
+
+
+def write_gif(path: str | os.PathLike, system, traj, name: str, max_frames: int = 60) -> Path:
+    """An animated GIF of (at most ``max_frames`` evenly spaced) recorded frames."""
+    import imageio.v2 as imageio
+
+    from ..io.atomic import atomic_path
+
+    axes = _view_axes(traj)
+    lo, hi = _limits(traj, axes)
+    picks = np.unique(np.linspace(0, len(traj.times) - 1, min(max_frames, len(traj.times)))
+                      .round().astype(int))
+    images = []
+    for k in picks:
+        fig = _figure()
+        ax = fig.add_subplot(1, 1, 1)
+        _draw(ax, system, traj.x[k], axes, lo, hi, f"{name}: t = {traj.times[k]:.4g}")
+        fig.canvas.draw()
+        images.append(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy())
+    with atomic_path(path) as tmp:
+        imageio.mimsave(tmp, images, format="GIF", duration=0.08, loop=0)
+    return Path(path)
+
+
+# ----------------------------------------------------------------------------- all
+
+def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
+    """Write every requested output of ``result`` (a SceneResult) into ``directory`` atomically."""
+    from ..io.results import write_json
+
+    opts = result.case.data["output"]
+    traj, system, tri = result.trajectory, result.system, result.triangles
+    final = Path(directory).resolve()
+    result.output_dir = final
+    files: list[str] = []
+    with atomic_directory(final) as tmp:
+        if opts["vtu"]:
+            frames = write_frames_vtu(tmp, system, traj, tri)
+            write_pvd(tmp / "scene.pvd", traj.times, frames)
+            files += ["scene.pvd", *frames]
+        if opts["xdmf"]:
+            write_frames_xdmf(tmp / "scene.xdmf", system, traj, tri)
+            files += ["scene.xdmf", "scene.h5"]
+        if opts["energy_csv"]:
+            write_energy_csv(tmp / "energy.csv", traj)
+            files.append("energy.csv")
+        if opts["png"]:
+            write_final_png(tmp / "final.png", system, traj, result.case.name)
+            files.append("final.png")
+        if opts["gif"]:
+            write_gif(tmp / "animation.gif", system, traj, result.case.name)
+            files.append("animation.gif")
+        files.append("result.json")
+        result.files = files
+        write_json(tmp / "result.json", result.to_dict())
+    return final

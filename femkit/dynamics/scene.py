@@ -1,0 +1,563 @@
+"""Run a ``problem: mass_spring`` scene end to end: system, forces, integrator, outputs.
+
+``femkit solve SCENE.yaml`` dispatches here through :data:`femkit.case.problems.PROBLEMS`:
+:func:`prepare_scene` checks everything at load time (integrator, linear solver and
+preconditioner names against their registries, integrator options, mesh geometry and file,
+expressions, output cadence), so bad input fails before anything is computed or written;
+:func:`run_scene` builds the system with *only the declared forces*, runs
+:func:`femkit.dynamics.simulate.simulate` and writes the outputs atomically
+(:mod:`femkit.dynamics.output`).
+
+Stability: an :class:`~femkit.errors.InstabilityError` does not escape :func:`run_scene`. The
+trajectory up to the last good step is written, ``result.json`` says ``"verdict":
+"unstable"`` with the error's facts, and :attr:`SceneResult.converged` is false, so
+``femkit solve`` exits with code 1 ("ran, but did not reach its goal").
+
+Each stage is a public function (:func:`build_system`, :func:`build_integrator`,
+:func:`build_context`, :func:`output_every`), so a Python user can reuse one of them::
+
+    case = femkit.load_case("cases/scenes/rope_pendulum.yaml", t_end=0.5)
+    system, triangles = build_system(case)
+    result = run_scene(case, write=False, quiet=True)
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import math
+import os
+import sys
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from ..case.load import Case
+from ..case.run import _prefixed  # "where: unknown X ..." (the Poisson loader's wording)
+from ..errors import CaseFileError, ExpressionError, InputError, InstabilityError, UnknownNameError
+
+__all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "build_context",
+           "output_every", "n_steps", "SceneResult", "state_checksum"]
+
+
+# ----------------------------------------------------------------------------- prepare
+
+
+
+def _time_value(case: Case, key: str) -> float:
+    """``dt``/``t_end``: a number, or a constant expression such as ``"1/60"``."""
+    from ..case.expressions import compile_expression
+
+    value = case.data[key]
+    if isinstance(value, str):
+        try:
+            f = compile_expression(value, ("x",), case.data.get("constants") or {})
+            value = float(f(np.zeros(1))[0])
+        except ExpressionError as exc:
+            raise ExpressionError(f"{key}: {exc}") from None
+    value = float(value)
+    if not (math.isfinite(value) and value > 0.0):
+        raise CaseFileError(f"{key}: must be a positive finite number, got {value!r}")
+    case.data[key] = value
+    return value
+
+
+def _normalise_forces(spec) -> list[dict]:
+    """Forces as a list of ``{type: ..., params...}`` (mapping form and gravity shorthand too)."""
+    if isinstance(spec, dict):
+        out = []
+        for name, params in spec.items():
+            if name == "gravity" and not isinstance(params, dict):
+                params = {"g": params}
+            out.append({"type": name, **{k: v for k, v in params.items() if k != "type"}})
+        return out
+    return [dict(f) for f in spec]
+
+
+def prepare_scene(case: Case) -> None:
+    """Check a validated scene against the registries and resolve it (load time, nothing runs).
+
+    Normalises ``integrator`` to ``{method, options}`` and ``forces`` to a list of
+    ``{type, ...}``, evaluates ``dt``/``t_end`` expressions, compiles ``system.velocity``
+    expressions into ``case.functions``, fills the linear solver's preconditioner, makes
+    ``system.file`` and ``output.dir`` absolute, and checks the output cadence.
+
+    Raises
+    ------
+    UnknownNameError
+        Unknown integrator, linear solver, preconditioner or mesh geometry (valid names listed).
+    CaseFileError
+        Bad integrator options, mesh file not found, conflicting keys.
+    ExpressionError
+        Unsafe or malformed expression.
+    """
+    d = case.data
+    if d.get("name"):
+        case.name = d["name"]
+
+    # integrator: name and options checked by building it once
+    integ = d["integrator"]
+    if isinstance(integ, str):
+        integ = {"method": integ}
+    integ = {"method": integ["method"], "options": dict(integ.get("options") or {})}
+    d["integrator"] = integ
+    from .integrators import INTEGRATORS, get_integrator
+
+    try:
+        INTEGRATORS.get(integ["method"])
+    except UnknownNameError as exc:
+        raise _prefixed(exc, "integrator.method") from None
+    try:
+        get_integrator(integ["method"], **integ["options"])
+    except UnknownNameError:
+        raise
+    except InputError as exc:
+        raise CaseFileError(f"integrator.options: {' '.join(str(exc).split())}") from None
+
+    # linear solver
+    from ..solvers.registry import PRECONDITIONERS, SOLVERS
+
+    ls = d["linear_solver"]
+    try:
+        SOLVERS.get(ls["method"])
+    except UnknownNameError as exc:
+        raise _prefixed(exc, "linear_solver.method") from None
+    if ls.get("preconditioner") is None:
+        ls["preconditioner"] = "jacobi" if ls["method"] == "pcg" else "none"
+    try:
+        PRECONDITIONERS.get(ls["preconditioner"])
+    except UnknownNameError as exc:
+        raise _prefixed(exc, "linear_solver.preconditioner") from None
+    if ls["preconditioner"] != "none" and ls["method"] != "pcg":
+        raise CaseFileError(f"linear_solver.preconditioner: {ls['preconditioner']!r} needs method "
+                            f"'pcg', not {ls['method']!r} (drop it or use method: pcg)")
+
+    # times
+    dt = _time_value(case, "dt")
+    t_end = _time_value(case, "t_end")
+    if round(t_end / dt) < 1:
+        raise CaseFileError(f"t_end: {t_end:g} is shorter than one step dt = {dt:g}")
+
+    # system
+    system = d["system"]
+    if system["type"] == "mesh":
+        _prepare_mesh(system, case.base_dir)
+    if "damping" in system and any(f["type"] == "dashpot" for f in _normalise_forces(d["forces"])):
+        raise CaseFileError("system.damping: give the dashpot coefficient either as "
+                            "system.damping or as a 'dashpot' force, not both")
+    d["forces"] = _normalise_forces(d["forces"])
+    kinds = [f["type"] for f in d["forces"]]
+    for kind in ("gravity", "dashpot", "viscous", "rayleigh", "ground"):
+        if kinds.count(kind) > 1:
+            raise CaseFileError(f"forces: {kind!r} is declared {kinds.count(kind)} times "
+                                "(only 'sphere' may repeat)")
+    from ..case.expressions import compile_expression
+
+    for i, comp in enumerate(system.get("velocity") or []):
+        key = f"system.velocity[{i}]"
+        try:
+            case.functions[key] = compile_expression(comp, ("x", "y", "z"),
+                                                     d.get("constants") or {})
+        except ExpressionError as exc:
+            raise ExpressionError(f"{key}: {exc}") from None
+
+    out = d["output"]
+    if "every" in out and "interval" in out:
+        raise CaseFileError("output: give 'every' (steps) or 'interval' (seconds), not both")
+    out["dir"] = str((case.base_dir / out.get("dir", os.path.join("runs", case.name))).resolve())
+
+
+def _prepare_mesh(system: dict, base: Path) -> None:
+    if "file" in system:
+        path = (base / system["file"]).resolve()
+        if not path.is_file():
+            raise CaseFileError(f"system.file: mesh file not found: {path}")
+        system["file"] = str(path)
+        return
+    from ..mesh.geometries import GEOMETRIES
+
+    try:
+        factory = GEOMETRIES.get(system["geometry"])
+    except UnknownNameError as exc:
+        raise _prefixed(exc, "system.geometry") from None
+    params = system.get("params") or {}
+    try:
+        inspect.signature(factory).bind(system["h"], **params)
+    except TypeError:
+        valid = [p for p in inspect.signature(factory).parameters if p != "h"]
+        raise CaseFileError(
+            f"system.params: {sorted(params)} do not fit geometry {system['geometry']!r}; "
+            f"valid parameters: {', '.join(valid) or '(none)'}") from None
+
+
+# ----------------------------------------------------------------------------- build
+
+def _forces(case: Case) -> tuple[list, float | None]:
+    """Force objects for the declared forces, and the dashpot coefficient (None: no dashpot)."""
+    from .forces import GroundContact, Gravity, RayleighDamping, SphereContact, ViscousDamping
+
+    objs, dashpot = [], None
+    for f in case.data["forces"]:
+        kind = f["type"]
+        if kind == "gravity":
+            g = f.get("g", 9.81)
+            objs.append(Gravity(g, axis=int(f.get("axis", -1))) if np.ndim(g) == 0
+                        else Gravity(list(g)))
+        elif kind == "dashpot":
+            dashpot = float(f["c"])
+        elif kind == "viscous":
+            objs.append(ViscousDamping(f["gamma"], per_mass=bool(f.get("per_mass", False))))
+        elif kind == "rayleigh":
+            objs.append(RayleighDamping(f.get("alpha", 0.0), f.get("beta", 0.0)))
+        elif kind == "ground":
+            objs.append(GroundContact(f["stiffness"], f.get("height", 0.0), f.get("normal")))
+        elif kind == "sphere":
+            objs.append(SphereContact(f["centre"], f["radius"], f["stiffness"]))
+        else:  # the schema admits nothing else
+            raise CaseFileError(f"forces: unknown force type {kind!r}")
+    return objs, dashpot
+
+
+def _grid_triangles(nx: int, ny: int) -> np.ndarray:
+    idx = np.arange(nx * ny).reshape(ny, nx)
+    a, b, c, d = idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]
+    return np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3),
+                           np.stack([a, c, d], -1).reshape(-1, 3)]).astype(np.int64)
+
+
+def build_system(case: Case):
+    """The :class:`MassSpringSystem` of the scene and its triangles (``None`` for rope/spring).
+
+    Only the declared forces are attached; the dashpot is present only when declared
+    (``system.damping`` or a ``dashpot`` force).
+    """
+    from . import topology
+
+    s = dict(case.data["system"])
+    kind = s.pop("type")
+    s.pop("velocity", None)
+    forces, dashpot = _forces(case)
+    damping = s.pop("damping", dashpot if dashpot is not None else 0.0)
+    origin = s.pop("origin", None)
+    kw = dict(forces=forces, damping=damping)
+    triangles = None
+    try:
+        if kind == "rope":
+            system = topology.rope(s.pop("n"), s.pop("length"), origin=origin, **s, **kw)
+        elif kind == "cloth":
+            nx, ny = s["nx"], s["ny"]
+            system = topology.cloth_grid(s.pop("nx"), s.pop("ny"), s.pop("width"), s.pop("height"),
+                                         origin=origin, **s, **kw)
+            triangles = _grid_triangles(nx, ny)
+        elif kind == "mesh":
+            mesh = _scene_mesh(s)
+            for key in ("geometry", "h", "params", "file"):
+                s.pop(key, None)
+            system = topology.mesh_springs(mesh, **s, **kw)
+            if origin is not None:
+                system.x0 = system.x0 + np.asarray(origin, float).reshape(1, system.dim)
+            triangles = np.asarray(mesh.triangles, dtype=np.int64)
+        elif kind == "single_spring":
+            system = topology.single_spring(s.pop("k"), s.pop("m"), s.pop("rest", 1.0),
+                                            gravity=None, **s, **kw)
+        else:  # pragma: no cover - the schema admits nothing else
+            raise CaseFileError(f"system.type: unknown system type {kind!r}")
+    except CaseFileError:
+        raise
+    except InputError as exc:
+        raise type(exc)(f"system: {' '.join(str(exc).split())}") from None
+    vel = [case.functions[f"system.velocity[{i}]"]
+           for i in range(len(case.data["system"].get("velocity") or []))]
+    if vel:
+        if len(vel) != system.dim:
+            raise CaseFileError(f"system.velocity: needs {system.dim} components for a "
+                                f"{system.dim}D system, got {len(vel)}")
+        x = system.x0
+        cols = [x[:, 0], x[:, 1], x[:, 2] if system.dim == 3 else np.zeros(system.n)]
+        v0 = np.stack([np.broadcast_to(f(*cols), (system.n,)) for f in vel], axis=1)
+        v0[system.pinned] = 0.0
+        system.v0 = np.ascontiguousarray(v0, dtype=float)
+    return system, triangles
+
+
+def _scene_mesh(spec: dict):
+    from ..mesh import generate, read_mesh, validate
+
+    where = f"system.file {spec['file']}" if "file" in spec else f"system.geometry {spec['geometry']}"
+    try:
+        if "file" in spec:
+            return validate(read_mesh(spec["file"]))
+        return validate(generate(spec["geometry"], spec["h"], **(spec.get("params") or {})))
+    except InputError as exc:
+        raise type(exc)(f"{where}: {' '.join(str(exc).split())}") from None
+
+
+def build_integrator(case: Case):
+    """The integrator object named by ``integrator.method`` with its ``options``."""
+    from .integrators import get_integrator
+
+    spec = case.data["integrator"]
+    return get_integrator(spec["method"], **spec["options"])
+
+
+def build_context(case: Case):
+    """A :class:`~femkit.dynamics.integrators.StepContext` from ``linear_solver``."""
+    from .integrators import StepContext
+
+    ls = case.data["linear_solver"]
+    return StepContext(solver=ls["method"], preconditioner=ls["preconditioner"], rtol=ls["rtol"],
+                       atol=ls["atol"], maxiter=ls.get("maxiter"))
+
+
+def n_steps(case: Case) -> int:
+    """Number of steps ``round(t_end / dt)``."""
+    return int(round(case.data["t_end"] / case.data["dt"]))
+
+
+def output_every(case: Case) -> int:
+    """Output cadence in steps: ``every``, else ``round(interval / dt)``, else enough steps
+    for about ``frames`` frames (``ceil(steps / frames)``)."""
+    out = case.data["output"]
+    if "every" in out:
+        return int(out["every"])
+    if "interval" in out:
+        return max(1, int(round(out["interval"] / case.data["dt"])))
+    return max(1, math.ceil(n_steps(case) / int(out["frames"])))
+
+
+def state_checksum(x: np.ndarray) -> str:
+    """SHA-256 of the positions rounded to 9 decimals (little-endian float64, ``-0`` folded to 0).
+
+    Equal checksums mean equal states to 1e-9 (up to a value straddling a rounding boundary).
+
+    >>> state_checksum(np.array([[1e-12, -1e-12]])) == state_checksum(np.zeros((1, 2)))
+    True
+    """
+    r = np.round(np.asarray(x, dtype=float), 9) + 0.0
+    return hashlib.sha256(np.ascontiguousarray(r, dtype="<f8").tobytes()).hexdigest()
+
+
+# ----------------------------------------------------------------------------- result
+
+def _declared(case: Case, system) -> list[str]:
+    """Declared force types, with ``dashpot`` when the springs carry a damping coefficient."""
+    kinds = [f["type"] for f in case.data["forces"]]
+    if "dashpot" not in kinds and np.any(np.asarray(system.damping) != 0):
+        kinds.append("dashpot")
+    return kinds
+
+
+@dataclass
+class SceneResult:
+    """What a scene run produced: the trajectory in memory and the facts of ``result.json``."""
+
+    case: Case
+    system: Any
+    integrator: Any
+    trajectory: Any
+    triangles: np.ndarray | None
+    instability: InstabilityError | None
+    every: int
+    wall_time: float
+    timings: dict
+    omega_max: float | None = None
+    warnings: list = field(default_factory=list)
+    output_dir: Path | None = None
+    files: list = field(default_factory=list)
+
+    @property
+    def converged(self) -> bool:
+        """False when the run stopped on an instability (``femkit solve`` then exits 1)."""
+        return self.instability is None
+
+    @property
+    def failure(self) -> str | None:
+        """One-line reason of the failure (None when stable)."""
+        return None if self.instability is None else " ".join(str(self.instability).split())
+
+    def stability(self) -> dict:
+        tr = self.trajectory
+        dt = float(self.case.data["dt"])
+        om = tr.omega_max if tr.omega_max is not None else self.omega_max
+        out = {"verdict": "stable" if self.instability is None else "unstable",
+               "omega_max": om, "dt_crit": tr.dt_crit,
+               "h_omega_max": None if om is None else dt * om,
+               "stability_bound": self.integrator.describe()["stability_bound"],
+               "energy_growth_limit": self.case.data["stability"]["energy_growth_limit"]}
+        e = self.instability
+        if e is not None:
+            out.update(method=e.method, step=int(e.step), time=float(e.time),
+                       energy_ratio=float(e.energy_ratio), dt=float(e.dt), reason=e.reason,
+                       dt_crit=e.dt_crit, message=self.failure)
+        return out
+
+    def to_dict(self) -> dict:
+        """The content of ``result.json`` (keys documented in docs/scenes.md)."""
+        from .. import __version__
+
+        tr = self.trajectory
+        s = self.system
+        x_final = tr.x[-1]
+        e = tr.energies["total"]
+        stats = tr.summary()["stats"]
+        desc = self.integrator.describe()
+        return {
+            "case": self.case.name,
+            "problem": self.case.problem,
+            "case_file": str(self.case.path) if self.case.path else None,
+            "femkit_version": __version__,
+            "system": {"type": self.case.data["system"]["type"], "particles": int(s.n),
+                       "springs": int(s.n_springs), "dim": int(s.dim), "dofs": int(s.ndof),
+                       "pinned": int(np.count_nonzero(s.pinned)),
+                       "triangles": 0 if self.triangles is None else int(len(self.triangles)),
+                       "forces": _declared(self.case, s)},
+            "integrator": {k: desc[k] for k in ("name", "order", "implicit", "symplectic",
+                                                "stability_bound", "options")},
+            "linear_solver": {**self.case.data["linear_solver"],
+                              "used": bool(desc["implicit"]),
+                              "factorizations": int(stats.get("factorizations", 0)),
+                              "linear_solves": int(stats.get("linear_solves", 0)),
+                              "iterations": int(stats.get("linear_iterations", 0)),
+                              "stats": stats},
+            "dt": float(self.case.data["dt"]),
+            "t_end": float(self.case.data["t_end"]),
+            "steps": int(tr.steps),
+            "steps_planned": n_steps(self.case),
+            "t_reached": float(tr.times[-1]),
+            "frames": int(len(tr.times)),
+            "output_every": int(self.every),
+            "wall_time": float(self.wall_time),
+            "step_time": float(tr.wall_time / tr.steps) if tr.steps else None,
+            "energy": {"initial": float(e[0]), "final": float(e[-1]),
+                       "scale": float(tr.energy_scale), "drift": float(tr.energy_drift),
+                       "max_deviation": float(np.max(np.abs(e - e[0])) / tr.energy_scale)},
+            "final_state": {"checksum": state_checksum(x_final),
+                            "sum_x": float(x_final.sum()),
+                            "sum_abs_x": float(np.abs(x_final).sum()),
+                            "sum_v": float(tr.v[-1].sum())},
+            "momentum_final": tr.momentum[-1],
+            "stability": self.stability(),
+            "converged": self.converged,
+            "warnings": list(self.warnings),
+            "timings": dict(self.timings),
+            "files": list(self.files),
+        }
+
+    def summary_lines(self) -> list[str]:
+        """Short human summary (what ``femkit solve`` prints)."""
+        d = self.to_dict()
+        sy, it, st = d["system"], d["integrator"], d["stability"]
+        kind = "implicit" if it["implicit"] else "explicit"
+        kind += ", symplectic" if it["symplectic"] else ""
+        lines = [
+            f"scene     {self.case.name} (problem {self.case.problem})",
+            f"system    {sy['type']}: {sy['particles']} particles, {sy['springs']} springs, "
+            f"{sy['dofs']} dofs ({sy['pinned']} pinned), forces: "
+            f"{', '.join(sy['forces']) or 'springs only'}",
+            f"method    {it['name']} (order {it['order']}, {kind}), dt {d['dt']:.4g}, "
+            f"t_end {d['t_end']:.4g}",
+        ]
+        if it["implicit"]:
+            ls = d["linear_solver"]
+            pc = f" + {ls['preconditioner']}" if ls["preconditioner"] != "none" else ""
+            lines.append(f"solver    {ls['method']}{pc}: {ls['linear_solves']} solves, "
+                         f"{ls['iterations']} iterations, {ls['factorizations']} factorisations")
+        step_ms = "" if d["step_time"] is None else f" ({1e3 * d['step_time']:.3g} ms/step)"
+        lines.append(f"steps     {d['steps']} of {d['steps_planned']}, {d['frames']} frames, "
+                     f"wall time {d['wall_time']:.3f} s{step_ms}")
+        lines.append(f"energy    drift {d['energy']['drift']:+.3e} (relative to scale "
+                     f"{d['energy']['scale']:.3e}), max deviation {d['energy']['max_deviation']:.3e}")
+        om = st["omega_max"]
+        stab = f"omega_max {om:.4g}, h*omega_max {st['h_omega_max']:.3g}" if om is not None else ""
+        if st["dt_crit"] is not None:
+            stab += f", critical dt {st['dt_crit']:.4g}"
+        verdict = st["verdict"] if self.instability is None else f"UNSTABLE: {self.failure}"
+        lines.append(f"verdict   {verdict}" + (f" ({stab})" if stab else ""))
+        if self.output_dir is not None:
+            lines.append(f"output    {self.output_dir} ({len(self.files)} files)")
+        return lines
+
+
+# ----------------------------------------------------------------------------- run
+
+def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bool = False,
+              write: bool = True, echo: Callable[[str], Any] | None = None) -> SceneResult:
+    """Run a prepared scene: build, simulate, write outputs, print the summary.
+
+    Parameters
+    ----------
+    case : a scene from :func:`femkit.case.load_case`.
+    output_dir : overrides ``output.dir``.
+    quiet : print nothing (and show no progress bar) when true. The progress bar also needs
+        stderr to be a terminal.
+    write : write the outputs (atomically) when true.
+    echo : printing function (default :func:`print`).
+
+    Returns
+    -------
+    SceneResult
+        ``converged`` is false when the run became unstable; the results up to the last good
+        step are still written, marked ``"verdict": "unstable"``.
+    """
+    from .simulate import StabilityWarning, simulate
+
+    out = echo or print
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    system, triangles = build_system(case)
+    integrator = build_integrator(case)
+    ctx = build_context(case)
+    every = output_every(case)
+    timings["build"] = time.perf_counter() - t0
+    st = case.data["stability"]
+    progress = (not quiet) and sys.stderr.isatty()
+
+    t1 = time.perf_counter()
+    caught: list[str] = []
+    instability = None
+    with warnings.catch_warnings(record=True) as wlist:
+        warnings.simplefilter("always", StabilityWarning)
+        try:
+            traj = simulate(system, integrator, case.data["dt"], case.data["t_end"], ctx=ctx,
+                            record_every=every, energy_growth_limit=st["energy_growth_limit"],
+                            check_stability=st["check"], check_every=st["check_every"],
+                            progress=progress)
+        except InstabilityError as exc:
+            instability = exc
+            traj = exc.partial
+        for w in wlist:
+            if issubclass(w.category, StabilityWarning):
+                caught.append(" ".join(str(w.message).split()))
+            else:
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    timings["simulate"] = time.perf_counter() - t1
+
+    omega = None
+    if st["check"] and traj.omega_max is None and system.n_springs:
+        from .stability import estimate_omega_max
+
+        omega = float(estimate_omega_max(system, iters=200))
+    result = SceneResult(case=case, system=system, integrator=integrator, trajectory=traj,
+                         triangles=triangles, instability=instability, every=every,
+                         wall_time=time.perf_counter() - t0, timings=timings, omega_max=omega,
+                         warnings=caught)
+    if not quiet:
+        for w in caught:
+            print(f"femkit: warning: {w}", file=sys.stderr)
+    if write:
+        from .output import write_scene_outputs
+
+        t2 = time.perf_counter()
+        write_scene_outputs(result, output_dir or case.data["output"]["dir"])
+        timings["output"] = time.perf_counter() - t2
+        result.wall_time = time.perf_counter() - t0
+    if instability is not None:
+        print(f"femkit: unstable: {result.failure}", file=sys.stderr)
+    if not quiet:
+        for line in result.summary_lines():
+            out(line)
+    return result
