@@ -37,7 +37,6 @@ from typing import Any, Callable
 import numpy as np
 
 from ..case.load import Case
-from ..case.run import _prefixed  # "where: unknown X ..." (the Poisson loader's wording)
 from ..errors import CaseFileError, ExpressionError, InputError, InstabilityError, UnknownNameError
 
 __all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "build_context",
@@ -45,6 +44,14 @@ __all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "bu
 
 
 # ----------------------------------------------------------------------------- prepare
+
+def _prefixed(exc: InputError, where: str) -> InputError:
+    """The same exception (type and attributes kept) with ``where: `` before its message."""
+    new = type(exc).__new__(type(exc))
+    new.__dict__.update(exc.__dict__)
+    new.args = (f"{where}: {' '.join(str(exc).split())}",)
+    return new
+
 
 
 
@@ -269,7 +276,7 @@ def build_system(case: Case):
     except CaseFileError:
         raise
     except InputError as exc:
-        raise type(exc)(f"system: {' '.join(str(exc).split())}") from None
+        raise _prefixed(exc, "system") from None
     vel = [case.functions[f"system.velocity[{i}]"]
            for i in range(len(case.data["system"].get("velocity") or []))]
     if vel:
@@ -293,7 +300,7 @@ def _scene_mesh(spec: dict):
             return validate(read_mesh(spec["file"]))
         return validate(generate(spec["geometry"], spec["h"], **(spec.get("params") or {})))
     except InputError as exc:
-        raise type(exc)(f"{where}: {' '.join(str(exc).split())}") from None
+        raise _prefixed(exc, where) from None
 
 
 def build_integrator(case: Case):
