@@ -101,6 +101,8 @@ class Expression:
         Names of the positional arguments.
     is_constant : bool
         True when the expression uses no variable.
+    label : str
+        Where the expression comes from (a case-file key path); prefixes error messages.
     """
 
     def __init__(self, source: str, variables: tuple[str, ...], fn: Callable,
@@ -110,6 +112,7 @@ class Expression:
         self._fn = fn
         self.is_constant = is_constant
         self.check_finite = check_finite
+        self.label = ""  # where the expression comes from (e.g. "source"), used in messages
 
     def __call__(self, *args):
         if len(args) != len(self.variables):
@@ -128,7 +131,8 @@ class Expression:
                 coords = ", ".join(f"{n}={float(np.broadcast_to(a, shape).ravel()[k]):.6g}"
                                    for n, a in zip(self.variables, arrays))
                 where = f", first at ({coords})"
-            raise ExpressionError(f"expression {self.source!r} gave non-finite values at "
+            label = f"{self.label}: " if self.label else ""
+            raise ExpressionError(f"{label}expression {self.source!r} gave non-finite values at "
                                   f"{bad.size} of {out.size} points{where}")
         return out
 

@@ -43,6 +43,7 @@ def _compile(case: Case, key: str, text, *, check_finite: bool = True):
                                 check_finite=check_finite)
     except ExpressionError as exc:
         raise ExpressionError(f"{key}: {exc}") from None
+    fn.label = key
     case.functions[key] = fn
     return fn
 
@@ -200,7 +201,7 @@ def element_kappa(case: Case, mesh) -> np.ndarray:
     except ExpressionError:
         raise
     except InputError as exc:
-        raise InputError(f"coefficient: {exc}") from None
+        raise _with_prefix(exc, "coefficient") from None
 
 
 def assemble_system(case: Case, mesh):

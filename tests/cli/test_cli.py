@@ -60,13 +60,18 @@ def bad_cases(tmp_path):
                               [str((tmp_path / "nowhere" / "plate.msh").resolve())]),
         "degenerate-triangle": (change(lambda d: d.update(mesh={"file": "bad.vtu"})),
                                 ["bad.vtu", "degenerate", "ids 3"]),
+        "non-finite-source": (change(lambda d: d.update(source="log(x - 0.5)")),
+                              ["source: expression 'log(x - 0.5)' gave non-finite values"]),
+        "negative-kappa-expression": (change(lambda d: d.update(coefficient="x - 0.5")),
+                                      ["coefficient", "> 0", "element(s) violate"]),
         "missing-tag": (change(lambda d: d["boundary"]["dirichlet"][0].update(tags=["lfet"])),
                         ["boundary.dirichlet[0].tags", "lfet", "left"]),
     }
 
 
 @pytest.mark.parametrize("kind", ["misspelled-key", "unknown-solver", "unsafe-expression",
-                                  "missing-mesh-file", "degenerate-triangle", "missing-tag"])
+                                  "missing-mesh-file", "degenerate-triangle", "missing-tag",
+                                  "non-finite-source", "negative-kappa-expression"])
 def test_bad_input_exit_2_one_line_and_no_output(kind, tmp_path, capsys):
     data, pieces = bad_cases(tmp_path)[kind]
     case = write(tmp_path, data)
