@@ -5,13 +5,13 @@ function that checks and compiles a validated case (names against registries, ex
 paths) and the function that runs it. Entries are ``"module:attribute"`` strings resolved on
 first use, so listing a problem type imports nothing heavy.
 
-Adding a problem type (e.g. the dynamics ``mass_spring`` scenes) is one entry::
+Adding a problem type is one entry (as for the dynamics ``mass_spring`` scenes)::
 
-    PROBLEMS["mass_spring"] = ProblemType(
-        schema="femkit.dynamics.scene_schema:SCENE_SCHEMA",
-        prepare="femkit.dynamics.scene:prepare_scene",   # (case: Case) -> None
-        run="femkit.dynamics.scene:run_scene",          # (case, output_dir=None, quiet=False, write=True) -> result
-    )
+    PROBLEMS["my_problem"] = ProblemType(
+        schema="my.module:SCHEMA",        # JSON schema dict (additionalProperties: false)
+        prepare="my.module:prepare",      # (case: Case) -> None: names, paths, expressions
+        run="my.module:run",              # (case, output_dir=None, quiet=False, write=True,
+    )                                     #  echo=None) -> result with .converged
 
 or, from outside this package, :func:`register_problem`. ``femkit solve`` dispatches on the
 ``problem`` key through this table; a result whose ``converged`` attribute is false makes the
