@@ -1,0 +1,399 @@
+"""``kind: stability``: the stress suite, one verdict row per (case, parameter, method).
+
+Each stress case (a file in ``cases/stress/`` or inline) sweeps one parameter (``values``):
+
+Poisson (structured triangulations built from arrays, ``-div(kappa grad u) = f``):
+- ``poisson_contrast``: kappa = contrast on the black cells of a 4x4 checkerboard, 1 elsewhere.
+- ``poisson_anisotropic``: the rectangle [0, a] x [0, 1] on an n x n grid: triangles of aspect ratio a.
+- ``poisson_scaled``: the unit square scaled by s (1e-6 ... 1e6) with u = sin(pi x/s) sin(pi y/s);
+  the stopping rule is relative to ||b|| and the error is relative to ||u||, so nothing depends on s.
+- ``poisson_degenerate``: one interior grid row moved to within eps*h of the next: slivers of area ~eps.
+- ``poisson_fine``: the unit square with ~``dofs`` unknowns (1e6 in the bundled file, small in tests).
+- ``poisson_neumann``: pure Neumann, singular K: direct on K (SingularSystemError expected), CG on the
+  consistent singular system, CG on an inconsistent one (must not report success), and the fix
+  (one node pinned to fix the constant).
+Solvers:
+- ``cg_residual_drift``: CG on an SPD matrix with eigenvalues 1 ... ``value`` (condition number): the
+  recursive residual keeps falling while the true one stalls; both reported.
+- ``jacobi_divergence``: Jacobi on the SPD, not diagonally dominant ``I + c (ones - I)``: divergence
+  must be reported as not converged, never as an exception or a NaN result.
+Dynamics:
+- ``dynamics_stiffness``: a two-spring chain (stiffness ``value``, masses 1 and ``mass_ratio``) run
+  at dt = factor x dt_crit for each explicit integrator; the measured stability boundary is
+  compared with bound / omega_max (2 for Verlet-type, 2 sqrt 2 for RK4).
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+
+import numpy as np
+
+from ..errors import FemkitError, InstabilityError, SingularSystemError
+from .poisson import solver_label
+from .progress import progress
+
+
+# ----------------------------------------------------------------------------- meshes
+
+def structured_mesh(nx: int, ny: int, width: float = 1.0, height: float = 1.0):
+    """Right triangles on an nx x ny grid of [0, width] x [0, height] (a Mesh, boundary tagged)."""
+    from ..mesh import Mesh
+
+    xs, ys = np.linspace(0, width, nx + 1), np.linspace(0, height, ny + 1)
+    X, Y = np.meshgrid(xs, ys)
+    pts = np.column_stack([X.ravel(), Y.ravel()])
+    i, j = np.meshgrid(np.arange(nx), np.arange(ny))
+    a = (j * (nx + 1) + i).ravel()
+    b, c, d = a + 1, a + nx + 2, a + nx + 1
+    tri = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    return Mesh(points=pts, triangles=tri)
+
+
+def _poisson_system(mesh, kappa, f, g=0.0):
+    from ..fem import apply_dirichlet, assemble_load, assemble_stiffness
+    from ..mesh import boundary_nodes
+
+    K = assemble_stiffness(mesh, kappa)
+    F = assemble_load(mesh, f)
+    nodes = boundary_nodes(mesh, None)
+    vals = g(*mesh.points[nodes].T) if callable(g) else np.full(len(nodes), g)
+    return K, F, apply_dirichlet(K, F, nodes, vals)
+
+
+def _solve_row(A, b, s, *, x_ref=None, maxiter=None):
+    from ..solvers import solve
+
+    kw = {"method": s["method"], "rtol": s.get("rtol", 1e-8), "atol": s.get("atol", 0.0)}
+    if s["method"] == "pcg":
+        kw["preconditioner"] = s.get("preconditioner") or "amg"
+    mi = s.get("maxiter") or maxiter
+    if mi:
+        kw["maxiter"] = mi
+    t0 = time.perf_counter()
+    try:
+        res = solve(A, b, **kw)
+    except FemkitError as exc:
+        return {"survived": False, "outcome": type(exc).__name__, "detail": str(exc)[:200],
+                "time": time.perf_counter() - t0}
+    row = {"survived": bool(res.converged), "outcome": res.reason, "iterations": int(res.iterations),
+           "relative_residual": float(res.relative_residual), "requested_rtol": kw["rtol"],
+           "recursive_residual": float(res.residuals[-1] / max(res.rhs_norm, 1e-300)) if len(res.residuals) else None,
+           "time": time.perf_counter() - t0, "detail": res.message[:200]}
+    if x_ref is not None:
+        nrm = np.linalg.norm(x_ref)
+        row["error"] = float(np.linalg.norm(res.x - x_ref) / nrm) if nrm > 0 else float(np.linalg.norm(res.x))
+    return row
+
+
+def _direct(A, b):
+    from ..solvers import solve
+
+    return solve(A, b, method="direct").x
+
+
+# ----------------------------------------------------------------------------- Poisson cases
+
+def _checker_kappa(mesh, contrast, cells=4):
+    c = mesh.centroids()
+    black = ((np.floor(c[:, 0] * cells) + np.floor(c[:, 1] * cells)) % 2).astype(bool)
+    return np.where(black, float(contrast), 1.0)
+
+
+def case_poisson(case, solvers, quick_n):
+    kind, n = case["type"], case.get("n", quick_n)
+    rows = []
+    for value in case["values"]:
+        if kind == "poisson_contrast":
+            mesh = structured_mesh(n, n)
+            K, F, sys = _poisson_system(mesh, _checker_kappa(mesh, value), 1.0)
+        elif kind == "poisson_anisotropic":
+            mesh = structured_mesh(n, n, float(value), 1.0)
+            K, F, sys = _poisson_system(mesh, 1.0, 1.0)
+        elif kind == "poisson_scaled":
+            s = float(value)
+            mesh = structured_mesh(n, n, s, s)
+            u = lambda x, y, s=s: np.sin(np.pi * x / s) * np.sin(np.pi * y / s)  # noqa: E731
+            K, F, sys = _poisson_system(mesh, 1.0, lambda x, y, s=s: 2 * np.pi**2 / s**2 * u(x, y))
+        elif kind == "poisson_degenerate":
+            mesh = structured_mesh(n, n)
+            pts = mesh.points.copy()
+            h = 1.0 / n
+            row = n // 2
+            sel = np.isclose(pts[:, 1], row * h)
+            pts[sel, 1] = (row + 1) * h - float(value) * h  # slivers of relative area eps
+            interior = sel & (pts[:, 0] > 0) & (pts[:, 0] < 1)
+            pts[sel & ~interior, 1] = row * h  # keep the boundary straight
+            from ..mesh import Mesh
+
+            mesh = Mesh(points=pts, triangles=mesh.triangles)
+            K, F, sys = _poisson_system(mesh, 1.0, 1.0)
+        elif kind == "poisson_fine":
+            m = max(2, int(round(np.sqrt(float(value)))) + 1)
+            mesh = structured_mesh(m, m)
+            K, F, sys = _poisson_system(mesh, 1.0, 1.0)
+        else:
+            raise ValueError(kind)
+        if kind == "poisson_fine":
+            x_ref = None
+        else:
+            x_ref = _direct(sys.A, sys.b)
+        base = {"case": case["name"], "type": kind, "value": value, "dofs": int(sys.A.shape[0])}
+        for s in solvers:
+            r = _solve_row(sys.A, sys.b, s, x_ref=x_ref, maxiter=case.get("maxiter"))
+            if kind == "poisson_scaled" and "error" in r:
+                # discretisation error relative to ||u||: identical at every scale if nothing leaks
+                uex = u(*mesh.points.T)
+                r["error"] = float(np.linalg.norm(sys.expand(_direct(sys.A, sys.b)) - uex) / np.linalg.norm(uex))
+            rows.append({**base, "method": solver_label(s), **r})
+    return rows
+
+
+def case_neumann(case, quick_n):
+    from ..fem import assemble_load, assemble_stiffness
+    from ..solvers import solve
+
+    n = case.get("n", quick_n)
+    mesh = structured_mesh(n, n)
+    K = assemble_stiffness(mesh, 1.0)
+    uex = lambda x, y: np.cos(np.pi * x) * np.cos(np.pi * y)  # noqa: E731
+    F = assemble_load(mesh, lambda x, y: 2 * np.pi**2 * uex(x, y), rule="gauss3")
+    F_cons = F - F.mean()  # exactly consistent: orthogonal to the constant null vector
+    F_bad = F_cons + 1.0   # inconsistent
+    ue = uex(*mesh.points.T)
+    base = {"case": case["name"], "type": "poisson_neumann", "dofs": mesh.n_points}
+    rows = []
+
+    def err(x):
+        d = (x - x.mean()) - (ue - ue.mean())
+        return float(np.linalg.norm(d) / np.linalg.norm(ue - ue.mean()))
+
+    from ..fem import apply_dirichlet
+
+    sys = apply_dirichlet(K, F_cons, [0], [ue[0]])
+    pinned_err = err(sys.expand(_direct(sys.A, sys.b)))
+    t0 = time.perf_counter()
+    try:
+        x = solve(K, F_cons, method="direct").x
+        ok = bool(np.all(np.isfinite(x))) and err(x) <= 2 * pinned_err
+        rows.append({**base, "value": "singular K, direct", "method": "direct", "survived": ok,
+                     "outcome": "no SingularSystemError; " + ("result finite and accurate up to the constant"
+                                                               if ok else "garbage result"),
+                     "error": err(x) if np.all(np.isfinite(x)) else None, "time": time.perf_counter() - t0})
+    except SingularSystemError as exc:
+        rows.append({**base, "value": "singular K, direct", "method": "direct", "survived": True,
+                     "outcome": "SingularSystemError (detected)", "detail": str(exc)[:200],
+                     "time": time.perf_counter() - t0})
+    r = _solve_row(K, F_cons, {"method": "cg", "rtol": 1e-10}, maxiter=case.get("maxiter", 5000))
+    if "iterations" in r:
+        r["error"] = None
+    rows.append({**base, "value": "singular K, consistent rhs", "method": "cg", **r})
+    r = _solve_row(K, F_bad, {"method": "cg", "rtol": 1e-10}, maxiter=case.get("maxiter", 2000))
+    # surviving here means: not claiming convergence on an unsolvable system
+    r["survived"] = not r.get("survived", False)
+    r["outcome"] = "reported not converged: " + str(r.get("outcome")) if r["survived"] else "claimed convergence!"
+    rows.append({**base, "value": "singular K, inconsistent rhs", "method": "cg", **r})
+    # the fix: pin one node (value of the exact solution there) -> SPD
+    r = _solve_row(sys.A, sys.b, {"method": "pcg", "preconditioner": "amg", "rtol": 1e-10})
+    rows.append({**base, "value": "one node pinned (constant fixed)", "method": "pcg+amg", **r,
+                 "error": pinned_err})
+    return rows
+
+
+# ----------------------------------------------------------------------------- solver cases
+
+def case_cg_drift(case):
+    import scipy.sparse as sp
+
+    from ..solvers import solve
+
+    rows = []
+    n = case.get("n", 300)
+    rng = np.random.default_rng(0)
+    for kappa in case["values"]:
+        # a cluster in [1, 2] and ten outliers up to kappa: CG converges, and the true residual
+        # stalls near eps * ||A|| ||x|| / ||b|| while the recursive one keeps falling
+        eig = np.concatenate([np.linspace(1.0, 2.0, n - 10), np.geomspace(1e2, float(kappa), 10)])
+        Q, _ = np.linalg.qr(rng.standard_normal((n, n)))
+        A = sp.csr_matrix((Q * eig) @ Q.T)
+        A = (A + A.T) * 0.5
+        b = Q @ rng.standard_normal(n)
+        t0 = time.perf_counter()
+        res = solve(A, b, method="cg", rtol=1e-14, maxiter=case.get("maxiter", 20 * n))
+        rec = float(res.residuals[-1] / res.rhs_norm)
+        rows.append({"case": case["name"], "type": "cg_residual_drift", "value": kappa, "dofs": n, "method": "cg",
+                     "survived": True, "outcome": res.reason, "iterations": int(res.iterations),
+                     "relative_residual": float(res.relative_residual), "recursive_residual": rec,
+                     "requested_rtol": 1e-14, "converged_flag": bool(res.converged),
+                     "drift": float(res.relative_residual / rec) if rec > 0 else None,
+                     "time": time.perf_counter() - t0,
+                     "detail": "recursive vs true relative residual; 'converged' must follow the true one"})
+        rows[-1]["survived"] = bool(res.converged) == bool(res.relative_residual <= 1e-14 * (1 + 1e-12))
+    return rows
+
+
+def case_jacobi(case):
+    import scipy.sparse as sp
+
+    from ..solvers import solve
+
+    rows = []
+    n = case.get("n", 10)
+    for c in case["values"]:
+        A = sp.csr_matrix((1 - c) * np.eye(n) + c * np.ones((n, n)))
+        b = np.ones(n)
+        t0 = time.perf_counter()
+        try:
+            res = solve(A, b, method="jacobi", rtol=1e-8, maxiter=case.get("maxiter", 200))
+            clean = (not res.converged) and np.all(np.isfinite(res.x)) if c * (n - 1) >= 1 else res.converged
+            rows.append({"case": case["name"], "type": "jacobi_divergence", "value": c, "dofs": n, "method": "jacobi",
+                         "survived": bool(clean), "outcome": res.reason, "iterations": int(res.iterations),
+                         "relative_residual": float(res.relative_residual), "time": time.perf_counter() - t0,
+                         "detail": f"Jacobi spectral radius {abs(c) * (n - 1):.3g}; {res.message[:150]}"})
+        except FemkitError as exc:
+            rows.append({"case": case["name"], "type": "jacobi_divergence", "value": c, "dofs": n, "method": "jacobi",
+                         "survived": False, "outcome": type(exc).__name__, "detail": str(exc)[:200],
+                         "time": time.perf_counter() - t0})
+    return rows
+
+
+# ----------------------------------------------------------------------------- dynamics
+
+#: Explicit methods whose stability region misses the imaginary axis: unstable on an undamped
+#: oscillator at every step size (energy grows as (1 + h^2 w^2)^n for explicit Euler).
+NEVER_STABLE = ("explicit_euler", "heun", "midpoint")
+#: A run "survived" when the largest total energy of its last third of steps is at most this
+#: multiple of the largest of its first third: bounded oscillation (a symplectic method near its
+#: limit swings the energy by 1 / (1 - (h w / 2)^2)) passes, exponential growth does not.
+ENERGY_FACTOR = 10.0
+#: ... and its energy never exceeded this multiple of the initial one (nonlinear springs can
+#: saturate an instability early, so growth between thirds alone would miss it).
+ENERGY_PEAK = 1e3
+
+
+def _chain(k, ratio):
+    from ..dynamics.system import MassSpringSystem
+
+    x0 = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    return MassSpringSystem(x0, np.array([1.0, 1.0, float(ratio)]), [[0, 1], [1, 2]], float(k), pinned=[0])
+
+
+def case_dynamics(case, integrators):
+    from ..dynamics.integrators import get_integrator
+    from ..dynamics.simulate import simulate
+    from ..dynamics.stability import estimate_omega_max
+    from .dynamics import integrator_spec
+
+    factors = case.get("dt_factors", [0.5, 0.9, 0.98, 1.02, 1.1, 2.0])
+    steps = int(case.get("t_end", 1000))  # number of steps per run
+    rows = []
+    for k in case["values"]:
+        for ratio in case.get("mass_ratio", [1.0]):
+            system = _chain(k, ratio)
+            x0 = system.x0.copy()
+            x0[2, 0] += 0.01  # small stretch of the outer spring
+            w = float(estimate_omega_max(system))
+            for item in integrators:
+                name, opts, label = integrator_spec(item)
+                integ = get_integrator(name, **opts)
+                if integ.implicit:
+                    continue
+                for fac in factors:
+                    dt = fac * integ.stability_bound / w
+                    t0 = time.perf_counter()
+                    try:
+                        with warnings.catch_warnings():
+                            warnings.simplefilter("ignore")
+                            tr = simulate(system, integ, dt, steps * dt, x0=x0, record_every=1,
+                                          energy_growth_limit=1e3)
+                        e = np.abs(tr.energies["total"])
+                        third = max(1, len(e) // 3)
+                        growth = float(e[-third:].max() / e[:third].max())
+                        peak = float(e.max() / e[0])
+                        ok = bool(np.isfinite(growth)) and growth <= ENERGY_FACTOR and peak <= ENERGY_PEAK
+                        outcome = ("completed" if ok else f"energy grew {growth:.3g} x from the first to the last "
+                                   f"third, peak {peak:.3g} x E0")
+                        drift = growth
+                    except InstabilityError as exc:
+                        ok, outcome, drift = False, f"InstabilityError at step {exc.step}", None
+                    rows.append({"case": case["name"], "type": "dynamics_stiffness", "value": f"k={k:g}, m2/m1={ratio:g}",
+                                 "k": float(k), "mass_ratio": float(ratio), "method": label, "dt": dt,
+                                 "dt_factor": fac, "omega_max": w, "h_omega": dt * w,
+                                 "bound": 0.0 if name in NEVER_STABLE else integ.stability_bound,
+                                 "survived": ok, "outcome": outcome, "energy_growth": drift, "time": time.perf_counter() - t0})
+    return rows
+
+
+def boundaries(rows) -> list[dict]:
+    """Measured stability boundary per (case value, method): largest surviving and smallest failing h*omega."""
+    out = []
+    keys = list(dict.fromkeys((r["value"], r["method"]) for r in rows if r["type"] == "dynamics_stiffness"))
+    for key in keys:
+        rs = [r for r in rows if r["type"] == "dynamics_stiffness" and (r["value"], r["method"]) == key]
+        ok = [r["h_omega"] for r in rs if r["survived"]]
+        bad = [r["h_omega"] for r in rs if not r["survived"]]
+        lo, hi = (max(ok) if ok else None), (min(bad) if bad else None)
+        bound = rs[0]["bound"]
+        consistent = (lo is None or lo <= bound * 1.0001) and (hi is None or hi >= bound * 0.9999)
+        out.append({"value": key[0], "method": key[1], "largest_stable_h_omega": lo,
+                    "smallest_unstable_h_omega": hi, "theory_h_omega": bound, "consistent_with_theory": consistent})
+    return out
+
+
+# ----------------------------------------------------------------------------- driver
+
+def load_cases(study) -> list[dict]:
+    from ..case.load import read_yaml
+    from ..case.schema import fill_defaults, validate_against
+    from .schema import STRESS_CASE_SCHEMA
+
+    cases = []
+    overrides = study.data.get("case_overrides") or {}
+    for i, c in enumerate(study.data["cases"]):
+        if isinstance(c, str):
+            p = study.resolve(c)
+            data = read_yaml(p)
+            validate_against(data, STRESS_CASE_SCHEMA, p.name)
+            data.setdefault("name", p.stem)
+        else:
+            data = dict(c)
+            data.setdefault("name", f"{data['type']}_{i}")
+        data = {**data, **(overrides.get(data["name"]) or {})}
+        validate_against(data, STRESS_CASE_SCHEMA, f"cases[{i}]")
+        data = fill_defaults(data, STRESS_CASE_SCHEMA)
+        data.setdefault("values", _DEFAULT_VALUES[data["type"]])
+        cases.append(data)
+    return cases
+
+
+_DEFAULT_VALUES = {
+    "poisson_contrast": [1.0, 1e2, 1e4, 1e6, 1e8], "poisson_anisotropic": [1.0, 10.0, 100.0, 1000.0],
+    "poisson_scaled": [1e-6, 1.0, 1e6], "poisson_degenerate": [1e-2, 1e-4, 1e-6], "poisson_fine": [1e6],
+    "poisson_neumann": [0], "cg_residual_drift": [1e4, 1e8, 1e12], "jacobi_divergence": [0.05, 0.5, 0.9],
+    "dynamics_stiffness": [1e2, 1e5, 1e9],
+}
+
+
+def run_stability_study(study, *, progress_enabled=None) -> dict:
+    d = study.data
+    cases = load_cases(study)
+    quick_n = 16 if study.quick else 64
+    rows = []
+    for case in progress(cases, total=len(cases), desc=study.name, enabled=progress_enabled):
+        t = case["type"]
+        if t == "poisson_neumann":
+            rows += case_neumann(case, quick_n)
+        elif t.startswith("poisson_"):
+            rows += case_poisson(case, d["solvers"], quick_n)
+        elif t == "cg_residual_drift":
+            rows += case_cg_drift(case)
+        elif t == "jacobi_divergence":
+            rows += case_jacobi(case)
+        else:
+            rows += case_dynamics(case, d["integrators"])
+    tables = {}
+    b = boundaries(rows)
+    if b:
+        tables["stability_boundaries"] = b
+    return {"records": rows, "tables": tables, "notes": []}
