@@ -15,6 +15,7 @@ frames are written.
 
 from __future__ import annotations
 
+import contextlib
 import os
 from pathlib import Path
 from typing import Sequence
@@ -90,7 +91,9 @@ def write_frames_xdmf(path: str | os.PathLike, system, traj, triangles=None) -> 
 
     m0 = _frame_mesh(system, traj.x[0], traj.v[0], triangles)
     x0 = _pad3(traj.x[0])
-    with meshio.xdmf.TimeSeriesWriter(str(path)) as w:
+    path = Path(path).resolve()
+    # meshio 5 opens the .h5 by its bare name, i.e. in the current directory: write from there
+    with contextlib.chdir(path.parent), meshio.xdmf.TimeSeriesWriter(str(path)) as w:
         w.write_points_cells(m0.points, m0.cells)
         for k, t in enumerate(traj.times):
             x = _pad3(traj.x[k])
