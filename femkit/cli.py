@@ -73,8 +73,11 @@ def _run_solve(args) -> int:
     converged = bool(getattr(result, "converged", True))
     if not converged:
         where = getattr(result, "output_dir", None)
-        print(f"femkit: solver did not converge; results written to {where} "
-              f"(marked converged: false)", file=sys.stderr)
+        # a run that failed for a reason of its own (e.g. an unstable integration) has already
+        # printed that reason; only a plain non-convergence is named here
+        what = "run failed" if getattr(result, "failure", None) else "solver did not converge"
+        print(f"femkit: {what}; results written to {where} (marked converged: false)",
+              file=sys.stderr)
         return EXIT_FAILED
     return EXIT_OK
 
