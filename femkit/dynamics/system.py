@@ -251,6 +251,42 @@ class MassSpringSystem:
         out[self.pinned] = 0.0
         return out
 
+    def constant_force(self) -> np.ndarray:
+        """Sum of the declared forces flagged ``constant`` (gravity), ``(n, d)``, zero on pins.
+
+        ``force(x, v, t) == spring_forces(x) + constant_force() + variable_force(x, v, t)``
+        (Hooke part unpinned-rows only), so a local/global solver can evaluate this once.
+        """
+        out = np.zeros((self.n, self.dim))
+        zero = np.zeros_like(out)
+        for f in self.forces:
+            if f.constant:
+                f.add_force(self.x0, zero, 0.0, out)
+        out[self.pinned] = 0.0
+        return out
+
+    @property
+    def has_variable_forces(self) -> bool:
+        """Whether :meth:`variable_force` can be non-zero (dashpots or a non-constant force)."""
+        return self._has_dashpots or any(not f.constant for f in self.forces)
+
+    def variable_force(self, x, v, t: float = 0.0) -> np.ndarray:
+        """Dashpots plus every declared force not flagged ``constant``, ``(n, d)``, zero on pins:
+        :meth:`force` minus the Hooke springs and :meth:`constant_force`."""
+        x = self._state(x)
+        v = self._state(v, "v")
+        if self._has_dashpots:
+            _, _, u = self._geometry(x)
+            out = self._scatter_springs(
+                dashpot_forces(np.take(v, self._i, axis=0), np.take(v, self._j, axis=0), u, self.damping))
+        else:
+            out = np.zeros((self.n, self.dim))
+        for f in self.forces:
+            if not f.constant:
+                f.add_force(x, v, t, out)
+        out[self.pinned] = 0.0
+        return out
+
     def acceleration(self, x, v, t: float = 0.0, *, rayleigh: bool = True) -> np.ndarray:
         """``force / mass``, zero on pinned nodes."""
         return self.force(x, v, t, rayleigh=rayleigh) / self.mass[:, None]

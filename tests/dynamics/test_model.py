@@ -164,3 +164,25 @@ def test_state_shape_checked_and_flat_accepted():
     assert np.allclose(s.force(s.x0.ravel(), s.v0), s.force(s.x0, s.v0))
     with pytest.raises(InputError, match="shape"):
         s.force(np.zeros((3, 2)), s.v0)
+
+
+@pytest.mark.parametrize("dim", [2, 3], ids=["2d", "3d"])
+def test_force_splits_into_springs_constant_and_variable(dim):
+    from femkit.dynamics.forces import RayleighDamping, ViscousDamping
+
+    forces = [Gravity(9.81), GroundContact(50.0, height=0.3), ViscousDamping(0.7),
+              RayleighDamping(0.2, 0.01)]
+    s, rng = _random(dim, 5, pinned=[1], forces=forces)
+    s = MassSpringSystem(s.x0, s.mass, s.springs, s.k, s.rest, damping=0.3, pinned=[1], forces=forces)
+    x = s.x0 + 0.2 * rng.standard_normal(s.x0.shape)
+    v = rng.standard_normal(s.x0.shape)
+    hooke = s.spring_forces(x)
+    hooke[s.pinned] = 0.0
+    total = hooke + s.constant_force() + s.variable_force(x, v, 0.5)
+    np.testing.assert_allclose(total, s.force(x, v, 0.5), rtol=1e-13, atol=1e-12)
+    assert s.has_variable_forces
+    g = s.constant_force()
+    assert np.all(g[s.pinned] == 0.0) and np.all(g[~s.pinned, -1] < 0.0)
+    plain = MassSpringSystem(s.x0, s.mass, s.springs, s.k, s.rest, forces=[Gravity(9.81)])
+    assert not plain.has_variable_forces
+    assert np.all(plain.variable_force(x, v) == 0.0)

@@ -6,7 +6,9 @@ per evaluation, only the methods below. Every method has a "nothing" default, so
 force implements only what it contributes.
 
 ``kind`` names the energy bucket (``"gravity"``, ``"contact"``) or ``None`` for
-non-conservative forces.
+non-conservative forces. ``constant = True`` declares a force independent of ``x``, ``v``
+and ``t`` (gravity): integrators may then evaluate it once per run
+(:meth:`~femkit.dynamics.system.MassSpringSystem.constant_force`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ class Force:
     """Base class of the declared forces (see module docstring)."""
 
     kind: str | None = None
+    constant: bool = False
 
     def bind(self, system) -> None:
         """Precompute per-system data (called once by the system)."""

@@ -29,6 +29,7 @@ class Gravity(Force):
     """
 
     kind = "gravity"
+    constant = True
 
     def __init__(self, g=9.81, *, axis: int = -1):
         self.g = g

@@ -6,16 +6,31 @@ spring energy is written ``1/2 k min_{|d| = r} |x_i - x_j - d|^2``; alternating
 * local step: ``d_s = r_s (x_i - x_j) / |x_i - x_j|`` for every spring (vectorised), and
 * global step: ``(M + h^2 L) x = M y + h^2 (J d + f_ext)``,
 
-decreases ``g`` monotonically. Since ``J d + f_ext = f(x) + L x`` at the current iterate (``f``:
-every declared force), the global step is ``(M + h^2 L) x+ = M y + h^2 (f(x) + L x)``; forces
-that depend on velocity see ``(x - x_n) / h`` (explicitly, per iteration).
+decreases ``g`` monotonically. ``f_ext`` is every declared force except the Hooke springs:
+forces flagged constant (gravity, :meth:`~femkit.dynamics.system.MassSpringSystem.constant_force`)
+are evaluated once per step; dashpots and the other forces
+(:meth:`~femkit.dynamics.system.MassSpringSystem.variable_force`) are evaluated per iteration,
+with velocity ``(x - x_n) / h`` (explicitly). Without such forces an iteration costs two sparse
+products over the springs and one triangular-solve pass.
 
+Implementation
+--------------
 ``L = system.spring_laplacian()`` is ``n x n``: the coordinates decouple, so one ``n x n``
-factorisation serves all ``d`` coordinates (``d`` right-hand sides per solve). The matrix depends
-only on ``dt``, masses, stiffnesses, topology and the pinned set, so it is factorised once (through
-``femkit.solvers``' direct factorisation) and kept in ``ctx.cache`` under a key built from those;
-``ctx.stats["factorizations"]`` counts factorisations. Pinned nodes are eliminated: their rows
-are dropped and their (fixed) positions move to the right-hand side.
+factorisation (``femkit.solvers.factorize``: SuperLU, symmetric mode with the ``MMD_AT_PLUS_A``
+ordering for this SPD matrix) serves all ``d`` coordinates, solved as one ``(n_free, d)``
+right-hand-side block in Fortran order (one pass through the factors). Pinned nodes are
+eliminated: their rows are dropped and their fixed positions move to the right-hand side.
+The local step and ``J d`` are two precomputed sparse matrices: ``G`` (``s x n_free``, the
+spring differences ``x_j - x_i``) and ``G^T diag(k r)``, so ``J d = G^T diag(k r) (dx / |dx|)``
+(lengths floored at ``system.length_floor``).
+
+Cache: the matrix depends only on ``dt``, masses, stiffnesses, rest lengths (in ``J``),
+topology and the pinned set, so the factor and the spring operators are built once and kept in
+``ctx.cache["fast_mass_spring"]``. The cache key is ``dt`` and the *identity* of the system and
+of its ``mass``, ``k``, ``rest``, ``springs``, ``pinned`` and ``forces`` attributes (the cache
+holds references, so identities cannot be recycled): assigning a new array invalidates it,
+modifying one of those arrays in place does not (clear ``ctx.cache`` then). No array is hashed
+per step. ``ctx.stats["factorizations"]`` counts factorisations.
 
 ``iterations`` local/global sweeps per step (Liu et al.: 10); with ``tol`` set, the sweeps stop
 early when ``||x+ - x||_inf <= tol * L_box``. Iterated to convergence this is implicit Euler
@@ -33,10 +48,31 @@ from ...errors import InputError
 from .base import Integrator, StepContext, StepperState, factorize_linear, restrict
 from .registry import INTEGRATORS
 
+_KEY_ATTRS = ("mass", "k", "rest", "springs", "pinned", "forces")
 
-def _digest(a) -> int:
-    a = np.ascontiguousarray(np.asarray(a))
-    return hash((a.dtype.str, a.shape, a.tobytes()))
+
+def _cache_key(system, dt: float) -> tuple:
+    return (float(dt), system) + tuple(getattr(system, a) for a in _KEY_ATTRS)
+
+
+def _same_key(a: tuple, b: tuple) -> bool:
+    return a[0] == b[0] and len(a) == len(b) and all(p is q for p, q in zip(a[1:], b[1:]))
+
+
+@dataclass
+class _Operators:
+    """Everything a fast mass-spring step reuses while the cache key holds."""
+
+    factor: object
+    free: np.ndarray
+    pinned: np.ndarray
+    m_free: np.ndarray          # (nf, 1)
+    G_free: object              # s x nf: x_j - x_i on free nodes
+    G_pin: object               # s x np: the pinned nodes' part of x_j - x_i
+    Jkr: object                 # nf x s: G_free^T diag(k r)
+    A_fp: object                # nf x np block of M + h^2 L
+    f_const: np.ndarray         # (nf, d) constant forces on the free nodes
+    floor: float
 
 
 @INTEGRATORS.register("fast_mass_spring")
@@ -54,48 +90,76 @@ class FastMassSpring(Integrator):
         if int(self.iterations) < 1:
             raise InputError(f"fast_mass_spring: iterations must be >= 1, got {self.iterations}")
 
-    def _factor(self, system, dt: float, ctx: StepContext):
-        key = (float(dt), _digest(system.mass), _digest(system.k), _digest(system.springs),
-               _digest(system.pinned), system.n)
+    def _operators(self, system, dt: float, ctx: StepContext) -> _Operators:
+        key = _cache_key(system, dt)
         cached = ctx.cache.get("fast_mass_spring")
-        if cached is not None and cached[0] == key:
+        if cached is not None and _same_key(cached[0], key):
             return cached[1]
-        free_nodes = np.flatnonzero(~system.pinned)
-        pinned_nodes = np.flatnonzero(system.pinned)
-        L = system.spring_laplacian().tocsr()
         import scipy.sparse as sp
 
-        A = (sp.diags(np.asarray(system.mass, dtype=float)) + (dt * dt) * L).tocsr()
-        A_fp = A[free_nodes][:, pinned_nodes].tocsr()
-        entry = {
-            "factor": factorize_linear(restrict(A, free_nodes), ctx),
-            "L": L,
-            "A_fp": A_fp,
-            "free": free_nodes,
-            "pinned": pinned_nodes,
-        }
-        ctx.cache["fast_mass_spring"] = (key, entry)
-        return entry
+        free = np.flatnonzero(~system.pinned)
+        pinned = np.flatnonzero(system.pinned)
+        mass = np.asarray(system.mass, dtype=float)
+        A = (sp.diags(mass) + (dt * dt) * system.spring_laplacian()).tocsr()
+        s = system.n_springs
+        rows = np.concatenate([np.arange(s), np.arange(s)])
+        cols = np.concatenate([system.springs[:, 1], system.springs[:, 0]])
+        vals = np.concatenate([np.ones(s), -np.ones(s)])
+        G = sp.csr_matrix((vals, (rows, cols)), shape=(s, system.n))
+        G_free = G[:, free].tocsr()
+        ops = _Operators(
+            factor=factorize_linear(restrict(A, free), ctx),
+            free=free,
+            pinned=pinned,
+            m_free=mass[free][:, None],
+            G_free=G_free,
+            G_pin=G[:, pinned].tocsr(),
+            Jkr=(G_free.T @ sp.diags(system.k * system.rest)).tocsr(),
+            A_fp=A[free][:, pinned].tocsr(),
+            f_const=system.constant_force()[free],
+            floor=float(system.length_floor),
+        )
+        ctx.cache["fast_mass_spring"] = (key, ops)
+        return ops
 
     def step(self, system, state: StepperState, dt: float, ctx: StepContext) -> StepperState:
         h = dt
-        fac = self._factor(system, h, ctx)
-        free, pinned, L = fac["free"], fac["pinned"], fac["L"]
-        m = np.asarray(system.mass, dtype=float)[:, None]
+        ops = self._operators(system, h, ctx)
+        free, pinned = ops.free, ops.pinned
         xn = state.x
-        y = xn + h * state.v
-        x = y.copy()
-        x[pinned] = xn[pinned]
-        rhs_pinned = fac["A_fp"] @ xn[pinned] if pinned.size else 0.0
-        length = float(np.linalg.norm(np.ptp(xn, axis=0))) or 1.0
         t_new = state.t + h
+        x = xn + h * state.v                    # y; pinned rows back to x_n below
+        x[pinned] = xn[pinned]
+        y_free = x[free]
+        const = ops.m_free * y_free + (h * h) * ops.f_const
+        dx_pin = None
+        if pinned.size:
+            x_pin = xn[pinned]
+            const -= ops.A_fp @ x_pin
+            dx_pin = ops.G_pin @ x_pin
+        variable = system.has_variable_forces
+        length = (float(np.linalg.norm(np.ptp(xn, axis=0))) or 1.0) if self.tol is not None else 1.0
+        x_free = y_free
         for _ in range(int(self.iterations)):
-            f = system.force(x, (x - xn) / h, t_new)
-            rhs = m * y + (h * h) * (f + L @ x)
-            x_free = fac["factor"].solve(rhs[free] - rhs_pinned)
-            change = np.abs(x_free - x[free]).max(initial=0.0)
-            x = x.copy()
-            x[free] = x_free
-            if self.tol is not None and change <= self.tol * length:
-                break
+            dx = ops.G_free @ x_free            # (s, d): x_j - x_i
+            if dx_pin is not None:
+                dx += dx_pin
+            ln = np.sqrt(np.einsum("sd,sd->s", dx, dx))
+            np.maximum(ln, ops.floor, out=ln)
+            dx /= ln[:, None]
+            rhs = ops.Jkr @ dx                  # J d, (nf, d)
+            if variable:
+                x[free] = x_free
+                rhs += system.variable_force(x, (x - xn) / h, t_new)[free]
+            rhs *= h * h
+            rhs += const
+            x_new = ops.factor.solve(np.asfortranarray(rhs))
+            if self.tol is not None:
+                change = np.abs(x_new - x_free).max(initial=0.0)
+                x_free = x_new
+                if change <= self.tol * length:
+                    break
+            else:
+                x_free = x_new
+        x[free] = x_free
         return StepperState(x, (x - xn) / h, t_new)
