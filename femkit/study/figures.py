@@ -56,6 +56,14 @@ def _style(i: int, s: dict) -> dict:
                 markersize=5, linewidth=1.6)
 
 
+def _legend(ax, n: int) -> None:
+    """Inside the axes for a few lines; outside on the right for many (never over the data)."""
+    if n > 6:
+        ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5))
+    else:
+        ax.legend(fontsize=8)
+
+
 def _slope_triangle(ax, xs: np.ndarray, ys: np.ndarray, order: float, *, decreasing_x: bool) -> None:
     """Reference triangle of slope ``order`` under the data, spanning a third of the x range (log)."""
     lx0, lx1 = np.log10(xs.min()), np.log10(xs.max())
@@ -111,7 +119,7 @@ def loglog_figure(path, series: Sequence[dict], *, title: str, xlabel: str, ylab
     if note:
         ax.text(0.01, 0.01, note, transform=ax.transAxes, fontsize=8, color="0.3", va="bottom")
     if allx:
-        ax.legend(fontsize=8)
+        _legend(ax, len(allx))
     return _save(fig, path)
 
 
@@ -143,7 +151,7 @@ def work_precision_figure(path, series: Sequence[dict], *, front: Iterable[tuple
     ax.grid(True, which="both", alpha=0.3)
     ax.text(0.99, 0.99, "better: lower left", transform=ax.transAxes, ha="right", va="top", fontsize=8, color="0.3")
     if any_data:
-        ax.legend(fontsize=8)
+        _legend(ax, len(series) + 1)
     return _save(fig, path)
 
 
@@ -168,7 +176,7 @@ def energy_figure(path, series: Sequence[dict], *, title: str, floor: float = 1e
     ax.set_ylabel("relative energy error |E(t) - E(0)| / |E(0)|")
     ax.grid(True, which="both", alpha=0.3)
     if drawn:
-        ax.legend(fontsize=8)
+        _legend(ax, len(series))
     return _save(fig, path)
 
 
@@ -199,11 +207,19 @@ def stability_map_figure(path, rows: Sequence[dict], *, title: str) -> str:
         ax.plot([b, b], [y - 0.35, y + 0.35], color="k", linewidth=2.5,
                 label="theoretical limit" if j == 0 else None, zorder=2)
     ax.set_xscale("log")
+    from matplotlib.ticker import FixedLocator, FormatStrFormatter, NullLocator
+
+    ticks = [t for t in (0.25, 0.5, 1.0, 2.0, 2.83, 4.0, 8.0, 16.0)
+             if len(hw) and hw.min() / 1.5 <= t <= hw.max() * 1.5]
+    if ticks:
+        ax.xaxis.set_major_locator(FixedLocator(ticks))
+        ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+        ax.xaxis.set_minor_locator(NullLocator())
     ax.set_yticks(range(len(methods)), methods)
     ax.set_ylim(-0.6, len(methods) - 0.4)
     ax.set_xlabel("dt * omega_max  (dimensionless step)")
     ax.set_title(title)
     ax.grid(True, axis="x", which="both", alpha=0.3)
     if rows:
-        ax.legend(fontsize=8, loc="best")
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3)
     return _save(fig, path)

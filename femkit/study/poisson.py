@@ -304,8 +304,7 @@ def _nested_runs(study, spec, meshes, mesh_times, records):
             stop = None
             if prev is None:
                 x0 = None
-                t0 = time.perf_counter()
-                res = _solve(sys, s)
+                tc = time_call(lambda: _solve(sys, s), repeats=d["repeats"], warmup=0)
             else:
                 x0 = interpolate_nested(meshes[lvl - 1], mesh, prev)[sys.free]
                 incs, last = [], [x0.copy()]
@@ -322,12 +321,9 @@ def _nested_runs(study, spec, meshes, mesh_times, records):
                     kw["preconditioner"] = s.get("preconditioner") or "amg"
                 _raw_solve(sys.A, sys.b, x0.copy(), method=s["method"], callback=cb, **kw)
                 stop, eta = _stop_iteration(np.array(incs), frac, eta)
-                t0 = time.perf_counter()
-                if stop is None:
-                    res = _solve(sys, s, x0=x0.copy())
-                else:
-                    res = _solve(sys, {**s, "maxiter": max(stop, 1)}, x0=x0.copy())
-            t_solve = time.perf_counter() - t0
+                s_run = s if stop is None else {**s, "maxiter": max(stop, 1)}
+                tc = time_call(lambda: _solve(sys, s_run, x0=x0.copy()), repeats=d["repeats"], warmup=0)
+            res, t_solve = tc.value, tc.min  # min over repeats, like the fixed-rtol runs
             u = sys.expand(res.x)
             prev = u
             eta_used = eta

@@ -33,7 +33,7 @@ def build_dynamics_report(report, study, result, data, stage) -> None:
         rows = [r for r in recs if r["integrator"] == lab and r["stable"]]
         series.append({"label": lab, "x": [r["dt"] for r in rows], "y": [r["error_max"] for r in rows],
                        "fit": fits.get(lab, {}).get("fit")})
-    F.loglog_figure(stage / "figures" / "error_vs_dt.png", series, title=f"{study.title}: error vs time step",
+    F.loglog_figure(stage / "figures" / "error_vs_dt.png", series, title="Error vs time step",
                     xlabel="time step dt [s]", ylabel="max position error over the trajectory [length]",
                     triangle=2, note="dotted: fitted order; triangle: slope 2")
     report.figure("figures/error_vs_dt.png", "Error against dt, fitted orders in the legend (unstable runs omitted)")
@@ -48,7 +48,7 @@ def build_dynamics_report(report, study, result, data, stage) -> None:
             idx.append(recs.index(r))
     front = pareto_front(t_all, e_all)
     F.work_precision_figure(stage / "figures" / "work_precision.png", wp, front=[(t_all[i], e_all[i]) for i in front],
-                            title=f"{study.title}: error vs run time",
+                            title="Work-precision: error vs run time",
                             xlabel="wall time [s] (min over repeats)", ylabel="max position error [length]")
     report.figure("figures/work_precision.png", "Work-precision: error against wall time, Pareto front highlighted")
     on_front = {idx[i] for i in front}
@@ -63,7 +63,7 @@ def build_dynamics_report(report, study, result, data, stage) -> None:
         if e is not None:
             es.append({"label": lab, "x": e[0], "y": e[1]})
     F.energy_figure(stage / "figures" / "energy_vs_time.png", es,
-                    title=f"{study.title}: energy error, dt = {mid:.4g}")
+                    title=f"Energy error at dt = {mid:.4g}")
     report.figure("figures/energy_vs_time.png",
                   f"Relative energy error against time at dt = {mid:.4g} (symplectic methods stay bounded)")
 
@@ -80,7 +80,7 @@ def build_dynamics_report(report, study, result, data, stage) -> None:
         for r in rows:
             r["bound"] = bounds.get(r["method"])
         F.stability_map_figure(stage / "figures" / "stability.png", rows,
-                               title=f"{study.title}: which runs survived")
+                               title="Which runs survived")
         report.figure("figures/stability.png", "Survived (o) and unstable (x) runs against dt * omega_max; "
                       "black bars: the method's theoretical limit")
 

@@ -54,12 +54,12 @@ def build_poisson_report(report, study, result, data, stage) -> None:
             base = {"label": lab, "reference": src != "femkit"}
             series_h.append({**base, "x": [r["h"] for r in rows_k], "y": y, "fit": fits.get((*key, norm), {}).get("fit")})
             series_dofs.append({**base, "x": [r["dofs"] for r in rows_k], "y": y})
-    F.loglog_figure(stage / "figures" / "error_vs_h.png", series_h, title=f"{study.title}: error vs mesh size",
+    F.loglog_figure(stage / "figures" / "error_vs_h.png", series_h, title="Error vs mesh size",
                     xlabel="h, longest edge [length]", ylabel="error norm", triangle=2, invert_x=True,
                     note="dotted: least-squares fit; triangle: slope 2")
     report.heading("Figures")
     report.figure("figures/error_vs_h.png", "Error against mesh size h (finer to the right), fitted rates in the legend")
-    F.loglog_figure(stage / "figures" / "error_vs_dofs.png", series_dofs, title=f"{study.title}: error vs unknowns",
+    F.loglog_figure(stage / "figures" / "error_vs_dofs.png", series_dofs, title="Error vs unknowns",
                     xlabel="degrees of freedom (free unknowns)", ylabel="error norm", triangle=-1,
                     note="triangle: slope -1 (L2 ~ h^2 ~ 1/dofs in 2D)")
     report.figure("figures/error_vs_dofs.png", "Error against the number of unknowns")
@@ -77,7 +77,7 @@ def build_poisson_report(report, study, result, data, stage) -> None:
                           "x": [n["dofs"] for n in rows_n], "y": [n["iterations_nested"] for n in rows_n]})
     if it_series:
         F.loglog_figure(stage / "figures" / "iterations_vs_dofs.png", it_series,
-                        title=f"{study.title}: iterations vs unknowns", xlabel="degrees of freedom",
+                        title="Iterations vs unknowns", xlabel="degrees of freedom",
                         ylabel="iterations to the stopping rule")
         report.figure("figures/iterations_vs_dofs.png", "Iterations against unknowns (AMG flat, CG ~ dofs^0.5)")
 
@@ -92,7 +92,7 @@ def build_poisson_report(report, study, result, data, stage) -> None:
     front = pareto_front(t_all, e_all)
     F.work_precision_figure(stage / "figures" / "work_precision.png", wp,
                             front=[(t_all[i], e_all[i]) for i in front],
-                            title=f"{study.title}: L2 error vs run time",
+                            title="Work-precision: L2 error vs run time",
                             xlabel="run time: assembly + boundary + solve [s] (min over repeats)",
                             ylabel="L2 error")
     report.figure("figures/work_precision.png",

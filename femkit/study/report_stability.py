@@ -70,7 +70,7 @@ def build_stability_report(report, study, result, data, stage) -> None:
         rows = [{"method": r["method"], "h_omega": r["h_omega"], "stable": r["survived"],
                  "bound": r["bound"] if r["bound"] > 0 else None} for r in dyn]
         F.stability_map_figure(stage / "figures" / "stability_map.png", rows,
-                               title=f"{study.title}: explicit integrators, all stiffness/mass cases")
+                               title="Explicit integrators across the critical step")
         report.figure("figures/stability_map.png",
                       f"Survived (o) / unstable (x) runs of {', '.join(methods_d)} against dt * omega_max over "
                       "every stiffness and mass ratio; black bars: theoretical limits")
@@ -89,7 +89,7 @@ def build_stability_report(report, study, result, data, stage) -> None:
                     series.append({"label": f"{case}: {m}", "x": xs, "y": [r["iterations"] for r in rs]})
         if series:
             F.loglog_figure(stage / "figures" / "iterations_vs_parameter.png", series,
-                            title=f"{study.title}: iterations vs stress parameter",
+                            title="Iterations vs stress parameter",
                             xlabel="stress parameter (contrast, aspect ratio, scale, sliver size, ...)",
                             ylabel="iterations to the requested true residual")
             report.figure("figures/iterations_vs_parameter.png", "Iterations against each case's stress parameter")
