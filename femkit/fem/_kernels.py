@@ -1,4 +1,8 @@
-"""Compiled (numba) kernels; imported only when a large mesh asks for them."""
+"""Compiled (numba) kernels; imported only when a large mesh asks for them.
+
+All kernels are serial (``parallel=False``): the benchmark and CI pin one thread, and the
+loops are memory-bound.  They are compiled on first use and cached on disk (``cache=True``).
+"""
 
 from __future__ import annotations
 
@@ -7,132 +11,217 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def _pattern(tri, n):  # pragma: no cover - compiled
-    """Edge-based P1 pattern: row i = [lower neighbours] [i] [upper neighbours], sorted."""
+def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  # pragma: no cover - compiled
+    """Node-wise P1 pattern: row i = sorted unique vertices of the elements around node i.
+
+    ``indices`` is a buffer of at least ``n + 6 m`` entries (each element adds at most three
+    edges, two entries each); ``slots`` (m, 9) is filled.  With ``with_data`` the stiffness
+    (coefficient ``kappa``) is summed in the same element-order pass that writes the slots.
+    Returns ``(indptr, nnz, data, number of bad areas)`` (``data`` empty without ``with_data``).
+
+    Node numbers of a mesh are far apart within an element, so node-wise passes over
+    ``tri`` would read it at random.  Instead the element's vertices are copied into the
+    node -> incidence list while it is built (one sequential read of ``tri``), the rows are
+    built from that list sequentially (overwriting each vertex with its CSR position), and
+    the slots are gathered back in element order.
+    """
     m = tri.shape[0]
-    # 1. each element edge (lo, hi) is a candidate in row lo (counting sort by lo).
+    # 1. node -> incidences, by counting sort; each incidence carries the element's vertices.
     start = np.zeros(n + 1, np.int64)
     for e in range(m):
         for a in range(3):
-            i, j = tri[e, a], tri[e, (a + 1) % 3]
-            start[min(i, j) + 1] += 1
+            start[tri[e, a] + 1] += 1
     for i in range(n):
         start[i + 1] += start[i]
-    fill = start[:-1].copy()
-    cand_col = np.empty(3 * m, np.int64)
-    cand_src = np.empty(3 * m, np.int64)  # 3 e + a: edge from vertex a to a+1
+    verts = np.empty((3 * m, 3), slots.dtype)  # incidence k: the three vertices of its element
+    where = np.empty(3 * m, slots.dtype)  # 3 e + a -> incidence k
     for e in range(m):
+        v0, v1, v2 = tri[e, 0], tri[e, 1], tri[e, 2]
         for a in range(3):
-            i, j = tri[e, a], tri[e, (a + 1) % 3]
-            lo = min(i, j)
-            k = fill[lo]
-            cand_col[k] = max(i, j)
-            cand_src[k] = 3 * e + a
-            fill[lo] = k + 1
-    # 2. per row: insertion sort of the candidates, de-duplicate -> unique upper neighbours.
-    edge_of = np.empty(3 * m, np.int64)  # candidate -> unique edge number
-    n_up = np.zeros(n, np.int64)
-    n_low = np.zeros(n, np.int64)
-    up_start = np.zeros(n + 1, np.int64)
-    n_edges = 0
-    for i in range(n):
-        s, t = start[i], start[i + 1]
-        for k in range(s + 1, t):
-            c, src = cand_col[k], cand_src[k]
-            j = k - 1
-            while j >= s and cand_col[j] > c:
-                cand_col[j + 1] = cand_col[j]
-                cand_src[j + 1] = cand_src[j]
-                j -= 1
-            cand_col[j + 1] = c
-            cand_src[j + 1] = src
-        last = -1
-        u = -1
-        for k in range(s, t):
-            c = cand_col[k]
-            if c != last:
-                u += 1
-                last = c
-                cand_col[s + u] = c
-                n_low[c] += 1
-            edge_of[cand_src[k]] = n_edges + u
-        n_up[i] = u + 1
-        n_edges += u + 1
-        up_start[i + 1] = n_edges
-    # 3. CSR: row i holds n_low[i] + 1 + n_up[i] entries.
+            i = tri[e, a]
+            k = start[i]
+            start[i] = k + 1
+            verts[k, 0] = v0
+            verts[k, 1] = v1
+            verts[k, 2] = v2
+            where[3 * e + a] = k
+    for i in range(n, 0, -1):  # start[i] now holds the old start[i + 1]: shift back
+        start[i] = start[i - 1]
+    start[0] = 0
+    # 2. per row: unique neighbours (stamp array), insertion sort (rows are short, ~7), then
+    #    each incidence's vertices replaced by the CSR positions of (i, vertex).
     indptr = np.zeros(n + 1, np.int64)
+    stamp = np.full(n, -1, np.int64)
+    pos = np.empty(n, slots.dtype)
+    nnz = 0
     for i in range(n):
-        indptr[i + 1] = indptr[i] + n_low[i] + 1 + n_up[i]
-    indices = np.empty(indptr[n], np.int64)
-    slot_up = np.empty(n_edges, np.int64)
-    slot_low = np.empty(n_edges, np.int64)
-    low_fill = indptr[:-1].copy()
-    diag = np.empty(n, np.int64)
-    for i in range(n):  # ascending i: lower parts of later rows are filled in sorted order
-        d = indptr[i] + n_low[i]
-        diag[i] = d
-        indices[d] = i
-        s = start[i]
-        for k in range(n_up[i]):
-            j = cand_col[s + k]
-            q = up_start[i] + k
-            slot_up[q] = d + 1 + k
-            indices[d + 1 + k] = j
-            slot_low[q] = low_fill[j]
-            indices[low_fill[j]] = i
-            low_fill[j] += 1
-    # 4. element slot map.
-    slots = np.empty((m, 9), np.int64)
+        s = nnz
+        for k in range(start[i], start[i + 1]):
+            for b in range(3):
+                j = verts[k, b]
+                if stamp[j] != i:
+                    stamp[j] = i
+                    q = nnz
+                    while q > s and indices[q - 1] > j:
+                        indices[q] = indices[q - 1]
+                        q -= 1
+                    indices[q] = j
+                    nnz += 1
+        for q in range(s, nnz):
+            pos[indices[q]] = q
+        for k in range(start[i], start[i + 1]):
+            for b in range(3):
+                verts[k, b] = pos[verts[k, b]]
+        indptr[i + 1] = nnz
+    # 3. slots in element order: entry (e, a, b) is position b of incidence (e, a); with
+    #    with_data the local stiffness goes straight to those positions.
+    data = np.zeros(nnz if with_data else 0)
+    bad = 0
     for e in range(m):
         for a in range(3):
-            slots[e, 4 * a] = diag[tri[e, a]]
-        for a in range(3):
-            b = (a + 1) % 3
-            q = edge_of[3 * e + a]
-            if tri[e, a] < tri[e, b]:
-                slots[e, 3 * a + b] = slot_up[q]
-                slots[e, 3 * b + a] = slot_low[q]
-            else:
-                slots[e, 3 * a + b] = slot_low[q]
-                slots[e, 3 * b + a] = slot_up[q]
-    return indptr, indices, slots
+            k = where[3 * e + a]
+            for b in range(3):
+                slots[e, 3 * a + b] = verts[k, b]
+        if with_data:
+            _, _, _, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(tri, points, e)
+            if not (area > 0.0 and area < np.inf):
+                bad += 1
+                continue
+            sc = (kappa[0] if scalar_kappa else kappa[e]) / (4.0 * area)
+            d00, d11, d22, d01, d02, d12 = _local_stiffness(sc, ex0, ey0, ex1, ey1, ex2, ey2)
+            data[slots[e, 0]] += d00
+            data[slots[e, 1]] += d01
+            data[slots[e, 2]] += d02
+            data[slots[e, 3]] += d01
+            data[slots[e, 4]] += d11
+            data[slots[e, 5]] += d12
+            data[slots[e, 6]] += d02
+            data[slots[e, 7]] += d12
+            data[slots[e, 8]] += d22
+    return indptr, nnz, data, bad
 
 
-def pattern_kernel(tri: np.ndarray, n: int):
-    """CSR ``indptr``, ``indices`` and the (m, 9) slot map of the P1 pattern (compiled)."""
-    return _pattern(np.ascontiguousarray(tri, dtype=np.int64), int(n))
+def pattern_kernel(tri: np.ndarray, n: int, points: np.ndarray | None = None, kappa=None):
+    """CSR ``indptr``, ``indices``, the (m, 9) slot map of the P1 pattern (compiled) and, when
+    ``points`` and ``kappa`` (a float or one value per element) are given, the CSR data of the
+    stiffness summed in the same pass (None if some triangle is degenerate; else None too
+    when not asked).
+
+    ``indices`` and ``slots`` are int32 when the entry count allows it (half the memory
+    traffic of int64), else int64.
+    """
+    tri = np.ascontiguousarray(tri, dtype=np.int64)
+    n = int(n)
+    m = tri.shape[0]
+    bound = n + 6 * m
+    dtype = np.int32 if bound < np.iinfo(np.int32).max else np.int64
+    indices = np.empty(bound, dtype)
+    slots = np.empty((m, 9), dtype)
+    with_data = points is not None and kappa is not None
+    pts = np.ascontiguousarray(points, dtype=np.float64) if with_data else np.zeros((0, 2))
+    kap, scalar = _values(kappa if with_data else 1.0)
+    indptr, nnz, data, bad = _pattern(tri, n, indices, slots, pts, kap, scalar, with_data)
+    return indptr, indices[:nnz].copy(), slots, (data if with_data and not bad else None)
 
 
 @numba.njit(cache=True)
-def _stiffness(tri, points, idx, kappa, slots, nnz):  # pragma: no cover - compiled
+def _triangle(tri, points, e):  # pragma: no cover - compiled
+    """Vertices, edges opposite each vertex ``(ex_a, ey_a)`` and area of element ``e``."""
+    i0, i1, i2 = tri[e, 0], tri[e, 1], tri[e, 2]
+    ex0, ey0 = points[i2, 0] - points[i1, 0], points[i2, 1] - points[i1, 1]
+    ex1, ey1 = points[i0, 0] - points[i2, 0], points[i0, 1] - points[i2, 1]
+    ex2, ey2 = points[i1, 0] - points[i0, 0], points[i1, 1] - points[i0, 1]
+    area = 0.5 * abs(ex2 * ey0 - ey2 * ex0)
+    return i0, i1, i2, ex0, ey0, ex1, ey1, ex2, ey2, area
+
+
+@numba.njit(cache=True)
+def _local_stiffness(s, ex0, ey0, ex1, ey1, ex2, ey2):  # pragma: no cover - compiled
+    """The 6 distinct entries ``s (e_a . e_b)``: (00, 11, 22, 01, 02, 12)."""
+    return (s * (ex0 * ex0 + ey0 * ey0), s * (ex1 * ex1 + ey1 * ey1), s * (ex2 * ex2 + ey2 * ey2),
+            s * (ex0 * ex1 + ey0 * ey1), s * (ex0 * ex2 + ey0 * ey2), s * (ex1 * ex2 + ey1 * ey2))
+
+
+@numba.njit(cache=True)
+def _stiffness(tri, points, idx, use_idx, kappa, scalar_kappa, slots, nnz):  # pragma: no cover - compiled
     """Fused local stiffness + scatter into CSR data; returns (data, number of bad areas)."""
     data = np.zeros(nnz)
-    ex = np.empty(3)
-    ey = np.empty(3)
+    count = idx.shape[0] if use_idx else tri.shape[0]
     bad = 0
-    for k in range(idx.shape[0]):
-        e = idx[k]
-        i0, i1, i2 = tri[e, 0], tri[e, 1], tri[e, 2]
-        ex[0] = points[i2, 0] - points[i1, 0]
-        ey[0] = points[i2, 1] - points[i1, 1]
-        ex[1] = points[i0, 0] - points[i2, 0]
-        ey[1] = points[i0, 1] - points[i2, 1]
-        ex[2] = points[i1, 0] - points[i0, 0]
-        ey[2] = points[i1, 1] - points[i0, 1]
-        area = 0.5 * abs(ex[2] * ey[0] - ey[2] * ex[0])
-        if not area > 0.0:
+    for k in range(count):
+        e = idx[k] if use_idx else k
+        i0, i1, i2, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(tri, points, e)
+        if not (area > 0.0 and area < np.inf):
             bad += 1
             continue
-        s = kappa[k] / (4.0 * area)
-        for a in range(3):
-            for b in range(3):
-                data[slots[e, 3 * a + b]] += s * (ex[a] * ex[b] + ey[a] * ey[b])
+        s = (kappa[0] if scalar_kappa else kappa[k]) / (4.0 * area)
+        d00, d11, d22, d01, d02, d12 = _local_stiffness(s, ex0, ey0, ex1, ey1, ex2, ey2)
+        data[slots[e, 0]] += d00
+        data[slots[e, 1]] += d01
+        data[slots[e, 2]] += d02
+        data[slots[e, 3]] += d01
+        data[slots[e, 4]] += d11
+        data[slots[e, 5]] += d12
+        data[slots[e, 6]] += d02
+        data[slots[e, 7]] += d12
+        data[slots[e, 8]] += d22
     return data, bad
 
 
 def stiffness_kernel(mesh, idx, kappa, pattern):
-    """CSR data of the stiffness of elements ``idx`` (kappa per selected element), or None if
-    some triangle is degenerate (the caller's numpy path then raises with the ids)."""
-    data, bad = _stiffness(mesh.triangles, mesh.points, idx, np.ascontiguousarray(kappa, dtype=np.float64),
-                           pattern.slots, pattern.nnz)
+    """CSR data of the stiffness of elements ``idx`` (None: all), or None if some triangle is
+    degenerate (the caller's numpy path then raises with the ids).
+
+    ``kappa`` is a float (the same for every element) or one value per selected element.
+    """
+    data, bad = _stiffness(mesh.triangles, mesh.points, *_selection(idx), *_values(kappa), pattern.slots, pattern.nnz)
     return None if bad else data
+
+
+@numba.njit(cache=True)
+def _load_barycentric(tri, points, idx, use_idx, fvals, scalar_f, n):  # pragma: no cover - compiled
+    """One-point load ``F_j += |T| f(c) / 3``; returns (F, number of bad areas)."""
+    out = np.zeros(n)
+    count = idx.shape[0] if use_idx else tri.shape[0]
+    bad = 0
+    for k in range(count):
+        e = idx[k] if use_idx else k
+        i0, i1, i2, _, _, _, _, _, _, area = _triangle(tri, points, e)
+        if not (area > 0.0 and area < np.inf):
+            bad += 1
+            continue
+        w = area * ((fvals[0] if scalar_f else fvals[k]) / 3.0)
+        out[i0] += w
+        out[i1] += w
+        out[i2] += w
+    return out, bad
+
+
+def load_kernel(mesh, idx, fvals):
+    """Barycentric-rule load vector of elements ``idx`` (None: all) with ``fvals`` a float or
+    one value of ``f`` per selected element's centroid; None if some triangle is degenerate."""
+    out, bad = _load_barycentric(mesh.triangles, mesh.points, *_selection(idx), *_values(fvals), mesh.n_points)
+    return None if bad else out
+
+
+def _selection(idx):
+    """Kernel arguments ``(idx array, use_idx)`` for an element subset (None: all)."""
+    if idx is None:
+        return np.zeros(0, np.int64), False
+    return np.ascontiguousarray(idx, dtype=np.int64), True
+
+
+def _values(values):
+    """Kernel arguments ``(float64 array, is_scalar)`` for a scalar or per-element values."""
+    return np.ascontiguousarray(np.atleast_1d(np.asarray(values, dtype=np.float64))), np.ndim(values) == 0
+
+
+def warm_up() -> None:
+    """Compile (or load from the on-disk cache) every kernel on a two-triangle mesh."""
+    tri = np.array([[0, 1, 2], [0, 2, 3]], dtype=np.int64)
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    ind = np.empty(4 + 12, np.int32)  # int32 slots: every mesh below 2**31 entries
+    slots = np.empty((2, 9), np.int32)
+    _, nnz, _, _ = _pattern(tri, 4, ind, slots, pts, np.ones(1), True, True)
+    _stiffness(tri, pts, np.zeros(1, np.int64), False, np.ones(1), True, slots, nnz)
+    _load_barycentric(tri, pts, np.zeros(1, np.int64), False, np.ones(1), True, 4)

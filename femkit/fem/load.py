@@ -21,11 +21,13 @@ from ..errors import InputError
 from ._elements import check_areas, select_elements
 from .coefficients import evaluate_callable
 from .quadrature import get_rule
+from .sparsity import NUMBA_THRESHOLD
 
 Source = Union[float, Callable]
 
 
-def assemble_load(mesh, f: Source, *, rule: str = "barycentric", elements=None) -> np.ndarray:
+def assemble_load(mesh, f: Source, *, rule: str = "barycentric", elements=None,
+                  backend: str = "auto") -> np.ndarray:
     """Assemble the load vector of the source ``f``.
 
     Parameters
@@ -36,6 +38,11 @@ def assemble_load(mesh, f: Source, *, rule: str = "barycentric", elements=None) 
         Quadrature rule name: ``barycentric`` (default, one point), ``gauss3``, ``gauss6``, ``gauss7``.
     elements : index array or boolean mask, optional
         Integrate over these elements only (global-size result).
+    backend : {"auto", "numpy", "numba"}
+        How the ``barycentric`` rule is summed: ``numpy`` (``np.bincount``), ``numba`` (one
+        compiled pass computing areas and scattering, imported lazily, cached on disk), ``auto``
+        (numba from :data:`~femkit.fem.sparsity.NUMBA_THRESHOLD` selected elements on).
+        Callables are evaluated by numpy either way; other rules always use numpy.
 
     Returns
     -------
@@ -43,16 +50,21 @@ def assemble_load(mesh, f: Source, *, rule: str = "barycentric", elements=None) 
     """
     quad = get_rule(rule)
     idx = select_elements(mesh, elements)
+    if backend not in ("auto", "numpy", "numba"):
+        raise InputError(f"unknown assembly backend {backend!r}; valid: auto, numba, numpy")
+    count = mesh.n_triangles if idx is None else len(idx)
+    if backend == "auto":
+        backend = "numba" if count >= NUMBA_THRESHOLD else "numpy"
+    if backend == "numba" and quad.points.shape[0] == 1 and np.all(quad.points == quad.points[0, 0]):
+        # a centroid rule (weights sum to 1): the kernel's |T| f(c) / 3 per vertex
+        out = _load_numba(mesh, f, quad, idx)
+        if out is not None:
+            return out
     tri = mesh.triangles if idx is None else mesh.triangles[idx]
     area = _areas(mesh, tri)
     check_areas(area, idx)
     if callable(f):
-        x, y = quad.physical_points(mesh, tri)  # (m, q)
-        fq = evaluate_callable(f, x, y, name="f")
-        if not np.isfinite(fq).all():
-            bad = np.flatnonzero(~np.isfinite(fq).all(axis=1))
-            ids = bad if idx is None else idx[bad]
-            raise InputError(f"source f is not finite on {len(ids)} element(s), first ids {ids[:10].tolist()}")
+        fq = _source_values(mesh, f, quad, tri, idx)
         # local[e, a] = |T_e| sum_q w_q f(x_q) lambda_a(x_q)
         local = (fq * quad.weights) @ quad.points
         local *= area[:, None]
@@ -60,6 +72,30 @@ def assemble_load(mesh, f: Source, *, rule: str = "barycentric", elements=None) 
     w = area * (_scalar(f) / 3.0)  # the same share for the three vertices
     n = mesh.n_points
     return sum(np.bincount(tri[:, a], weights=w, minlength=n) for a in range(3))
+
+
+def _source_values(mesh, f, quad, tri, idx) -> np.ndarray:
+    """``f`` at the rule's physical points, (k, q); raises naming elements where it is not finite."""
+    x, y = quad.physical_points(mesh, tri)  # (m, q)
+    fq = evaluate_callable(f, x, y, name="f")
+    if not np.isfinite(fq).all():
+        bad = np.flatnonzero(~np.isfinite(fq).all(axis=1))
+        ids = bad if idx is None else idx[bad]
+        raise InputError(f"source f is not finite on {len(ids)} element(s), first ids {ids[:10].tolist()}")
+    return fq
+
+
+def _load_numba(mesh, f, quad, idx):
+    """One-point rule through the compiled kernel; None when some triangle is degenerate
+    (the numpy path then raises naming them)."""
+    from ._kernels import load_kernel
+
+    if callable(f):
+        tri = mesh.triangles if idx is None else mesh.triangles[idx]
+        fvals = _source_values(mesh, f, quad, tri, idx)[:, 0]
+    else:
+        fvals = _scalar(f)
+    return load_kernel(mesh, idx, fvals)
 
 
 def _areas(mesh, tri):

@@ -43,6 +43,15 @@ def local_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None) -> np.ndar
     return local
 
 
+def _kernel_coefficient(mesh, kappa, idx):
+    """A valid scalar kappa as a float (the kernel broadcasts it), else per-element values."""
+    if isinstance(kappa, (int, float, np.floating, np.integer)) and not isinstance(kappa, bool):
+        val = float(kappa)
+        if np.isfinite(val) and val > 0:
+            return val
+    return element_coefficient(mesh, kappa, idx)  # validates (raises with the reason)
+
+
 def edge_components(mesh, idx):
     """x and y components of the edges opposite each vertex (3 arrays each) and the areas."""
     tri = mesh.triangles if idx is None else mesh.triangles[idx]
@@ -80,19 +89,25 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
     scipy.sparse.csr_matrix, shape (n, n)
         Symmetric, sorted indices, the full P1 pattern.
     """
-    if pattern is None:
-        pattern = SparsityPattern.for_mesh(mesh)
-    else:
-        pattern.check(mesh)
     idx = select_elements(mesh, elements)
     count = mesh.n_triangles if idx is None else len(idx)
     if backend == "auto":
         backend = "numba" if count >= NUMBA_THRESHOLD else "numpy"
+    if pattern is None:
+        pattern = SparsityPattern.cached(mesh)
+        if pattern is None and backend == "numba" and idx is None:
+            # first assembly on a large mesh: pattern, slots and stiffness in one pass
+            pattern, data = SparsityPattern.with_stiffness(mesh, _kernel_coefficient(mesh, kappa, None))
+            if data is not None:
+                return pattern.matrix(data)
+        if pattern is None:
+            pattern = SparsityPattern.for_mesh(mesh)
+    else:
+        pattern.check(mesh)
     if backend == "numba":
         from ._kernels import stiffness_kernel
 
-        kap = element_coefficient(mesh, kappa, idx)
-        data = stiffness_kernel(mesh, np.arange(count) if idx is None else idx, kap, pattern)
+        data = stiffness_kernel(mesh, idx, _kernel_coefficient(mesh, kappa, idx), pattern)
         if data is not None:
             return pattern.matrix(data)
     elif backend != "numpy":

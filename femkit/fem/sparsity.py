@@ -81,11 +81,35 @@ class SparsityPattern:
         elif backend == "numba":
             from ._kernels import pattern_kernel
 
-            indptr, indices, slots = pattern_kernel(tri, n)
+            indptr, indices, slots, _ = pattern_kernel(tri, n)
         else:
             raise InputError(f"unknown sparsity backend {backend!r}; valid: auto, numba, numpy")
+        return cls._from_arrays(n, indptr, indices, slots)
+
+    @classmethod
+    def _from_arrays(cls, n, indptr, indices, slots) -> "SparsityPattern":
         idx_dtype = np.int32 if max(len(indices), n) < np.iinfo(np.int32).max else np.int64
         return cls(n, indptr.astype(idx_dtype, copy=False), indices.astype(idx_dtype, copy=False), slots)
+
+    @classmethod
+    def with_stiffness(cls, mesh, kappa) -> "tuple[SparsityPattern, np.ndarray | None]":
+        """Build (and cache) the pattern of ``mesh`` and the CSR data of its stiffness matrix
+        for ``kappa`` (a float or one value per element) in one compiled pass.
+
+        This is the first assembly on a large mesh: the element-order pass that writes the
+        slot map sums the local matrices too.  ``data`` is None if a triangle is degenerate.
+        """
+        from ._kernels import pattern_kernel
+
+        indptr, indices, slots, data = pattern_kernel(mesh.triangles, mesh.n_points, mesh.points, kappa)
+        pat = cls._from_arrays(mesh.n_points, indptr, indices, slots)
+        _CACHE[mesh] = pat
+        return pat, data
+
+    @classmethod
+    def cached(cls, mesh) -> "SparsityPattern | None":
+        """The cached pattern of ``mesh``, or None if none was built yet."""
+        return _CACHE.get(mesh)
 
     @classmethod
     def for_mesh(cls, mesh) -> "SparsityPattern":
