@@ -88,16 +88,7 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
                 bad += 1
                 continue
             sc = (kappa[0] if scalar_kappa else kappa[e]) / (4.0 * area)
-            d00, d11, d22, d01, d02, d12 = _local_stiffness(sc, ex0, ey0, ex1, ey1, ex2, ey2)
-            data[slots[e, 0]] += d00
-            data[slots[e, 1]] += d01
-            data[slots[e, 2]] += d02
-            data[slots[e, 3]] += d01
-            data[slots[e, 4]] += d11
-            data[slots[e, 5]] += d12
-            data[slots[e, 6]] += d02
-            data[slots[e, 7]] += d12
-            data[slots[e, 8]] += d22
+            _add_local_stiffness(data, slots, e, sc, ex0, ey0, ex1, ey1, ex2, ey2)
     return indptr, nnz, data, bad
 
 
@@ -136,10 +127,20 @@ def _triangle(tri, points, e):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _local_stiffness(s, ex0, ey0, ex1, ey1, ex2, ey2):  # pragma: no cover - compiled
-    """The 6 distinct entries ``s (e_a . e_b)``: (00, 11, 22, 01, 02, 12)."""
-    return (s * (ex0 * ex0 + ey0 * ey0), s * (ex1 * ex1 + ey1 * ey1), s * (ex2 * ex2 + ey2 * ey2),
-            s * (ex0 * ex1 + ey0 * ey1), s * (ex0 * ex2 + ey0 * ey2), s * (ex1 * ex2 + ey1 * ey2))
+def _add_local_stiffness(data, slots, e, s, ex0, ey0, ex1, ey1, ex2, ey2):  # pragma: no cover - compiled
+    """``data[slots[e, 3 a + b]] += s (e_a . e_b)``: element e's local matrix into CSR data."""
+    d01 = s * (ex0 * ex1 + ey0 * ey1)
+    d02 = s * (ex0 * ex2 + ey0 * ey2)
+    d12 = s * (ex1 * ex2 + ey1 * ey2)
+    data[slots[e, 0]] += s * (ex0 * ex0 + ey0 * ey0)
+    data[slots[e, 1]] += d01
+    data[slots[e, 2]] += d02
+    data[slots[e, 3]] += d01
+    data[slots[e, 4]] += s * (ex1 * ex1 + ey1 * ey1)
+    data[slots[e, 5]] += d12
+    data[slots[e, 6]] += d02
+    data[slots[e, 7]] += d12
+    data[slots[e, 8]] += s * (ex2 * ex2 + ey2 * ey2)
 
 
 @numba.njit(cache=True)
@@ -155,16 +156,7 @@ def _stiffness(tri, points, idx, use_idx, kappa, scalar_kappa, slots, nnz):  # p
             bad += 1
             continue
         s = (kappa[0] if scalar_kappa else kappa[k]) / (4.0 * area)
-        d00, d11, d22, d01, d02, d12 = _local_stiffness(s, ex0, ey0, ex1, ey1, ex2, ey2)
-        data[slots[e, 0]] += d00
-        data[slots[e, 1]] += d01
-        data[slots[e, 2]] += d02
-        data[slots[e, 3]] += d01
-        data[slots[e, 4]] += d11
-        data[slots[e, 5]] += d12
-        data[slots[e, 6]] += d02
-        data[slots[e, 7]] += d12
-        data[slots[e, 8]] += d22
+        _add_local_stiffness(data, slots, e, s, ex0, ey0, ex1, ey1, ex2, ey2)
     return data, bad
 
 
