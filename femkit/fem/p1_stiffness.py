@@ -82,13 +82,18 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
     backend : {"auto", "numpy", "numba"}
         ``numpy``: (m, 3, 3) local matrices + ``np.bincount``; ``numba``: one fused compiled
         loop (imported lazily, cached on disk); ``auto``: numba from
-        :data:`~femkit.fem.sparsity.NUMBA_THRESHOLD` selected elements on.
+        :data:`~femkit.fem.sparsity.NUMBA_THRESHOLD` selected elements on.  A first numba
+        assembly of the whole mesh without a cached pattern builds the pattern and sums the
+        matrix in the same compiled pass (:meth:`SparsityPattern.with_stiffness`) and caches
+        the pattern for later calls.
 
     Returns
     -------
     scipy.sparse.csr_matrix, shape (n, n)
         Symmetric, sorted indices, the full P1 pattern.
     """
+    if backend not in ("auto", "numpy", "numba"):
+        raise InputError(f"unknown assembly backend {backend!r}; valid: auto, numba, numpy")
     idx = select_elements(mesh, elements)
     count = mesh.n_triangles if idx is None else len(idx)
     if backend == "auto":
@@ -110,7 +115,5 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
         data = stiffness_kernel(mesh, idx, _kernel_coefficient(mesh, kappa, idx), pattern)
         if data is not None:
             return pattern.matrix(data)
-    elif backend != "numpy":
-        raise InputError(f"unknown assembly backend {backend!r}; valid: auto, numba, numpy")
     local = local_stiffness(mesh, kappa, elements=idx)
     return pattern.assemble(local, elements=idx)

@@ -45,7 +45,8 @@ class SparsityPattern:
         CSR structure with sorted column indices (int32 when it fits).
     slots : ndarray, shape (m, 9)
         ``slots[e, 3 a + b]`` is the index into CSR ``data`` of entry
-        ``(triangles[e, a], triangles[e, b])``.
+        ``(triangles[e, a], triangles[e, b])`` (int32 from the compiled builder when the
+        entry count fits, else int64).
     """
 
     n: int

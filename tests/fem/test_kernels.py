@@ -76,6 +76,13 @@ def test_load_kernel_names_degenerate_and_bad_source():
         assemble_load(good, 1.0, backend="fortran")
 
 
+def test_unknown_stiffness_backend_raises_before_any_work():
+    good = Mesh(np.array([[0, 0], [1, 0], [0, 1]], float), [[0, 1, 2]])
+    with pytest.raises(InputError, match="'fortran'; valid: auto, numba, numpy"):
+        assemble_stiffness(good, backend="fortran")
+    assert SparsityPattern.cached(good) is None
+
+
 @pytest.mark.parametrize("kappa", [2.5, "per-element"])
 def test_first_assembly_builds_pattern_and_stiffness_in_one_pass(make_square, kappa):
     """A first numba assembly without a pattern fuses pattern + stiffness and caches the pattern."""
