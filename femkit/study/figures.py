@@ -59,6 +59,7 @@ def _style(i: int, s: dict) -> dict:
 def _legend(ax, n: int) -> None:
     """Inside the axes for a few lines; outside on the right for many (never over the data)."""
     if n > 6:
+        ax.figure.set_size_inches(10.0, 5.0)  # room for the legend beside the axes
         ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5))
     else:
         ax.legend(fontsize=8)

@@ -71,7 +71,7 @@ def build_poisson_report(report, study, result, data, stage) -> None:
             continue
         it_series.append({"label": _label(key, False), "reference": key[0] != "femkit",
                           "x": [r["dofs"] for r in rows_k], "y": [r["iterations"] for r in rows_k]})
-    for s in {n["solver"] for n in data.get("nested", [])}:
+    for s in dict.fromkeys(n["solver"] for n in data.get("nested", [])):
         rows_n = [n for n in data["nested"] if n["solver"] == s]
         it_series.append({"label": f"{s}, nested, stop at discretisation error",
                           "x": [n["dofs"] for n in rows_n], "y": [n["iterations_nested"] for n in rows_n]})
