@@ -113,7 +113,13 @@ def _run_check(args) -> int:
 
 
 #: Subcommands, in help order: each adds its parser to the subparsers object.
-SUBCOMMANDS: list[Callable] = [_add_solve, _add_check]
+def _add_study(sub) -> None:
+    from .study.cli import add_parser  # standard library only at import time
+
+    add_parser(sub)
+
+
+SUBCOMMANDS: list[Callable] = [_add_solve, _add_check, _add_study]
 
 
 def build_parser() -> argparse.ArgumentParser:

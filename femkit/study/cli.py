@@ -6,8 +6,8 @@
 where the study did not expect it is *not* an error: a study reports failures as data.
 
 BLAS threads are pinned (``OPENBLAS_NUM_THREADS=OMP_NUM_THREADS=MKL_NUM_THREADS=1`` unless
-already set) when this module is imported without numpy loaded, and again in :func:`cli_main`
-(effective when numpy is not yet imported, as on the ``femkit`` command line).
+already set) by :func:`cli_main`, before the study imports numpy, so timings are comparable.
+Importing this module has no side effect (``femkit solve`` builds the same parser).
 """
 
 from __future__ import annotations
@@ -16,9 +16,6 @@ import argparse
 import sys
 
 from .timing import pin_blas_threads
-
-if "numpy" not in sys.modules:
-    pin_blas_threads(1)
 
 HELP = "run a study file (convergence, work-precision or stability sweep) and write its report"
 
