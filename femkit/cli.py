@@ -46,9 +46,20 @@ class _Parser(argparse.ArgumentParser):
 
 # ----------------------------------------------------------------------------- solve
 
+def _case_parser(sub, name: str, help: str, description: str, case_help: str, quiet_help: str,
+                 handler: Callable) -> argparse.ArgumentParser:
+    """A subcommand taking one CASE file and ``--quiet`` (the shape of ``solve`` and ``check``)."""
+    p = sub.add_parser(name, help=help, description=description, epilog=_EPILOG,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("case", metavar="CASE", help=case_help)
+    p.add_argument("-q", "--quiet", action="store_true", help=quiet_help)
+    p.set_defaults(handler=handler)
+    return p
+
+
 def _add_solve(sub) -> None:
-    p = sub.add_parser(
-        "solve", help="run a case file and write its results",
+    p = _case_parser(
+        sub, "solve", help="run a case file and write its results",
         description=(
             "Load CASE (YAML), validate it completely (schema, names, expressions, mesh file), "
             "build and check the mesh, assemble, solve, and write result.json plus the "
@@ -56,13 +67,11 @@ def _add_solve(sub) -> None:
             "directory, which appears only when the run finishes (atomically). Prints a short "
             "summary: mesh size, dofs, solver and iterations, true residual, error norms "
             "when the case gives an exact solution, and the time of each stage."),
-        epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("case", metavar="CASE", help="case file (.yaml), e.g. cases/poisson_lshape.yaml")
+        case_help="case file (.yaml), e.g. cases/poisson_lshape.yaml",
+        quiet_help="print nothing on success", handler=_run_solve)
     p.add_argument("-o", "--output", metavar="DIR",
                    help="output directory (default: output.dir of the case, resolved against "
                         "the case file's directory)")
-    p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
-    p.set_defaults(handler=_run_solve)
 
 
 def _run_solve(args) -> int:
@@ -85,8 +94,8 @@ def _run_solve(args) -> int:
 # ----------------------------------------------------------------------------- check
 
 def _add_check(sub) -> None:
-    p = sub.add_parser(
-        "check", help="cross-check a Poisson case against scikit-fem and pyamg",
+    _case_parser(
+        sub, "check", help="cross-check a Poisson case against scikit-fem and pyamg",
         description=(
             "Build the case's mesh and compare, on that same mesh: femkit's stiffness matrix "
             "and one-point (barycentric) load vector with scikit-fem's (its Basis given the same centroid rule), "
@@ -94,10 +103,8 @@ def _add_check(sub) -> None:
             "system solved with pyamg's own smoothed-aggregation solver (accel='cg'). "
             "Prints each relative difference next to its tolerance; nothing is written. "
             "Tolerances: K and F 1e-12 relative; solutions 10*rtol relative (at least 1e-10)."),
-        epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("case", metavar="CASE", help="Poisson case file (.yaml)")
-    p.add_argument("-q", "--quiet", action="store_true", help="print only failures")
-    p.set_defaults(handler=_run_check)
+        case_help="Poisson case file (.yaml)", quiet_help="print only failures",
+        handler=_run_check)
 
 
 def _run_check(args) -> int:

@@ -18,7 +18,6 @@ atomically (see :func:`femkit.io.atomic.atomic_directory`).
 from __future__ import annotations
 
 import contextlib
-import inspect
 import os
 import time
 from dataclasses import dataclass, field
@@ -27,7 +26,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import CaseFileError, ExpressionError, InputError, UnknownNameError
+from ..errors import CaseFileError, ExpressionError, InputError
+from .checks import check_geometry_spec, check_solver_spec, lookup, resolve_file, with_prefix
 from .expressions import compile_expression
 from .load import Case
 
@@ -60,52 +60,17 @@ def prepare_poisson(case: Case) -> None:
         case.name = d["name"]
     mesh = d["mesh"]
     if "file" in mesh:
-        path = (base / mesh["file"]).resolve()
-        if not path.is_file():
-            raise CaseFileError(f"mesh.file: mesh file not found: {path}")
-        mesh["file"] = str(path)
+        resolve_file(mesh, "mesh", base)
         if "params" in mesh or "h" in mesh:
             bad = "params" if "params" in mesh else "h"
             raise CaseFileError(f"mesh.{bad}: only used with mesh.geometry, not with mesh.file")
     else:
-        from ..mesh.geometries import GEOMETRIES
-
-        try:
-            factory = GEOMETRIES.get(mesh["geometry"])
-        except UnknownNameError as exc:
-            raise _with_prefix(exc, "mesh.geometry") from None
-        params = mesh.get("params") or {}
-        try:
-            inspect.signature(factory).bind(mesh["h"], **params)
-        except TypeError:
-            valid = [p for p in inspect.signature(factory).parameters if p != "h"]
-            raise CaseFileError(
-                f"mesh.params: {sorted(params)} do not fit geometry {mesh['geometry']!r}; "
-                f"valid parameters: {', '.join(valid) or '(none)'}") from None
-
-    from ..solvers.registry import PRECONDITIONERS, SOLVERS
-
-    solver = d["solver"]
-    try:
-        SOLVERS.get(solver["method"])
-    except UnknownNameError as exc:
-        raise _with_prefix(exc, "solver.method") from None
-    if solver.get("preconditioner") is None:
-        solver["preconditioner"] = "amg" if solver["method"] == "pcg" else "none"
-    try:
-        PRECONDITIONERS.get(solver["preconditioner"])
-    except UnknownNameError as exc:
-        raise _with_prefix(exc, "solver.preconditioner") from None
-    if solver["preconditioner"] != "none" and solver["method"] != "pcg":
-        raise CaseFileError(f"solver.preconditioner: {solver['preconditioner']!r} needs method "
-                            f"'pcg', not {solver['method']!r} (drop it or use method: pcg)")
+        check_geometry_spec(mesh, "mesh")
+    check_solver_spec(d["solver"], "solver", default_preconditioner="amg")
 
     from ..fem.quadrature import QUADRATURE
 
-    try:
-        QUADRATURE.get(d["quadrature"]["load"])
-    except UnknownNameError as exc:
-        raise _with_prefix(exc, "quadrature.load") from None
+    lookup(QUADRATURE, d["quadrature"]["load"], "quadrature.load")
 
     coef = d["coefficient"]
     if isinstance(coef, str):
@@ -141,7 +106,7 @@ def build_mesh(case: Case):
             mesh = generate(spec["geometry"], spec["h"], **(spec.get("params") or {}))
         mesh = validate(mesh)
     except InputError as exc:
-        raise _with_prefix(exc, where) from None
+        raise with_prefix(exc, where) from None
     if spec.get("refine"):
         mesh = refine(mesh, spec["refine"])
     bnd = case.data["boundary"]
@@ -152,23 +117,14 @@ def build_mesh(case: Case):
                 try:
                     check_tags(mesh, tags, kind="boundary")
                 except InputError as exc:
-                    raise _with_prefix(exc, f"boundary.{kind}[{i}].tags") from None
+                    raise with_prefix(exc, f"boundary.{kind}[{i}].tags") from None
     coef = case.data["coefficient"]
     if isinstance(coef, dict):
         try:
             check_tags(mesh, list(coef["regions"]), kind="cell")
         except InputError as exc:
-            raise _with_prefix(exc, "coefficient.regions") from None
+            raise with_prefix(exc, "coefficient.regions") from None
     return mesh
-
-
-def _with_prefix(exc: InputError, where: str) -> InputError:
-    """The same exception (type and attributes kept) with ``where: `` before its message."""
-    cls = type(exc)
-    new = cls.__new__(cls)
-    new.__dict__.update(exc.__dict__)
-    new.args = (f"{where}: {exc}",)
-    return new
 
 
 def _is_whole_boundary(mesh, tag) -> bool:
@@ -201,7 +157,7 @@ def element_kappa(case: Case, mesh) -> np.ndarray:
     except ExpressionError:
         raise
     except InputError as exc:
-        raise _with_prefix(exc, "coefficient") from None
+        raise with_prefix(exc, "coefficient") from None
 
 
 def assemble_system(case: Case, mesh):

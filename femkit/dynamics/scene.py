@@ -24,7 +24,6 @@ Each stage is a public function (:func:`build_system`, :func:`build_integrator`,
 from __future__ import annotations
 
 import hashlib
-import inspect
 import math
 import os
 import sys
@@ -126,22 +125,9 @@ def prepare_scene(case: Case) -> None:
         raise CaseFileError(f"integrator.options: {' '.join(str(exc).split())}") from None
 
     # linear solver
-    from ..solvers.registry import PRECONDITIONERS, SOLVERS
+    from ..case.checks import check_solver_spec
 
-    ls = d["linear_solver"]
-    try:
-        SOLVERS.get(ls["method"])
-    except UnknownNameError as exc:
-        raise _prefixed(exc, "linear_solver.method") from None
-    if ls.get("preconditioner") is None:
-        ls["preconditioner"] = "jacobi" if ls["method"] == "pcg" else "none"
-    try:
-        PRECONDITIONERS.get(ls["preconditioner"])
-    except UnknownNameError as exc:
-        raise _prefixed(exc, "linear_solver.preconditioner") from None
-    if ls["preconditioner"] != "none" and ls["method"] != "pcg":
-        raise CaseFileError(f"linear_solver.preconditioner: {ls['preconditioner']!r} needs method "
-                            f"'pcg', not {ls['method']!r} (drop it or use method: pcg)")
+    check_solver_spec(d["linear_solver"], "linear_solver", default_preconditioner="jacobi")
 
     # times
     dt = _time_value(case, "dt")
@@ -179,26 +165,12 @@ def prepare_scene(case: Case) -> None:
 
 
 def _prepare_mesh(system: dict, base: Path) -> None:
-    if "file" in system:
-        path = (base / system["file"]).resolve()
-        if not path.is_file():
-            raise CaseFileError(f"system.file: mesh file not found: {path}")
-        system["file"] = str(path)
-        return
-    from ..mesh.geometries import GEOMETRIES
+    from ..case.checks import check_geometry_spec, resolve_file
 
-    try:
-        factory = GEOMETRIES.get(system["geometry"])
-    except UnknownNameError as exc:
-        raise _prefixed(exc, "system.geometry") from None
-    params = system.get("params") or {}
-    try:
-        inspect.signature(factory).bind(system["h"], **params)
-    except TypeError:
-        valid = [p for p in inspect.signature(factory).parameters if p != "h"]
-        raise CaseFileError(
-            f"system.params: {sorted(params)} do not fit geometry {system['geometry']!r}; "
-            f"valid parameters: {', '.join(valid) or '(none)'}") from None
+    if "file" in system:
+        resolve_file(system, "system", base)
+    else:
+        check_geometry_spec(system, "system")
 
 
 # ----------------------------------------------------------------------------- build
