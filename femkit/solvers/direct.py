@@ -58,7 +58,7 @@ class Factor:
     matvec = solve
 
 
-def factorize(A, *, spd: bool | None = None) -> Factor:
+def factorize(A, *, spd: bool | None = None, permc_spec: str | None = None) -> Factor:
     """Factorise a square sparse (or dense) matrix with SuperLU.
 
     Parameters
@@ -67,6 +67,10 @@ def factorize(A, *, spd: bool | None = None) -> Factor:
     spd : bool, optional
         Use the symmetric ordering and diagonal pivoting. ``None`` (default) decides
         automatically: symmetric to 1e-10 and a positive diagonal.
+    permc_spec : str, optional
+        SuperLU column ordering overriding the default (``"MMD_AT_PLUS_A"`` for SPD,
+        ``"COLAMD"`` otherwise); ``"NATURAL"`` for a matrix the caller has already permuted
+        with an ordering it reuses across many factorisations of the same pattern.
 
     Raises
     ------
@@ -99,12 +103,12 @@ def factorize(A, *, spd: bool | None = None) -> Factor:
     t0 = time.perf_counter()
     try:
         if spd:
-            permc = "MMD_AT_PLUS_A"
+            permc = permc_spec or "MMD_AT_PLUS_A"
             lu = splu(Ac, permc_spec=permc, diag_pivot_thresh=0.0,
                       options=dict(SymmetricMode=True))
         else:
-            permc = "COLAMD"
-            lu = splu(Ac)
+            permc = permc_spec or "COLAMD"
+            lu = splu(Ac, permc_spec=permc)
     except RuntimeError as e:  # "Factor is exactly singular"
         raise SingularSystemError(f"direct factorisation failed: {e}") from None
     dt = time.perf_counter() - t0

@@ -125,3 +125,25 @@ def test_fast_mass_spring_cache_follows_new_parameter_arrays():
     fresh = StepContext()
     s3 = integ.step(system, s, 0.01, fresh)
     np.testing.assert_array_equal(s2.x, s3.x)
+
+
+@pytest.mark.parametrize("name", ["implicit_euler", "newton", "newmark"])
+def test_direct_solves_with_reused_ordering_match_plain_direct(name):
+    from femkit.dynamics.integrators.base import dof_ordering
+
+    system = _cloth(7)
+    dt = 1.0 / 60.0
+    ordered, ctx = _one_step(name, system, dt, StepContext(solver="direct"))
+    # any ctx.options sends the solve through femkit.solvers.solve (SuperLU's own ordering)
+    plain, ctx_plain = _one_step(name, system, dt, StepContext(solver="direct", options={"spd": None}))
+    assert "orderings" not in ctx_plain.stats
+    assert ctx.stats["orderings"] == 1  # computed once, reused by every factorisation
+    assert ctx.stats["factorizations"] == ctx.stats["linear_solves"] >= 3
+    scale = np.abs(plain.x - system.x0).max()
+    np.testing.assert_allclose(ordered.x, plain.x, rtol=0, atol=1e-10 * scale)
+    perm = dof_ordering(system, ctx)
+    nfree = system.free_dofs.size
+    assert np.array_equal(np.sort(perm), np.arange(nfree))
+    triples = perm.reshape(-1, system.dim)  # each node's dofs stay together, in order
+    assert np.all(triples % system.dim == np.arange(system.dim))
+    assert np.all(np.diff(triples, axis=1) == 1)

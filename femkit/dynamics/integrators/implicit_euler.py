@@ -48,7 +48,7 @@ class ImplicitEuler(Integrator):
         if D.nnz:
             A = A + h * D
         b = h * (f - (h + rk) * (K @ vf) - rm * (M @ vf))
-        dv = solve_linear(restrict(A, free), b[free], ctx)
+        dv = solve_linear(restrict(A, free), b[free], ctx, system=system)
         v_new = vf.copy()
         v_new[free] += dv
         v_new = v_new.reshape(v.shape)

@@ -89,7 +89,7 @@ class Newmark(Integrator):
             D = system.damping_matrix(x_new)
             if D.nnz:
                 J = J + (h * gamma) * D
-            a_new[free] -= solve_linear(restrict(J, free), r[free], ctx)
+            a_new[free] -= solve_linear(restrict(J, free), r[free], ctx, system=system)
         else:
             x_new = (x_pred + (h * h * beta) * a_new).reshape(shape)
             v_new = (v_pred + (h * gamma) * a_new).reshape(shape)

@@ -79,7 +79,7 @@ class NewtonImplicitEuler(Integrator):
                 + h * (C @ (x - xn))
             H = M + (h * h) * system.stiffness_matrix(x.reshape(shape), fix=self.fix) + h * C
             dx = np.zeros_like(x)
-            dx[free] = solve_linear(restrict(H, free), -grad[free], ctx)
+            dx[free] = solve_linear(restrict(H, free), -grad[free], ctx, system=system)
             slope = grad[free] @ dx[free]
             t = 1.0
             if slope < 0.0:

@@ -64,7 +64,7 @@ class VariationalSymplectic(Integrator):
             D = system.damping_matrix(q.reshape(shape))
             if D.nnz:
                 J = J + (2.0 / h) * D
-            dq = solve_linear(restrict(J, free), -R[free], ctx)
+            dq = solve_linear(restrict(J, free), -R[free], ctx, system=system)
             q[free] += dq
             if np.abs(dq).max(initial=0.0) <= self.tol * length:
                 break
