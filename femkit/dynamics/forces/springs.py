@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["spring_geometry", "hooke_forces", "dashpot_forces", "spring_energy"]
+__all__ = ["spring_geometry", "geometry_from_difference", "hooke_forces", "dashpot_forces",
+           "spring_energy"]
 
 
 def spring_geometry(x: np.ndarray, i: np.ndarray, j: np.ndarray, floor: float = 0.0):
@@ -32,7 +33,11 @@ def spring_geometry(x: np.ndarray, i: np.ndarray, j: np.ndarray, floor: float = 
     >>> float(l[0]), u[0].tolist()
     (5.0, [0.6, 0.8])
     """
-    dx = np.take(x, j, axis=0) - np.take(x, i, axis=0)
+    return geometry_from_difference(np.take(x, j, axis=0) - np.take(x, i, axis=0), floor)
+
+
+def geometry_from_difference(dx: np.ndarray, floor: float = 0.0):
+    """:func:`spring_geometry` from the spring vectors ``dx = x_j - x_i``, ``(s, d)``."""
     length = np.sqrt(np.einsum("sd,sd->s", dx, dx))
     if floor > 0.0:
         tiny = length < floor

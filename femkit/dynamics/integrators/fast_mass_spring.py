@@ -101,11 +101,7 @@ class FastMassSpring(Integrator):
         pinned = np.flatnonzero(system.pinned)
         mass = np.asarray(system.mass, dtype=float)
         A = (sp.diags(mass) + (dt * dt) * system.spring_laplacian()).tocsr()
-        s = system.n_springs
-        rows = np.concatenate([np.arange(s), np.arange(s)])
-        cols = np.concatenate([system.springs[:, 1], system.springs[:, 0]])
-        vals = np.concatenate([np.ones(s), -np.ones(s)])
-        G = sp.csr_matrix((vals, (rows, cols)), shape=(s, system.n))
+        G = system.difference_operators[0]
         G_free = G[:, free].tocsr()
         ops = _Operators(
             factor=factorize_linear(restrict(A, free), ctx),
