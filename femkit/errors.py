@@ -17,6 +17,12 @@ Hierarchy::
     │   ├── NotSPDError            input to CG-type method is not symmetric positive definite
     │   └── SingularSystemError    singular system (e.g. pure Neumann, inconsistent rhs)
     └── InstabilityError           a time integrator blew up (method, step, time, energy ratio, dt_crit)
+
+Warnings (not errors; the run goes on)::
+
+    UserWarning
+    └── StabilityWarning           an explicit integrator is started with dt above its critical
+                                   step bound / omega_max (both numbers in the message)
 """
 
 from __future__ import annotations
@@ -104,3 +110,11 @@ class InstabilityError(FemkitError):
             f"{reason or 'energy grew'}; energy ratio {energy_ratio:.3e}, dt = {dt:.3e}, "
             f"critical step {crit}"
         )
+
+
+class StabilityWarning(UserWarning):
+    """An explicit method is run with ``dt`` above its critical step ``bound / omega_max``.
+
+    Issued by :func:`femkit.dynamics.simulate.simulate` before the run (``warnings.warn``);
+    the message names ``dt``, the critical step and ``omega_max``.
+    """

@@ -30,16 +30,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, InstabilityError
+from ..errors import InputError, InstabilityError, StabilityWarning  # StabilityWarning re-exported
 from .integrators import Integrator, StepContext, get_integrator
 
 __all__ = ["simulate", "Trajectory", "StabilityWarning"]
 
 _ENERGY_KEYS = ("kinetic", "spring", "gravity", "contact", "total")
-
-
-class StabilityWarning(UserWarning):
-    """An explicit method is run with ``dt`` above its critical step ``bound / omega_max``."""
 
 
 @dataclass

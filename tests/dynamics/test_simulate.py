@@ -86,3 +86,12 @@ def test_bad_input():
         simulate(system, "rk4", 1e-3, -1.0)
     with pytest.raises(InputError, match="options"):
         simulate(system, "newmark", 1e-3, 1.0, betta=0.3)
+
+
+def test_stability_warning_lives_in_errors_and_is_reexported():
+    import femkit.errors
+    import femkit.dynamics.simulate as sim
+
+    assert sim.StabilityWarning is femkit.errors.StabilityWarning
+    assert issubclass(femkit.errors.StabilityWarning, UserWarning)
+    assert not issubclass(femkit.errors.StabilityWarning, femkit.errors.FemkitError)
