@@ -1,11 +1,23 @@
-"""Dynamics benchmark (run by hand): ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_dynamics.py``.
+"""Dynamics benchmark (run by hand): ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_dynamics.py [--quick]``.
 
-* Liu et al.'s cloth (81 x 81 nodes), fast mass-spring with 10 local/global iterations per
-  1/30 s frame (paper: 50 ms/frame in C++; REFERENCE.md: scipy splu, n x n, 3 rhs: 47-67 ms);
-* a 128 x 128 cloth (~97k springs): time per step of symplectic Euler, Baraff-Witkin implicit
-  Euler (direct) and Newton implicit Euler (direct).
+Scenes
+------
+* Liu et al.'s cloth (81 x 81 nodes, 38,558 springs), fast mass-spring with 10 local/global
+  iterations per 1/30 s frame (paper: 50 ms/frame in C++; REFERENCE.md: scipy ``splu`` on the
+  shared ``n x n`` matrix with 3 right-hand sides, 47-67 ms/frame), and one Baraff-Witkin step
+  on the same cloth (one sparse factorisation of 19,677 unknowns; REFERENCE.md: one Newton step
+  of implicit Euler there, sparse LU, 0.55-0.7 s).
+* A 128 x 128 cloth (97,026 springs, ``k = 3e4``, the Taichi demo's ``spring_Y``) with the
+  per-node mass chosen so that ``dt omega_max = 1.6`` at the demo's ``dt = 3.125e-4`` (the
+  demo's regime, REFERENCE.md): symplectic Euler (Taichi CPU: 424-525 substeps/s), and
+  Baraff-Witkin and Newton implicit Euler at ``dt = 1/60`` (direct solver; the fill-reducing
+  ordering is computed once and reused by every factorisation).
 
-Prints medians over repeats (after a warm-up step, which also pays the one-time factorisation).
+Every figure is the median over repeats after one warm-up step (which pays one-time setup:
+the fast mass-spring factorisation, the implicit methods' ordering). The table prints the time
+per step, factorisations per step, the time split of the implicit methods (assembly =
+everything outside the ordering, the permutation, the factorisation and the solves) and the
+reference figure with the ratio ours / reference.
 """
 
 from __future__ import annotations
@@ -23,42 +35,82 @@ from femkit.dynamics.forces import Gravity  # noqa: E402
 from femkit.dynamics.integrators import StepContext, get_integrator  # noqa: E402
 from femkit.dynamics.topology import cloth_grid  # noqa: E402
 
+_SPLIT = ("time_ordering", "time_permute", "time_factorization", "time_solve")
 
-def _time_steps(system, name, dt, repeats, **opts):
+
+def _time_steps(system, name, dt, repeats, **opts) -> dict:
+    """Median seconds per step after a warm-up, factorisations and the time split per step."""
     ctx = StepContext(solver="direct")
     integ = get_integrator(name, **opts)
     s = integ.start(system, system.x0, system.v0, 0.0, dt, ctx)
-    t0 = time.perf_counter()
-    s = integ.step(system, s, dt, ctx)  # warm-up (one-time factorisation for fast mass-spring)
-    first = time.perf_counter() - t0
+    s = integ.step(system, s, dt, ctx)  # warm-up: one-time factorisation / ordering
+    before = dict(ctx.stats)
     times = []
     for _ in range(repeats):
         t0 = time.perf_counter()
         s = integ.step(system, s, dt, ctx)
         times.append(time.perf_counter() - t0)
-    return first, statistics.median(times), ctx.stats
+    per = {key: (ctx.stats.get(key, 0) - before.get(key, 0)) / repeats
+           for key in ("factorizations",) + _SPLIT}
+    total = sum(times) / repeats
+    split = {k: per[k] for k in _SPLIT}
+    split["assembly"] = total - sum(split.values())
+    iters = ctx.stats.get("newton_iterations", [])[1:]
+    return {"median": statistics.median(times), "factorizations": per["factorizations"],
+            "split": split, "total": total, "newton": iters}
+
+
+def _ref(ours: float, lo: float, hi: float) -> str:
+    return f"{ours / hi:.2f}-{ours / lo:.2f}x"
+
+
+def _fmt_time(sec: float) -> str:
+    return f"{1e3 * sec:8.1f} ms" if sec < 10 else f"{sec:8.2f} s "
 
 
 def main(quick: bool = False) -> None:
+    rows = []
     liu = cloth_grid(81, 81, 1.0, 1.0, k_structural=1e3, k_shear=1e3, k_bending=1e2,
                      total_mass=1.0, pinned="top_corners", forces=[Gravity(9.81)])
-    first, med, stats = _time_steps(liu, "fast_mass_spring", 1.0 / 30.0, 3 if quick else 10,
-                                    iterations=10)
-    print(f"Liu cloth 81x81 ({liu.n_springs} springs), fast mass-spring 10 it: "
-          f"{1e3 * med:.1f} ms/frame median (first frame incl. factorisation {1e3 * first:.1f} ms; "
-          f"factorizations {stats.get('factorizations')})")
+    r = _time_steps(liu, "fast_mass_spring", 1.0 / 30.0, 5 if quick else 20, iterations=10)
+    rows.append(("Liu 81x81", "fast_mass_spring 10 it", "1/30", r,
+                 "47-67 ms (scipy), 50 ms (paper, C++)", _ref(r["median"], 0.047, 0.067)))
+    r = _time_steps(liu, "implicit_euler", 1.0 / 30.0, 2 if quick else 5)
+    rows.append(("Liu 81x81", "implicit_euler (BW)", "1/30", r,
+                 "0.55-0.7 s (1 Newton step, LU)", _ref(r["median"], 0.55, 0.7)))
 
+    dt_explicit = 3.125e-4
+    unit = cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4, k_bending=3e4,
+                      mass=1.0, pinned="top_corners", forces=[Gravity(9.81)])
+    mass = (unit.omega_max() * dt_explicit / 1.6) ** 2  # omega scales as 1/sqrt(m)
     big = cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4, k_bending=3e4,
-                     total_mass=1.0, pinned="top_corners", forces=[Gravity(9.81)])
-    print(f"cloth 128x128: {big.n_springs} springs, {big.ndof} dofs")
-    for name, dt, reps, opts in (("symplectic_euler", 3.125e-4, 5 if quick else 30, {}),
-                                 ("implicit_euler", 1.0 / 60.0, 2 if quick else 5, {}),
-                                 ("newton", 1.0 / 60.0, 1 if quick else 3, {"max_iterations": 10})):
-        first, med, stats = _time_steps(big, name, dt, reps, **opts)
-        extra = ""
-        if "newton_iterations" in stats:
-            extra = f", Newton iterations/step {stats['newton_iterations']}"
-        print(f"  {name:18s} dt={dt:.3g}: {1e3 * med:9.1f} ms/step median{extra}")
+                     mass=mass, pinned="top_corners", forces=[Gravity(9.81)])
+    r = _time_steps(big, "symplectic_euler", dt_explicit, 50 if quick else 300)
+    rows.append(("cloth 128x128", "symplectic_euler", "3.125e-4", r,
+                 "424-525 substeps/s (Taichi CPU)", _ref(r["median"], 1 / 525, 1 / 424)))
+    for name, reps, opts in (("implicit_euler", 1 if quick else 3, {}),
+                             ("newton", 1 if quick else 2, {"max_iterations": 20})):
+        r = _time_steps(big, name, 1.0 / 60.0, reps, **opts)
+        rows.append(("cloth 128x128", name + (" (BW)" if name == "implicit_euler" else ""),
+                     "1/60", r, "-", "-"))
+
+    print(f"OPENBLAS_NUM_THREADS={os.environ['OPENBLAS_NUM_THREADS']}; medians after a warm-up step; "
+          f"128x128 cloth: {big.n_springs} springs, {big.ndof} dofs, node mass {mass:.3g} "
+          f"(dt omega_max = 1.6 at dt = {dt_explicit})")
+    head = (f"{'scene':14s} {'method':24s} {'dt':>8s} {'time/step':>11s} {'fact/step':>9s}  "
+            f"{'split: assembly / permute / factor / solve':44s} {'reference':38s} ours/ref")
+    print(head)
+    print("-" * len(head))
+    for scene, method, dt, r, ref, ratio in rows:
+        sp = r["split"]
+        split = "-"
+        if r["factorizations"] and method != "fast_mass_spring 10 it":
+            split = (f"{1e3 * sp['assembly']:.0f} / {1e3 * sp['time_permute']:.0f} / "
+                     f"{1e3 * sp['time_factorization']:.0f} / {1e3 * sp['time_solve']:.0f} ms")
+        if r["newton"]:
+            method = f"{method} ({statistics.mean(r['newton']):.1f} it)"
+        print(f"{scene:14s} {method:24s} {dt:>8s} {_fmt_time(r['median']):>11s} "
+              f"{r['factorizations']:9.1f}  {split:44s} {ref:38s} {ratio}")
 
 
 if __name__ == "__main__":
