@@ -5,9 +5,10 @@ Figures are built with :class:`matplotlib.figure.Figure` and the Agg canvas dire
 pyplot global state and no display is touched.
 
 Series are dicts ``{"label": str, "x": array, "y": array}`` with optional ``"reference": True``
-(drawn dashed in grey: e.g. scikit-fem on the same meshes) and ``"fit": RateFit``
-(its slope goes into the legend and the fitted line is drawn dotted). Points with non-finite or
-non-positive values are dropped from log axes, never plotted as garbage.
+(drawn black dashed: e.g. scikit-fem on the same meshes), ``"fit": RateFit`` (its slope goes into
+the legend and the fitted line is drawn dotted) and ``"style"`` (matplotlib line keywords, usually
+from a :class:`StyleBook`, so the same method looks the same in every figure of a report).
+Points with non-finite or non-positive values are dropped from log axes, never plotted as garbage.
 """
 
 from __future__ import annotations
@@ -17,10 +18,65 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
-__all__ = ["loglog_figure", "work_precision_figure", "energy_figure", "stability_map_figure"]
+__all__ = ["StyleBook", "REFERENCE_STYLE", "loglog_figure", "work_precision_figure", "energy_figure",
+           "stability_map_figure"]
 
 DPI = 100
-_MARKERS = "osD^v<>ph*"
+#: 12 colours that stay distinguishable side by side (tab10 without its grey, plus navy, olive, teal).
+PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
+           "#bcbd22", "#000080", "#6b6b00", "#008080")
+_MARKERS = "osD^v<>phP*X"
+#: the peer reference line (scikit-fem): black, dashed, crosses.
+REFERENCE_STYLE = {"color": "k", "linestyle": "--", "marker": "x", "markersize": 7, "linewidth": 1.6,
+                   "zorder": 1.9}
+
+
+def _readable_log_ticks(ax) -> None:
+    """Plain numbers (``0.01``, ``30``) instead of ``3x10^1``; no crowded minor labels on wide ranges."""
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    def fmt(v, _pos=None):
+        if v <= 0:
+            return ""
+        return f"{v:g}" if 1e-3 <= v < 1e5 else f"$10^{{{int(round(np.log10(v)))}}}$" \
+            if abs(np.log10(v) - round(np.log10(v))) < 1e-9 else f"{v:.0e}"
+
+    from matplotlib.ticker import LogLocator
+
+    for axis, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+        if axis.get_scale() != "log":
+            continue
+        lo, hi = sorted((lo, hi))
+        if lo > 0 and np.log10(hi / lo) < 2.5:  # short range: label 1, 2, 5 x 10^k
+            axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+        axis.set_major_formatter(FuncFormatter(fmt))
+        axis.set_minor_formatter(NullFormatter())
+
+
+class StyleBook:
+    """Colour + marker per method, line style per family, the same in every figure of a report.
+
+    The first key asked for gets the first colour and marker, the next one the next; with at
+    most ``len(PALETTE)`` (12) keys no two methods share a colour or a marker.
+
+    >>> book = StyleBook({"explicit": "-", "symplectic": "--"})
+    >>> a = book("explicit_euler", "explicit"); b = book("symplectic_euler", "symplectic")
+    >>> a["color"] != b["color"], a["marker"] != b["marker"], b["linestyle"]
+    (True, True, '--')
+    >>> book("explicit_euler", "explicit") == a
+    True
+    """
+
+    def __init__(self, linestyles: dict | None = None):
+        self.linestyles = dict(linestyles or {})
+        self._index: dict = {}
+
+    def __call__(self, key, family=None, **extra) -> dict:
+        i = self._index.setdefault(key, len(self._index))
+        st = {"color": PALETTE[i % len(PALETTE)], "marker": _MARKERS[i % len(_MARKERS)],
+              "linestyle": self.linestyles.get(family, "-"), "markersize": 5, "linewidth": 1.6}
+        st.update(extra)
+        return st
 
 
 def _figure(width: float = 7.0, height: float = 5.0):
@@ -47,22 +103,22 @@ def _positive(x, y):
 
 
 def _style(i: int, s: dict) -> dict:
+    if s.get("style"):
+        return {"markersize": 5, "linewidth": 1.6, **s["style"]}
     if s.get("reference"):
-        return dict(color="0.35", linestyle="--", marker="x", markersize=7, linewidth=1.6)
-    import matplotlib as mpl
-
-    colours = mpl.rcParams["axes.prop_cycle"].by_key()["color"]
-    return dict(color=colours[i % len(colours)], linestyle="-", marker=_MARKERS[i % len(_MARKERS)],
+        return dict(REFERENCE_STYLE)
+    return dict(color=PALETTE[i % len(PALETTE)], linestyle="-", marker=_MARKERS[i % len(_MARKERS)],
                 markersize=5, linewidth=1.6)
 
 
-def _legend(ax, n: int) -> None:
+def _legend(ax, n: int, title: str | None = None) -> None:
     """Inside the axes for a few lines; outside on the right for many (never over the data)."""
+    kw = {"fontsize": 8, "title": title, "title_fontsize": 8}
     if n > 6:
         ax.figure.set_size_inches(10.0, 5.0)  # room for the legend beside the axes
-        ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5))
+        ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), **kw)
     else:
-        ax.legend(fontsize=8)
+        ax.legend(**kw)
 
 
 def _slope_triangle(ax, xs: np.ndarray, ys: np.ndarray, order: float, *, decreasing_x: bool) -> None:
@@ -83,7 +139,8 @@ def _slope_triangle(ax, xs: np.ndarray, ys: np.ndarray, order: float, *, decreas
 
 
 def loglog_figure(path, series: Sequence[dict], *, title: str, xlabel: str, ylabel: str,
-                  triangle: float | None = None, invert_x: bool = False, note: str | None = None) -> str:
+                  triangle: float | None = None, invert_x: bool = False, note: str | None = None,
+                  legend_title: str | None = None) -> str:
     """Log-log lines (e.g. error vs h, error vs dofs, iterations vs dofs).
 
     ``triangle`` draws a reference slope triangle; ``invert_x`` puts large x on the left
@@ -113,6 +170,7 @@ def loglog_figure(path, series: Sequence[dict], *, title: str, xlabel: str, ylab
         _slope_triangle(ax, np.concatenate(allx), np.concatenate(ally), triangle, decreasing_x=invert_x)
     if invert_x:
         ax.invert_xaxis()
+    _readable_log_ticks(ax)
     ax.set_title(title)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
@@ -120,12 +178,13 @@ def loglog_figure(path, series: Sequence[dict], *, title: str, xlabel: str, ylab
     if note:
         ax.text(0.01, 0.01, note, transform=ax.transAxes, fontsize=8, color="0.3", va="bottom")
     if allx:
-        _legend(ax, len(allx))
+        _legend(ax, len(allx), legend_title)
     return _save(fig, path)
 
 
 def work_precision_figure(path, series: Sequence[dict], *, front: Iterable[tuple[float, float]] = (),
-                          title: str, xlabel: str = "run time [s]", ylabel: str = "error") -> str:
+                          title: str, xlabel: str = "run time [s]", ylabel: str = "error",
+                          legend_title: str | None = None) -> str:
     """Error against run time, one line per method; the Pareto front drawn as a thick band.
 
     Lower-left wins: a point on the front is not beaten by any other run on both counts.
@@ -135,28 +194,31 @@ def work_precision_figure(path, series: Sequence[dict], *, front: Iterable[tuple
     front = [(t, e) for t, e in front if np.isfinite(t) and np.isfinite(e) and t > 0 and e > 0]
     if front:
         ft, fe = np.array(sorted(front)).T
-        ax.step(ft, fe, where="post", color="gold", linewidth=7, alpha=0.45, zorder=0, label="Pareto front")
-        ax.scatter(ft, fe, s=140, facecolors="none", edgecolors="darkorange", linewidths=1.8, zorder=3)
+        ax.step(ft, fe, where="post", color="gold", linewidth=8, alpha=0.5, zorder=0,
+                label="Pareto front (not beaten on time and error)")
+        ax.scatter(ft, fe, s=150, facecolors="none", edgecolors="darkorange", linewidths=1.8, zorder=3)
     any_data = bool(front)
     for i, s in enumerate(series):
         x, y = _positive(s["x"], s["y"])
         if x.size == 0:
             continue
         any_data = True
-        ax.plot(x, y, label=s["label"], **_style(i, s))
+        ax.plot(x, y, label=s["label"], **_style(i, s))  # in sweep order (coarse to fine)
     ax.set_xscale("log")
     ax.set_yscale("log")
+    _readable_log_ticks(ax)
     ax.set_title(title)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.grid(True, which="both", alpha=0.3)
     ax.text(0.99, 0.99, "better: lower left", transform=ax.transAxes, ha="right", va="top", fontsize=8, color="0.3")
     if any_data:
-        _legend(ax, len(series) + 1)
+        _legend(ax, len(series) + 1, legend_title)
     return _save(fig, path)
 
 
-def energy_figure(path, series: Sequence[dict], *, title: str, floor: float = 1e-16) -> str:
+def energy_figure(path, series: Sequence[dict], *, title: str, floor: float = 1e-16,
+                  legend_title: str | None = None) -> str:
     """Relative energy error ``|E(t) - E(0)| / |E(0)|`` against time, one line per integrator."""
     fig = _figure()
     ax = fig.add_subplot()
@@ -168,7 +230,8 @@ def energy_figure(path, series: Sequence[dict], *, title: str, floor: float = 1e
         if not ok.any():
             continue
         st = _style(i, s)
-        st.update(marker=None)
+        every = max(1, int(ok.sum()) // 10)  # markers tell lines apart, staggered so coinciding lines show each
+        st.update(markevery=((3 * i) % every, every), markersize=4)
         ax.plot(t[ok], np.maximum(e[ok], floor), label=s["label"], **st)
         drawn = True
     ax.set_yscale("log")
@@ -177,7 +240,7 @@ def energy_figure(path, series: Sequence[dict], *, title: str, floor: float = 1e
     ax.set_ylabel("relative energy error |E(t) - E(0)| / |E(0)|")
     ax.grid(True, which="both", alpha=0.3)
     if drawn:
-        _legend(ax, len(series))
+        _legend(ax, len(series), legend_title)
     return _save(fig, path)
 
 

@@ -5,12 +5,38 @@ from __future__ import annotations
 from . import figures as F
 from .pareto import pareto_front
 
+FAMILY_LINES = {"explicit": "-", "symplectic": "--", "implicit": "-."}
+LEGEND_TITLE = "solid: explicit, dashed: symplectic, dash-dot: implicit"
+
+
+def integrator_family(name: str, **options) -> str:
+    """``"symplectic"``, ``"implicit"`` or ``"explicit"`` (a symplectic implicit method counts as symplectic)."""
+    from ..dynamics.integrators import get_integrator
+
+    integ = get_integrator(name, **options)
+    if getattr(integ, "symplectic", False):
+        return "symplectic"
+    return "implicit" if getattr(integ, "implicit", False) else "explicit"
+
+
+def integrator_styles(study) -> dict:
+    """Label -> line style: one colour + marker per integrator, line style per family."""
+    from .dynamics import integrator_spec
+
+    book = F.StyleBook(FAMILY_LINES)
+    styles = {}
+    for item in study.data["integrators"]:
+        name, opts, lab = integrator_spec(item)
+        styles[lab] = book(lab, integrator_family(name, **opts))
+    return styles
+
 
 def build_dynamics_report(report, study, result, data, stage) -> None:
     recs = result.records
     scene = study.data["scene"]
     labels = list(dict.fromkeys(r["integrator"] for r in recs))
     fits = {f["integrator"]: f for f in result.fits}
+    styles = integrator_styles(study)
     report.paragraph(f"Scene: {scene['type']} (k = {scene['k']:g}, m = {scene['mass']:g}, t_end = {scene['t_end']:g}); "
                      f"dt = {', '.join(f'{dt:.4g}' for dt in data['dts'])}.")
     report.heading("Fitted orders")
@@ -32,24 +58,27 @@ def build_dynamics_report(report, study, result, data, stage) -> None:
     for lab in labels:
         rows = [r for r in recs if r["integrator"] == lab and r["stable"]]
         series.append({"label": lab, "x": [r["dt"] for r in rows], "y": [r["error_max"] for r in rows],
-                       "fit": fits.get(lab, {}).get("fit")})
-    F.loglog_figure(stage / "figures" / "error_vs_dt.png", series, title="Error vs time step",
-                    xlabel="time step dt [s]", ylabel="max position error over the trajectory [length]",
-                    triangle=2, note="dotted: fitted order; triangle: slope 2")
+                       "fit": fits.get(lab, {}).get("fit"), "style": styles.get(lab)})
+    F.loglog_figure(stage / "figures" / "error_vs_dt.png", series,
+                    title="Convergence of the integrators: error vs time step",
+                    xlabel="time step dt [s]", ylabel="max position error over the trajectory [m]",
+                    triangle=2, note="dotted: fitted order; triangle: slope 2", legend_title=LEGEND_TITLE)
     report.figure("figures/error_vs_dt.png", "Error against dt, fitted orders in the legend (unstable runs omitted)")
 
     wp, t_all, e_all, idx = [], [], [], []
     for lab in labels:
         rows = [r for r in recs if r["integrator"] == lab and r["stable"]]
-        wp.append({"label": lab, "x": [r["wall_time"] for r in rows], "y": [r["error_max"] for r in rows]})
+        wp.append({"label": lab, "x": [r["wall_time"] for r in rows], "y": [r["error_max"] for r in rows],
+                   "style": styles.get(lab)})
         for r in rows:
             t_all.append(r["wall_time"])
             e_all.append(r["error_max"])
             idx.append(recs.index(r))
     front = pareto_front(t_all, e_all)
     F.work_precision_figure(stage / "figures" / "work_precision.png", wp, front=[(t_all[i], e_all[i]) for i in front],
-                            title="Work-precision: error vs run time",
-                            xlabel="wall time [s] (min over repeats)", ylabel="max position error [length]")
+                            title="Work-precision of the integrators: error vs run time",
+                            xlabel="wall time per run [s] (min over repeats)",
+                            ylabel="max position error over the trajectory [m]", legend_title=LEGEND_TITLE)
     report.figure("figures/work_precision.png", "Work-precision: error against wall time, Pareto front highlighted")
     on_front = {idx[i] for i in front}
     for i, r in enumerate(recs):
@@ -61,9 +90,9 @@ def build_dynamics_report(report, study, result, data, stage) -> None:
     for lab in labels:
         e = data["energy"].get(lab, {}).get(mid)
         if e is not None:
-            es.append({"label": lab, "x": e[0], "y": e[1]})
+            es.append({"label": lab, "x": e[0], "y": e[1], "style": styles.get(lab)})
     F.energy_figure(stage / "figures" / "energy_vs_time.png", es,
-                    title=f"Energy error at dt = {mid:.4g}")
+                    title=f"Energy conservation of the integrators at dt = {mid:.4g} s", legend_title=LEGEND_TITLE)
     report.figure("figures/energy_vs_time.png",
                   f"Relative energy error against time at dt = {mid:.4g} (symplectic methods stay bounded)")
 

@@ -21,11 +21,34 @@ def _label(key, many_rules):
     return f"{solver} / {rule}" if many_rules else solver
 
 
+RULE_LINES = ("-", ":", "-.", (0, (5, 1, 1, 1, 1, 1)))
+
+
+def line_styles(recs, rules) -> dict:
+    """(source, solver, rule) -> style: solver = colour + marker, rule = line style, peer black dashed."""
+    book = F.StyleBook({rule: RULE_LINES[i % len(RULE_LINES)] for i, rule in enumerate(rules)})
+    out = {}
+    for key in _lines(recs):
+        src, solver, rule = key
+        out[key] = dict(F.REFERENCE_STYLE) if src != "femkit" else book(solver, rule)
+    return out
+
+
+def _rule_legend(rules) -> str | None:
+    names = {"-": "solid", ":": "dotted", "-.": "dash-dot"}
+    if len(rules) < 2:
+        return None
+    return "line style = quadrature rule\n" + ", ".join(
+        f"{names.get(RULE_LINES[i], 'dash-dot-dot')}: {r}" for i, r in enumerate(rules)) + "\nblack dashed: scikit-fem"
+
+
 def build_poisson_report(report, study, result, data, stage) -> None:
     recs = result.records
     femkit_recs = [r for r in recs if r["source"] == "femkit"]
     rules = list(dict.fromkeys(r["quadrature"] for r in femkit_recs))
     many = len(rules) > 1
+    styles = line_styles(recs, rules)
+    norm_book = F.StyleBook({rule: RULE_LINES[i % len(RULE_LINES)] for i, rule in enumerate(rules)})
     lines = _lines(recs)
     fits = {(f["source"], f["solver"], f["quadrature"], f["norm"]): f for f in result.fits}
 
@@ -51,16 +74,20 @@ def build_poisson_report(report, study, result, data, stage) -> None:
         for norm, name in (("L2", "L2"), ("H1_semi", "H1 seminorm")):
             y = [np.nan if r[norm] is None else r[norm] for r in rows_k]
             lab = f"{name} ({'scikit-fem' if src != 'femkit' else 'femkit'}{', ' + rule if many and src == 'femkit' else ''})"
-            base = {"label": lab, "reference": src != "femkit"}
+            st = dict(F.REFERENCE_STYLE, marker="x" if norm == "L2" else "+") if src != "femkit" \
+                else norm_book(norm, rule)
+            base = {"label": lab, "reference": src != "femkit", "style": st}
             series_h.append({**base, "x": [r["h"] for r in rows_k], "y": y, "fit": fits.get((*key, norm), {}).get("fit")})
             series_dofs.append({**base, "x": [r["dofs"] for r in rows_k], "y": y})
-    F.loglog_figure(stage / "figures" / "error_vs_h.png", series_h, title="Error vs mesh size",
-                    xlabel="h, longest edge [length]", ylabel="error norm", triangle=2, invert_x=True,
-                    note="dotted: least-squares fit; triangle: slope 2")
+    F.loglog_figure(stage / "figures" / "error_vs_h.png", series_h,
+                    title="P1 convergence: L2 and H1 errors vs mesh size",
+                    xlabel="h, longest edge [length unit of the mesh]", ylabel="error norm (L2, H1 seminorm)",
+                    triangle=2, invert_x=True, note="thin dotted: least-squares fit; triangle: slope 2")
     report.heading("Figures")
     report.figure("figures/error_vs_h.png", "Error against mesh size h (finer to the right), fitted rates in the legend")
-    F.loglog_figure(stage / "figures" / "error_vs_dofs.png", series_dofs, title="Error vs unknowns",
-                    xlabel="degrees of freedom (free unknowns)", ylabel="error norm", triangle=-1,
+    F.loglog_figure(stage / "figures" / "error_vs_dofs.png", series_dofs,
+                    title="P1 convergence: L2 and H1 errors vs unknowns",
+                    xlabel="degrees of freedom (free unknowns)", ylabel="error norm (L2, H1 seminorm)", triangle=-1,
                     note="triangle: slope -1 (L2 ~ h^2 ~ 1/dofs in 2D)")
     report.figure("figures/error_vs_dofs.png", "Error against the number of unknowns")
 
@@ -69,16 +96,21 @@ def build_poisson_report(report, study, result, data, stage) -> None:
         rows_k = [r for r in recs if (r["source"], r["solver"], r["quadrature"]) == key]
         if key[0] == "femkit" and (rows_k[0]["method"] == "direct" or (many and key[2] != rules[0])):
             continue
-        it_series.append({"label": _label(key, False), "reference": key[0] != "femkit",
-                          "x": [r["dofs"] for r in rows_k], "y": [r["iterations"] for r in rows_k]})
+        it_series.append({"label": f"{_label(key, False)}, fixed rtol", "reference": key[0] != "femkit",
+                          "x": [r["dofs"] for r in rows_k], "y": [r["iterations"] for r in rows_k],
+                          "style": {**styles[key], "linestyle": "-"} if key[0] == "femkit" else styles[key]})
     for s in dict.fromkeys(n["solver"] for n in data.get("nested", [])):
         rows_n = [n for n in data["nested"] if n["solver"] == s]
+        key = next(k for k in lines if k[0] == "femkit" and k[1] == s)
         it_series.append({"label": f"{s}, nested, stop at discretisation error",
-                          "x": [n["dofs"] for n in rows_n], "y": [n["iterations_nested"] for n in rows_n]})
+                          "x": [n["dofs"] for n in rows_n], "y": [n["iterations_nested"] for n in rows_n],
+                          "style": {**styles[key], "linestyle": ":", "markerfacecolor": "none"}})
     if it_series:
         F.loglog_figure(stage / "figures" / "iterations_vs_dofs.png", it_series,
-                        title="Iterations vs unknowns", xlabel="degrees of freedom",
-                        ylabel="iterations to the stopping rule")
+                        title="Solver cost: iterations vs unknowns (fixed rtol and nested)",
+                        xlabel="degrees of freedom (free unknowns)",
+                        ylabel="iterations to the stopping rule",
+                        legend_title="solid: fixed rtol from zero; dotted, open: nested" if data.get("nested") else None)
         report.figure("figures/iterations_vs_dofs.png", "Iterations against unknowns (AMG flat, CG ~ dofs^0.5)")
 
     wp, t_all, e_all = [], [], []
@@ -86,15 +118,16 @@ def build_poisson_report(report, study, result, data, stage) -> None:
         rows_k = [r for r in recs if (r["source"], r["solver"], r["quadrature"]) == key]
         t = [r["t_total"] for r in rows_k]
         e = [r["L2"] for r in rows_k]
-        wp.append({"label": _label(key, many), "reference": key[0] != "femkit", "x": t, "y": e})
+        wp.append({"label": _label(key, many), "reference": key[0] != "femkit", "x": t, "y": e,
+                   "style": styles[key]})
         t_all += t
         e_all += e
     front = pareto_front(t_all, e_all)
     F.work_precision_figure(stage / "figures" / "work_precision.png", wp,
                             front=[(t_all[i], e_all[i]) for i in front],
-                            title="Work-precision: L2 error vs run time",
+                            title="Work-precision of the solvers: L2 error vs run time",
                             xlabel="run time: assembly + boundary + solve [s] (min over repeats)",
-                            ylabel="L2 error")
+                            ylabel="L2 error ||u - u_h||", legend_title=_rule_legend(rules))
     report.figure("figures/work_precision.png",
                   "Work-precision: L2 error against run time, one line per solver; the Pareto front highlighted")
     pareto_ids = set(front.tolist())

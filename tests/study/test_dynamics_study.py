@@ -72,3 +72,15 @@ def test_bundled_dynamics_study_quick(tmp_path):
     res = load_study(ROOT / "studies" / "dynamics_work_precision.yaml", quick=True).run(tmp_path / "r")
     assert abs(res.fit(integrator="rk4")["slope"] - 4) < 0.3
     assert len(res.figures) == 4
+
+
+def test_every_integrator_has_its_own_style_and_family_line():
+    from femkit.study.report_dynamics import FAMILY_LINES, integrator_styles
+
+    names = list(ORDERS) + ["variational_symplectic"]
+    st = integrator_styles(study_from_dict({**OSC, "integrators": names}))
+    assert len({s["color"] for s in st.values()}) == len(names)
+    assert len({s["marker"] for s in st.values()}) == len(names)
+    assert st["rk4"]["linestyle"] == FAMILY_LINES["explicit"]
+    assert st["velocity_verlet"]["linestyle"] == st["variational_symplectic"]["linestyle"] == FAMILY_LINES["symplectic"]
+    assert st["implicit_euler"]["linestyle"] == st["newmark"]["linestyle"] == FAMILY_LINES["implicit"]
