@@ -128,10 +128,13 @@ def run_study(study, output_dir=None, *, progress: bool | None = None, write: bo
             for n in result.notes:
                 report.paragraph(n)
         report.heading("Data files")
-        report.paragraph("runs.csv (one row per run), results.json (records, fits, tables, notes)"
+        report.paragraph("runs.csv (one row per run), " + ("fits.csv (every fitted rate), " if result.fits else "")
+                         + "results.json (records, fits, tables, notes)"
                          + "".join(f", {k}.csv" for k in result.tables) + ".")
         result.figures = report.figures
         write_csv(stage / "runs.csv", result.records)
+        if result.fits:
+            write_csv(stage / "fits.csv", result.to_dict()["fits"])
         for name, rows in result.tables.items():
             write_csv(stage / f"{name}.csv", rows)
         write_json(stage / "results.json", result.to_dict())

@@ -128,3 +128,19 @@ def test_bundled_poisson_study_quick(tmp_path):
     fit = res.fit(source="femkit", solver="direct", quadrature="barycentric", norm="H1_semi")
     assert abs(fit["slope"] - 1.0) < 0.15
     assert (tmp_path / "r" / "report.html").exists()
+
+
+def test_rate_table_groups_solvers_with_equal_fits(smooth):
+    from femkit.study.report_poisson import grouped_rate_rows
+
+    rows = grouped_rate_rows(smooth.fits)
+    femkit_rows = [r for r in rows if r[0] != "scikit-fem+pyamg"]
+    # 3 solvers x 2 rules x 3 norms fits, all solvers reach the same discretisation error: one row per rule x norm
+    assert len(smooth.fits) == 3 * 2 * 3 + 3
+    assert [r[0] for r in femkit_rows] == ["all solvers"] * 6
+    assert [(r[1], r[2]) for r in femkit_rows[:3]] == [("barycentric", n) for n in ("L2", "H1_semi", "max_nodal")]
+    # a solver whose fit differs keeps its own row
+    odd = [dict(f, slope=f["slope"] + 0.5) if f["solver"] == "cg" else f for f in smooth.fits]
+    names = [r[0] for r in grouped_rate_rows(odd) if r[1] == "barycentric" and r[2] == "L2"]
+    assert names == ["pcg+amg, direct", "cg"]
+    assert (smooth.output_dir / "fits.csv").read_text().count("\n") == len(smooth.fits) + 1
