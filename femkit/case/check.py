@@ -15,6 +15,8 @@ by ``cond(A) * rtol`` in theory, and observed far below ``10 * rtol`` on the bun
 Solution tolerances are never tighter than ``1e-10`` (round-off of a direct solve).
 The load row uses the source term only (femkit's one-point rule against skfem's
 one-point rule); Neumann terms, when present, are femkit's in both solution rows.
+Pure-Neumann cases: the solutions are compared at mean zero (``int u dx = 0``), scikit-fem's
+with node 0 pinned, pyamg's on the pinned SPD system.
 """
 
 from __future__ import annotations
@@ -67,7 +69,8 @@ def cross_check(case: Case) -> list[CheckRow]:
     from skfem.helpers import dot, grad
 
     from ..fem import assemble_load
-    from .run import assemble_system, build_mesh, dirichlet_data, dirichlet_system, solve_system
+    from .run import (assemble_system, build_mesh, dirichlet_data, dirichlet_system,
+                      is_pure_neumann, solve_system)
 
     mesh = build_mesh(case)
     K, F, kappa = assemble_system(case, mesh)
@@ -107,22 +110,45 @@ def cross_check(case: Case) -> list[CheckRow]:
     s = case.data["solver"]
     sol_tol = max(SOLUTION_FACTOR * s["rtol"], SOLUTION_FLOOR)
 
-    nodes, values = dirichlet_data(case, mesh)
+    F_sk = F_sk + neumann
+    pure = is_pure_neumann(case)
+    if pure:
+        # u is defined up to a constant: skfem pins node 0, both compared at mean zero
+        from ..fem.poisson import check_compatibility, node_weights, pure_neumann_system
+
+        w = node_weights(mesh)
+        F_sk = check_compatibility(F_sk, weights=w, rtol=case.data["boundary"]["compatibility_rtol"])[0]
+        nodes, values = np.array([0]), np.array([0.0])
+
+        def at_mean_zero(v):
+            return v - float(w @ v) / float(w.sum())
+
+        u = at_mean_zero(u)
+    else:
+        nodes, values = dirichlet_data(case, mesh)
     x_d = np.zeros(mesh.n_points)
     x_d[nodes] = values
-    u_sk = skfem.solve(*condense(sp.csr_matrix(K_sk), F_sk + neumann, x=x_d, D=nodes))
-    rows.append(CheckRow("solution vs scikit-fem", _rel(u, u_sk), sol_tol,
+    u_sk = skfem.solve(*condense(sp.csr_matrix(K_sk), F_sk, x=x_d, D=nodes))
+    if pure:
+        u_sk = at_mean_zero(u_sk)
+    rows.append(CheckRow("solution vs scikit-fem" + (" (mean zero)" if pure else ""),
+                         _rel(u, u_sk), sol_tol,
                          f"femkit {res.method}+{res.preconditioner}, {res.iterations} it; "
                          "skfem condense + direct"))
 
     import pyamg
 
-    ml = pyamg.smoothed_aggregation_solver(system.A.tocsr())
+    spd = system
+    if getattr(system, "bordered", False):  # indefinite: pyamg gets the pinned SPD system
+        spd = pure_neumann_system(K, system.b[:-1], mode="mean_zero", weights=w, method="pcg")
+    ml = pyamg.smoothed_aggregation_solver(spd.A.tocsr())
     pyres: list[float] = []
-    x_amg = ml.solve(system.b, tol=s["rtol"], accel="cg", maxiter=s["maxiter"],
-                     residuals=pyres)
-    x_amg = np.asarray(x_amg).ravel()
-    rows.append(CheckRow("solution vs pyamg SA (accel=cg)", _rel(res.x, x_amg), sol_tol,
+    x_amg = ml.solve(spd.b, tol=s["rtol"], accel="cg", maxiter=s["maxiter"], residuals=pyres)
+    x_amg = spd.expand(np.asarray(x_amg).ravel())
+    u_ours = u if pure else res.x
+    if not pure:
+        x_amg = x_amg[system.free]
+    rows.append(CheckRow("solution vs pyamg SA (accel=cg)", _rel(u_ours, x_amg), sol_tol,
                          f"pyamg {max(len(pyres) - 1, 0)} it, femkit {res.iterations} it"))
     return rows
 

@@ -146,6 +146,10 @@ def case_from_dict(data: Mapping, base_dir: str | os.PathLike = ".", *, name: st
     if not isinstance(data, Mapping):
         raise CaseFileError(f"a case file must be a mapping of keys, got {type(data).__name__}")
     data = apply_overrides(dict(data), overrides)
+    # no case schema has a top-level 'kind' (study files) and stress cases have no 'problem'
+    hint = _not_a_case(data, path) if "kind" in data or "problem" not in data else None
+    if hint:
+        raise CaseFileError(hint)
     if "problem" not in data:
         raise CaseFileError("(top level): missing required key 'problem' "
                             "(e.g. 'problem: poisson')")
@@ -162,6 +166,23 @@ def case_from_dict(data: Mapping, base_dir: str | os.PathLike = ".", *, name: st
                 path=Path(path).resolve() if path is not None else None)
     ptype.get_prepare()(case)
     return case
+
+
+def _not_a_case(data: Mapping, path) -> str | None:
+    """What a file without ``problem:`` is instead, and the command that runs it (or None).
+
+    >>> _not_a_case({"kind": "stability"}, "s.yaml")
+    'this is a study file (kind: stability), not a case; run it with `femkit study s.yaml`'
+    """
+    name = str(path) if path is not None else "FILE"
+    if "kind" in data:
+        return (f"this is a study file (kind: {data['kind']}), not a case; run it with "
+                f"`femkit study {name}`")
+    if "type" in data:
+        return (f"this is a stress-suite case (type: {data['type']}), not a case "
+                "file; cases/stress/*.yaml run together in the stress study: "
+                "`femkit study studies/stress.yaml`")
+    return None
 
 
 def load_case(path: str | os.PathLike, **overrides) -> Case:

@@ -76,7 +76,8 @@ def prepare_poisson(case: Case) -> None:
     if isinstance(coef, str):
         _compile(case, "coefficient", coef)
     _compile(case, "source", d["source"])
-    for i, bc in enumerate(d["boundary"]["dirichlet"]):
+    _prepare_nullspace(d["boundary"])
+    for i, bc in enumerate(d["boundary"].get("dirichlet", [])):
         _compile(case, f"boundary.dirichlet[{i}].value", bc["value"])
     for i, bc in enumerate(d["boundary"].get("neumann", [])):
         _compile(case, f"boundary.neumann[{i}].flux", bc["flux"])
@@ -89,6 +90,25 @@ def prepare_poisson(case: Case) -> None:
 
     out = d["output"]
     out["dir"] = str((base / out.get("dir", os.path.join("runs", case.name))).resolve())
+
+
+def _prepare_nullspace(bnd: dict) -> None:
+    """Pure Neumann (no ``dirichlet``): fill ``nullspace`` (mean_zero) and ``compatibility_rtol``."""
+    from ..fem.poisson import COMPATIBILITY_RTOL
+
+    if bnd.get("dirichlet"):
+        for key in ("nullspace", "compatibility_rtol"):
+            if key in bnd:
+                raise CaseFileError(f"boundary.{key}: only for pure-Neumann problems (no "
+                                    "boundary.dirichlet); remove it or the Dirichlet conditions")
+        return
+    bnd.setdefault("nullspace", "mean_zero")
+    bnd.setdefault("compatibility_rtol", COMPATIBILITY_RTOL)
+
+
+def is_pure_neumann(case: Case) -> bool:
+    """True when the case has no Dirichlet condition (``u`` fixed only up to a constant)."""
+    return not case.data["boundary"].get("dirichlet")
 
 
 # ----------------------------------------------------------------------------- stages
@@ -162,15 +182,22 @@ def element_kappa(case: Case, mesh) -> np.ndarray:
 
 def assemble_system(case: Case, mesh):
     """Stiffness matrix, load vector (with Neumann fluxes) and per-element kappa."""
-    from ..fem import assemble_load, assemble_neumann, assemble_stiffness
+    from ..fem import assemble_load, assemble_stiffness
 
     kappa = element_kappa(case, mesh)
     K = assemble_stiffness(mesh, kappa)
     F = assemble_load(mesh, case.functions["source"], rule=case.data["quadrature"]["load"])
+    return K, F + neumann_load(case, mesh), kappa
+
+
+def neumann_load(case: Case, mesh) -> np.ndarray:
+    """The load of every ``boundary.neumann`` flux, ``int h N_i ds`` (zeros without any)."""
+    from ..fem import assemble_neumann
+
+    F = np.zeros(mesh.n_points)
     for i, bc in enumerate(case.data["boundary"].get("neumann", [])):
-        flux = case.functions[f"boundary.neumann[{i}].flux"]
-        F = F + assemble_neumann(mesh, bc["tags"], flux)
-    return K, F, kappa
+        F += assemble_neumann(mesh, bc["tags"], case.functions[f"boundary.neumann[{i}].flux"])
+    return F
 
 
 def dirichlet_data(case: Case, mesh) -> tuple[np.ndarray, np.ndarray]:
@@ -198,11 +225,38 @@ def dirichlet_data(case: Case, mesh) -> tuple[np.ndarray, np.ndarray]:
 
 
 def dirichlet_system(case: Case, mesh, K, F):
-    """Eliminate the Dirichlet nodes: an SPD reduced system (``.A``, ``.b``, ``.expand``)."""
+    """Eliminate the Dirichlet nodes: an SPD reduced system (``.A``, ``.b``, ``.expand``).
+
+    Pure Neumann (no ``boundary.dirichlet``): check the compatibility of the data and fix
+    the constant as ``boundary.nullspace`` says (a
+    :class:`~femkit.fem.poisson.NullspaceSystem` with the same interface).
+    """
+    if is_pure_neumann(case):
+        return nullspace_system(case, mesh, K, F)
     from ..fem import apply_dirichlet
 
     nodes, values = dirichlet_data(case, mesh)
     return apply_dirichlet(K, F, nodes, values)
+
+
+def nullspace_system(case: Case, mesh, K, F):
+    """The pure-Neumann system: compatibility checked, constant fixed (``boundary.nullspace``).
+
+    ``pin`` pins node 0 to the exact solution's value there when ``exact`` is given, else to 0.
+    """
+    from ..fem.poisson import check_compatibility, node_weights, pure_neumann_system
+
+    bnd = case.data["boundary"]
+    w = node_weights(mesh)
+    F_flux = neumann_load(case, mesh)
+    F, info = check_compatibility(F - F_flux, F_flux, weights=w, rtol=bnd["compatibility_rtol"])
+    pin_value = 0.0
+    if bnd["nullspace"] == "pin" and "exact.u" in case.functions:
+        x0, y0 = mesh.points[0]
+        pin_value = float(np.asarray(case.functions["exact.u"](np.array([x0]), np.array([y0])))[0])
+    return pure_neumann_system(K, F, mode=bnd["nullspace"], weights=w,
+                               method=case.data["solver"]["method"], pin_node=0,
+                               pin_value=pin_value, compatibility=info)
 
 
 def solve_system(case: Case, A, b, x0=None, callback=None):
@@ -218,7 +272,11 @@ def solve_system(case: Case, A, b, x0=None, callback=None):
 
 
 def compute_errors(case: Case, mesh, u: np.ndarray) -> dict | None:
-    """Error norms against ``exact`` (None when the case gives no exact solution)."""
+    """Error norms against ``exact`` (None when the case gives no exact solution).
+
+    Pure Neumann: modulo the constant, i.e. of ``u - c`` with ``c`` the mean difference
+    ``int (u_h - u) dx / |Omega|`` (:func:`femkit.fem.poisson.mean_shift`).
+    """
     if "exact.u" not in case.functions:
         return None
     from ..fem import error_norms
@@ -230,7 +288,12 @@ def compute_errors(case: Case, mesh, u: np.ndarray) -> dict | None:
         def grad(x, y):
             return gx(x, y), gy(x, y)
 
-    errs = error_norms(mesh, u, case.functions["exact.u"], grad)
+    exact = case.functions["exact.u"]
+    if is_pure_neumann(case):  # u is defined up to a constant: compare u - c with int(u - c - exact) = 0
+        from ..fem.poisson import mean_shift
+
+        u = u - mean_shift(mesh, u, exact)
+    errs = error_norms(mesh, u, exact, grad)
     return {k: (None if v is None else float(v)) for k, v in errs.items()}
 
 
@@ -253,6 +316,7 @@ class CaseResult:
     nnz: int
     output_dir: Path | None = None
     files: list = field(default_factory=list)
+    nullspace: dict | None = None
 
     @property
     def converged(self) -> bool:
@@ -279,6 +343,7 @@ class CaseResult:
             "mesh": mesh_info,
             "dofs": self.dofs,
             "n_dirichlet": self.n_dirichlet,
+            "nullspace": self.nullspace,
             "nnz": self.nnz,
             "solver": self.solve.summary(),
             "converged": self.converged,
@@ -298,6 +363,13 @@ class CaseResult:
             f"h_max {q.get('h_max', float('nan')):.3g}, min angle {q.get('min_angle', float('nan')):.1f} deg",
             f"system    {self.dofs} dofs ({self.n_dirichlet} Dirichlet nodes eliminated), nnz {self.nnz}",
         ]
+        if self.nullspace is not None:
+            ns = self.nullspace
+            lines[-1] = (f"system    {self.dofs} dofs, pure Neumann: constant fixed by {ns['mode']} "
+                         f"({ns['how']}), nnz {self.nnz}")
+            lines.append(f"data      int f dx {ns['source_integral']:.4e} + int h ds "
+                         f"{ns['flux_integral']:.4e}: relative imbalance "
+                         f"{ns['relative_imbalance']:.2e} (<= {ns['rtol']:g}) removed")
         pc = f" + {s.preconditioner}" if s.preconditioner not in ("none", "", None) else ""
         status = "converged" if s.converged else f"NOT converged ({s.reason})"
         lines.append(f"solver    {s.method}{pc}: {status}, {s.iterations} iterations, "
@@ -363,8 +435,8 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
             errors = compute_errors(case, mesh, u)
     result = CaseResult(case=case, mesh=mesh, u=u, kappa=kappa, solve=res, errors=errors,
                         timings=stage.timings, quality=q, dofs=int(system.A.shape[0]),
-                        n_dirichlet=int(mesh.n_points - system.A.shape[0]),
-                        nnz=int(system.A.nnz))
+                        n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
+                        nnz=int(system.A.nnz), nullspace=_nullspace_facts(system))
     if write:
         write_outputs(result, output_dir or case.data["output"]["dir"])
     if not quiet:
@@ -372,6 +444,18 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         for line in result.summary_lines():
             out(line)
     return result
+
+
+def _nullspace_facts(system) -> dict | None:
+    """result.json's ``nullspace``: mode, how the constant was fixed, the compatibility check."""
+    mode = getattr(system, "mode", None)
+    if mode is None:
+        return None
+    if getattr(system, "bordered", False):
+        how = "bordered matrix [[K, w], [w^T, 0]], LU"
+    else:
+        how = f"node {int(system.fixed[0])} pinned" + (", shifted to mean zero" if mode == "mean_zero" else "")
+    return {"mode": mode, "how": how, **system.compatibility}
 
 
 def write_outputs(result: CaseResult, directory: str | os.PathLike) -> Path:

@@ -69,7 +69,6 @@ POISSON_SCHEMA: dict = {
         "boundary": {
             "type": "object",
             "additionalProperties": False,
-            "required": ["dirichlet"],
             "properties": {
                 "dirichlet": {
                     "type": "array", "minItems": 1,
@@ -84,6 +83,10 @@ POISSON_SCHEMA: dict = {
                               "required": ["tags", "flux"],
                               "properties": {"tags": _TAGS, "flux": _NUMBER_OR_EXPR}},
                 },
+                # pure Neumann only (no dirichlet): filled at load time (mean_zero, 1e-3)
+                "nullspace": {"enum": ["mean_zero", "pin", "error"]},
+                "compatibility_rtol": {"type": "number", "exclusiveMinimum": 0,
+                                       "exclusiveMaximum": 1},
             },
         },
         "exact": {

@@ -8,6 +8,39 @@
 >>> u, result = prob.solve()
 >>> round(float(u[4]), 12)
 1.0
+
+Pure Neumann (no Dirichlet data): the solution is fixed up to a constant, here by its mean.
+
+>>> prob = PoissonProblem(Mesh(pts, tri), f=0.0, dirichlet=[], neumann=[(None, 0.0)])
+>>> u, result = prob.solve()
+>>> bool(np.abs(u).max() < 1e-12), prob.system.mode
+(True, 'mean_zero')
+
+Pure Neumann problems
+---------------------
+Without Dirichlet data ``K`` is singular (``K 1 = 0``) and ``K u = F`` is solvable only when
+the discrete compatibility condition ``1^T F = int f dx + int h ds = 0`` holds.
+:func:`check_compatibility` raises :class:`~femkit.errors.SingularSystemError` when
+``|sum F| > rtol * sum |F|`` and otherwise removes the small remainder (a quadrature error of
+``int f``) by subtracting the matching constant from ``f``. The constant in ``u`` is then
+fixed by the ``nullspace`` mode (:func:`pure_neumann_system`):
+
+- ``mean_zero`` (default): the solution with ``int u_h dx = 0``. The direct solver gets the
+  bordered (Lagrange-multiplier) matrix ``[[K, w], [w^T, 0]]`` with ``w_i = int N_i dx``,
+  symmetric indefinite, so it is factorised by LU, never Cholesky. Iterative methods solve
+  the SPD system with one node pinned to 0 and the result is shifted to mean zero: plain CG
+  would also converge on the singular but consistent ``K u = F``, but smoothed-aggregation
+  AMG and IC(0) built on a singular matrix are not reliably positive definite (measured:
+  ``r^T M r < 0`` breakdowns), and the pinned system works with every preconditioner.
+- ``pin``: ``u = value`` at one node (eliminated like a Dirichlet node): an SPD system of
+  ``n - 1`` unknowns for any solver.
+- ``error``: raise :class:`PureNeumannError`.
+
+:class:`PureNeumannError` is a :class:`~femkit.errors.SingularSystemError` and an
+:class:`~femkit.errors.InputError`: the data are at fault, so ``femkit solve`` exits with 2.
+
+The discrete solutions of ``pin`` and ``mean_zero`` differ by a constant only. Compare a
+pure-Neumann solution with an exact solution modulo the constant: :func:`mean_shift`.
 """
 
 from __future__ import annotations
@@ -18,12 +51,189 @@ from typing import Callable, NamedTuple, Sequence
 import numpy as np
 
 from ..errors import InputError, SingularSystemError
-from .coefficients import Coefficient
+from ._elements import triangle_geometry
+from .coefficients import Coefficient, evaluate_callable
 from .dirichlet import DirichletSystem, apply_dirichlet, dirichlet_values
 from .load import assemble_load
 from .neumann import assemble_neumann
 from .p1_stiffness import assemble_stiffness
 from .sparsity import SparsityPattern
+
+
+NULLSPACE_MODES = ("mean_zero", "pin", "error")
+
+
+class PureNeumannError(SingularSystemError, InputError):
+    """A pure-Neumann problem that cannot be solved as given: incompatible data, or
+    ``nullspace="error"``.
+
+    Both a :class:`~femkit.errors.SingularSystemError` (what it is) and an
+    :class:`~femkit.errors.InputError` (whose fault it is: the data), so ``femkit solve``
+    exits with code 2 and writes nothing.
+    """
+
+#: default of ``compatibility_rtol``: |int f + int h| relative to sum |F| accepted as quadrature error
+COMPATIBILITY_RTOL = 1e-3
+
+
+def node_weights(mesh) -> np.ndarray:
+    """``w_i = int N_i dx`` (one third of the area of each triangle around node i); ``sum w = |Omega|``.
+
+    >>> from femkit.mesh import Mesh
+    >>> node_weights(Mesh(np.array([[0., 0.], [3., 0.], [0., 2.]]), np.array([[0, 1, 2]]))).tolist()
+    [1.0, 1.0, 1.0]
+    """
+    _, area, _, tri = triangle_geometry(mesh, None)
+    return np.bincount(tri.ravel(), weights=np.repeat(area / 3.0, 3), minlength=mesh.n_points)
+
+
+def check_compatibility(F_source: np.ndarray, F_flux=None, *, weights: np.ndarray | None = None,
+                        rtol: float = COMPATIBILITY_RTOL) -> tuple[np.ndarray, dict]:
+    """Check ``int f dx + int h ds = 0`` on the discrete load of a pure-Neumann problem.
+
+    Parameters
+    ----------
+    F_source, F_flux : ndarray, shape (n,)
+        Load vectors of the source and of the Neumann fluxes (``F_flux`` may be None).
+    weights : ndarray, shape (n,), optional
+        ``int N_i dx`` (:func:`node_weights`); the remainder is removed as a constant source,
+        ``F - (sum F) w / sum w``. Without it, a uniform shift of ``F``.
+    rtol : float
+        Largest ``|sum F| / sum |F|`` accepted (the quadrature error of ``int f``).
+
+    Returns
+    -------
+    F : ndarray
+        The consistent load (``sum F = 0`` to rounding).
+    info : dict
+        ``source_integral``, ``flux_integral``, ``relative_imbalance``, ``rtol``.
+
+    Raises
+    ------
+    PureNeumannError
+        (a SingularSystemError and an InputError) ``|sum F| > rtol * sum |F|``: the data
+        admit no solution.
+
+    >>> F, info = check_compatibility(np.array([1.0, -1.0 + 1e-9]))
+    >>> bool(abs(F.sum()) < 1e-15), info["relative_imbalance"] < 1e-8
+    (True, True)
+    >>> check_compatibility(np.array([1.0, 1.0]))
+    Traceback (most recent call last):
+    ...
+    femkit.fem.poisson.PureNeumannError: pure-Neumann data are incompatible: int f dx = 2 and int h ds = 0 must sum to 0 (relative imbalance 1 > 0.001); change the source or the fluxes so they balance, or add a Dirichlet condition
+    """
+    F_source = np.asarray(F_source, dtype=np.float64)
+    F_flux = np.zeros_like(F_source) if F_flux is None else np.asarray(F_flux, dtype=np.float64)
+    F = F_source + F_flux
+    total = float(F.sum())
+    scale = float(np.abs(F_source).sum() + np.abs(F_flux).sum())
+    rel = abs(total) / scale if scale > 0 else 0.0
+    info = {"source_integral": float(F_source.sum()), "flux_integral": float(F_flux.sum()),
+            "relative_imbalance": rel, "rtol": float(rtol)}
+    if rel > rtol:
+        raise PureNeumannError(
+            f"pure-Neumann data are incompatible: int f dx = {info['source_integral']:.6g} and "
+            f"int h ds = {info['flux_integral']:.6g} must sum to 0 (relative imbalance "
+            f"{rel:.3g} > {rtol:g}); change the source or the fluxes so they balance, or add a "
+            "Dirichlet condition")
+    if weights is None:
+        return F - total / len(F), info
+    weights = np.asarray(weights, dtype=np.float64)
+    return F - total * weights / weights.sum(), info
+
+
+class NullspaceSystem:
+    """A pure-Neumann system with its constant fixed; the same interface as DirichletSystem.
+
+    Attributes
+    ----------
+    A, b : the matrix and right-hand side handed to the solver (``A`` is ``K`` itself,
+        the bordered ``(n+1) x (n+1)`` matrix, or the SPD matrix with one node eliminated).
+    mode : ``"mean_zero"`` or ``"pin"``.
+    free, fixed : node indices (``fixed`` holds the pinned node, or nothing).
+    n : number of nodes; ``weights``: ``int N_i dx``; ``compatibility``: the check's facts.
+    """
+
+    def __init__(self, A, b, mode: str, n: int, weights: np.ndarray, *, bordered: bool = False,
+                 pinned: DirichletSystem | None = None, compatibility: dict | None = None):
+        self.A, self.b, self.mode, self.n = A, b, mode, n
+        self.weights = weights
+        self.bordered = bordered
+        self.pinned = pinned
+        self.compatibility = compatibility or {}
+        self.fixed = pinned.fixed if pinned is not None else np.zeros(0, dtype=np.int64)
+        self.free = pinned.free if pinned is not None else np.arange(n)
+
+    def expand(self, x: np.ndarray) -> np.ndarray:
+        """Full nodal vector from the solver's ``x`` (mean-zero mode: shifted to ``int u = 0``)."""
+        if self.pinned is not None:
+            u = self.pinned.expand(x)
+        else:
+            x = np.asarray(x, dtype=np.float64)
+            if x.shape != (self.n + 1,):
+                raise InputError(f"expected {self.n + 1} values, got shape {x.shape}")
+            u = x[:self.n]
+        if self.mode == "pin":
+            return u
+        return u - float(self.weights @ u) / float(self.weights.sum())
+
+
+def pure_neumann_system(K, F, *, mode: str = "mean_zero", weights: np.ndarray, method: str = "direct",
+                        pin_node: int = 0, pin_value: float = 0.0,
+                        compatibility: dict | None = None) -> NullspaceSystem:
+    """Fix the constant of the singular pure-Neumann system ``K u = F`` (``F`` consistent).
+
+    Parameters
+    ----------
+    K : sparse matrix (n, n), symmetric with ``K 1 = 0``.
+    F : ndarray (n,) with ``sum F = 0`` (see :func:`check_compatibility`).
+    mode : ``mean_zero``, ``pin`` or ``error`` (raises SingularSystemError).
+    weights : ``int N_i dx`` (:func:`node_weights`).
+    method : the solver that will be used: ``direct`` gets the bordered matrix in mean-zero mode,
+        the others the SPD system with ``pin_node`` eliminated (then shifted to mean zero).
+    pin_node, pin_value : the node pinned, and its value in ``pin`` mode.
+    """
+    import scipy.sparse as sp
+
+    if mode not in NULLSPACE_MODES:
+        raise InputError(f"unknown nullspace mode {mode!r}; valid modes: {', '.join(NULLSPACE_MODES)}")
+    if mode == "error":
+        raise PureNeumannError(
+            "no Dirichlet condition: the pure-Neumann Poisson problem is singular (u is fixed only "
+            "up to a constant); choose nullspace 'mean_zero' or 'pin', or add a Dirichlet condition")
+    n = K.shape[0]
+    if mode == "mean_zero" and method == "direct":
+        w = sp.csr_matrix(np.asarray(weights, dtype=np.float64)[None, :])
+        A = sp.bmat([[K, w.T], [w, None]], format="csr")
+        A.sort_indices()
+        return NullspaceSystem(A, np.append(F, 0.0), mode, n, weights, bordered=True,
+                               compatibility=compatibility)
+    if not 0 <= int(pin_node) < n:
+        raise InputError(f"pin node {pin_node} out of range 0..{n - 1}")
+    value = float(pin_value) if mode == "pin" else 0.0
+    pinned = apply_dirichlet(K, F, [int(pin_node)], [value])
+    return NullspaceSystem(pinned.A, pinned.b, mode, n, weights, pinned=pinned,
+                           compatibility=compatibility)
+
+
+def mean_shift(mesh, u: np.ndarray, exact: Callable, *, order: int = 5) -> float:
+    """The constant ``c`` with ``int (u_h - c - u) dx = 0``: compare ``u_h - c`` with ``exact``.
+
+    ``int u_h`` is exact (``w . u``); ``int u`` uses a quadrature rule of degree ``order``.
+
+    >>> from femkit.mesh import Mesh
+    >>> m = Mesh(np.array([[0., 0.], [1., 0.], [0., 1.]]), np.array([[0, 1, 2]]))
+    >>> round(mean_shift(m, np.array([3., 4., 3.]), lambda x, y: x), 12)
+    3.0
+    """
+    from .quadrature import rule_for_degree
+
+    rule = rule_for_degree(order)
+    _, area, _, tri = triangle_geometry(mesh, None)
+    x, y = rule.physical_points(mesh, tri)
+    exact_integral = float(area @ (evaluate_callable(exact, x, y, name="exact") @ rule.weights))
+    w = node_weights(mesh)
+    return (float(w @ np.asarray(u, dtype=np.float64)) - exact_integral) / float(area.sum())
 
 
 class PoissonSolution(NamedTuple):
@@ -48,17 +258,29 @@ class PoissonProblem:
         Outward flux ``kappa du/dn = h`` on those boundary edges.
     load_rule : str
         Quadrature rule of the load (``barycentric`` default; ``gauss3``, ``gauss6``, ``gauss7``).
+    nullspace : {"mean_zero", "pin", "error"}, optional
+        Only without Dirichlet data (pure Neumann, ``dirichlet=[]``): how the constant is
+        fixed (default ``mean_zero``; see the module docstring). Giving it together with
+        Dirichlet data is an InputError.
+    compatibility_rtol : float
+        Pure Neumann: largest accepted ``|int f + int h| / sum |F|`` (default 1e-3).
+    pin_node, pin_value : int, float
+        Pure Neumann, ``nullspace="pin"``: the node fixed and its value.
 
     Attributes
     ----------
     timings : dict
         Seconds spent per stage of the last :meth:`assemble` / :meth:`solve`
         (``pattern``, ``stiffness``, ``load``, ``neumann``, ``dirichlet``, ``solve``).
+    system : DirichletSystem or NullspaceSystem
+        The system of the last :meth:`assemble`.
     """
 
     def __init__(self, mesh, kappa: Coefficient = 1.0, f=0.0, *,
                  dirichlet: Sequence = ((None, 0.0),), neumann: Sequence = (),
-                 load_rule: str = "barycentric"):
+                 load_rule: str = "barycentric", nullspace: str | None = None,
+                 compatibility_rtol: float = COMPATIBILITY_RTOL, pin_node: int = 0,
+                 pin_value: float = 0.0):
         self.mesh = mesh
         self.kappa = kappa
         self.f = f
@@ -66,16 +288,27 @@ class PoissonProblem:
         self.neumann = [tuple(d) for d in neumann]
         self.load_rule = load_rule
         self.timings: dict[str, float] = {}
-        self.system: DirichletSystem | None = None
-        if not self.dirichlet:
-            raise SingularSystemError(
-                "no Dirichlet condition: the pure Neumann Poisson problem is singular (fix u somewhere)")
+        self.system: DirichletSystem | NullspaceSystem | None = None
+        if self.dirichlet and nullspace is not None:
+            raise InputError("nullspace only applies to pure-Neumann problems (no Dirichlet data)")
+        if nullspace is not None and nullspace not in NULLSPACE_MODES:
+            raise InputError(f"unknown nullspace mode {nullspace!r}; valid modes: "
+                             f"{', '.join(NULLSPACE_MODES)}")
+        self.nullspace = None if self.dirichlet else (nullspace or "mean_zero")
+        self.compatibility_rtol = float(compatibility_rtol)
+        self.pin_node, self.pin_value = int(pin_node), float(pin_value)
+        if self.nullspace == "error":
+            pure_neumann_system(None, None, mode="error", weights=None)
         for entry in self.dirichlet + self.neumann:
             if len(entry) != 2:
                 raise InputError(f"boundary conditions are (tags, value) pairs, got {entry!r}")
 
-    def assemble(self) -> DirichletSystem:
-        """Assemble K, F (+ Neumann) and eliminate the Dirichlet nodes; stage times in ``timings``."""
+    def assemble(self, method: str = "direct") -> DirichletSystem | NullspaceSystem:
+        """Assemble K, F (+ Neumann) and eliminate the Dirichlet nodes; stage times in ``timings``.
+
+        Pure Neumann: check the compatibility of the data and fix the constant
+        (:func:`pure_neumann_system`; ``method`` says whether a direct solver will be used).
+        """
         t = {}
         t0 = time.perf_counter()
         pattern = SparsityPattern.for_mesh(self.mesh)
@@ -87,10 +320,21 @@ class PoissonProblem:
         F = assemble_load(self.mesh, self.f, rule=self.load_rule)
         t["load"] = time.perf_counter() - t0
         t0 = time.perf_counter()
+        F_flux = np.zeros(self.mesh.n_points)
         for tags, h in self.neumann:
-            F += assemble_neumann(self.mesh, tags, h)
+            F_flux += assemble_neumann(self.mesh, tags, h)
         t["neumann"] = time.perf_counter() - t0
         t0 = time.perf_counter()
+        if self.nullspace is not None:
+            w = node_weights(self.mesh)
+            F, info = check_compatibility(F, F_flux, weights=w, rtol=self.compatibility_rtol)
+            self.system = pure_neumann_system(K, F, mode=self.nullspace, weights=w, method=method,
+                                              pin_node=self.pin_node, pin_value=self.pin_value,
+                                              compatibility=info)
+            t["dirichlet"] = time.perf_counter() - t0
+            self.timings = t
+            return self.system
+        F = F + F_flux
         g = np.full(self.mesh.n_points, np.nan)
         for tags, value in self.dirichlet:
             nodes = _boundary_nodes(self.mesh, tags)
@@ -107,7 +351,10 @@ class PoissonProblem:
         ``method``, ``preconditioner`` and ``solver_opts`` (rtol, atol, maxiter, ...) go to
         :func:`femkit.solvers.solve`.
         """
-        system = self.system if self.system is not None else self.assemble()
+        system = self.system
+        if system is None or (isinstance(system, NullspaceSystem)
+                              and system.bordered != (method == "direct" and system.mode == "mean_zero")):
+            system = self.assemble(method)  # bordered only for a direct mean-zero solve
         t0 = time.perf_counter()
         result = _solve(system.A, system.b, method=method, preconditioner=preconditioner, **solver_opts)
         self.timings["solve"] = time.perf_counter() - t0

@@ -23,6 +23,9 @@ EXPECT = {
     "poisson_annulus": ({"mesh": {"h": 0.1}}, 5e-3, 5e-3),
     "poisson_high_contrast": ({"mesh": {"h": 0.08}}, None, None),
     "poisson_plate_mesh_file": ({}, 2e-3, 2e-3),
+    # the same smooth solution class as the unit square (cos instead of sin), errors modulo
+    # the constant; the nodal error of the mean-shifted solution is not superconvergent here
+    "poisson_neumann": ({"mesh": {"h": 0.1}}, 1e-2, 2e-2),
 }
 
 

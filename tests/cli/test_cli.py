@@ -32,6 +32,18 @@ def write(tmp_path, data, name="case.yaml"):
     return p
 
 
+def assert_bad_input(argv, pieces, capsys) -> str:
+    """``femkit argv`` exits 2 with one line ``femkit: error: ...`` holding every piece; stderr."""
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("femkit: error: "), err
+    for piece in pieces:
+        assert piece in lines[0], (piece, lines[0])
+    return err
+
+
 def degenerate_vtu(path):
     """Two triangles of a unit square plus one zero-area triangle (three collinear nodes)."""
     import meshio
@@ -66,23 +78,23 @@ def bad_cases(tmp_path):
                                       ["coefficient", "> 0", "element(s) violate"]),
         "missing-tag": (change(lambda d: d["boundary"]["dirichlet"][0].update(tags=["lfet"])),
                         ["boundary.dirichlet[0].tags", "lfet", "left"]),
+        # pure Neumann, f = 1 and zero flux: no solution exists (the data are at fault: exit 2)
+        "incompatible-neumann": (change(lambda d: d.update(
+            source=1, exact={"u": "0"},
+            boundary={"neumann": [{"tags": ["boundary"], "flux": 0}], "nullspace": "mean_zero"})),
+            ["pure-Neumann data are incompatible", "int f dx = 1", "int h ds = 0"]),
     }
 
 
 @pytest.mark.parametrize("kind", ["misspelled-key", "unknown-solver", "unsafe-expression",
                                   "missing-mesh-file", "degenerate-triangle", "missing-tag",
-                                  "non-finite-source", "negative-kappa-expression"])
+                                  "non-finite-source", "negative-kappa-expression",
+                                  "incompatible-neumann"])
 def test_bad_input_exit_2_one_line_and_no_output(kind, tmp_path, capsys):
     data, pieces = bad_cases(tmp_path)[kind]
     case = write(tmp_path, data)
     before = set(tmp_path.iterdir())
-    code = main(["solve", str(case)])
-    err = capsys.readouterr().err
-    assert code == 2
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("femkit: error: "), err
-    for piece in pieces:
-        assert piece in lines[0], (piece, lines[0])
+    err = assert_bad_input(["solve", str(case)], pieces, capsys)
     assert "Traceback" not in err
     assert set(tmp_path.iterdir()) == before  # no output dir, no temp dir
 
@@ -219,3 +231,21 @@ def test_usage_error_exits_2_with_one_line(capsys):
         main(["solv", "x.yaml"])
     assert info.value.code == 2
     assert capsys.readouterr().err.strip().count("\n") == 0
+
+
+@pytest.mark.parametrize("path,pieces", [
+    ("studies/stress.yaml", ["study file (kind: stability)", "femkit study ", "studies/stress.yaml`"]),
+    ("studies/poisson_convergence.yaml", ["study file (kind: ", "run it with `femkit study "]),
+    ("cases/stress/neumann.yaml", ["stress-suite case (type: poisson_neumann)",
+                                   "`femkit study studies/stress.yaml`"]),
+], ids=["stress-study", "convergence-study", "stress-case"])
+def test_solve_on_a_study_or_stress_file_says_what_to_run(path, pieces, capsys):
+    assert_bad_input(["solve", str(ROOT / path)], ["femkit: error: this is a ", *pieces], capsys)
+
+
+def test_solve_pure_neumann_case_prints_how_the_constant_was_fixed(tmp_path, capsys):
+    code = main(["solve", str(CASES / "poisson_neumann.yaml"), "--output", str(tmp_path / "o")])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert "pure Neumann: constant fixed by mean_zero" in out
+    assert "relative imbalance" in out and "Dirichlet nodes" not in out
