@@ -201,11 +201,14 @@ def neumann_load(case: Case, mesh) -> np.ndarray:
 
 
 def dirichlet_data(case: Case, mesh) -> tuple[np.ndarray, np.ndarray]:
-    """Dirichlet nodes and values; a later entry wins on shared nodes (e.g. corners)."""
+    """Dirichlet nodes and values; a later entry wins on shared nodes (e.g. corners).
+
+    Empty arrays for a pure-Neumann case (see :func:`nullspace_system`).
+    """
     from ..mesh import boundary_nodes
 
-    all_nodes, all_vals = [], []
-    for i, bc in enumerate(case.data["boundary"]["dirichlet"]):
+    all_nodes, all_vals = [np.zeros(0, dtype=np.int64)], [np.zeros(0)]  # none: pure Neumann
+    for i, bc in enumerate(case.data["boundary"].get("dirichlet", [])):
         g = case.functions[f"boundary.dirichlet[{i}].value"]
         parts = []
         named = [t for t in bc["tags"] if not _is_whole_boundary(mesh, t)]
