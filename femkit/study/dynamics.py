@@ -9,7 +9,10 @@ nodes, first pinned, falling under gravity): a converged reference run by ``refe
 Per run: error at the end time and the maximum over the trajectory (2-norm of all position
 errors at the common times, multiples of the largest dt), relative energy drift and its maximum,
 steps, wall time (minimum over repeats after a warm-up). A run that raises
-:class:`~femkit.errors.InstabilityError` is recorded as unstable (step, time, reason), never a crash.
+:class:`~femkit.errors.InstabilityError` is recorded as unstable (step, time, reason), never a crash,
+and left out of the fits. Orders are fitted over the asymptotic range only
+(:func:`~femkit.study.fit.fit_asymptotic`: coarse dt dropped until the finest ones lie on a line);
+the fit records the dt used, those dropped and the local slopes between consecutive dt.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ import warnings
 import numpy as np
 
 from ..errors import InstabilityError
-from .fit import fit_rate
+from .fit import fit_asymptotic
 from .progress import progress
 from .timing import time_call
 
@@ -138,15 +141,18 @@ def run_dynamics_study(study, *, progress_enabled=None) -> dict:
         rec["h_omega"] = dt * rec["omega_max"] if rec.get("omega_max") else None
         records.append(rec)
     fits = []
+    from ..dynamics.integrators import get_integrator
+
+    # drop the round-off floor: errors below 1e-11 of the motion's scale no longer follow dt^p
+    scale = float(np.abs(ref_x[:, free] - ref_x[0, free]).max()) or 1.0
     for name, opts, label in integrators:
         rows = [r for r in records if r["integrator"] == label and r["stable"] and r["error_end"]]
-        # drop the round-off floor: errors below 1e-11 of the motion's scale no longer follow dt^p
-        scale = float(np.abs(ref_x[:, free] - ref_x[0, free]).max()) or 1.0
         pts = [(r["dt"], r["error_max"]) for r in rows if r["error_max"] > 1e-11 * scale]
         if len(pts) >= 2:
-            f = fit_rate(*np.array(pts).T)
-            from ..dynamics.integrators import get_integrator
-
-            fits.append({"integrator": label, "error": "max over trajectory", "declared_order": get_integrator(name, **opts).order,
-                         **f.as_dict(), "fit": f})
+            a = fit_asymptotic(*np.array(pts).T)
+            fits.append({"integrator": label, "error": "max over trajectory",
+                         "declared_order": get_integrator(name, **opts).order, **a.fit.as_dict(), "fit": a.fit,
+                         "dt_used": a.used.tolist(), "dt_dropped": a.dropped.tolist(),
+                         "local_slopes": a.local_slopes.tolist(), "asymptotic": a.asymptotic,
+                         "unstable_dt": [r["dt"] for r in records if r["integrator"] == label and not r["stable"]]})
     return {"records": records, "fits": fits, "notes": notes, "energy": energy_series, "dts": dts}

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["RateFit", "fit_rate"]
+__all__ = ["RateFit", "fit_rate", "AsymptoticFit", "fit_asymptotic", "local_slopes"]
 
 
 @dataclass(frozen=True)
@@ -95,3 +95,73 @@ def fit_rate(x, y) -> RateFit:
     n = int(x.size)
     stderr = float(np.sqrt(ss_res / (n - 2) / sxx)) if n > 2 else float("nan")
     return RateFit(float(slope), float(intercept), float(r2), stderr, n)
+
+
+@dataclass(frozen=True)
+class AsymptoticFit:
+    """A rate fitted over the asymptotic (finest) part of a sequence; see :func:`fit_asymptotic`.
+
+    Attributes
+    ----------
+    fit : RateFit
+        The fit over the points used.
+    used : ndarray
+        The ``x`` values used, coarse to fine.
+    dropped : ndarray
+        The coarse ``x`` values left out (pre-asymptotic).
+    local_slopes : ndarray
+        Slopes between consecutive points over *all* points, coarse to fine
+        (``local_slopes[i]`` joins point ``i`` and ``i + 1``).
+    asymptotic : bool
+        True when the acceptance test passed; False when even the finest ``min_points`` points
+        fail it (the fit over them is returned anyway, flagged).
+    """
+
+    fit: RateFit
+    used: np.ndarray
+    dropped: np.ndarray
+    local_slopes: np.ndarray
+    asymptotic: bool
+
+
+def local_slopes(x, y) -> np.ndarray:
+    """Slopes ``log(y_i / y_{i+1}) / log(x_i / x_{i+1})`` between consecutive points (order kept).
+
+    >>> local_slopes([0.1, 0.05, 0.025], [1e-2, 2.5e-3, 6.25e-4]).round(12).tolist()
+    [2.0, 2.0]
+    """
+    lx = np.log(np.asarray(x, dtype=float))
+    ly = np.log(np.asarray(y, dtype=float))
+    return np.diff(ly) / np.diff(lx)
+
+
+def fit_asymptotic(x, y, *, tol: float = 0.05, min_r2: float = 0.999, min_points: int = 3) -> AsymptoticFit:
+    """Fit the rate over the finest points only, dropping coarse (pre-asymptotic) ones.
+
+    Points are ordered coarse to fine (``x`` decreasing). Starting from all of them, the
+    coarsest point is dropped until the fit over the rest has ``R^2 >= min_r2`` *and* every
+    local slope inside the window lies within ``tol`` of the fitted slope (the line is straight
+    there), keeping at least ``min_points`` points (fewer if fewer exist, but at least 2).
+
+    >>> h = 2.0 ** -np.arange(4, 11)
+    >>> err = h * (1 + 16 * h)           # order 1 with a large O(h^2) term at coarse h
+    >>> round(fit_rate(h, err).slope, 2)  # all points: too steep
+    1.15
+    >>> a = fit_asymptotic(h, err)
+    >>> round(a.fit.slope, 2), a.asymptotic, len(a.dropped)
+    (1.05, True, 3)
+    """
+    x = np.asarray(x, dtype=float).ravel()
+    y = np.asarray(y, dtype=float).ravel()
+    fit_rate(x, y)  # validates (raises InputError on bad input)
+    order = np.argsort(-x, kind="stable")
+    x, y = x[order], y[order]
+    slopes = local_slopes(x, y)
+    keep = max(2, min(min_points, x.size))
+    for start in range(0, x.size - keep + 1):
+        f = fit_rate(x[start:], y[start:])
+        window = slopes[start:]
+        if f.r2 >= min_r2 and np.all(np.abs(window - f.slope) <= tol):
+            return AsymptoticFit(f, x[start:], x[:start], slopes, True)
+    start = x.size - keep
+    return AsymptoticFit(fit_rate(x[start:], y[start:]), x[start:], x[:start], slopes, False)
