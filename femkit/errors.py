@@ -16,6 +16,8 @@ Hierarchy::
     ├── SolverError                a linear solver could not do what was asked
     │   ├── NotSPDError            input to CG-type method is not symmetric positive definite
     │   └── SingularSystemError    singular system (e.g. pure Neumann, inconsistent rhs)
+    │       └── PureNeumannError   pure-Neumann data violating int f + int h = 0, or
+    │                              nullspace: error (also an InputError: exit code 2)
     └── InstabilityError           a time integrator blew up (method, step, time, energy ratio, dt_crit)
 
 Warnings (not errors; the run goes on)::
@@ -84,6 +86,15 @@ class NotSPDError(SolverError):
 
 class SingularSystemError(SolverError):
     """The system is singular (e.g. pure Neumann with an inconsistent right-hand side)."""
+
+
+class PureNeumannError(SingularSystemError, InputError):
+    """A pure-Neumann problem that cannot be solved as given: incompatible data
+    (``int f dx + int h ds != 0`` beyond the tolerance), or ``nullspace="error"``.
+
+    Both a :class:`SingularSystemError` (what it is) and an :class:`InputError` (whose
+    fault it is: the data), so ``femkit solve`` exits with code 2 and writes nothing.
+    """
 
 
 class InstabilityError(FemkitError):

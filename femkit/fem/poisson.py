@@ -50,7 +50,7 @@ from typing import Callable, NamedTuple, Sequence
 
 import numpy as np
 
-from ..errors import InputError, SingularSystemError
+from ..errors import InputError, PureNeumannError, SingularSystemError  # noqa: F401 (re-exported)
 from ._elements import triangle_geometry
 from .coefficients import Coefficient, evaluate_callable
 from .dirichlet import DirichletSystem, apply_dirichlet, dirichlet_values
@@ -62,15 +62,6 @@ from .sparsity import SparsityPattern
 
 NULLSPACE_MODES = ("mean_zero", "pin", "error")
 
-
-class PureNeumannError(SingularSystemError, InputError):
-    """A pure-Neumann problem that cannot be solved as given: incompatible data, or
-    ``nullspace="error"``.
-
-    Both a :class:`~femkit.errors.SingularSystemError` (what it is) and an
-    :class:`~femkit.errors.InputError` (whose fault it is: the data), so ``femkit solve``
-    exits with code 2 and writes nothing.
-    """
 
 #: default of ``compatibility_rtol``: |int f + int h| relative to sum |F| accepted as quadrature error
 COMPATIBILITY_RTOL = 1e-3
