@@ -111,7 +111,7 @@ def check_compatibility(F_source: np.ndarray, F_flux=None, *, weights: np.ndarra
     >>> check_compatibility(np.array([1.0, 1.0]))
     Traceback (most recent call last):
     ...
-    femkit.fem.poisson.PureNeumannError: pure-Neumann data are incompatible: int f dx = 2 and int h ds = 0 must sum to 0 (relative imbalance 1 > 0.001); change the source or the fluxes so they balance, or add a Dirichlet condition
+    femkit.errors.PureNeumannError: pure-Neumann data are incompatible: int f dx = 2 and int h ds = 0 must sum to 0 (relative imbalance 1 > 0.001); change the source or the fluxes so they balance, or add a Dirichlet condition
     """
     F_source = np.asarray(F_source, dtype=np.float64)
     F_flux = np.zeros_like(F_source) if F_flux is None else np.asarray(F_flux, dtype=np.float64)
