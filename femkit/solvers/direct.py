@@ -47,6 +47,12 @@ class Factor:
         self.setup_time = setup_time
         self.info = info
 
+    @property
+    def perm_c(self) -> np.ndarray:
+        """SuperLU's column permutation; ``A[p][:, p]`` with ``p = argsort(perm_c)`` factorised
+        with ``permc_spec="NATURAL"`` reuses this ordering (same fill) for a matrix of equal pattern."""
+        return self._lu.perm_c
+
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Return ``A^-1 b`` (``b`` of shape ``(n,)`` or ``(n, k)``)."""
         b = np.asarray(b, dtype=np.float64)

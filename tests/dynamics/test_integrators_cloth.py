@@ -128,22 +128,33 @@ def test_fast_mass_spring_cache_follows_new_parameter_arrays():
 
 
 @pytest.mark.parametrize("name", ["implicit_euler", "newton", "newmark"])
-def test_direct_solves_with_reused_ordering_match_plain_direct(name):
-    from femkit.dynamics.integrators.base import dof_ordering
-
+def test_direct_solves_reusing_the_ordering_match_plain_direct(name):
     system = _cloth(7)
     dt = 1.0 / 60.0
     ordered, ctx = _one_step(name, system, dt, StepContext(solver="direct"))
-    # any ctx.options sends the solve through femkit.solvers.solve (SuperLU's own ordering)
+    # any ctx.options sends the solve through femkit.solvers.solve (SuperLU orders every matrix)
     plain, ctx_plain = _one_step(name, system, dt, StepContext(solver="direct", options={"spd": None}))
     assert "orderings" not in ctx_plain.stats
-    assert ctx.stats["orderings"] == 1  # computed once, reused by every factorisation
     assert ctx.stats["factorizations"] == ctx.stats["linear_solves"] >= 3
+    # on this flat start the pattern grows while out-of-plane couplings fill in (re-ordered);
+    # reuse on a fixed pattern is tested below
+    assert ctx.stats.get("orderings", 0) <= ctx.stats["factorizations"]
     scale = np.abs(plain.x - system.x0).max()
     np.testing.assert_allclose(ordered.x, plain.x, rtol=0, atol=1e-10 * scale)
-    perm = dof_ordering(system, ctx)
-    nfree = system.free_dofs.size
-    assert np.array_equal(np.sort(perm), np.arange(nfree))
-    triples = perm.reshape(-1, system.dim)  # each node's dofs stay together, in order
-    assert np.all(triples % system.dim == np.arange(system.dim))
-    assert np.all(np.diff(triples, axis=1) == 1)
+
+
+def test_ordering_is_reused_while_the_pattern_holds_and_redone_when_it_changes():
+    system = _cloth(6)
+    dt = 1.0 / 60.0
+    rng = np.random.default_rng(4)
+    x = system.x0 + 0.01 * rng.standard_normal(system.x0.shape)  # generic 3D state: full pattern
+    x[system.pinned] = system.x0[system.pinned]
+    integ = get_integrator("implicit_euler", fix="clamp")
+    ctx = StepContext()
+    s = integ.start(system, x, np.zeros_like(x), 0.0, dt, ctx)
+    for _ in range(4):
+        s = integ.step(system, s, dt, ctx)
+    assert ctx.stats["orderings"] == 1 and ctx.stats["factorizations"] == 4
+    # the flat rest state has exact zeros (axis-aligned springs, no out-of-plane coupling)
+    s = integ.step(system, integ.start(system, system.x0, system.v0, 0.0, dt, ctx), dt, ctx)
+    assert ctx.stats["orderings"] == 2

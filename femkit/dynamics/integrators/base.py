@@ -18,13 +18,16 @@ Linear solves of the implicit methods go through :func:`solve_linear` / :func:`f
 which call :mod:`femkit.solvers` with the solver named in the context and restrict every system
 to ``system.free_dofs`` (pinned dofs are eliminated).
 
-Direct solves of a new matrix every step (Baraff-Witkin, Newton) reuse the symbolic part:
-the sparsity of ``M + h^2 K`` is that of the spring graph (times the ``d x d`` blocks) and never
-changes, so :func:`dof_ordering` computes a fill-reducing ordering once per topology
-(minimum degree on the *node* graph, each node's ``d`` dofs kept together: about half the fill
-of minimum degree on the dof graph on a cloth) and every factorisation then runs on the
-pre-permuted matrix with SuperLU's ``NATURAL`` column order. ``ctx.stats`` accumulates the time
-split ``time_assembly`` (left to the integrators), ``time_factorization`` and ``time_solve``.
+Direct solves of a new matrix every step (Baraff-Witkin, Newton) reuse the ordering: the
+first factorisation lets SuperLU order the matrix (symmetric mode, minimum degree on the actual
+nonzero pattern); while later matrices have exactly the same pattern (compared by ``indptr`` and
+``indices``, cached in ``ctx.cache["direct_ordering"]``), they are factorised pre-permuted with
+that ordering and SuperLU's ``NATURAL`` column order, skipping the ordering step. A new pattern
+(e.g. a planar cloth whose zero out-of-plane couplings fill in) is ordered afresh
+(``ctx.stats["orderings"]``). Minimum degree on the node graph (dof triples kept together) was
+tried and dropped: less fill but 1.3-1.5x the factorisation time on the cloths of the benchmark.
+``ctx.stats`` accumulates the time split ``time_permute``, ``time_factorization`` and
+``time_solve`` (seconds; assembly is what the integrator spends outside them).
 """
 
 from __future__ import annotations
@@ -45,7 +48,6 @@ __all__ = [
     "solve_linear",
     "factorize_linear",
     "restrict",
-    "dof_ordering",
 ]
 
 
@@ -154,43 +156,6 @@ def restrict(A, free):
     return A[free][:, free].tocsr()
 
 
-def dof_ordering(system, ctx: StepContext) -> np.ndarray:
-    """Fill-reducing symmetric ordering of ``system.free_dofs`` (indices into the free block).
-
-    Minimum degree (SuperLU's ``MMD_AT_PLUS_A``) on the graph of the free nodes (springs as
-    edges), expanded so each node's ``d`` dofs stay consecutive. Cached in
-    ``ctx.cache["dof_ordering"]`` under the identities of the system, its ``springs`` and its
-    ``pinned`` arrays (contact and dashpot blocks lie inside the spring graph's pattern).
-    """
-    key = (system, system.springs, system.pinned)
-    cached = ctx.cache.get("dof_ordering")
-    if cached is not None and all(a is b for a, b in zip(cached[0], key)):
-        return cached[1]
-    import scipy.sparse as sp
-    from scipy.sparse.linalg import splu
-
-    t0 = time.perf_counter()
-    free_nodes = np.flatnonzero(~system.pinned)
-    nf = len(free_nodes)
-    pos = np.full(system.n, -1)
-    pos[free_nodes] = np.arange(nf)
-    i, j = pos[system.springs[:, 0]], pos[system.springs[:, 1]]
-    keep = (i >= 0) & (j >= 0)
-    i, j = i[keep], j[keep]
-    adj = sp.csr_matrix((-np.ones(len(i)), (i, j)), shape=(nf, nf))
-    adj = adj + adj.T
-    # a strictly diagonally dominant matrix with the graph's pattern: any pivot order is safe
-    graph = (adj + sp.diags(1.0 - np.asarray(adj.sum(axis=1)).ravel())).tocsc()
-    node_perm = np.argsort(splu(graph, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                                options=dict(SymmetricMode=True)).perm_c)
-    d = system.dim
-    perm = (node_perm[:, None] * d + np.arange(d)).ravel()
-    ctx.cache["dof_ordering"] = (key, perm)
-    ctx.count("orderings")
-    ctx.stats["time_ordering"] = ctx.stats.get("time_ordering", 0.0) + time.perf_counter() - t0
-    return perm
-
-
 class PermutedFactor:
     """The factor of ``A[p][:, p]`` used as a solver for ``A``: ``solve(b) = A^-1 b``."""
 
@@ -216,16 +181,17 @@ def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = Non
                  system=None) -> np.ndarray:
     """Solve ``A x = b`` with the method named in ``ctx`` through ``femkit.solvers``.
 
-    With ``ctx.solver == "direct"`` and the ``system`` whose free block ``A`` is, ``A`` is
-    factorised pre-permuted with :func:`dof_ordering` (computed once, no ordering work per
-    call); the result must meet the direct solver's rule ``||b - A x|| <= max(rtol ||b||, atol)``.
+    With ``ctx.solver == "direct"`` and the ``system`` (which marks a matrix refactorised every
+    step), the SuperLU ordering is reused while the pattern of ``A`` stays the same (module
+    docstring); the result must meet the direct solver's rule
+    ``||b - A x|| <= max(rtol ||b||, atol)``.
 
     Raises :class:`~femkit.errors.SolverError` when an iterative method does not converge (or a
     direct solve misses the residual rule): an implicit step never continues from an
     unconverged solve.
     """
     if system is not None and ctx.solver == "direct" and not ctx.options:
-        return _solve_direct_ordered(A, b, ctx, dof_ordering(system, ctx))
+        return _solve_direct_reusing_ordering(A, b, ctx)
     from ...solvers import solve as _solve  # lazy: keeps ``import femkit.dynamics`` light
 
     ctx.count("linear_solves")
@@ -240,28 +206,44 @@ def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = Non
     return np.asarray(res.x, dtype=float)
 
 
-def _solve_direct_ordered(A, b: np.ndarray, ctx: StepContext, perm: np.ndarray) -> np.ndarray:
-    import scipy.sparse as sp
-
+def _ordered_factor(A, ctx: StepContext):
+    """Factor of csr ``A``, reusing the cached SuperLU ordering when the pattern is unchanged."""
     from ...solvers import factorize
+
+    cached = ctx.cache.get("direct_ordering")
+    if (cached is not None and cached[0].shape == A.indptr.shape and cached[1].shape == A.indices.shape
+            and np.array_equal(cached[0], A.indptr) and np.array_equal(cached[1], A.indices)):
+        perm = cached[2]
+        t0 = time.perf_counter()
+        Ap = A[perm][:, perm]
+        t1 = time.perf_counter()
+        factor = PermutedFactor(factorize(Ap, permc_spec="NATURAL"), perm)
+        _add_time(ctx, "time_permute", t1 - t0)
+        _add_time(ctx, "time_factorization", time.perf_counter() - t1)
+        return factor
+    t0 = time.perf_counter()
+    factor = factorize(A)
+    _add_time(ctx, "time_factorization", time.perf_counter() - t0)
+    if factor.symmetric:  # symmetric mode: rows and columns share SuperLU's ordering
+        ctx.cache["direct_ordering"] = (A.indptr.copy(), A.indices.copy(), np.argsort(factor.perm_c))
+        ctx.count("orderings")
+    return factor
+
+
+def _solve_direct_reusing_ordering(A, b: np.ndarray, ctx: StepContext) -> np.ndarray:
+    import scipy.sparse as sp
 
     ctx.count("linear_solves")
     b = np.asarray(b, dtype=float)
     bnorm = float(np.linalg.norm(b))
     if bnorm == 0.0:
         return np.zeros_like(b)
-    t0 = time.perf_counter()
     A = sp.csr_matrix(A)
-    Ap = A[perm][:, perm]
-    t1 = time.perf_counter()
-    factor = PermutedFactor(factorize(Ap, permc_spec="NATURAL"), perm)
+    factor = _ordered_factor(A, ctx)
     ctx.count("factorizations")
-    t2 = time.perf_counter()
+    t0 = time.perf_counter()
     x = factor.solve(b)
-    t3 = time.perf_counter()
-    _add_time(ctx, "time_permute", t1 - t0)
-    _add_time(ctx, "time_factorization", t2 - t1)
-    _add_time(ctx, "time_solve", t3 - t2)
+    _add_time(ctx, "time_solve", time.perf_counter() - t0)
     res = float(np.linalg.norm(b - A @ x))
     if not (np.isfinite(res) and res <= max(ctx.rtol * bnorm, ctx.atol)):
         raise SolverError(
