@@ -21,8 +21,10 @@ back to partial pivoting (1.6x the fill, ~2x the time).
 Every figure is the median over repeats after one warm-up step (which pays one-time setup:
 the fast mass-spring factorisation, the implicit methods' ordering). The table prints the time
 per step, factorisations per step, the time split of the implicit methods (assembly =
-everything outside the ordering, the permutation, the factorisation and the solves) and the
-reference figure with the ratio ours / reference.
+everything outside the permutation, the factorisation, the triangular solves and the PCG solves
+preconditioned with a reused factor) and the reference figure with the ratio ours / reference.
+Newton runs twice: ``exact`` (a factorisation per Newton iteration) and ``reuse`` (an older
+factorisation preconditions PCG to the same tolerance, refactorised when PCG is slow).
 """
 
 from __future__ import annotations
@@ -40,7 +42,7 @@ from femkit.dynamics.forces import Gravity  # noqa: E402
 from femkit.dynamics.integrators import StepContext, get_integrator  # noqa: E402
 from femkit.dynamics.topology import cloth_grid  # noqa: E402
 
-_SPLIT = ("time_ordering", "time_permute", "time_factorization", "time_solve")
+_SPLIT = ("time_permute", "time_factorization", "time_solve", "time_pcg")
 
 
 def _time_steps(system, name, dt, repeats, **opts) -> dict:
@@ -56,12 +58,13 @@ def _time_steps(system, name, dt, repeats, **opts) -> dict:
         s = integ.step(system, s, dt, ctx)
         times.append(time.perf_counter() - t0)
     per = {key: (ctx.stats.get(key, 0) - before.get(key, 0)) / repeats
-           for key in ("factorizations",) + _SPLIT}
+           for key in ("factorizations", "linear_iterations") + _SPLIT}
     total = sum(times) / repeats
     split = {k: per[k] for k in _SPLIT}
     split["assembly"] = total - sum(split.values())
     iters = ctx.stats.get("newton_iterations", [])[1:]
     return {"median": statistics.median(times), "factorizations": per["factorizations"],
+            "pcg": per["linear_iterations"],
             "split": split, "total": total, "newton": iters}
 
 
@@ -94,24 +97,32 @@ def main(quick: bool = False) -> None:
     rows.append(("cloth 128x128", "symplectic_euler", "3.125e-4", r,
                  "424-525 substeps/s (Taichi CPU)", _ref(r["median"], 1 / 525, 1 / 424)))
     for name, reps, opts in (("implicit_euler", 1 if quick else 3, {"fix": "clamp"}),
-                             ("newton", 1 if quick else 2, {"max_iterations": 20})):
+                             ("newton", 2 if quick else 4, {"max_iterations": 20,
+                                                            "reuse_factorization": False}),
+                             ("newton", 2 if quick else 4, {"max_iterations": 20})):
         r = _time_steps(big, name, 1.0 / 60.0, reps, **opts)
-        rows.append(("cloth 128x128", name + (" clamp" if name == "implicit_euler" else ""),
+        label = name + (" clamp" if name == "implicit_euler" else "")
+        if name == "newton":
+            label += " reuse" if opts.get("reuse_factorization", True) else " exact"
+        rows.append(("cloth 128x128", label,
                      "1/60", r, "-", "-"))
 
     print(f"OPENBLAS_NUM_THREADS={os.environ['OPENBLAS_NUM_THREADS']}; medians after a warm-up step; "
           f"128x128 cloth: {big.n_springs} springs, {big.ndof} dofs, node mass {mass:.3g} "
           f"(dt omega_max = 1.6 at dt = {dt_explicit})")
     head = (f"{'scene':14s} {'method':24s} {'dt':>8s} {'time/step':>11s} {'fact/step':>9s}  "
-            f"{'split: assembly / permute / factor / solve':44s} {'reference':38s} ours/ref")
+            f"{'split ms: assembly/permute/factor/solve/pcg':44s} {'reference':38s} ours/ref")
     print(head)
     print("-" * len(head))
     for scene, method, dt, r, ref, ratio in rows:
         sp = r["split"]
         split = "-"
-        if r["factorizations"] and method != "fast_mass_spring 10 it":
+        if (r["factorizations"] or r["pcg"]) and method != "fast_mass_spring 10 it":
             split = (f"{1e3 * sp['assembly']:.0f} / {1e3 * sp['time_permute']:.0f} / "
-                     f"{1e3 * sp['time_factorization']:.0f} / {1e3 * sp['time_solve']:.0f} ms")
+                     f"{1e3 * sp['time_factorization']:.0f} / {1e3 * sp['time_solve']:.0f} / "
+                     f"{1e3 * sp['time_pcg']:.0f}")
+            if r["pcg"]:
+                split += f" ({r['pcg']:.0f} pcg it)"
         if r["newton"]:
             method = f"{method} ({statistics.mean(r['newton']):.1f} it)"
         print(f"{scene:14s} {method:24s} {dt:>8s} {_fmt_time(r['median']):>11s} "

@@ -131,9 +131,11 @@ def test_fast_mass_spring_cache_follows_new_parameter_arrays():
 def test_direct_solves_reusing_the_ordering_match_plain_direct(name):
     system = _cloth(7)
     dt = 1.0 / 60.0
-    ordered, ctx = _one_step(name, system, dt, StepContext(solver="direct"))
+    opts = {"reuse_factorization": False} if name == "newton" else {}
+    ordered, ctx = _one_step(name, system, dt, StepContext(solver="direct"), **opts)
     # any ctx.options sends the solve through femkit.solvers.solve (SuperLU orders every matrix)
-    plain, ctx_plain = _one_step(name, system, dt, StepContext(solver="direct", options={"spd": None}))
+    plain, ctx_plain = _one_step(name, system, dt, StepContext(solver="direct", options={"spd": None}),
+                                 **opts)
     assert "orderings" not in ctx_plain.stats
     assert ctx.stats["factorizations"] == ctx.stats["linear_solves"] >= 3
     # on this flat start the pattern grows while out-of-plane couplings fill in (re-ordered);
@@ -158,3 +160,18 @@ def test_ordering_is_reused_while_the_pattern_holds_and_redone_when_it_changes()
     # the flat rest state has exact zeros (axis-aligned springs, no out-of-plane coupling)
     s = integ.step(system, integ.start(system, system.x0, system.v0, 0.0, dt, ctx), dt, ctx)
     assert ctx.stats["orderings"] == 2
+
+
+def test_newton_reusing_an_older_factorisation_gives_the_same_steps():
+    system = _cloth(8)
+    dt = 1.0 / 60.0
+    exact, ctx_exact = _one_step("newton", system, dt, StepContext(solver="direct"),
+                                 reuse_factorization=False, tol=1e-12)
+    reused, ctx = _one_step("newton", system, dt, StepContext(solver="direct"), tol=1e-12)
+    scale = np.abs(exact.x - system.x0).max()
+    np.testing.assert_allclose(reused.x, exact.x, rtol=0, atol=1e-8 * scale)
+    np.testing.assert_allclose(reused.v, exact.v, rtol=0, atol=1e-8 * scale / dt)
+    assert ctx_exact.stats["factorizations"] == ctx_exact.stats["linear_solves"]
+    assert ctx.stats["linear_solves"] >= ctx_exact.stats["linear_solves"] - 1
+    assert ctx.stats["factorizations"] < ctx.stats["linear_solves"] / 2
+    assert ctx.stats["linear_iterations"] > 0  # the later directions came from PCG

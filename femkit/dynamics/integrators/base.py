@@ -172,13 +172,16 @@ class PermutedFactor:
         x[self.perm] = y
         return x
 
+    __call__ = solve
+    symmetric = property(lambda self: self.factor.symmetric)
+
 
 def _add_time(ctx: StepContext, key: str, seconds: float) -> None:
     ctx.stats[key] = ctx.stats.get(key, 0.0) + seconds
 
 
 def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = None, *,
-                 system=None) -> np.ndarray:
+                 system=None, reuse_key: str | None = None) -> np.ndarray:
     """Solve ``A x = b`` with the method named in ``ctx`` through ``femkit.solvers``.
 
     With ``ctx.solver == "direct"`` and the ``system`` (which marks a matrix refactorised every
@@ -186,11 +189,20 @@ def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = Non
     docstring); the result must meet the direct solver's rule
     ``||b - A x|| <= max(rtol ||b||, atol)``.
 
+    ``reuse_key`` (direct only): keep the factorisation in ``ctx.cache[reuse_key]`` and solve
+    later systems (a slowly changing matrix: Newton iterations and steps) by PCG preconditioned
+    with that older factor, to the same rule ``||b - A x|| <= max(rtol ||b||, atol)`` on the
+    true residual; when PCG needs more than ``REUSE_MAX_ITERATIONS`` iterations (or breaks
+    down), the matrix is refactorised and cached instead. The answer is the solution of
+    ``A x = b`` to ``rtol`` either way; only the cost changes.
+
     Raises :class:`~femkit.errors.SolverError` when an iterative method does not converge (or a
     direct solve misses the residual rule): an implicit step never continues from an
     unconverged solve.
     """
     if system is not None and ctx.solver == "direct" and not ctx.options:
+        if reuse_key is not None:
+            return _solve_reusing_factor(A, b, ctx, reuse_key, x0)
         return _solve_direct_reusing_ordering(A, b, ctx)
     from ...solvers import solve as _solve  # lazy: keeps ``import femkit.dynamics`` light
 
@@ -230,7 +242,32 @@ def _ordered_factor(A, ctx: StepContext):
     return factor
 
 
-def _solve_direct_reusing_ordering(A, b: np.ndarray, ctx: StepContext) -> np.ndarray:
+REUSE_MAX_ITERATIONS = 20
+"""PCG iterations allowed with a reused (older) factorisation before refactorising."""
+
+
+def _solve_reusing_factor(A, b: np.ndarray, ctx: StepContext, key: str, x0=None) -> np.ndarray:
+    import scipy.sparse as sp
+
+    from ...solvers import solve as _solve
+
+    cached = ctx.cache.get(key)
+    b = np.asarray(b, dtype=float)
+    if cached is not None and tuple(cached.shape) == A.shape and float(np.linalg.norm(b)) > 0.0:
+        t0 = time.perf_counter()
+        res = _solve(sp.csr_matrix(A), b, x0, method="pcg", preconditioner=cached, rtol=ctx.rtol,
+                     atol=ctx.atol, maxiter=REUSE_MAX_ITERATIONS, check_symmetry=False)
+        _add_time(ctx, "time_pcg", time.perf_counter() - t0)
+        ctx.count("linear_solves")
+        ctx.count("linear_iterations", int(res.iterations))
+        if res.converged:
+            return np.asarray(res.x, dtype=float)
+        ctx.count("refactorizations")
+    return _solve_direct_reusing_ordering(A, b, ctx, keep=key)
+
+
+def _solve_direct_reusing_ordering(A, b: np.ndarray, ctx: StepContext,
+                                   keep: str | None = None) -> np.ndarray:
     import scipy.sparse as sp
 
     ctx.count("linear_solves")
@@ -241,6 +278,11 @@ def _solve_direct_reusing_ordering(A, b: np.ndarray, ctx: StepContext) -> np.nda
     A = sp.csr_matrix(A)
     factor = _ordered_factor(A, ctx)
     ctx.count("factorizations")
+    if keep is not None:  # a symmetric-mode (SPD) factor preconditions later solves
+        if factor.symmetric:
+            ctx.cache[keep] = factor
+        else:
+            ctx.cache.pop(keep, None)
     t0 = time.perf_counter()
     x = factor.solve(b)
     _add_time(ctx, "time_solve", time.perf_counter() - t0)

@@ -14,6 +14,14 @@ is a descent direction), then backtracks (Armijo: ``g(x + t dx) <= g(x) + c t gr
 ``x_n``) or after ``max_iterations``; the iteration count of every step is appended to
 ``ctx.stats["newton_iterations"]``.
 
+With the ``direct`` solver and ``reuse_factorization=True`` (default) the factorisation of an
+earlier Newton matrix (this step's or a previous step's) is kept and later Newton systems are
+solved by PCG preconditioned with it, to the same relative residual ``ctx.rtol`` on the true
+residual; when PCG needs more than ``base.REUSE_MAX_ITERATIONS`` iterations the current matrix is
+refactorised (``ctx.stats``: ``factorizations``, ``refactorizations``, ``linear_iterations``).
+Each Newton direction is the same to that tolerance, so the iterates are those of Newton with
+exact solves; only the cost changes (one factorisation typically serves several steps).
+
 First order; unconditionally stable.
 """
 
@@ -37,6 +45,7 @@ class NewtonImplicitEuler(Integrator):
     armijo: float = 1e-4
     shrink: float = 0.5
     max_backtracks: int = 40
+    reuse_factorization: bool = True
 
     name = "newton"
     order = 1
@@ -79,7 +88,8 @@ class NewtonImplicitEuler(Integrator):
                 + h * (C @ (x - xn))
             H = M + (h * h) * system.stiffness_matrix(x.reshape(shape), fix=self.fix) + h * C
             dx = np.zeros_like(x)
-            dx[free] = solve_linear(restrict(H, free), -grad[free], ctx, system=system)
+            dx[free] = solve_linear(restrict(H, free), -grad[free], ctx, system=system,
+                                    reuse_key="newton_factor" if self.reuse_factorization else None)
             slope = grad[free] @ dx[free]
             t = 1.0
             if slope < 0.0:
