@@ -247,102 +247,183 @@ def _energy_norm(A, d) -> float:
     return float(np.sqrt(max(float(d @ (A @ d)), 0.0)))
 
 
-HS_DELAY = 4
+def cg_history(A, b, x0, s: dict) -> dict:
+    """Untimed analysis pass of (P)CG: the coefficients a stopping test on the error needs.
 
-
-def _stop_iteration(increments: np.ndarray, fraction: float, eta: float | None,
-                    delay: int = HS_DELAY) -> tuple[int | None, float]:
-    """First iteration ``m`` at which the delayed Hestenes-Stiefel test passes, and the eta used.
-
-    ``increments[j] = ||x_{j+1} - x_j||_A^2`` (``alpha_j ||r_j||^2`` for (P)CG). At iteration ``m``
-    the algebraic error of iterate ``k = min(m - delay, m // 4)`` is estimated by
-    ``sum_{j=k}^{m-1} increments[j]`` (a lower bound that tightens with the window; a fixed short
-    window misses the plateaus of unpreconditioned CG). The iterate returned is ``x_m``, better still. ``eta`` is the estimated discretisation error
-    (energy norm) of this level; ``None`` (the first nested level, whose start is the exactly
-    solved coarsest level) estimates it from the start's algebraic error
-    ``||u_1 - u_0||_A^2 ~ sum_j increments[j]`` over ``sqrt(3)`` (Galerkin orthogonality on nested
-    spaces with H1 rate 1: ``||u - u_0||^2 = ||u - u_1||^2 + ||u_1 - u_0||^2``, ``||u - u_1|| = ||u - u_0|| / 2``).
-    The test is ``estimate <= (fraction * eta)^2``.
+    Runs femkit's solver with a callback (which receives only the iterate ``x_k``) and recovers
+    per iteration, from one matrix-vector product and one preconditioner application,
+    ``rz[k] = r_k^T z_k`` (``z = M^-1 r``; ``z = r`` for CG) and
+    ``inc[k] = ||x_{k+1} - x_k||_A^2 = alpha_k r_k^T z_k`` (the Hestenes-Stiefel terms;
+    ``A (x_{k+1} - x_k) = r_k - r_{k+1}``), hence ``alpha[k] = inc[k] / rz[k]``.
     """
-    c = np.concatenate([[0.0], np.cumsum(increments)])
-    if eta is None:
-        eta = float(np.sqrt(c[-1] / 3.0))
-    for m in range(delay, len(increments) + 1):
-        k = min(m - delay, m // 4)  # the window grows with m: short windows miss CG plateaus
-        if c[m] - c[k] <= (fraction * eta) ** 2:
-            return m, eta
-    return None, eta
+    from ..solvers import get_preconditioner, solve
+
+    M = None
+    kw = {k: v for k, v in s.items() if k in ("rtol", "atol", "maxiter")}
+    if s["method"] == "pcg":
+        M = get_preconditioner(s.get("preconditioner") or "amg")(A)
+        kw["preconditioner"] = M
+    x_prev = [np.array(x0, dtype=float, copy=True)]
+    r_prev = [b - A @ x_prev[0]]
+    z0 = r_prev[0] if M is None else M(r_prev[0])
+    rz, inc = [float(r_prev[0] @ z0)], []
+
+    def cb(xk):
+        r = b - A @ xk
+        z = r if M is None else M(r)
+        dx = xk - x_prev[0]
+        inc.append(float(dx @ (r_prev[0] - r)))
+        rz.append(float(r @ z))
+        x_prev[0] = np.array(xk, copy=True)
+        r_prev[0] = r
+
+    solve(A, b, np.array(x0, dtype=float, copy=True), method=s["method"], callback=cb, **kw)
+    rz_a, inc_a = np.array(rz), np.array(inc)
+    return {"rz": rz_a, "inc": inc_a, "alpha": inc_a / np.maximum(rz_a[:-1], 1e-300)}
+
+
+def smallest_ritz_value(alpha: np.ndarray, rz: np.ndarray) -> float:
+    """Smallest eigenvalue of the Lanczos (Jacobi) matrix built from the (P)CG coefficients.
+
+    ``T`` has diagonal ``1/alpha_k + beta_k/alpha_{k-1}`` and off-diagonal ``sqrt(beta_{k+1})/alpha_k``
+    with ``beta_k = rz_k / rz_{k-1}``; after a converged run its smallest eigenvalue approximates
+    ``lambda_min(M^-1 A)`` from above.
+
+    >>> import numpy as np, scipy.sparse as sp
+    >>> A = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(30, 30)).tocsr()
+    >>> h = cg_history(A, np.ones(30), np.zeros(30), {"method": "cg", "rtol": 1e-12})
+    >>> lam = 2 - 2 * np.cos(np.pi / 31)     # exact smallest eigenvalue
+    >>> bool(abs(smallest_ritz_value(h["alpha"], h["rz"]) / lam - 1) < 1e-6)
+    True
+    """
+    n = len(alpha)
+    if n == 0:
+        return float("nan")
+    beta = rz[1:n] / rz[: n - 1]
+    diag = 1.0 / alpha
+    diag[1:] += beta / alpha[:-1]
+    off = np.sqrt(beta) / alpha[:-1]
+    from scipy.linalg import eigvalsh_tridiagonal
+
+    return float(eigvalsh_tridiagonal(diag, off, select="i", select_range=(0, 0))[0])
+
+
+def gauss_radau_bounds(inc: np.ndarray, rz: np.ndarray, mu: float) -> np.ndarray:
+    """Upper bounds ``U_k >= ||x - x_k||_A^2`` of every (P)CG iterate (Gauss-Radau quadrature).
+
+    With ``0 < mu <= lambda_min(M^-1 A)`` (Meurant and Tichy's CGQ recurrence, preconditioned form)::
+
+        U_0 = rz_0 / mu,   U_{k+1} = rz_{k+1} (U_k - inc_k) / (mu (U_k - inc_k) + rz_{k+1})
+
+    where ``inc_k = alpha_k r_k^T z_k``. Unlike the Hestenes-Stiefel sum over a delay window, a
+    lower bound that a plateau of (P)CG fools, this bounds the error from above. Where round-off
+    makes ``U_k - inc_k <= 0`` the recurrence restarts from the cruder bound ``rz_k / mu``.
+    """
+    U = np.empty(len(rz))
+    U[0] = rz[0] / mu
+    for k in range(len(rz) - 1):
+        t = U[k] - inc[k]
+        U[k + 1] = rz[k + 1] * t / (mu * t + rz[k + 1]) if t > 0 else rz[k + 1] / mu
+    return U
+
+
+def stop_iteration(hist: dict, mu: float, fraction: float) -> tuple[int | None, np.ndarray, np.ndarray]:
+    """First iterate ``m >= 1`` whose error bound is ``fraction`` x the estimated discretisation error.
+
+    ``eta_m = sqrt(||x_m - x_0||_A^2 / 3)`` with ``||x_m - x_0||_A^2 = sum_{j<m} inc_j`` (the (P)CG
+    directions are A-orthogonal): the start interpolates the coarse solution, and Galerkin
+    orthogonality on nested spaces with H1 rate 1 gives ``||u_l - u_{l-1}||_A^2 = 3 ||u - u_l||_A^2``;
+    the partial sums approach it from below, so ``eta_m`` errs on the safe (small) side. The test
+    is ``U_m <= (fraction eta_m)^2`` with ``U`` from :func:`gauss_radau_bounds`.
+    Returns ``(m or None, U, eta)``.
+    """
+    U = gauss_radau_bounds(hist["inc"], hist["rz"], mu)
+    eta = np.sqrt(np.concatenate([[0.0], np.cumsum(hist["inc"])]) / 3.0)
+    ok = np.flatnonzero(U[1:] <= (fraction * eta[1:]) ** 2)
+    return (int(ok[0]) + 1 if ok.size else None), U, eta
 
 
 def _nested_runs(study, spec, meshes, mesh_times, records):
     """Nested iteration stopped at a fraction of the estimated discretisation error ((P)CG only).
 
-    Level 0 is solved from zero with the solver's fixed ``rtol``. On level ``l >= 1`` the start is
-    the coarse nested solution interpolated to the refined mesh; an untimed analysis pass records
-    the energy-norm increments of the iterates and :func:`_stop_iteration` picks the iteration at
-    which the algebraic error is ``fraction`` x the estimated discretisation error (estimated on
-    level 1, then halved per level); the timed run
-    then stops there (``maxiter``). The report checks the estimate afterwards: the attained algebraic
-    error ``||u_nested - u_fixed||_A`` against the H1 discretisation error of the fixed-rtol run.
+    Level 0 is solved from zero with the solver's fixed ``rtol``; its converged Lanczos coefficients
+    give ``lambda_0``, the smallest Ritz value of ``M^-1 A`` there. On level ``l >= 1`` the start is the
+    coarse nested solution interpolated to the refined mesh; an untimed analysis pass
+    (:func:`cg_history`) records the coefficients and :func:`stop_iteration` picks the first iterate
+    whose Gauss-Radau error bound, with ``mu_l = lambda_0 (h_l / h_0)^2 / 2`` (the smallest
+    eigenvalue of a second-order operator decays at worst like ``h^2``: exact for CG and IC(0),
+    pessimistic for AMG, whose ``lambda_min`` stays O(1)), is ``fraction`` x the estimated
+    discretisation error; the timed run then stops there (``maxiter``), from the same start.
+    The record checks the test afterwards: the attained algebraic error
+    ``||u_nested - u_l||_A`` (``u_l`` the exact discrete solution, by a direct solve) over the
+    energy-norm discretisation error ``||u - u_l||_A`` of the level.
     """
+    from ..solvers import solve as _solve_raw
+
     d = study.data
     frac = d["stop_at_discretisation_error"]["fraction"]
     rule = d["quadrature"][0]
     out = []
+    systems, exact = [], []
+    for mesh in meshes:
+        K, F = _assemble(spec, mesh, rule)
+        systems.append(_boundary(spec, mesh, K, F))
+        exact.append(_solve_raw(systems[-1].A, systems[-1].b, method="direct").x)
     for s in d["solvers"]:
         if s["method"] not in ("cg", "pcg"):
             continue
         label = solver_label(s)
         prev = None
-        eta = None
+        lam0 = h0 = None
         for lvl, mesh in enumerate(meshes):
-            K, F = _assemble(spec, mesh, rule)
-            sys = _boundary(spec, mesh, K, F)
+            sys = systems[lvl]
             fixed = next(r for r in records if r["source"] == "femkit" and r["level"] == lvl
                          and r["solver"] == label and r["quadrature"] == rule)
-            ref = _solve(sys, s)
-            stop = None
+            stop, bound, eta_m, mu = None, None, None, None
             if prev is None:
-                x0 = None
+                x0 = np.zeros(sys.A.shape[0])
+                hist = cg_history(sys.A, sys.b, x0, s)
+                lam0, h0 = smallest_ritz_value(hist["alpha"], hist["rz"]), fixed["h"]
                 tc = time_call(lambda: _solve(sys, s), repeats=d["repeats"], warmup=0)
             else:
                 x0 = interpolate_nested(meshes[lvl - 1], mesh, prev)[sys.free]
-                incs, last = [], [x0.copy()]
-
-                def cb(xk):
-                    dx = xk - last[0]
-                    incs.append(float(dx @ (sys.A @ dx)))
-                    last[0] = np.array(xk, copy=True)
-
-                from ..solvers import solve as _raw_solve  # analysis pass, untimed
-
-                kw = {k: v for k, v in s.items() if k in ("rtol", "atol", "maxiter")}
-                if s["method"] == "pcg":
-                    kw["preconditioner"] = s.get("preconditioner") or "amg"
-                _raw_solve(sys.A, sys.b, x0.copy(), method=s["method"], callback=cb, **kw)
-                stop, eta = _stop_iteration(np.array(incs), frac, eta)
-                s_run = s if stop is None else {**s, "maxiter": max(stop, 1)}
+                hist = cg_history(sys.A, sys.b, x0, s)
+                mu = lam0 * (fixed["h"] / h0) ** 2 / 2.0
+                stop, U, eta = stop_iteration(hist, mu, frac)
+                if stop is not None:
+                    bound, eta_m = float(np.sqrt(U[stop])), float(eta[stop])
+                s_run = s if stop is None else {**s, "maxiter": stop}
                 tc = time_call(lambda: _solve(sys, s_run, x0=x0.copy()), repeats=d["repeats"], warmup=0)
             res, t_solve = tc.value, tc.min  # min over repeats, like the fixed-rtol runs
             u = sys.expand(res.x)
             prev = u
-            eta_used = eta
-            if eta is not None:
-                eta = eta / 2.0  # H1 rate 1: the next level's discretisation error halves
             errs = _errors(spec, mesh, u, d["error_order"])
-            alg = _energy_norm(sys.A, res.x - ref.x)
-            disc = fixed["H1_semi"]
+            alg = _energy_norm(sys.A, res.x - exact[lvl])
+            disc = _energy_norm_error(spec, mesh, fixed["H1_semi"])
             out.append({
                 "solver": label, "level": lvl, "dofs": fixed["dofs"], "h": fixed["h"],
                 "iterations_fixed": fixed["iterations"], "iterations_nested": int(res.iterations),
                 "t_solve_fixed": fixed["t_solve"], "t_solve_nested": t_solve,
                 "L2_fixed": fixed["L2"], "L2_nested": errs["L2"],
-                "H1_fixed": disc, "H1_nested": errs["H1_semi"],
-                "algebraic_error_energy": alg, "estimated_discretisation_error": eta_used,
-                "algebraic_over_discretisation": (alg / disc) if disc else None,
+                "H1_fixed": fixed["H1_semi"], "H1_nested": errs["H1_semi"],
+                "mu": mu, "error_bound": bound, "estimated_discretisation_error": eta_m,
+                "bound_over_estimate": (bound / eta_m) if bound is not None and eta_m else None,
+                "algebraic_error_energy": alg, "discretisation_error_energy": disc,
+                "algebraic_over_discretisation": (alg / disc) if disc and np.isfinite(disc) else None,
                 "stopped_by_estimate": stop is not None, "fraction": frac,
             })
     return out
+
+
+def _energy_norm_error(spec, mesh, h1_semi: float) -> float:
+    """``||u - u_l||_A`` from the H1 seminorm error: ``sqrt(kappa) |u - u_l|_1`` for a constant ``kappa``.
+
+    A piecewise ``kappa`` has no such relation: ``nan`` (the ratio column then stays empty).
+    """
+    kap = np.asarray(spec.kappa_elements(mesh), dtype=float)
+    if np.allclose(kap, kap.flat[0]):
+        return float(np.sqrt(kap.flat[0]) * h1_semi)
+    return float("nan")
 
 
 def fit_all(records) -> list[dict]:
