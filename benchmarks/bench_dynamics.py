@@ -23,8 +23,9 @@ the fast mass-spring factorisation, the implicit methods' ordering). The table p
 per step, factorisations per step, the time split of the implicit methods (assembly =
 everything outside the permutation, the factorisation, the triangular solves and the PCG solves
 preconditioned with a reused factor) and the reference figure with the ratio ours / reference.
-Newton runs twice: ``exact`` (a factorisation per Newton iteration) and ``reuse`` (an older
-factorisation preconditions PCG to the same tolerance, refactorised when PCG is slow).
+Baraff-Witkin (BW) and Newton run twice: ``exact`` (a factorisation per linear solve) and
+``reuse`` (an older factorisation preconditions PCG to the same tolerance ``rtol = 1e-10``,
+refactorised when PCG is slow).
 """
 
 from __future__ import annotations
@@ -83,9 +84,11 @@ def main(quick: bool = False) -> None:
     r = _time_steps(liu, "fast_mass_spring", 1.0 / 30.0, 5 if quick else 20, iterations=10)
     rows.append(("Liu 81x81", "fast_mass_spring 10 it", "1/30", r,
                  "47-67 ms (scipy), 50 ms (paper, C++)", _ref(r["median"], 0.047, 0.067)))
-    r = _time_steps(liu, "implicit_euler", 1.0 / 30.0, 2 if quick else 5, fix="clamp")
-    rows.append(("Liu 81x81", "implicit_euler clamp", "1/30", r,
-                 "0.55-0.7 s (1 Newton step, LU)", _ref(r["median"], 0.55, 0.7)))
+    for reuse in (False, True):
+        r = _time_steps(liu, "implicit_euler", 1.0 / 30.0, (3 if quick else 8) * (1 + 2 * reuse), fix="clamp",
+                        reuse_factorization=reuse)
+        rows.append(("Liu 81x81", "BW clamp " + ("reuse" if reuse else "exact"), "1/30", r,
+                     "0.55-0.7 s (1 Newton step, LU)", _ref(r["median"], 0.55, 0.7)))
 
     dt_explicit = 3.125e-4
     unit = cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4, k_bending=3e4,
@@ -96,14 +99,15 @@ def main(quick: bool = False) -> None:
     r = _time_steps(big, "symplectic_euler", dt_explicit, 50 if quick else 300)
     rows.append(("cloth 128x128", "symplectic_euler", "3.125e-4", r,
                  "424-525 substeps/s (Taichi CPU)", _ref(r["median"], 1 / 525, 1 / 424)))
-    for name, reps, opts in (("implicit_euler", 1 if quick else 3, {"fix": "clamp"}),
+    for name, reps, opts in (("implicit_euler", 2 if quick else 4, {"fix": "clamp",
+                                                                    "reuse_factorization": False}),
+                             ("implicit_euler", 6 if quick else 12, {"fix": "clamp"}),
                              ("newton", 2 if quick else 4, {"max_iterations": 20,
                                                             "reuse_factorization": False}),
-                             ("newton", 2 if quick else 4, {"max_iterations": 20})):
+                             ("newton", 3 if quick else 8, {"max_iterations": 20})):
         r = _time_steps(big, name, 1.0 / 60.0, reps, **opts)
-        label = name + (" clamp" if name == "implicit_euler" else "")
-        if name == "newton":
-            label += " reuse" if opts.get("reuse_factorization", True) else " exact"
+        label = "BW clamp" if name == "implicit_euler" else name
+        label += " reuse" if opts.get("reuse_factorization", True) else " exact"
         rows.append(("cloth 128x128", label,
                      "1/60", r, "-", "-"))
 

@@ -131,7 +131,7 @@ def test_fast_mass_spring_cache_follows_new_parameter_arrays():
 def test_direct_solves_reusing_the_ordering_match_plain_direct(name):
     system = _cloth(7)
     dt = 1.0 / 60.0
-    opts = {"reuse_factorization": False} if name == "newton" else {}
+    opts = {"reuse_factorization": False} if name in ("newton", "implicit_euler") else {}
     ordered, ctx = _one_step(name, system, dt, StepContext(solver="direct"), **opts)
     # any ctx.options sends the solve through femkit.solvers.solve (SuperLU orders every matrix)
     plain, ctx_plain = _one_step(name, system, dt, StepContext(solver="direct", options={"spd": None}),
@@ -151,7 +151,7 @@ def test_ordering_is_reused_while_the_pattern_holds_and_redone_when_it_changes()
     rng = np.random.default_rng(4)
     x = system.x0 + 0.01 * rng.standard_normal(system.x0.shape)  # generic 3D state: full pattern
     x[system.pinned] = system.x0[system.pinned]
-    integ = get_integrator("implicit_euler", fix="clamp")
+    integ = get_integrator("implicit_euler", fix="clamp", reuse_factorization=False)
     ctx = StepContext()
     s = integ.start(system, x, np.zeros_like(x), 0.0, dt, ctx)
     for _ in range(4):
@@ -162,12 +162,14 @@ def test_ordering_is_reused_while_the_pattern_holds_and_redone_when_it_changes()
     assert ctx.stats["orderings"] == 2
 
 
-def test_newton_reusing_an_older_factorisation_gives_the_same_steps():
+@pytest.mark.parametrize("name,opts", [("newton", {"tol": 1e-12}), ("implicit_euler", {"fix": "clamp"})],
+                         ids=["newton", "baraff-witkin"])
+def test_reusing_an_older_factorisation_gives_the_same_steps(name, opts):
     system = _cloth(8)
     dt = 1.0 / 60.0
-    exact, ctx_exact = _one_step("newton", system, dt, StepContext(solver="direct"),
-                                 reuse_factorization=False, tol=1e-12)
-    reused, ctx = _one_step("newton", system, dt, StepContext(solver="direct"), tol=1e-12)
+    exact, ctx_exact = _one_step(name, system, dt, StepContext(solver="direct"),
+                                 reuse_factorization=False, **opts)
+    reused, ctx = _one_step(name, system, dt, StepContext(solver="direct"), **opts)
     scale = np.abs(exact.x - system.x0).max()
     np.testing.assert_allclose(reused.x, exact.x, rtol=0, atol=1e-8 * scale)
     np.testing.assert_allclose(reused.v, exact.v, rtol=0, atol=1e-8 * scale / dt)

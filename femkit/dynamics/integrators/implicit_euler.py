@@ -14,6 +14,12 @@ solver named in the step context (``direct``, ``cg``, ``pcg``, ``jacobi``).
 First order; unconditionally stable on the linear oscillator (amplitude ``1/sqrt(1 + h^2 w^2)``
 per step), i.e. artificially damped. Option ``fix`` (``None``, ``"clamp"``, ``"regularize"``)
 makes ``K`` positive semi-definite for CG-type solvers when springs are compressed.
+
+With the ``direct`` solver and ``reuse_factorization=True`` (default) the factorisation of an
+earlier step's matrix is kept (when it is SPD) and later steps solve by PCG preconditioned with
+it, to ``ctx.rtol`` on the true residual, refactorising when PCG needs more than
+``base.REUSE_MAX_ITERATIONS`` iterations: the same step to that tolerance at a fraction of the
+cost while the matrix changes slowly. ``reuse_factorization=False``: one factorisation per step.
 """
 
 from __future__ import annotations
@@ -28,6 +34,7 @@ from .registry import INTEGRATORS
 @dataclass(frozen=True)
 class ImplicitEuler(Integrator):
     fix: str | None = None
+    reuse_factorization: bool = True
 
     name = "implicit_euler"
     order = 1
@@ -48,7 +55,8 @@ class ImplicitEuler(Integrator):
         if D.nnz:
             A = A + h * D
         b = h * (f - (h + rk) * (K @ vf) - rm * (M @ vf))
-        dv = solve_linear(restrict(A, free), b[free], ctx, system=system)
+        dv = solve_linear(restrict(A, free), b[free], ctx, system=system,
+                          reuse_key="implicit_euler_factor" if self.reuse_factorization else None)
         v_new = vf.copy()
         v_new[free] += dv
         v_new = v_new.reshape(v.shape)
