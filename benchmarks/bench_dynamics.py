@@ -85,7 +85,8 @@ def main(quick: bool = False) -> None:
     rows.append(("Liu 81x81", "fast_mass_spring 10 it", "1/30", r,
                  "47-67 ms (scipy), 50 ms (paper, C++)", _ref(r["median"], 0.047, 0.067)))
     for reuse in (False, True):
-        r = _time_steps(liu, "implicit_euler", 1.0 / 30.0, (3 if quick else 8) * (1 + 2 * reuse), fix="clamp",
+        reps = (3 if quick else 8) * (3 if reuse else 1)
+        r = _time_steps(liu, "implicit_euler", 1.0 / 30.0, reps, fix="clamp",
                         reuse_factorization=reuse)
         rows.append(("Liu 81x81", "BW clamp " + ("reuse" if reuse else "exact"), "1/30", r,
                      "0.55-0.7 s (1 Newton step, LU)", _ref(r["median"], 0.55, 0.7)))
