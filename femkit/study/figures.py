@@ -111,10 +111,10 @@ def _style(i: int, s: dict) -> dict:
                 markersize=5, linewidth=1.6)
 
 
-def _legend(ax, n: int, title: str | None = None) -> None:
+def _legend(ax, n: int, title: str | None = None, outside: bool = False) -> None:
     """Inside the axes for a few lines; outside on the right for many (never over the data)."""
     kw = {"fontsize": 8, "title": title, "title_fontsize": 8}
-    if n > 6:
+    if n > 6 or outside:
         ax.figure.set_size_inches(10.0, 5.0)  # room for the legend beside the axes
         ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), **kw)
     else:
@@ -129,13 +129,21 @@ def _slope_triangle(ax, xs: np.ndarray, ys: np.ndarray, order: float, *, decreas
     width = (lx1 - lx0) / 3.0
     xa = 10 ** (lx0 + (lx1 - lx0) * 0.55)
     xb = xa * 10 ** width
-    ya = ys.min() * 0.35 / (xb / xa) ** order if order > 0 else ys.min() * 0.35
+    near = (xs >= xa / 1.5) & (xs <= xb * 1.5)
+    low = ys[near].min() if near.any() else ys.min()
+    # just under the lowest data in its x span, never over a line (slope p: the data rises as fast)
+    ya = 0.4 * low * max(1.0, (xa / xb) ** order)
     yb = ya * (xb / xa) ** order
-    ax.plot([xa, xb, xb, xa], [ya, ya, yb, ya], color="k", linewidth=1.0)
-    ax.text(np.sqrt(xa * xb), ya * 0.8, "1", ha="center", va="top", fontsize=9)
-    ax.text(xb * 1.05, np.sqrt(ya * yb), f"{order:g}", ha="left", va="center", fontsize=9)
-    ax.text(np.sqrt(xa * xb), np.sqrt(ya * yb) * 1.6, f"slope {order:g}", ha="right", va="bottom",
-            fontsize=8, color="0.2")
+    # the right angle sits at the bottom: under the rising end for p > 0, under the falling start for p < 0
+    xc = xb if order > 0 else xa
+    ybot, ytop = min(ya, yb), max(ya, yb)
+    ax.plot([xa, xb, xc, xa], [ya, yb, ybot, ya], color="k", linewidth=1.0)
+    ax.text(np.sqrt(xa * xb), ybot * 0.8, "1", ha="center", va="top", fontsize=9)
+    # the order beside the vertical edge, outside the triangle (which side is "outside" on screen
+    # depends on whether the x axis is inverted)
+    ha = "left" if (order > 0) != decreasing_x else "right"
+    ax.text(xc * (1.05 if order > 0 else 1 / 1.05), np.sqrt(ybot * ytop), f"{abs(order):g}", va="center",
+            ha=ha, fontsize=9)
 
 
 def loglog_figure(path, series: Sequence[dict], *, title: str, xlabel: str, ylabel: str,
@@ -178,7 +186,8 @@ def loglog_figure(path, series: Sequence[dict], *, title: str, xlabel: str, ylab
     if note:
         ax.text(0.01, 0.01, note, transform=ax.transAxes, fontsize=8, color="0.3", va="bottom")
     if allx:
-        _legend(ax, len(allx), legend_title)
+        # with a slope triangle and fit lines the inside of the axes is full: legend beside them
+        _legend(ax, len(allx), legend_title, outside=triangle is not None)
     return _save(fig, path)
 
 
