@@ -56,9 +56,16 @@ def cli_main(args) -> int:
         print(f"femkit study: error: {exc}", file=sys.stderr)
         return 2
     print(f"{study.kind} '{study.name}': {len(result.records)} runs in {result.elapsed:.1f} s")
-    for f in result.fits[:12]:
-        what = " / ".join(str(f[k]) for k in ("solver", "integrator", "quadrature", "norm", "error") if k in f)
-        print(f"  rate {what}: {f['slope']:.3f} (R^2 {f['r2']:.4f})")
+    if study.kind == "poisson_convergence":  # one line per group of solvers with the same fit, like the report
+        from .report_poisson import grouped_rate_rows
+
+        for who, rule, norm, slope, _, r2, *_ in grouped_rate_rows(result.fits):
+            print(f"  rate {who} / {rule} / {norm}: {slope:.3f} (R^2 {r2:.4f})")
+    else:
+        for f in result.fits[:12]:
+            what = " / ".join(str(f[k]) for k in ("solver", "integrator", "quadrature", "norm", "error") if k in f)
+            extra = f", dt {max(f['dt_used']):.3g}..{min(f['dt_used']):.3g}" if f.get("dt_used") else ""
+            print(f"  rate {what}: {f['slope']:.3f} (R^2 {f['r2']:.4f}{extra})")
     for line in result.notes:
         print(f"  note: {line}")
     print(f"report: {result.output_dir / 'report.html'}")
