@@ -17,7 +17,6 @@ atomically (see :func:`femkit.io.atomic.atomic_directory`).
 
 from __future__ import annotations
 
-import contextlib
 import os
 import time
 from dataclasses import dataclass, field
@@ -389,19 +388,6 @@ class CaseResult:
 
 # ----------------------------------------------------------------------------- run
 
-class _Stages:
-    def __init__(self):
-        self.timings: dict[str, float] = {}
-
-    @contextlib.contextmanager
-    def __call__(self, name: str):
-        t0 = time.perf_counter()
-        try:
-            yield
-        finally:
-            self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - t0
-
-
 def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: bool = False,
                 write: bool = True, echo: Callable[[str], Any] | None = None) -> CaseResult:
     """Run a prepared Poisson case; see the module docstring for the stages.
@@ -421,7 +407,9 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     """
     from ..mesh import quality
 
-    stage = _Stages()
+    from ..timing import StageTimer
+
+    stage = StageTimer()
     with stage("mesh"):
         mesh = build_mesh(case)
         q = quality(mesh)
@@ -437,7 +425,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         with stage("errors"):
             errors = compute_errors(case, mesh, u)
     result = CaseResult(case=case, mesh=mesh, u=u, kappa=kappa, solve=res, errors=errors,
-                        timings=stage.timings, quality=q, dofs=int(system.A.shape[0]),
+                        timings=stage.times, quality=q, dofs=int(system.A.shape[0]),
                         n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
                         nnz=int(system.A.nnz), nullspace=_nullspace_facts(system))
     if write:

@@ -26,6 +26,8 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+from ..timing import StageTimer  # noqa: F401  (re-exported: the studies time stages with it)
+
 __all__ = ["BLAS_ENV", "pin_blas_threads", "blas_thread_limit", "StageTimer", "Timing", "time_call"]
 
 #: Environment variables that pin BLAS / OpenMP thread pools.
@@ -52,25 +54,6 @@ def blas_thread_limit(threads: int = 1):
         return
     with threadpool_limits(limits=threads, user_api="blas"):
         yield True
-
-
-class StageTimer:
-    """Accumulates wall-clock seconds per named stage (``time.perf_counter``)."""
-
-    def __init__(self) -> None:
-        self.times: dict[str, float] = {}
-
-    @contextlib.contextmanager
-    def __call__(self, stage: str):
-        t0 = time.perf_counter()
-        try:
-            yield
-        finally:
-            self.times[stage] = self.times.get(stage, 0.0) + time.perf_counter() - t0
-
-    @property
-    def total(self) -> float:
-        return float(sum(self.times.values()))
 
 
 @dataclass
