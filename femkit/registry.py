@@ -17,7 +17,7 @@ femkit.errors.UnknownNameError: unknown colour 'blue'; valid colours: red
 
 from __future__ import annotations
 
-from typing import Callable, Generic, Iterator, TypeVar
+from typing import Generic, Iterator, TypeVar
 
 from .errors import UnknownNameError
 

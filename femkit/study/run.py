@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .cache import fingerprint
-from .report import Report, staged_output, to_jsonable, write_csv, write_json
+from .report import Report, staged_output, write_csv, write_json
 
 __all__ = ["StudyResult", "run_study"]
 

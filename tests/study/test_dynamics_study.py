@@ -51,8 +51,8 @@ def test_symplectic_energy_bounded_explicit_euler_grows(osc):
 
 
 def test_unstable_run_recorded_not_raised(tmp_path):
-    data = {**OSC, "scene": {**OSC["scene"], "k": 1e4}, "integrators": ["velocity_verlet", "rk4"],
-            "dt": {"values": [0.04, 0.02, 0.01]}, "scene": {**OSC["scene"], "k": 1e4, "t_end": 0.4}}
+    data = {**OSC, "integrators": ["velocity_verlet", "rk4"], "dt": {"values": [0.04, 0.02, 0.01]},
+            "scene": {**OSC["scene"], "k": 1e4, "t_end": 0.4}}
     res = run_study(study_from_dict(data), tmp_path / "r")
     # omega = 100: Verlet's limit dt = 0.02, RK4's 0.0283
     vv = {r["dt"]: r["stable"] for r in res.records if r["integrator"] == "velocity_verlet"}
