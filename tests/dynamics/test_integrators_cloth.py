@@ -175,5 +175,6 @@ def test_reusing_an_older_factorisation_gives_the_same_steps(name, opts):
     np.testing.assert_allclose(reused.v, exact.v, rtol=0, atol=1e-8 * scale / dt)
     assert ctx_exact.stats["factorizations"] == ctx_exact.stats["linear_solves"]
     assert ctx.stats["linear_solves"] >= ctx_exact.stats["linear_solves"] - 1
-    assert ctx.stats["factorizations"] < ctx.stats["linear_solves"] / 2
+    # every kept factor serves at least one PCG solve (how many more depends on measured costs)
+    assert ctx.stats["factorizations"] <= (ctx.stats["linear_solves"] + 1) // 2
     assert ctx.stats["linear_iterations"] > 0  # the later directions came from PCG

@@ -192,9 +192,10 @@ def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = Non
     ``reuse_key`` (direct only): keep the factorisation in ``ctx.cache[reuse_key]`` and solve
     later systems (a slowly changing matrix: Newton iterations and steps) by PCG preconditioned
     with that older factor, to the same rule ``||b - A x|| <= max(rtol ||b||, atol)`` on the
-    true residual; when PCG needs more than ``REUSE_MAX_ITERATIONS`` iterations (or breaks
-    down), the matrix is refactorised and cached instead. The answer is the solution of
-    ``A x = b`` to ``rtol`` either way; only the cost changes.
+    true residual. The factor is renewed when a PCG solve costs more than the average cost per
+    solve since the factorisation (factorisation included), and at once when PCG misses the
+    tolerance within ``REUSE_MAX_ITERATIONS`` iterations (or breaks down). The answer is the
+    solution of ``A x = b`` to ``rtol`` either way; only the cost changes.
 
     Raises :class:`~femkit.errors.SolverError` when an iterative method does not converge (or a
     direct solve misses the residual rule): an implicit step never continues from an
@@ -242,25 +243,44 @@ def _ordered_factor(A, ctx: StepContext):
     return factor
 
 
-REUSE_MAX_ITERATIONS = 20
-"""PCG iterations allowed with a reused (older) factorisation before refactorising."""
+REUSE_MAX_ITERATIONS = 50
+"""Hard cap on the PCG iterations with a reused (older) factorisation before refactorising."""
+
+
+@dataclass
+class _ReusedFactor:
+    """A kept factorisation and what it has cost so far (seconds)."""
+
+    factor: Any
+    factor_time: float
+    solve_time: float = 0.0
+    solves: int = 1
 
 
 def _solve_reusing_factor(A, b: np.ndarray, ctx: StepContext, key: str, x0=None) -> np.ndarray:
+    """PCG with the kept factor; the renewal rule drops the factor once one PCG solve costs more
+    than the average cost per solve since it was made (factorisation included), so the next
+    solve refactorises; a PCG solve that misses the tolerance within the cap refactorises now."""
     import scipy.sparse as sp
 
     from ...solvers import solve as _solve
 
-    cached = ctx.cache.get(key)
+    kept = ctx.cache.get(key)
     b = np.asarray(b, dtype=float)
-    if cached is not None and tuple(cached.shape) == A.shape and float(np.linalg.norm(b)) > 0.0:
+    if kept is not None and tuple(kept.factor.shape) == A.shape and float(np.linalg.norm(b)) > 0.0:
         t0 = time.perf_counter()
-        res = _solve(sp.csr_matrix(A), b, x0, method="pcg", preconditioner=cached, rtol=ctx.rtol,
-                     atol=ctx.atol, maxiter=REUSE_MAX_ITERATIONS, check_symmetry=False)
-        _add_time(ctx, "time_pcg", time.perf_counter() - t0)
+        res = _solve(sp.csr_matrix(A), b, x0, method="pcg", preconditioner=kept.factor,
+                     rtol=ctx.rtol, atol=ctx.atol, maxiter=REUSE_MAX_ITERATIONS,
+                     check_symmetry=False)
+        spent = time.perf_counter() - t0
+        _add_time(ctx, "time_pcg", spent)
         ctx.count("linear_solves")
         ctx.count("linear_iterations", int(res.iterations))
         if res.converged:
+            kept.solves += 1
+            kept.solve_time += spent
+            if spent * kept.solves > kept.factor_time + kept.solve_time:
+                ctx.cache.pop(key, None)  # marginal cost above the average: refactorise next
             return np.asarray(res.x, dtype=float)
         ctx.count("refactorizations")
     return _solve_direct_reusing_ordering(A, b, ctx, keep=key)
@@ -276,11 +296,12 @@ def _solve_direct_reusing_ordering(A, b: np.ndarray, ctx: StepContext,
     if bnorm == 0.0:
         return np.zeros_like(b)
     A = sp.csr_matrix(A)
+    t_factor = time.perf_counter()
     factor = _ordered_factor(A, ctx)
     ctx.count("factorizations")
     if keep is not None:  # a symmetric-mode (SPD) factor preconditions later solves
         if factor.symmetric:
-            ctx.cache[keep] = factor
+            ctx.cache[keep] = _ReusedFactor(factor, time.perf_counter() - t_factor)
         else:
             ctx.cache.pop(keep, None)
     t0 = time.perf_counter()

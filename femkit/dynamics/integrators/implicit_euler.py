@@ -17,9 +17,9 @@ makes ``K`` positive semi-definite for CG-type solvers when springs are compress
 
 With the ``direct`` solver and ``reuse_factorization=True`` (default) the factorisation of an
 earlier step's matrix is kept (when it is SPD) and later steps solve by PCG preconditioned with
-it, to ``ctx.rtol`` on the true residual, refactorising when PCG needs more than
-``base.REUSE_MAX_ITERATIONS`` iterations: the same step to that tolerance at a fraction of the
-cost while the matrix changes slowly. ``reuse_factorization=False``: one factorisation per step.
+it, to ``ctx.rtol`` on the true residual, renewing the factor when a PCG solve costs more than
+the average per solve since the factorisation (:func:`.base.solve_linear`): the same step to
+that tolerance at a fraction of the cost while the matrix changes slowly. ``reuse_factorization=False``: one factorisation per step.
 """
 
 from __future__ import annotations

@@ -17,8 +17,9 @@ is a descent direction), then backtracks (Armijo: ``g(x + t dx) <= g(x) + c t gr
 With the ``direct`` solver and ``reuse_factorization=True`` (default) the factorisation of an
 earlier Newton matrix (this step's or a previous step's) is kept and later Newton systems are
 solved by PCG preconditioned with it, to the same relative residual ``ctx.rtol`` on the true
-residual; when PCG needs more than ``base.REUSE_MAX_ITERATIONS`` iterations the current matrix is
-refactorised (``ctx.stats``: ``factorizations``, ``refactorizations``, ``linear_iterations``).
+residual; the factor is renewed when a PCG solve costs more than the average cost per solve
+since the factorisation (see :func:`.base.solve_linear`; ``ctx.stats``: ``factorizations``,
+``refactorizations``, ``linear_iterations``, ``time_pcg``).
 Each Newton direction is the same to that tolerance, so the iterates are those of Newton with
 exact solves; only the cost changes (one factorisation typically serves several steps).
 
