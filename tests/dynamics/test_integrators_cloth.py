@@ -165,11 +165,12 @@ def test_ordering_is_reused_while_the_pattern_holds_and_redone_when_it_changes()
 @pytest.mark.parametrize("name,opts", [("newton", {"tol": 1e-12}), ("implicit_euler", {"fix": "clamp"})],
                          ids=["newton", "baraff-witkin"])
 def test_reusing_an_older_factorisation_gives_the_same_steps(name, opts):
+    """Opt-in reuse (the default factorises every system: 'direct' means direct)."""
     system = _cloth(8)
     dt = 1.0 / 60.0
-    exact, ctx_exact = _one_step(name, system, dt, StepContext(solver="direct"),
-                                 reuse_factorization=False, **opts)
-    reused, ctx = _one_step(name, system, dt, StepContext(solver="direct"), **opts)
+    exact, ctx_exact = _one_step(name, system, dt, StepContext(solver="direct"), **opts)
+    reused, ctx = _one_step(name, system, dt, StepContext(solver="direct"),
+                            reuse_factorization=True, **opts)
     scale = np.abs(exact.x - system.x0).max()
     np.testing.assert_allclose(reused.x, exact.x, rtol=0, atol=1e-8 * scale)
     np.testing.assert_allclose(reused.v, exact.v, rtol=0, atol=1e-8 * scale / dt)

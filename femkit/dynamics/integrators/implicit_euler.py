@@ -15,7 +15,8 @@ First order; unconditionally stable on the linear oscillator (amplitude ``1/sqrt
 per step), i.e. artificially damped. Option ``fix`` (``None``, ``"clamp"``, ``"regularize"``)
 makes ``K`` positive semi-definite for CG-type solvers when springs are compressed.
 
-With the ``direct`` solver and ``reuse_factorization=True`` (default) the factorisation of an
+With the ``direct`` solver and ``reuse_factorization=True`` (opt-in; the default
+``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
 earlier step's matrix is kept (when it is SPD) and later steps solve by PCG preconditioned with
 it, to ``ctx.rtol`` on the true residual, renewing the factor when a PCG solve costs more than
 the average per solve since the factorisation (:func:`.base.solve_linear`): the same step to
@@ -34,7 +35,7 @@ from .registry import INTEGRATORS
 @dataclass(frozen=True)
 class ImplicitEuler(Integrator):
     fix: str | None = None
-    reuse_factorization: bool = True
+    reuse_factorization: bool = False
 
     name = "implicit_euler"
     order = 1

@@ -14,7 +14,8 @@ is a descent direction), then backtracks (Armijo: ``g(x + t dx) <= g(x) + c t gr
 ``x_n``) or after ``max_iterations``; the iteration count of every step is appended to
 ``ctx.stats["newton_iterations"]``.
 
-With the ``direct`` solver and ``reuse_factorization=True`` (default) the factorisation of an
+With the ``direct`` solver and ``reuse_factorization=True`` (opt-in; the default
+``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
 earlier Newton matrix (this step's or a previous step's) is kept and later Newton systems are
 solved by PCG preconditioned with it, to the same relative residual ``ctx.rtol`` on the true
 residual; the factor is renewed when a PCG solve costs more than the average cost per solve
@@ -46,7 +47,7 @@ class NewtonImplicitEuler(Integrator):
     armijo: float = 1e-4
     shrink: float = 0.5
     max_backtracks: int = 40
-    reuse_factorization: bool = True
+    reuse_factorization: bool = False
 
     name = "newton"
     order = 1
