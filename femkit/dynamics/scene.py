@@ -362,7 +362,11 @@ class SceneResult:
         tr = self.trajectory
         dt = float(self.case.data["dt"])
         om = tr.omega_max if tr.omega_max is not None else self.omega_max
+        exceeds = tr.dt_exceeds_critical
+        if exceeds is None and self.integrator.implicit:
+            exceeds = False  # unconditionally stable: no critical step to exceed
         out = {"verdict": "stable" if self.instability is None else "unstable",
+               "dt_exceeds_critical": exceeds,
                "omega_max": om, "dt_crit": tr.dt_crit,
                "h_omega_max": None if om is None else dt * om,
                "stability_bound": self.integrator.describe()["stability_bound"],
@@ -455,6 +459,8 @@ class SceneResult:
         if st["dt_crit"] is not None:
             stab += f", critical dt {st['dt_crit']:.4g}"
         verdict = st["verdict"] if self.instability is None else f"UNSTABLE: {self.failure}"
+        if st["dt_exceeds_critical"] and self.instability is None:
+            verdict += " (but dt exceeds the critical step: growth may not have shown yet)"
         lines.append(f"verdict   {verdict}" + (f" ({stab})" if stab else ""))
         if self.output_dir is not None:
             lines.append(f"output    {self.output_dir} ({len(self.files)} files)")
