@@ -4,29 +4,26 @@ The first step is the Taylor step ``x_1 = x_0 + h v_0 + h^2/2 a_0``. Velocities 
 by the recurrence; ``state.v`` reports the second-order estimate
 ``v_{n+1} = (x_{n+1} - x_n) / h + h/2 a_{n+1}`` (exactly velocity Verlet's velocity in exact
 arithmetic), which is also what velocity-dependent forces see. Second order, symplectic,
-time reversible; stable for ``h omega < 2``.
+time reversible; stable for ``h omega < 2``. The closing half kick is the shared
+:mod:`.kick_drift_kick` core.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .base import Integrator, StepContext, StepperState
+from .base import StepContext, StepperState
+from .kick_drift_kick import KickDriftKick
 from .registry import INTEGRATORS
 
 
 @INTEGRATORS.register("verlet")
 @dataclass(frozen=True)
-class Verlet(Integrator):
+class Verlet(KickDriftKick):
     name = "verlet"
-    order = 2
-    implicit = False
-    symplectic = True
-    stability_bound = 2.0
 
     def start(self, system, x, v, t, dt, ctx):
         state = super().start(system, x, v, t, dt, ctx)
-        state.aux["a"] = system.acceleration(state.x, state.v, state.t)
         state.aux["x_prev"] = None
         return state
 
@@ -37,6 +34,5 @@ class Verlet(Integrator):
         else:
             x_new = 2.0 * x - x_prev + (dt * dt) * a
         v_drift = (x_new - x) / dt
-        a_new = system.acceleration(x_new, v_drift, state.t + dt)
-        v_new = v_drift + (0.5 * dt) * a_new
+        a_new, v_new = self.kick(system, x_new, v_drift, v_drift, state.t + dt, dt)
         return StepperState(x_new, v_new, state.t + dt, {"a": a_new, "x_prev": x})
