@@ -48,6 +48,8 @@ __all__ = [
     "solve_linear",
     "factorize_linear",
     "restrict",
+    "box_length",
+    "check_iteration_options",
 ]
 
 
@@ -84,6 +86,10 @@ class StepContext:
     def count(self, key: str, n: int = 1) -> None:
         """Add ``n`` to counter ``key`` of :attr:`stats`."""
         self.stats[key] = self.stats.get(key, 0) + n
+
+    def record(self, key: str, value) -> None:
+        """Append ``value`` to the per-step list ``stats[key]`` (e.g. ``newton_iterations``)."""
+        self.stats.setdefault(key, []).append(value)
 
 
 @dataclass
@@ -147,6 +153,26 @@ class Integrator:
             "stability_bound": None if math.isinf(bound) else float(bound),
             "options": opts,
         }
+
+
+# ----------------------------------------------------------------------------- iterative steps
+def box_length(x: np.ndarray) -> float:
+    """Bounding-box diagonal of ``x`` (1 when it is 0): the length ``L`` of the stopping rules
+    ``||dx||_inf <= tol * L`` of the iterative implicit steps.
+
+    >>> box_length(np.array([[0.0, 0.0], [3.0, 4.0]]))
+    5.0
+    """
+    return float(np.linalg.norm(np.ptp(x, axis=0))) or 1.0
+
+
+def check_iteration_options(name: str, max_iterations: int, tol: float | None, *,
+                            option: str = "max_iterations") -> None:
+    """Raise :class:`~femkit.errors.InputError` unless ``max_iterations >= 1`` and ``tol > 0``
+    (``tol=None``: no tolerance, sweeps only); ``option`` is the option's name in messages."""
+    if int(max_iterations) < 1 or (tol is not None and not tol > 0):
+        raise InputError(f"{name}: need {option} >= 1 and tol > 0, "
+                         f"got {option}={max_iterations!r}, tol={tol!r}")
 
 
 # ----------------------------------------------------------------------------- linear algebra

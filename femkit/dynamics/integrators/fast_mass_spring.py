@@ -44,8 +44,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InputError
-from .base import Integrator, StepContext, StepperState, factorize_linear, restrict
+from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
+                   factorize_linear, restrict)
 from .registry import INTEGRATORS
 
 _KEY_ATTRS = ("mass", "k", "rest", "springs", "pinned", "forces")
@@ -87,8 +87,7 @@ class FastMassSpring(Integrator):
     symplectic = False
 
     def __post_init__(self):
-        if int(self.iterations) < 1:
-            raise InputError(f"fast_mass_spring: iterations must be >= 1, got {self.iterations}")
+        check_iteration_options(self.name, self.iterations, self.tol, option="iterations")
 
     def _operators(self, system, dt: float, ctx: StepContext) -> _Operators:
         key = _cache_key(system, dt)
@@ -134,7 +133,7 @@ class FastMassSpring(Integrator):
             const -= ops.A_fp @ x_pin
             dx_pin = ops.G_pin @ x_pin
         variable = system.has_variable_forces
-        length = (float(np.linalg.norm(np.ptp(xn, axis=0))) or 1.0) if self.tol is not None else 1.0
+        length = box_length(xn) if self.tol is not None else 1.0
         x_free = y_free
         for _ in range(int(self.iterations)):
             dx = ops.G_free @ x_free            # (s, d): x_j - x_i

@@ -34,7 +34,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
-from .base import Integrator, StepContext, StepperState, restrict, solve_linear
+from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
+                   restrict, solve_linear)
 from .registry import INTEGRATORS
 
 
@@ -55,8 +56,7 @@ class NewtonImplicitEuler(Integrator):
     symplectic = False
 
     def __post_init__(self):
-        if self.max_iterations < 1 or self.tol <= 0:
-            raise InputError("newton: need max_iterations >= 1 and tol > 0")
+        check_iteration_options(self.name, self.max_iterations, self.tol)
         if not (0.0 < self.armijo < 0.5 and 0.0 < self.shrink < 1.0):
             raise InputError("newton: need 0 < armijo < 1/2 and 0 < shrink < 1")
 
@@ -74,7 +74,7 @@ class NewtonImplicitEuler(Integrator):
         if rk != 0.0:
             C = C + rk * system.stiffness_matrix(state.x)
         y = xn + h * state.v.reshape(-1)
-        length = float(np.linalg.norm(np.ptp(state.x, axis=0))) or 1.0
+        length = box_length(state.x)
 
         def g(xf):
             d, e = xf - y, xf - xn
@@ -110,7 +110,7 @@ class NewtonImplicitEuler(Integrator):
             x, gx = x_try, g_try
             if step_size <= self.tol * length:
                 break
-        ctx.stats.setdefault("newton_iterations", []).append(iterations)
+        ctx.record("newton_iterations", iterations)
         x_new = x.reshape(shape)
         v_new = ((x - xn) / h).reshape(shape)
         return StepperState(x_new, v_new, state.t + h)

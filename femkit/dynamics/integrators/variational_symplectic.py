@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InputError
-from .base import Integrator, StepContext, StepperState, restrict, solve_linear
+from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
+                   restrict, solve_linear)
 from .registry import INTEGRATORS
 
 
@@ -39,8 +39,7 @@ class VariationalSymplectic(Integrator):
     symplectic = True
 
     def __post_init__(self):
-        if self.max_iterations < 1 or self.tol <= 0:
-            raise InputError("variational_symplectic: need max_iterations >= 1 and tol > 0")
+        check_iteration_options(self.name, self.max_iterations, self.tol)
 
     def step(self, system, state: StepperState, dt: float, ctx: StepContext) -> StepperState:
         h = dt
@@ -52,7 +51,7 @@ class VariationalSymplectic(Integrator):
         M = system.mass_matrix()
         m = M.diagonal()
         pn = m * vn
-        length = float(np.linalg.norm(np.ptp(state.x, axis=0))) or 1.0
+        length = box_length(state.x)
         q = qn + 0.5 * h * vn
         iterations = 0
         for iterations in range(1, self.max_iterations + 1):
@@ -68,7 +67,7 @@ class VariationalSymplectic(Integrator):
             q[free] += dq
             if np.abs(dq).max(initial=0.0) <= self.tol * length:
                 break
-        ctx.stats.setdefault("newton_iterations", []).append(iterations)
+        ctx.record("newton_iterations", iterations)
         vbar = 2.0 * (q - qn) / h
         x_new = (2.0 * q - qn).reshape(shape)
         v_new = (2.0 * vbar - vn).reshape(shape)
