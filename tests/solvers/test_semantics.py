@@ -259,3 +259,19 @@ def test_inexact_operator_true_residual_refused(builders):
     assert res.residuals[-1] <= 1e-14 * np.linalg.norm(b)
     assert np.linalg.norm(b - op @ res.x) == pytest.approx(res.true_residual)
     assert res.relative_residual > 1e-10
+
+
+def test_default_stagnation_window_lets_high_contrast_cg_converge():
+    # P1 on a 4x4 checkerboard with kappa contrast 1e4 (n = 16,129): plain CG's residual rises to
+    # ~60x its initial value and stays above it past iteration 1000, yet CG converges (~6,600
+    # iterations). A fixed 1000-iteration window called this "stagnation"; the default window
+    # max(1000, n) must not.
+    from femkit.study.stability import _checker_kappa, _poisson_system, structured_mesh
+
+    mesh = structured_mesh(128, 128)
+    _, _, system = _poisson_system(mesh, _checker_kappa(mesh, 1e4), 1.0)
+    res = cg(system.A, system.b, rtol=1e-8, maxiter=20000)
+    first_below_initial = int(np.argmax(np.asarray(res.residuals[1:]) < res.residuals[0])) + 1
+    assert first_below_initial > 1000  # the case really defeats a 1000-iteration window
+    assert res.converged and res.reason == "converged", res.message
+    assert res.relative_residual <= 1e-8
