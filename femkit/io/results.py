@@ -24,7 +24,8 @@ RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs",
 
 
 def to_jsonable(value: Any) -> Any:
-    """Convert numpy scalars/arrays and paths to JSON types; non-finite floats become null."""
+    """Convert numpy scalars/arrays, paths and ``as_dict()`` objects to JSON types (strict JSON:
+    non-finite floats become null; anything else unknown becomes its ``str``)."""
     if isinstance(value, dict):
         return {str(k): to_jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
@@ -40,7 +41,11 @@ def to_jsonable(value: Any) -> Any:
         return v if math.isfinite(v) else None
     if isinstance(value, os.PathLike):
         return os.fspath(value)
-    return value
+    if hasattr(value, "as_dict"):
+        return to_jsonable(value.as_dict())
+    if value is None or isinstance(value, (str, int)):
+        return value
+    return str(value)
 
 
 def write_json(path: str | os.PathLike, data: dict) -> Path:

@@ -27,6 +27,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ..io.results import to_jsonable  # noqa: F401  (one JSON conversion for every femkit output)
+
 __all__ = ["Report", "staged_output", "write_csv", "write_json", "to_jsonable", "fmt"]
 
 
@@ -46,28 +48,6 @@ def fmt(v: Any) -> str:
             return "inf" if v > 0 else "-inf"
         return f"{v:.4g}"
     return str(v)
-
-
-def to_jsonable(obj: Any) -> Any:
-    """Numpy scalars/arrays to Python, non-finite floats to None (strict JSON)."""
-    if isinstance(obj, dict):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
-    if isinstance(obj, (bool, np.bool_)):
-        return bool(obj)
-    if isinstance(obj, (int, np.integer)):
-        return int(obj)
-    if isinstance(obj, (float, np.floating)):
-        f = float(obj)
-        return f if math.isfinite(f) else None
-    if hasattr(obj, "as_dict"):
-        return to_jsonable(obj.as_dict())
-    if obj is None or isinstance(obj, str):
-        return obj
-    return str(obj)
 
 
 def write_json(path, obj: Any) -> None:
