@@ -9,7 +9,7 @@ springs as ``line`` cells, plus the ``triangle`` cells of cloth and mesh systems
 triangles) and ``scene.pvd`` listing them with their times (ParaView opens the ``.pvd`` as a
 time series). ``xdmf: true`` writes ``scene.xdmf`` + ``scene.h5`` (meshio's time-series writer).
 
-Matplotlib and imageio are imported only when a PNG or GIF is asked for; meshio only when
+Matplotlib and Pillow (pictures: :mod:`femkit.dynamics.plot`) are imported only when a PNG or GIF is asked for; meshio only when
 frames are written.
 """
 
@@ -122,87 +122,25 @@ def write_energy_csv(path: str | os.PathLike, traj) -> Path:
 
 # ----------------------------------------------------------------------------- pictures
 
-def _view_axes(traj) -> tuple[int, int]:
-    """The two coordinate axes with the largest extent over the run (x, last axis for ties)."""
-    d = traj.x.shape[2]
-    if d == 2:
-        return 0, 1
-    ext = traj.x.max(axis=(0, 1)) - traj.x.min(axis=(0, 1))
-    order = sorted(range(3), key=lambda c: (-ext[c], -c))
-    a, b = sorted(order[:2])
-    return a, b
+def write_final_png(path: str | os.PathLike, system, traj, name: str, triangles=None) -> Path:
+    """The last frame (3-D view for 3-D systems) and the energy of the run as a PNG.
+
+    Thin wrapper of :func:`femkit.dynamics.plot.write_final_png` (matplotlib imported only here).
+    """
+    from .plot import write_final_png as _png
+
+    return _png(path, system, traj, name, triangles=triangles)
 
 
-def _limits(traj, axes):
-    lo = traj.x[..., list(axes)].min(axis=(0, 1))
-    hi = traj.x[..., list(axes)].max(axis=(0, 1))
-    pad = 0.05 * max(float(np.max(hi - lo)), 1e-12)
-    return lo - pad, hi + pad
+def write_gif(path: str | os.PathLike, system, traj, name: str, max_frames: int = 60,
+              triangles=None) -> Path:
+    """An animated GIF of at most ``max_frames`` evenly spaced recorded frames.
 
+    Thin wrapper of :func:`femkit.dynamics.plot.write_gif`.
+    """
+    from .plot import write_gif as _gif
 
-def _draw(ax, system, x, axes, lo, hi, title):
-    from matplotlib.collections import LineCollection
-
-    a, b = axes
-    seg = np.stack([x[system.springs[:, 0]][:, [a, b]], x[system.springs[:, 1]][:, [a, b]]], 1)
-    ax.add_collection(LineCollection(seg, linewidths=0.5, colors="tab:blue"))
-    free = ~system.pinned
-    ax.plot(x[free, a], x[free, b], ".", ms=2, color="k")
-    ax.plot(x[~free, a], x[~free, b], "s", ms=4, color="tab:red")
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_aspect("equal")
-    ax.set_xlabel("xyz"[a])
-    ax.set_ylabel("xyz"[b])
-    ax.set_title(title, fontsize=9)
-
-
-def _figure():
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    from matplotlib.figure import Figure
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    fig = Figure(figsize=(5, 5), dpi=80)
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def write_final_png(path: str | os.PathLike, system, traj, name: str) -> Path:
-    """The springs of the last frame (projected on the two widest axes) as a PNG."""
-    from ..io.atomic import atomic_path
-
-    axes = _view_axes(traj)
-    lo, hi = _limits(traj, axes)
-    fig = _figure()
-    ax = fig.add_subplot(1, 1, 1)
-    _draw(ax, system, traj.x[-1], axes, lo, hi, f"{name}: t = {traj.times[-1]:.4g}")
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png")
-    return Path(path)
-
-
-def write_gif(path: str | os.PathLike, system, traj, name: str, max_frames: int = 60) -> Path:
-    """An animated GIF of (at most ``max_frames`` evenly spaced) recorded frames."""
-    import imageio.v2 as imageio
-
-    from ..io.atomic import atomic_path
-
-    axes = _view_axes(traj)
-    lo, hi = _limits(traj, axes)
-    picks = np.unique(np.linspace(0, len(traj.times) - 1, min(max_frames, len(traj.times)))
-                      .round().astype(int))
-    images = []
-    for k in picks:
-        fig = _figure()
-        ax = fig.add_subplot(1, 1, 1)
-        _draw(ax, system, traj.x[k], axes, lo, hi, f"{name}: t = {traj.times[k]:.4g}")
-        fig.canvas.draw()
-        images.append(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy())
-    with atomic_path(path) as tmp:
-        imageio.mimsave(tmp, images, format="GIF", duration=0.08, loop=0)
-    return Path(path)
+    return _gif(path, system, traj, name, triangles=triangles, max_frames=max_frames)
 
 
 # ----------------------------------------------------------------------------- all
@@ -228,10 +166,10 @@ def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
             write_energy_csv(tmp / "energy.csv", traj)
             files.append("energy.csv")
         if opts["png"]:
-            write_final_png(tmp / "final.png", system, traj, result.case.name)
+            write_final_png(tmp / "final.png", system, traj, result.case.name, tri)
             files.append("final.png")
         if opts["gif"]:
-            write_gif(tmp / "animation.gif", system, traj, result.case.name)
+            write_gif(tmp / "animation.gif", system, traj, result.case.name, triangles=tri)
             files.append("animation.gif")
         files.append("result.json")
         result.files = files
