@@ -25,7 +25,7 @@ Example: one spring stretched from rest length 1 to 2 pulls its ends together.
 from __future__ import annotations
 
 import copy
-from typing import Iterable
+from typing import Callable, Iterable
 
 import numpy as np
 import scipy.sparse as sp
@@ -36,6 +36,7 @@ from .forces.rayleigh import RayleighDamping
 from .forces.springs import dashpot_forces, geometry_from_difference, hooke_forces, spring_energy
 from .jacobian import (
     FIXES,
+    _transverse_factor,
     SpringPattern,
     dashpot_blocks,
     regularization_shift,
@@ -401,6 +402,113 @@ class MassSpringSystem:
         if fix == "regularize":
             out += self.regularization_shift(x) * dd
         return out
+
+    def stiffness_operator(self, x, *, fix: str | None = None) -> Callable[[np.ndarray], np.ndarray]:
+        """``d -> K d`` at a fixed ``x`` without assembling ``K``: the spring geometry and the
+        per-spring coefficients are computed once, each product is two sparse passes over the
+        springs (``G d``, scatter) plus the declared forces' own products. Equal to
+        :meth:`hessian_product` ``(x, d, fix=fix)``; ``d`` flat or ``(n, d)``, result ``(n, d)``."""
+        self._check_fix(fix)
+        x = self._state(x)
+        _, l, u = self._geometry(x)
+        a = _transverse_factor(l, self.rest, "clamp" if fix == "clamp" else None)
+        ka, kb = self.k * a, self.k * (1.0 - a)
+        mu = self.regularization_shift(x) if fix == "regularize" else 0.0
+        G, S = self.difference_operators if self.n_springs else (None, None)
+        force_fix = "clamp" if fix == "clamp" else None
+
+        def product(d):
+            dd = self._state(d, "d")
+            if self.n_springs:
+                diff = G @ dd
+                y = ka[:, None] * diff + (kb * np.einsum("sd,sd->s", u, diff))[:, None] * u
+                out = S @ (-y)
+            else:
+                out = np.zeros((self.n, self.dim))
+            for f in self.forces:
+                p = f.stiffness_product(x, dd, force_fix)
+                if p is not None:
+                    out += p
+            if mu:
+                out += mu * dd
+            return out
+
+        return product
+
+    def damping_operator(self, x) -> Callable[[np.ndarray], np.ndarray]:
+        """``d -> D d`` at a fixed ``x`` without assembling the spring-pattern matrix ``D``
+        (dashpots ``c u u^T`` per spring, computed once; nodal forces such as viscous damping
+        through their diagonal ``D``). Equal to ``damping_matrix(x) @ d``; result ``(n, d)``."""
+        x = self._state(x)
+        if self._has_dashpots:
+            _, _, u = self._geometry(x)
+            G, S = self.difference_operators
+            c = self.damping
+        nodal = [D for D in (f.damping(x) for f in self.forces) if D is not None]
+
+        def product(d):
+            dd = self._state(d, "d")
+            if self._has_dashpots:
+                diff = G @ dd
+                out = S @ (-(c * np.einsum("sd,sd->s", u, diff))[:, None] * u)
+            else:
+                out = np.zeros((self.n, self.dim))
+            for D in nodal:
+                out += (D @ dd.reshape(-1)).reshape(self.n, self.dim)
+            return out
+
+        return product
+
+    def damping_product(self, x, d) -> np.ndarray:
+        """Matrix-free ``D d`` (dashpots + viscous, not Rayleigh), equal to
+        ``damping_matrix(x) @ d``; ``d`` flat or ``(n, d)``, result ``(n, d)``."""
+        return self.damping_operator(x)(d)
+
+    def _spring_diagonal(self, per_spring: np.ndarray) -> np.ndarray:
+        """Flat ``(ndof,)`` diagonal from the ``(s, d)`` diagonals of the spring blocks (each
+        block enters the ``(i, i)`` and ``(j, j)`` blocks with a plus sign)."""
+        if not self.n_springs:
+            return np.zeros(self.ndof)
+        w = per_spring.ravel()
+        return np.bincount(self._scatter, weights=np.concatenate([w, w]), minlength=self.ndof)
+
+    def stiffness_diagonal(self, x, fix: str | None = None) -> np.ndarray:
+        """Diagonal of ``stiffness_matrix(x, fix=fix)``, flat ``(ndof,)``, without assembling
+        it: ``k (a + (1 - a) u_c^2)`` per spring and coordinate (``a = 1 - L/l``, clamped for
+        ``fix="clamp"``) scattered to both ends with one ``np.bincount``, plus the declared
+        forces' (contact) diagonals and the shift of ``fix="regularize"``. For a Jacobi
+        preconditioner of matrix-free solves.
+
+        >>> s = MassSpringSystem(np.array([[0., 0.], [2., 0.]]), 1.0, [[0, 1]], k=3.0, rest=1.0)
+        >>> s.stiffness_diagonal(s.x0).tolist()      # along u: k = 3; across: k (1 - 1/2)
+        [3.0, 1.5, 3.0, 1.5]
+        """
+        self._check_fix(fix)
+        x = self._state(x)
+        _, l, u = self._geometry(x)
+        a = _transverse_factor(l, self.rest, "clamp" if fix == "clamp" else None)
+        diag = self._spring_diagonal((self.k * a)[:, None] + (self.k * (1.0 - a))[:, None] * u * u)
+        for f in self.forces:
+            Kf = f.stiffness(x, "clamp" if fix == "clamp" else None)
+            if Kf is not None:
+                diag += Kf.diagonal()
+        if fix == "regularize":
+            diag += self.regularization_shift(x)
+        return diag
+
+    def damping_diagonal(self, x) -> np.ndarray:
+        """Diagonal of :meth:`damping_matrix`, flat ``(ndof,)``, without assembling it."""
+        x = self._state(x)
+        if self._has_dashpots:
+            _, _, u = self._geometry(x)
+            diag = self._spring_diagonal(self.damping[:, None] * u * u)
+        else:
+            diag = np.zeros(self.ndof)
+        for f in self.forces:
+            Df = f.damping(x)
+            if Df is not None:
+                diag += Df.diagonal()
+        return diag
 
     def damping_matrix(self, x) -> sp.csr_matrix:
         """``D = -df/dv`` of the dashpots (``c u u^T`` blocks) and viscous damping (not Rayleigh)."""

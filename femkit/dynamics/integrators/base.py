@@ -50,6 +50,10 @@ __all__ = [
     "restrict",
     "box_length",
     "check_iteration_options",
+    "MATRIX_FREE_MESSAGE",
+    "check_matrix_free",
+    "check_matrix_free_options",
+    "free_operator",
 ]
 
 
@@ -128,6 +132,8 @@ class Integrator:
                 f"got {x.shape} and {v.shape}"
             )
         v[system.pinned] = 0.0
+        if getattr(self, "matrix_free", False):  # refuse a solver that needs the matrix up front
+            check_matrix_free(self.name, ctx)
         return StepperState(x, v, float(t))
 
     def step(self, system, state: StepperState, dt: float, ctx: StepContext) -> StepperState:
@@ -207,8 +213,14 @@ def _add_time(ctx: StepContext, key: str, seconds: float) -> None:
 
 
 def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = None, *,
-                 system=None, reuse_key: str | None = None) -> np.ndarray:
+                 system=None, reuse_key: str | None = None,
+                 diagonal: np.ndarray | None = None) -> np.ndarray:
     """Solve ``A x = b`` with the method named in ``ctx`` through ``femkit.solvers``.
+
+    ``A`` may be a ``scipy.sparse.linalg.LinearOperator`` (matrix-free, :func:`free_operator`):
+    then ``ctx`` must name ``cg`` or ``pcg`` with preconditioner ``none`` or ``jacobi``
+    (:func:`check_matrix_free`) and ``diagonal`` (the operator's diagonal) builds the Jacobi
+    preconditioner.
 
     With ``ctx.solver == "direct"`` and the ``system`` (which marks a matrix refactorised every
     step), the SuperLU ordering is reused while the pattern of ``A`` stays the same (module
@@ -227,7 +239,16 @@ def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = Non
     direct solve misses the residual rule): an implicit step never continues from an
     unconverged solve.
     """
-    if system is not None and ctx.solver == "direct" and not ctx.options:
+    from scipy.sparse.linalg import LinearOperator
+
+    pc_options = None
+    if isinstance(A, LinearOperator):
+        check_matrix_free("matrix-free solve", ctx)
+        if ctx.solver == "pcg" and ctx.preconditioner == "jacobi":
+            if diagonal is None:
+                raise InputError("matrix-free pcg with jacobi needs the operator's diagonal")
+            pc_options = {"diagonal": diagonal}
+    elif system is not None and ctx.solver == "direct" and not ctx.options:
         if reuse_key is not None:
             return _solve_reusing_factor(A, b, ctx, reuse_key, x0)
         return _solve_direct_reusing_ordering(A, b, ctx)
@@ -235,7 +256,8 @@ def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = Non
 
     ctx.count("linear_solves")
     res = _solve(A, b, x0, method=ctx.solver, preconditioner=ctx.preconditioner,
-                 rtol=ctx.rtol, atol=ctx.atol, maxiter=ctx.maxiter, **ctx.options)
+                 rtol=ctx.rtol, atol=ctx.atol, maxiter=ctx.maxiter,
+                 preconditioner_options=pc_options, **ctx.options)
     ctx.count("linear_iterations", int(res.iterations))
     if not res.converged:
         raise SolverError(
@@ -350,3 +372,60 @@ def factorize_linear(A, ctx: StepContext):
 
     ctx.count("factorizations")
     return factorize(A)
+
+
+# ----------------------------------------------------------------------------- matrix-free
+MATRIX_FREE_MESSAGE = "matrix-free needs an iterative solver: cg or pcg (jacobi)"
+"""The reason given when ``matrix_free`` meets a solver or preconditioner that needs the matrix."""
+
+MATRIX_FREE_SOLVERS = {"cg": ("none",), "pcg": ("none", "jacobi")}
+"""Solvers (and their preconditioners) that need only products ``A d`` and ``diag(A)``."""
+
+
+def check_matrix_free(name: str, ctx: StepContext) -> None:
+    """Raise :class:`~femkit.errors.InputError` unless ``ctx`` names a solver that works from
+    products alone: ``cg``, or ``pcg`` with preconditioner ``none``/``jacobi`` (``direct``,
+    ``jacobi`` iteration, ``ic0`` and ``amg`` need the assembled matrix).
+
+    >>> check_matrix_free("implicit_euler", StepContext(solver="pcg", preconditioner="jacobi"))
+    >>> check_matrix_free("implicit_euler", StepContext(solver="direct"))
+    Traceback (most recent call last):
+    ...
+    femkit.errors.InputError: implicit_euler: matrix-free needs an iterative solver: cg or pcg (jacobi); got linear solver 'direct'
+    """
+    allowed = MATRIX_FREE_SOLVERS.get(ctx.solver)
+    if allowed is None:
+        raise InputError(f"{name}: {MATRIX_FREE_MESSAGE}; got linear solver {ctx.solver!r}")
+    pc = ctx.preconditioner if ctx.solver == "pcg" else "none"
+    if pc not in allowed:
+        raise InputError(f"{name}: {MATRIX_FREE_MESSAGE}; preconditioner {pc!r} needs the "
+                         f"assembled matrix")
+
+
+def check_matrix_free_options(name: str, matrix_free: bool, reuse_factorization: bool) -> None:
+    """Raise :class:`~femkit.errors.InputError` when both options are on (nothing to factorise)."""
+    if matrix_free and reuse_factorization:
+        raise InputError(f"{name}: matrix_free and reuse_factorization exclude each other "
+                         "(there is no matrix to factorise)")
+
+
+def free_operator(product, free: np.ndarray, ndof: int):
+    """The ``LinearOperator`` ``z -> (A e)[free]`` with ``e`` = ``z`` on the ``free`` dofs
+    and 0 on the pinned ones, i.e. ``A[free][:, free]`` applied without forming it.
+
+    ``product`` maps a flat ``(ndof,)`` vector to ``A e`` (flat or ``(n, d)``).
+
+    >>> op = free_operator(lambda e: 2.0 * e, np.array([0, 2]), 3)
+    >>> op.matvec(np.array([1.0, 5.0])).tolist()
+    [2.0, 10.0]
+    """
+    from scipy.sparse.linalg import LinearOperator
+
+    nf = len(free)
+
+    def matvec(z):
+        e = np.zeros(ndof)
+        e[free] = np.ravel(z)
+        return np.asarray(product(e)).reshape(-1)[free]
+
+    return LinearOperator((nf, nf), matvec=matvec, rmatvec=matvec, dtype=np.float64)

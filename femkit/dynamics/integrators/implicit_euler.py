@@ -21,13 +21,26 @@ earlier step's matrix is kept (when it is SPD) and later steps solve by PCG prec
 it, to ``ctx.rtol`` on the true residual, renewing the factor when a PCG solve costs more than
 the average per solve since the factorisation (:func:`.base.solve_linear`): the same step to
 that tolerance at a fraction of the cost while the matrix changes slowly. ``reuse_factorization=False``: one factorisation per step.
+
+``matrix_free=True`` (seed 001, matrix-free CG) solves the same system without assembling
+it: a ``LinearOperator`` on the free dofs applies
+``A d = (1 + h r_M) M d + h (h + r_K) K d + h D d`` through ``system.stiffness_operator`` /
+``system.damping_operator`` (spring geometry computed once per step, two sparse passes over
+the springs per product), and the right-hand side uses the product ``K v``. It needs
+``cg`` or ``pcg`` with ``none``/``jacobi`` (the Jacobi diagonal comes from the spring blocks'
+diagonals, :meth:`~femkit.dynamics.system.MassSpringSystem.stiffness_diagonal`); any other
+solver raises :class:`~femkit.errors.InputError` when the run starts
+(:meth:`.base.Integrator.start`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .base import Integrator, StepContext, StepperState, restrict, solve_linear
+import numpy as np
+
+from .base import (Integrator, StepContext, StepperState, check_matrix_free_options, free_operator,
+                   restrict, solve_linear)
 from .registry import INTEGRATORS
 
 
@@ -36,11 +49,33 @@ from .registry import INTEGRATORS
 class ImplicitEuler(Integrator):
     fix: str | None = None
     reuse_factorization: bool = False
+    matrix_free: bool = False
 
     name = "implicit_euler"
     order = 1
     implicit = True
     symplectic = False
+
+    def __post_init__(self):
+        check_matrix_free_options(self.name, self.matrix_free, self.reuse_factorization)
+
+    def operator(self, system, x, dt: float):
+        """``(op, diagonal, K)``: this step's matrix on the free dofs as a ``LinearOperator``
+        (never assembled), its diagonal (Jacobi) and the ``d -> K d`` product at ``x``."""
+        h = dt
+        rm, rk = system.rayleigh
+        m = np.repeat(system.mass, system.dim)
+        K = system.stiffness_operator(x, fix=self.fix)
+        D = system.damping_operator(x)
+        a_m, a_k = 1.0 + h * rm, h * (h + rk)
+
+        def product(e):
+            return a_m * m * e + a_k * K(e).reshape(-1) + h * D(e).reshape(-1)
+
+        free = system.free_dofs
+        diag = a_m * m + a_k * system.stiffness_diagonal(x, fix=self.fix) \
+            + h * system.damping_diagonal(x)
+        return free_operator(product, free, system.ndof), diag[free], K
 
     def step(self, system, state: StepperState, dt: float, ctx: StepContext) -> StepperState:
         h = dt
@@ -49,6 +84,12 @@ class ImplicitEuler(Integrator):
         free = system.free_dofs
         vf = v.reshape(-1)
         f = system.force(x, v, state.t, rayleigh=False).reshape(-1)
+        if self.matrix_free:
+            op, diag, Kop = self.operator(system, x, h)
+            m = np.repeat(system.mass, system.dim)
+            b = h * (f - (h + rk) * Kop(vf).reshape(-1) - rm * m * vf)
+            dv = solve_linear(op, b[free], ctx, diagonal=diag)
+            return self._advance(state, vf, free, dv, h)
         K = system.stiffness_matrix(x, fix=self.fix)
         M = system.mass_matrix()
         A = (1.0 + h * rm) * M + (h * (h + rk)) * K
@@ -58,10 +99,14 @@ class ImplicitEuler(Integrator):
         b = h * (f - (h + rk) * (K @ vf) - rm * (M @ vf))
         dv = solve_linear(restrict(A, free), b[free], ctx, system=system,
                           reuse_key="implicit_euler_factor" if self.reuse_factorization else None)
+        return self._advance(state, vf, free, dv, h)
+
+    @staticmethod
+    def _advance(state: StepperState, vf, free, dv, h: float) -> StepperState:
         v_new = vf.copy()
         v_new[free] += dv
-        v_new = v_new.reshape(v.shape)
-        return StepperState(x + h * v_new, v_new, state.t + h)
+        v_new = v_new.reshape(state.v.shape)
+        return StepperState(state.x + h * v_new, v_new, state.t + h)
 
     def dahlquist_amplification(self, z: complex) -> complex:
         return 1.0 / (1.0 - z)

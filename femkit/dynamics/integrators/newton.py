@@ -24,6 +24,14 @@ since the factorisation (see :func:`.base.solve_linear`; ``ctx.stats``: ``factor
 Each Newton direction is the same to that tolerance, so the iterates are those of Newton with
 exact solves; only the cost changes (one factorisation typically serves several steps).
 
+``matrix_free=True`` assembles nothing: ``C`` is applied as the product
+``D(x_n) e + r_M M e + r_K K(x_n) e`` (``system.damping_operator``/``stiffness_operator``) in
+``g``, its gradient and the Newton operator ``M + h^2 K_fix(x) + h C``, a ``LinearOperator`` on
+the free dofs solved by ``cg`` or ``pcg`` with ``none``/``jacobi`` (diagonal from the spring
+blocks, :meth:`~femkit.dynamics.system.MassSpringSystem.stiffness_diagonal`); other solvers
+raise :class:`~femkit.errors.InputError` when the run starts. The iterates are those of the
+assembled path to the linear solver's tolerance.
+
 First order; unconditionally stable.
 """
 
@@ -35,7 +43,7 @@ import numpy as np
 
 from ...errors import InputError
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
-                   restrict, solve_linear)
+                   check_matrix_free_options, free_operator, restrict, solve_linear)
 from .registry import INTEGRATORS
 
 
@@ -49,6 +57,7 @@ class NewtonImplicitEuler(Integrator):
     shrink: float = 0.5
     max_backtracks: int = 40
     reuse_factorization: bool = False
+    matrix_free: bool = False
 
     name = "newton"
     order = 1
@@ -59,6 +68,41 @@ class NewtonImplicitEuler(Integrator):
         check_iteration_options(self.name, self.max_iterations, self.tol)
         if not (0.0 < self.armijo < 0.5 and 0.0 < self.shrink < 1.0):
             raise InputError("newton: need 0 < armijo < 1/2 and 0 < shrink < 1")
+        check_matrix_free_options(self.name, self.matrix_free, self.reuse_factorization)
+
+    def damping_operator(self, system, xn):
+        """``(e -> C e, diag C)``, flat vectors, of the step's frozen damping
+        ``C = D(x_n) + r_M M + r_K K(x_n)`` without assembling it (``matrix_free=True``)."""
+        rm, rk = system.rayleigh
+        m = np.repeat(system.mass, system.dim)
+        D = system.damping_operator(xn)
+        K = system.stiffness_operator(xn) if rk != 0.0 else None
+        diag = system.damping_diagonal(xn) + rm * m
+        if K is not None:
+            diag = diag + rk * system.stiffness_diagonal(xn)
+
+        def product(e):
+            out = D(e).reshape(-1) + rm * m * e
+            if K is not None:
+                out += rk * K(e).reshape(-1)
+            return out
+
+        return product, diag
+
+    def newton_operator(self, system, x, h: float, C):
+        """``(op, diag)``: ``M + h^2 K_fix(x) + h C`` on the free dofs as a ``LinearOperator``
+        (never assembled) and its diagonal; ``C = (product, diagonal)`` from
+        :meth:`damping_operator`."""
+        m = np.repeat(system.mass, system.dim)
+        K = system.stiffness_operator(x, fix=self.fix)
+        c_apply, c_diag = C
+
+        def product(e):
+            return m * e + (h * h) * K(e).reshape(-1) + h * c_apply(e)
+
+        free = system.free_dofs
+        diag = m + (h * h) * system.stiffness_diagonal(x, fix=self.fix) + h * c_diag
+        return free_operator(product, free, system.ndof), diag[free]
 
     def step(self, system, state: StepperState, dt: float, ctx: StepContext) -> StepperState:
         h = dt
@@ -68,18 +112,23 @@ class NewtonImplicitEuler(Integrator):
         xn = state.x.reshape(-1)
         M = system.mass_matrix()
         m = M.diagonal()
-        C = system.damping_matrix(state.x)
-        if rm != 0.0:
-            C = C + rm * M
-        if rk != 0.0:
-            C = C + rk * system.stiffness_matrix(state.x)
+        if self.matrix_free:
+            C = self.damping_operator(system, state.x)
+            c_apply = C[0]
+        else:
+            C = system.damping_matrix(state.x)
+            if rm != 0.0:
+                C = C + rm * M
+            if rk != 0.0:
+                C = C + rk * system.stiffness_matrix(state.x)
+            c_apply = C.__matmul__
         y = xn + h * state.v.reshape(-1)
         length = box_length(state.x)
 
         def g(xf):
             d, e = xf - y, xf - xn
             return 0.5 * d @ (m * d) + h * h * system.potential_energy(xf.reshape(shape)) \
-                + 0.5 * h * (e @ (C @ e))
+                + 0.5 * h * (e @ c_apply(e))
 
         x = y.copy()
         x[~_free_mask(free, xn.size)] = xn[~_free_mask(free, xn.size)]
@@ -87,11 +136,15 @@ class NewtonImplicitEuler(Integrator):
         iterations = 0
         for iterations in range(1, self.max_iterations + 1):
             grad = m * (x - y) + h * h * system.potential_gradient(x.reshape(shape)).reshape(-1) \
-                + h * (C @ (x - xn))
-            H = M + (h * h) * system.stiffness_matrix(x.reshape(shape), fix=self.fix) + h * C
+                + h * c_apply(x - xn)
             dx = np.zeros_like(x)
-            dx[free] = solve_linear(restrict(H, free), -grad[free], ctx, system=system,
-                                    reuse_key="newton_factor" if self.reuse_factorization else None)
+            if self.matrix_free:
+                op, diag = self.newton_operator(system, x.reshape(shape), h, C)
+                dx[free] = solve_linear(op, -grad[free], ctx, diagonal=diag)
+            else:
+                H = M + (h * h) * system.stiffness_matrix(x.reshape(shape), fix=self.fix) + h * C
+                dx[free] = solve_linear(restrict(H, free), -grad[free], ctx, system=system,
+                                        reuse_key="newton_factor" if self.reuse_factorization else None)
             slope = grad[free] @ dx[free]
             t = 1.0
             if slope < 0.0:
