@@ -200,7 +200,7 @@ def _shade(pts: np.ndarray) -> np.ndarray:
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
     light = np.array([-0.4, -0.5, 0.77])
     light /= np.linalg.norm(light)
-    b = 0.55 + 0.45 * np.abs(n @ light)             # two-sided
+    b = 0.4 + 0.6 * np.abs(n @ light)               # two-sided
     rgb = np.clip(_SURFACE[None, :] * b[:, None] + 0.08, 0, 1)
     return np.column_stack([rgb, np.ones(len(rgb))])
 
@@ -245,8 +245,11 @@ def _draw_3d(fig, rect, system, x, triangles, view: SceneView, name, traj, k):
     mappable = None
     if triangles is not None and len(triangles):
         pts = x[np.asarray(triangles)]
-        ax.add_collection3d(Poly3DCollection(pts, facecolors=_shade(pts),
-                                             edgecolors=(0.2, 0.3, 0.45, 0.55), linewidths=0.3))
+        # thin edges while they can be told apart; a dense mesh reads better by shading alone
+        faces = _shade(pts)
+        edges = (0.2, 0.3, 0.45, 0.55) if len(pts) <= 3000 else faces   # faces: no seams
+        ax.add_collection3d(Poly3DCollection(pts, facecolors=faces, edgecolors=edges,
+                                             linewidths=0.3))
     elif system.n_springs:
         cmap, norm = _strain_mappable(view)
         seg = np.stack([x[system.springs[:, 0]], x[system.springs[:, 1]]], axis=1)
@@ -403,6 +406,8 @@ def write_final_png(path: str | os.PathLike, system, traj, name: str, *, triangl
 
     3-D systems are framed on the final shape; 2-D ones on the whole run (the tracked paths).
     """
+    from PIL import Image
+
     from ..io.atomic import atomic_path
 
     frames = [len(traj.times) - 1] if system.dim == 3 else None
@@ -413,9 +418,40 @@ def write_final_png(path: str | os.PathLike, system, traj, name: str, *, triangl
         final = np.abs(spring_strain(system, traj.x[-1]))
         view.strain_max = max(float(np.max(final[np.isfinite(final)], initial=0.0)), 1e-6)
     fig = plot_frame(system, traj, -1, triangles=triangles, name=name, view=view, dpi=dpi)
+    rgb = _rgb_image(fig)
+    image = rgb.quantize(palette=_palette([rgb], 256), dither=Image.Dither.NONE)
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png")
+        image.save(tmp, format="PNG", optimize=True)        # 8-bit palette: ~1/3 the bytes
     return Path(path)
+
+
+#: Colours kept exactly by the palettes (pins, curves, text), whatever their pixel count.
+_KEY_COLOURS = (_PIN, "#000000", "#ffffff", "tab:orange", "tab:blue", "tab:green", "0.35",
+                "0.3", "#404040")
+
+
+def _palette(images, colours: int):
+    """A Pillow palette image: median-cut colours of ``images`` plus the key colours."""
+    from matplotlib.colors import to_rgb
+    from PIL import Image
+
+    strip = Image.new("RGB", (images[0].width, images[0].height * len(images)))
+    for i, im in enumerate(images):
+        strip.paste(im, (0, i * im.height))
+    keys = [round(255 * c) for name in _KEY_COLOURS for c in to_rgb(name)]
+    base = strip.quantize(colors=colours - len(_KEY_COLOURS), method=Image.Quantize.MEDIANCUT)
+    flat = base.getpalette()[: 3 * (colours - len(_KEY_COLOURS))] + keys
+    pal = Image.new("P", (1, 1))
+    pal.putpalette(flat + [0] * (768 - len(flat)))
+    return pal
+
+
+def _rgb_image(fig):
+    """The rendered figure as a Pillow RGB image."""
+    from PIL import Image
+
+    fig.canvas.draw()
+    return Image.fromarray(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy())
 
 
 def gif_frames(n: int, max_frames: int = 60) -> np.ndarray:
@@ -475,13 +511,8 @@ def write_gif(path: str | os.PathLike, system, traj, name: str, *, triangles=Non
     for k in picks:
         fig = plot_frame(system, traj, int(k), triangles=triangles, name=name, view=view,
                          dpi=dpi, marker=True)
-        fig.canvas.draw()
-        images.append(Image.fromarray(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()))
-    sample = [images[i] for i in sorted({0, len(images) // 2, len(images) - 1})]
-    strip = Image.new("RGB", (sample[0].width, sample[0].height * len(sample)))
-    for i, im in enumerate(sample):
-        strip.paste(im, (0, i * im.height))
-    palette = strip.quantize(colors=128, method=Image.Quantize.MEDIANCUT)
+        images.append(_rgb_image(fig))
+    palette = _palette([images[i] for i in sorted({0, len(images) // 2, len(images) - 1})], 128)
     frames = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
     ms = [int(round(1000 * d)) for d in gif_frame_times(traj.times, picks)]
     with atomic_path(path) as tmp:
