@@ -253,7 +253,7 @@ def _draw_3d(fig, rect, system, x, triangles, view: SceneView, name, traj, k):
     elif system.n_springs:
         cmap, norm = _strain_mappable(view)
         seg = np.stack([x[system.springs[:, 0]], x[system.springs[:, 1]]], axis=1)
-        lc = Line3DCollection(seg, cmap=cmap, norm=norm, linewidths=1.6)
+        lc = Line3DCollection(seg, cmap=cmap, norm=norm, linewidths=2.2)
         lc.set_array(spring_strain(system, x))
         ax.add_collection3d(lc)
         free = ~system.pinned
@@ -384,7 +384,7 @@ def plot_frame(system, traj, frame: int = -1, *, triangles=None, name: str = "",
     if system.dim == 3:
         main = [-0.03, 0.0, 0.68, 0.9] if energy else [0.0, 0.0, 0.9, 0.9]
         ax, mappable = _draw_3d(fig, main, system, x, triangles, view, name, traj, k)
-        cax = fig.add_axes([main[0] + main[2] - 0.02, 0.2, 0.012, 0.55]) if mappable else None
+        cax = fig.add_axes([0.6, 0.2, 0.012, 0.55]) if mappable else None
     else:
         main = [0.06, 0.11, 0.54, 0.76] if energy else [0.08, 0.1, 0.78, 0.78]
         ax, mappable = _draw_2d(fig, main, system, x, triangles, view, name, traj, k)
@@ -395,7 +395,8 @@ def plot_frame(system, traj, frame: int = -1, *, triangles=None, name: str = "",
         cb.ax.tick_params(labelsize=6)
     text, colour = _title(name, traj, k)
     fig.text(0.02, 0.975, text, fontsize=10, color=colour, va="top", ha="left")
-    eax = _draw_energy(fig, [0.72, 0.13, 0.26, 0.72], traj, k, view, marker) if energy else None
+    left = 0.75 if (mappable is not None and system.dim == 3) else 0.72
+    eax = _draw_energy(fig, [left, 0.13, 0.98 - left, 0.72], traj, k, view, marker) if energy else None
     fig.scene_axes, fig.energy_axes, fig.strain_mappable = ax, eax, mappable
     return fig
 
@@ -406,8 +407,6 @@ def write_final_png(path: str | os.PathLike, system, traj, name: str, *, triangl
 
     3-D systems are framed on the final shape; 2-D ones on the whole run (the tracked paths).
     """
-    from PIL import Image
-
     from ..io.atomic import atomic_path
 
     frames = [len(traj.times) - 1] if system.dim == 3 else None
@@ -418,8 +417,7 @@ def write_final_png(path: str | os.PathLike, system, traj, name: str, *, triangl
         final = np.abs(spring_strain(system, traj.x[-1]))
         view.strain_max = max(float(np.max(final[np.isfinite(final)], initial=0.0)), 1e-6)
     fig = plot_frame(system, traj, -1, triangles=triangles, name=name, view=view, dpi=dpi)
-    rgb = _rgb_image(fig)
-    image = rgb.quantize(palette=_palette([rgb], 256), dither=Image.Dither.NONE)
+    image = _quantize([_rgb_image(fig)], 256)[0]
     with atomic_path(path) as tmp:
         image.save(tmp, format="PNG", optimize=True)        # 8-bit palette: ~1/3 the bytes
     return Path(path)
@@ -430,20 +428,27 @@ _KEY_COLOURS = (_PIN, "#000000", "#ffffff", "tab:orange", "tab:blue", "tab:green
                 "0.3", "#404040")
 
 
-def _palette(images, colours: int):
-    """A Pillow palette image: median-cut colours of ``images`` plus the key colours."""
+def _quantize(images, colours: int):
+    """The RGB ``images`` as palette images sharing one median-cut palette of ``colours``.
+
+    All images (plus a band of the key colours, so small markers keep their exact colour) are
+    quantised together, so every pixel gets its exact nearest palette colour and the frames of
+    a GIF share one palette.
+    """
     from matplotlib.colors import to_rgb
     from PIL import Image
 
-    strip = Image.new("RGB", (images[0].width, images[0].height * len(images)))
+    w, h = images[0].width, images[0].height
+    band = max(4, h // 10)
+    keys = np.array([[round(255 * c) for c in to_rgb(name)] for name in _KEY_COLOURS], np.uint8)
+    cols = np.repeat(np.arange(len(keys)), -(-w // len(keys)))[:w]
+    strip = Image.new("RGB", (w, h * len(images) + band))
     for i, im in enumerate(images):
-        strip.paste(im, (0, i * im.height))
-    keys = [round(255 * c) for name in _KEY_COLOURS for c in to_rgb(name)]
-    base = strip.quantize(colors=colours - len(_KEY_COLOURS), method=Image.Quantize.MEDIANCUT)
-    flat = base.getpalette()[: 3 * (colours - len(_KEY_COLOURS))] + keys
-    pal = Image.new("P", (1, 1))
-    pal.putpalette(flat + [0] * (768 - len(flat)))
-    return pal
+        strip.paste(im, (0, i * h))
+    strip.paste(Image.fromarray(np.ascontiguousarray(np.broadcast_to(keys[cols], (band, w, 3)))),
+                (0, h * len(images)))
+    q = strip.quantize(colors=colours, method=Image.Quantize.MEDIANCUT)
+    return [q.crop((0, i * h, w, (i + 1) * h)) for i in range(len(images))]
 
 
 def _rgb_image(fig):
@@ -501,8 +506,6 @@ def write_gif(path: str | os.PathLike, system, traj, name: str, *, triangles=Non
     Same two panels as the PNG, with fixed axes over the whole animation and the current time
     marked on the energy panel; one shared palette; frame times from :func:`gif_frame_times`.
     """
-    from PIL import Image
-
     from ..io.atomic import atomic_path
 
     picks = gif_frames(len(traj.times), max_frames)
@@ -512,8 +515,7 @@ def write_gif(path: str | os.PathLike, system, traj, name: str, *, triangles=Non
         fig = plot_frame(system, traj, int(k), triangles=triangles, name=name, view=view,
                          dpi=dpi, marker=True)
         images.append(_rgb_image(fig))
-    palette = _palette([images[i] for i in sorted({0, len(images) // 2, len(images) - 1})], 128)
-    frames = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+    frames = _quantize(images, 128)
     ms = [int(round(1000 * d)) for d in gif_frame_times(traj.times, picks)]
     with atomic_path(path) as tmp:
         frames[0].save(tmp, format="GIF", save_all=True, append_images=frames[1:], duration=ms,
