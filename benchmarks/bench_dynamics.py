@@ -1,4 +1,4 @@
-"""Dynamics benchmark (run by hand): ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_dynamics.py [--quick]``.
+"""Dynamics benchmark (run by hand): ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_dynamics.py [--quick] [--matrix-free]``.
 
 Scenes
 ------
@@ -26,6 +26,12 @@ preconditioned with a reused factor) and the reference figure with the ratio our
 Baraff-Witkin (BW) and Newton run twice: ``exact`` (a factorisation per linear solve) and
 ``reuse`` (an older factorisation preconditions PCG to the same tolerance ``rtol = 1e-10``,
 refactorised when PCG is slow).
+
+Matrix-free (issue 3, seed 001): Baraff-Witkin (clamp) on the 128 x 128 cloth at ``dt = 1/60``
+three ways, all to ``rtol = 1e-10``: assembled + direct, assembled + PCG (Jacobi), and
+``matrix_free=True`` + PCG (Jacobi, diagonal from the spring blocks): time per step, PCG
+iterations per step and the memory of the assembled free-dof matrix (``nnz * 12`` bytes of
+values and column indices + ``indptr``; the matrix-free path stores none).
 """
 
 from __future__ import annotations
@@ -46,9 +52,10 @@ from femkit.dynamics.topology import cloth_grid  # noqa: E402
 _SPLIT = ("time_permute", "time_factorization", "time_solve", "time_pcg")
 
 
-def _time_steps(system, name, dt, repeats, **opts) -> dict:
+def _time_steps(system, name, dt, repeats, *, solver="direct", preconditioner="none",
+                **opts) -> dict:
     """Median seconds per step after a warm-up, factorisations and the time split per step."""
-    ctx = StepContext(solver="direct")
+    ctx = StepContext(solver=solver, preconditioner=preconditioner)
     integ = get_integrator(name, **opts)
     s = integ.start(system, system.x0, system.v0, 0.0, dt, ctx)
     s = integ.step(system, s, dt, ctx)  # warm-up: one-time factorisation / ordering
@@ -66,7 +73,7 @@ def _time_steps(system, name, dt, repeats, **opts) -> dict:
     iters = ctx.stats.get("newton_iterations", [])[1:]
     return {"median": statistics.median(times), "factorizations": per["factorizations"],
             "pcg": per["linear_iterations"],
-            "split": split, "total": total, "newton": iters}
+            "split": split, "total": total, "newton": iters, "x": s.x}
 
 
 def _ref(ours: float, lo: float, hi: float) -> str:
@@ -75,6 +82,13 @@ def _ref(ours: float, lo: float, hi: float) -> str:
 
 def _fmt_time(sec: float) -> str:
     return f"{1e3 * sec:8.1f} ms" if sec < 10 else f"{sec:8.2f} s "
+
+
+def _big_mass(dt_explicit: float = 3.125e-4) -> float:
+    """Per-node mass of the 128 x 128 cloth with ``dt omega_max = 1.6`` at ``dt_explicit``."""
+    unit = cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4, k_bending=3e4,
+                      mass=1.0, pinned="top_corners", forces=[Gravity(9.81)])
+    return (unit.omega_max() * dt_explicit / 1.6) ** 2  # omega scales as 1/sqrt(m)
 
 
 def main(quick: bool = False) -> None:
@@ -92,9 +106,7 @@ def main(quick: bool = False) -> None:
                      "0.55-0.7 s (1 Newton step, LU)", _ref(r["median"], 0.55, 0.7)))
 
     dt_explicit = 3.125e-4
-    unit = cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4, k_bending=3e4,
-                      mass=1.0, pinned="top_corners", forces=[Gravity(9.81)])
-    mass = (unit.omega_max() * dt_explicit / 1.6) ** 2  # omega scales as 1/sqrt(m)
+    mass = _big_mass(dt_explicit)
     big = cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4, k_bending=3e4,
                      mass=mass, pinned="top_corners", forces=[Gravity(9.81)])
     r = _time_steps(big, "symplectic_euler", dt_explicit, 50 if quick else 300)
@@ -132,7 +144,42 @@ def main(quick: bool = False) -> None:
             method = f"{method} ({statistics.mean(r['newton']):.1f} it)"
         print(f"{scene:14s} {method:24s} {dt:>8s} {_fmt_time(r['median']):>11s} "
               f"{r['factorizations']:9.1f}  {split:44s} {ref:38s} {ratio}")
+    matrix_free_rows(big, quick)
+
+
+def matrix_free_rows(system, quick: bool = False) -> None:
+    """Baraff-Witkin (clamp, dt = 1/60): assembled direct / assembled PCG-Jacobi / matrix-free
+    PCG-Jacobi; time per step, PCG iterations per step, assembled-matrix memory."""
+    from femkit.dynamics.integrators.base import restrict
+
+    h = 1.0 / 60.0
+    reps = 2 if quick else 4
+    results = {}
+    for label, solver, pc, mf in (("assembled + direct", "direct", "none", False),
+                                  ("assembled + pcg (jacobi)", "pcg", "jacobi", False),
+                                  ("matrix-free + pcg (jacobi)", "pcg", "jacobi", True)):
+        results[label] = (solver, mf, _time_steps(system, "implicit_euler", h, reps, solver=solver,
+                                                  preconditioner=pc, fix="clamp", matrix_free=mf))
+    # the matrix of the last step (the planar start has exact zeros that later fill in)
+    x = results["assembled + direct"][2]["x"]
+    A = restrict(system.mass_matrix() + h * h * system.stiffness_matrix(x, fix="clamp"),
+                 system.free_dofs)
+    mem = A.nnz * 12 + A.indptr.nbytes
+    print(f"\nMatrix-free Baraff-Witkin (clamp), cloth 128x128, dt = 1/60, rtol = 1e-10; "
+          f"assembled free-dof matrix: n = {A.shape[0]}, nnz = {A.nnz}, {mem / 2**20:.1f} MiB")
+    head = f"{'variant':34s} {'time/step':>11s} {'pcg it/step':>11s} {'matrix memory':>14s}"
+    print(head)
+    print("-" * len(head))
+    for label, (solver, mf, r) in results.items():
+        memory = "none" if mf else f"{mem / 2**20:.1f} MiB"
+        it = f"{r['pcg']:.0f}" if solver != "direct" else "-"
+        print(f"{label:34s} {_fmt_time(r['median']):>11s} {it:>11s} {memory:>14s}")
 
 
 if __name__ == "__main__":
-    main(quick="--quick" in sys.argv)
+    if "--matrix-free" in sys.argv:  # only the matrix-free comparison
+        matrix_free_rows(cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4,
+                                    k_bending=3e4, mass=_big_mass(), pinned="top_corners",
+                                    forces=[Gravity(9.81)]), quick="--quick" in sys.argv)
+    else:
+        main(quick="--quick" in sys.argv)

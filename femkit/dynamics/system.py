@@ -412,17 +412,23 @@ class MassSpringSystem:
         x = self._state(x)
         _, l, u = self._geometry(x)
         a = _transverse_factor(l, self.rest, "clamp" if fix == "clamp" else None)
-        ka, kb = self.k * a, self.k * (1.0 - a)
+        # signs folded in: the scatter S puts +y on end i, K d needs -H (d_j - d_i) there
+        ka, kb = (-self.k * a)[:, None], -self.k * (1.0 - a)
         mu = self.regularization_shift(x) if fix == "regularize" else 0.0
         G, S = self.difference_operators if self.n_springs else (None, None)
         force_fix = "clamp" if fix == "clamp" else None
+        buf = np.empty_like(u)
 
         def product(d):
             dd = self._state(d, "d")
-            if self.n_springs:
+            if self.n_springs:  # in place: one (s, d) temporary besides G d
                 diff = G @ dd
-                y = ka[:, None] * diff + (kb * np.einsum("sd,sd->s", u, diff))[:, None] * u
-                out = S @ (-y)
+                ud = np.einsum("sd,sd->s", u, diff)
+                ud *= kb
+                diff *= ka
+                np.multiply(u, ud[:, None], out=buf)
+                diff += buf
+                out = S @ diff
             else:
                 out = np.zeros((self.n, self.dim))
             for f in self.forces:
