@@ -128,6 +128,16 @@ def prepare_scene(case: Case) -> None:
     from ..case.checks import check_solver_spec
 
     check_solver_spec(d["linear_solver"], "linear_solver", default_preconditioner="jacobi")
+    if integ["options"].get("matrix_free"):  # caught at load time, before anything runs
+        from .integrators import StepContext
+        from .integrators.base import check_matrix_free
+
+        ls = d["linear_solver"]
+        try:
+            check_matrix_free(integ["method"], StepContext(solver=ls["method"],
+                                                           preconditioner=ls.get("preconditioner") or "none"))
+        except InputError as exc:
+            raise CaseFileError(f"linear_solver: {exc}") from None
 
     # times
     dt = _time_value(case, "dt")

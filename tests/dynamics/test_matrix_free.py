@@ -200,4 +200,6 @@ def test_scene_matrix_free_with_direct_is_an_input_error(tmp_path, capsys):
     path = _scene(tmp_path, "bad", {"method": "implicit_euler", "options": {"matrix_free": True}},
                   {"method": "direct"})
     assert main(["solve", str(path), "-o", str(tmp_path / "bad"), "-q"]) == 2
-    assert MATRIX_FREE_MESSAGE in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert MATRIX_FREE_MESSAGE in err and err.startswith("femkit: error: linear_solver:")
+    assert not (tmp_path / "bad").exists()  # refused at load time: nothing written
