@@ -38,6 +38,11 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
+def _r2(r2) -> str:
+    """``R^2 0.9998``, or ``2 points, no R^2`` for a two-point fit (None / nan)."""
+    return "2 points, no R^2" if r2 is None or r2 != r2 else f"R^2 {r2:.4f}"
+
+
 def cli_main(args) -> int:
     """Run ``femkit study``; ``args`` is a namespace from :func:`add_parser` or a list of strings."""
     if not isinstance(args, argparse.Namespace):
@@ -60,12 +65,12 @@ def cli_main(args) -> int:
         from .report_poisson import grouped_rate_rows
 
         for who, rule, norm, slope, _, r2, *_ in grouped_rate_rows(result.fits):
-            print(f"  rate {who} / {rule} / {norm}: {slope:.3f} (R^2 {r2:.4f})")
+            print(f"  rate {who} / {rule} / {norm}: {slope:.3f} ({_r2(r2)})")
     else:
         for f in result.fits[:12]:
             what = " / ".join(str(f[k]) for k in ("solver", "integrator", "quadrature", "norm", "error") if k in f)
             extra = f", dt {max(f['dt_used']):.3g}..{min(f['dt_used']):.3g}" if f.get("dt_used") else ""
-            print(f"  rate {what}: {f['slope']:.3f} (R^2 {f['r2']:.4f}{extra})")
+            print(f"  rate {what}: {f['slope']:.3f} ({_r2(f['r2'])}{extra})")
     for line in result.notes:
         print(f"  note: {line}")
     print(f"report: {result.output_dir / 'report.html'}")

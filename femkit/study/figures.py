@@ -166,7 +166,8 @@ def loglog_figure(path, series: Sequence[dict], *, title: str, xlabel: str, ylab
         fit = s.get("fit")
         st = _style(i, s)
         if fit is not None:
-            label += f"  (rate {fit.slope:.2f}, R² {fit.r2:.3f})"
+            quality = "2 points" if not np.isfinite(fit.r2) else f"R² {fit.r2:.3f}"
+            label += f"  (rate {fit.slope:.2f}, {quality})"
         ax.plot(x[order], y[order], label=label, **st)
         if fit is not None:
             ax.plot(x[order], fit.predict(x[order]), color=st["color"], linestyle=":", linewidth=1.0)

@@ -34,7 +34,8 @@ class RateFit:
     intercept : float
         ``c`` in ``log y = p log x + c`` (natural logarithms).
     r2 : float
-        Coefficient of determination of the fit on the log-log scale (1 for a perfect line).
+        Coefficient of determination of the fit on the log-log scale (1 for a perfect line);
+        ``nan`` with only two points (any two points lie on a line: R² = 1 would say nothing).
     slope_stderr : float
         Standard error of the slope; ``nan`` with only two points (no degrees of freedom left).
     n : int
@@ -91,8 +92,8 @@ def fit_rate(x, y) -> RateFit:
     resid = ly - (slope * lx + intercept)
     ss_res = float(resid @ resid)
     ss_tot = float(np.sum((ly - ly.mean()) ** 2))
-    r2 = 1.0 - ss_res / ss_tot if ss_tot > 0 else 1.0
     n = int(x.size)
+    r2 = (1.0 - ss_res / ss_tot if ss_tot > 0 else 1.0) if n > 2 else float("nan")
     stderr = float(np.sqrt(ss_res / (n - 2) / sxx)) if n > 2 else float("nan")
     return RateFit(float(slope), float(intercept), float(r2), stderr, n)
 
@@ -142,6 +143,7 @@ def fit_asymptotic(x, y, *, tol: float = 0.05, min_r2: float = 0.999, min_points
     coarsest point is dropped until the fit over the rest has ``R^2 >= min_r2`` *and* every
     local slope inside the window lies within ``tol`` of the fitted slope (the line is straight
     there), keeping at least ``min_points`` points (fewer if fewer exist, but at least 2).
+    A fit over two points has no R² and is never called asymptotic (nothing tests the line).
 
     >>> h = 2.0 ** -np.arange(4, 11)
     >>> err = h * (1 + 16 * h)           # order 1 with a large O(h^2) term at coarse h
