@@ -107,8 +107,20 @@ def study_from_dict(data: Mapping, base_dir: str | os.PathLike = ".", *, name: s
     return study
 
 
+def _check_solver_names(solvers) -> None:
+    """Unknown solver or preconditioner names fail here, before any run (not as FAIL rows)."""
+    from ..solvers.registry import PRECONDITIONERS, SOLVERS
+
+    for s in solvers or ():
+        SOLVERS.get(s["method"])
+        if s.get("preconditioner") is not None:
+            PRECONDITIONERS.get(s["preconditioner"])
+
+
 def _check_kind(study: Study) -> None:
     d = study.data
+    if study.kind in ("poisson_convergence", "stability"):
+        _check_solver_names(d.get("solvers"))
     if study.kind == "poisson_convergence":
         if ("problem" in d) == ("base_case" in d):
             raise CaseFileError("poisson_convergence: give exactly one of 'problem' (inline) or 'base_case' (a case file)")

@@ -100,7 +100,7 @@ STRESS_CASE = _obj({
     "type": {"enum": ["poisson_contrast", "poisson_anisotropic", "poisson_scaled", "poisson_degenerate",
                       "poisson_fine", "poisson_neumann", "cg_residual_drift", "jacobi_divergence",
                       "dynamics_stiffness"]},
-    "values": {"type": "array", "minItems": 1,
+    "values": {"type": "array", "minItems": 1, "items": {"type": "number"},
                "description": "the swept parameter: contrast, aspect ratio, scale, degeneracy, ..."},
     "n": {"type": "integer", "minimum": 2},
     "dofs": POSINT,

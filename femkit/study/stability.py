@@ -364,6 +364,12 @@ def load_cases(study) -> list[dict]:
         data = fill_defaults(data, STRESS_CASE_SCHEMA)
         data.setdefault("values", _DEFAULT_VALUES[data["type"]])
         cases.append(data)
+    unknown = sorted(set(overrides) - {c["name"] for c in cases})
+    if unknown:  # a typo here would silently run that case at full size
+        from ..errors import CaseFileError
+
+        raise CaseFileError(f"case_overrides.{unknown[0]}: no such case; case names: "
+                            + ", ".join(c["name"] for c in cases))
     return cases
 
 
