@@ -16,6 +16,7 @@ silently running to ``maxiter``.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -42,6 +43,7 @@ class Problem:
     tolerance: float
     maxiter: int
     n: int
+    t_start: float = 0.0        # perf_counter() when validation began (for solve_time)
 
 
 def _matvec_of(A) -> Callable[[np.ndarray], np.ndarray]:
@@ -50,30 +52,103 @@ def _matvec_of(A) -> Callable[[np.ndarray], np.ndarray]:
     return A.__matmul__
 
 
+def real_array(x, *, name: str) -> np.ndarray:
+    """``x`` as a float64 array; complex or non-numeric data raise :class:`InputError`.
+
+    (A plain ``astype(float64)`` would drop imaginary parts with only a warning: a wrong answer.)
+    """
+    try:
+        arr = np.asarray(x)
+    except (TypeError, ValueError) as e:
+        raise InputError(f"{name} is not a numeric array: {e}") from None
+    if np.iscomplexobj(arr):
+        raise InputError(f"{name} is complex ({arr.dtype}); femkit's solvers are real (float64): "
+                         f"solve real and imaginary parts separately, or use a complex solver")
+    if arr.dtype.kind not in "biuf":
+        raise InputError(f"{name} must be a numeric array, got dtype {arr.dtype}")
+    return np.asarray(arr, dtype=np.float64)
+
+
+def _check_real_dtype(dtype, name: str) -> None:
+    dtype = np.dtype(dtype)
+    if dtype.kind == "c":
+        raise InputError(f"{name} is complex ({dtype}); femkit's solvers are real (float64)")
+    if dtype.kind not in "biuf":
+        raise InputError(f"{name} must be numeric, got dtype {dtype}")
+
+
+def _check_finite_entries(values: np.ndarray, name: str) -> None:
+    finite = np.isfinite(values)
+    if not finite.all():
+        raise InputError(f"{name} has {int(finite.size - np.count_nonzero(finite))} non-finite "
+                         f"entries (NaN or inf)")
+
+
 def as_operator(A, *, name: str = "A"):
     """Return ``A`` as CSR (sparse input), a 2-D float ndarray, or the LinearOperator itself.
 
-    Raises :class:`InputError` for anything else or a non-square shape.
+    Raises :class:`InputError` for anything else, a non-square shape, complex or
+    non-numeric entries, or non-finite entries of an explicit matrix.
     """
     if sp.issparse(A):
         if A.ndim != 2 or A.shape[0] != A.shape[1]:
             raise InputError(f"{name} must be square, got shape {A.shape}")
+        _check_real_dtype(A.dtype, name)
         A = A.tocsr()
         if A.dtype != np.float64:
             A = A.astype(np.float64)
+        _check_finite_entries(A.data, name)
         return A
     if isinstance(A, LinearOperator):
         if A.shape[0] != A.shape[1]:
             raise InputError(f"{name} must be square, got shape {A.shape}")
+        if A.dtype is not None and np.dtype(A.dtype).kind == "c":
+            raise InputError(f"{name} is a complex LinearOperator ({A.dtype}); femkit's solvers "
+                             f"are real (float64)")
         return A
     if isinstance(A, np.ndarray):
         if A.ndim != 2 or A.shape[0] != A.shape[1]:
             raise InputError(f"{name} must be a square matrix, got shape {A.shape}")
-        return np.asarray(A, dtype=np.float64)
+        A = real_array(A, name=name)
+        _check_finite_entries(A, name)
+        return A
     raise InputError(
         f"{name} must be a scipy.sparse matrix, a 2-D numpy array or a "
         f"scipy.sparse.linalg.LinearOperator, got {type(A).__name__}"
     )
+
+
+def explicit_csr(A, *, what: str) -> sp.csr_matrix:
+    """A validated sparse or dense matrix as float64 CSR; a LinearOperator raises
+    :class:`InputError` (``what`` needs the entries)."""
+    A = as_operator(A)
+    if isinstance(A, LinearOperator):
+        raise InputError(f"{what} needs an explicit matrix (sparse or dense), got a "
+                         f"{type(A).__name__}")
+    return sp.csr_matrix(A) if not sp.issparse(A) else A
+
+
+def check_options(fn: Callable, options: dict, *, what: str, exclude=()) -> None:
+    """Raise :class:`InputError` naming every key of ``options`` that ``fn`` does not take as a
+    keyword (so a misspelt option is an error, not a Python ``TypeError`` or silently ignored).
+    Functions with ``**kwargs`` are not checked here (they validate their own)."""
+    import inspect
+
+    params = inspect.signature(fn).parameters
+    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
+        return
+    valid = sorted(name for name, p in params.items()
+                   if p.kind in (inspect.Parameter.KEYWORD_ONLY,
+                                 inspect.Parameter.POSITIONAL_OR_KEYWORD)
+                   and p.default is not inspect.Parameter.empty and name not in exclude)
+    unknown_options(sorted(set(options) - set(valid)), valid, what=what)
+
+
+def unknown_options(bad, valid, *, what: str) -> None:
+    """Raise :class:`InputError` if ``bad`` (option names) is not empty."""
+    if bad:
+        raise InputError(f"unknown option(s) {', '.join(repr(k) for k in bad)} for {what}; "
+                         f"valid options: {', '.join(valid) if valid else 'none'}")
 
 
 def check_tolerances(rtol: float, atol: float) -> None:
@@ -125,7 +200,7 @@ def check_symmetric(A, *, method: str, tol: float = SYMMETRY_TOL) -> None:
 def diagonal_of(A, diagonal=None) -> np.ndarray:
     """The diagonal of ``A`` (``diagonal=`` is required for a LinearOperator)."""
     if diagonal is not None:
-        d = np.asarray(diagonal, dtype=np.float64).ravel()
+        d = real_array(diagonal, name="diagonal").ravel()
         if d.shape != (A.shape[0],):
             raise InputError(f"diagonal has shape {d.shape}, expected ({A.shape[0]},)")
         return d
@@ -149,10 +224,11 @@ def prepare(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter=Non
             method: str, symmetric: bool = False, check_symmetry: bool = True,
             default_maxiter_factor: int = 10) -> Problem:
     """Validate a system and return a :class:`Problem` (``x`` is a fresh float64 copy)."""
+    t_start = time.perf_counter()
     check_tolerances(rtol, atol)
     A = as_operator(A)
     n = A.shape[0]
-    b = np.asarray(b, dtype=np.float64)
+    b = real_array(b, name="b")
     if b.ndim == 2 and b.shape[1] == 1:
         b = b[:, 0]
     if b.shape != (n,):
@@ -163,7 +239,7 @@ def prepare(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter=Non
     if x0 is None:
         x = np.zeros(n)
     else:
-        x = np.array(x0, dtype=np.float64).ravel()
+        x = np.array(real_array(x0, name="x0"), dtype=np.float64, copy=True).ravel()
         if x.shape != (n,):
             raise InputError(f"x0 has shape {np.shape(x0)}, expected ({n},)")
         if not np.all(np.isfinite(x)):
@@ -180,7 +256,8 @@ def prepare(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter=Non
         check_symmetric(A, method=method)
     rhs_norm = float(np.linalg.norm(b))
     return Problem(A=A, matvec=_matvec_of(A), b=b, x=x, rhs_norm=rhs_norm,
-                   tolerance=max(float(rtol) * rhs_norm, float(atol)), maxiter=maxiter, n=n)
+                   tolerance=max(float(rtol) * rhs_norm, float(atol)), maxiter=maxiter, n=n,
+                   t_start=t_start)
 
 
 def as_apply(M, n: int) -> Callable[[np.ndarray], np.ndarray] | None:
@@ -238,16 +315,21 @@ def finish(prob: Problem, *, iterations: int, residuals, reason: str, message: s
         residuals=np.asarray(residuals, dtype=np.float64), reason=reason, message=message,
         true_residual=true_res, rhs_norm=prob.rhs_norm, tolerance=prob.tolerance,
         method=method, preconditioner=preconditioner, info=dict(info or {}),
+        solve_time=time.perf_counter() - prob.t_start,
     )
 
 
 def zero_rhs_result(prob: Problem, *, method: str) -> SolveResult:
-    """``b = 0``: the solution is ``x = 0`` exactly, converged after 0 iterations."""
+    """``b = 0``: the solution is ``x = 0`` exactly, converged after 0 iterations.
+
+    ``residuals[0]`` is still the initial residual ``||A x0||`` of the given ``x0``.
+    """
+    r0 = float(np.linalg.norm(prob.matvec(prob.x))) if np.any(prob.x) else 0.0
     prob.x = np.zeros(prob.n)
     return SolveResult(
-        x=prob.x, converged=True, iterations=0, residuals=np.zeros(1), reason="converged",
+        x=prob.x, converged=True, iterations=0, residuals=np.array([r0]), reason="converged",
         message="zero right-hand side: x = 0", true_residual=0.0, rhs_norm=0.0,
-        tolerance=prob.tolerance, method=method,
+        tolerance=prob.tolerance, method=method, solve_time=time.perf_counter() - prob.t_start,
     )
 
 

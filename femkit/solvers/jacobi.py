@@ -10,6 +10,7 @@ classical smoothing weight). A divergent iteration stops with ``reason="non-fini
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -46,7 +47,7 @@ def jacobi(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int
     >>> res.converged, bool(np.allclose(A @ res.x, 1.0))
     (True, True)
     """
-    if not (isinstance(omega, (int, float)) and 0.0 < omega < 2.0):
+    if isinstance(omega, bool) or not (isinstance(omega, numbers.Real) and 0.0 < omega < 2.0):
         raise InputError(f"jacobi: omega must be in (0, 2), got {omega!r}")
     prob = prepare(A, b, x0, rtol=rtol, atol=atol, maxiter=maxiter, method="jacobi")
     apply_M = as_apply(M, prob.n)

@@ -53,6 +53,11 @@ def _krylov_loop(prob: Problem, apply_M: Callable | None, *, method: str, callba
         z, rz = r, rr
     else:
         z = apply_M(r)
+        if np.shape(z) != r.shape:
+            from ..errors import InputError
+
+            raise InputError(f"the preconditioner returned shape {np.shape(z)} for a residual of "
+                             f"shape {r.shape}; M(r) must return an array of r's shape")
         rz = float(np.dot(r, z))
     reason, message = "maxiter", ""
     if not rz > 0:

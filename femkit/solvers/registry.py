@@ -14,6 +14,7 @@ from typing import Callable
 from ..errors import InputError
 from ..registry import Registry
 from .cg import cg
+from .checks import check_options
 from .direct import direct
 from .jacobi import jacobi
 from .pcg import pcg
@@ -103,6 +104,8 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     fn = SOLVERS.get(method)
     if "M" in options:
         raise InputError("solve() takes the preconditioner by name (preconditioner=...), not M=")
+    check_options(fn, options, what=f"method {method!r}",
+                  exclude=("rtol", "atol", "maxiter", "M", "callback"))
     pc_name = "none"
     M = None
     setup = 0.0
@@ -121,6 +124,8 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
                 f"{method!r} (use method='pcg', or preconditioner=None)")
         if preconditioner_options and preconditioner == "none":
             raise InputError("preconditioner_options given but no preconditioner is used")
+        check_options(factory, preconditioner_options or {},
+                      what=f"preconditioner {preconditioner!r}")
         t0 = time.perf_counter()
         M = factory(A, **(preconditioner_options or {}))
         setup = time.perf_counter() - t0

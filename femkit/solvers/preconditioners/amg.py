@@ -14,9 +14,8 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import scipy.sparse as sp
 
-from ...errors import InputError
+from ..checks import explicit_csr, unknown_options
 from .base import Preconditioner
 
 
@@ -71,20 +70,26 @@ def _wrap(name: str, ml, cycle: str, t0: float) -> Preconditioner:
     return Preconditioner(name, apply, ml.levels[0].A.shape[0], dt, info)
 
 
+def _check_opts(solver, opts: dict, name: str) -> None:
+    """Unknown keyword -> :class:`InputError` naming it (pyamg would raise a ``TypeError`` from
+    deep inside, or pass it on to ``MultilevelSolver``)."""
+    import inspect
+
+    params = inspect.signature(solver).parameters
+    valid = sorted({k for k, p in params.items() if k != "A"
+                    and p.kind is not inspect.Parameter.VAR_KEYWORD} | {"coarse_solver", "cycle"})
+    unknown_options(sorted(set(opts) - set(valid)), valid, what=f"preconditioner {name!r}")
+
+
 def _csr(A):
-    if not sp.issparse(A):
-        raise InputError("AMG preconditioners need an explicit sparse matrix, "
-                         f"got {type(A).__name__}")
-    A = sp.csr_matrix(A, dtype=np.float64)
-    if A.shape[0] != A.shape[1]:
-        raise InputError(f"A must be square, got shape {A.shape}")
-    return A
+    return explicit_csr(A, what="AMG preconditioners")
 
 
 def build_sa(A, *, cycle: str = "V", **opts) -> Preconditioner:
     """Smoothed-aggregation AMG (``pyamg.smoothed_aggregation_solver(A, **opts)``), one cycle."""
     import pyamg
 
+    _check_opts(pyamg.smoothed_aggregation_solver, opts, "amg_sa")
     t0 = time.perf_counter()
     ml = pyamg.smoothed_aggregation_solver(_csr(A), **opts)
     return _wrap("amg_sa", ml, cycle, t0)
@@ -94,6 +99,7 @@ def build_rs(A, *, cycle: str = "V", **opts) -> Preconditioner:
     """Ruge-Stueben AMG (``pyamg.ruge_stuben_solver(A, **opts)``), one cycle."""
     import pyamg
 
+    _check_opts(pyamg.ruge_stuben_solver, opts, "amg_rs")
     t0 = time.perf_counter()
     ml = pyamg.ruge_stuben_solver(_csr(A), **opts)
     return _wrap("amg_rs", ml, cycle, t0)

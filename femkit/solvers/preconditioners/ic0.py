@@ -21,7 +21,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...errors import InputError, NotSPDError
-from ..checks import check_positive_diagonal, check_symmetric
+from ..checks import check_positive_diagonal, check_symmetric, explicit_csr
 from .base import Preconditioner
 
 
@@ -29,11 +29,13 @@ def lower_factor(A, *, shift: float = 0.0, max_shift_tries: int = 8):
     """Return ``(L, shift_used, tries)`` with ``L`` the CSR IC(0) factor of symmetric ``A``."""
     from ._ic0_kernels import ic0_factor
 
-    if not sp.issparse(A):
-        raise InputError(f"ic0 needs an explicit sparse matrix, got {type(A).__name__}")
-    A = sp.csr_matrix(A, dtype=np.float64)
-    if A.shape[0] != A.shape[1]:
-        raise InputError(f"A must be square, got shape {A.shape}")
+    try:
+        shift_ok = bool(np.isfinite(shift) and shift >= 0)
+    except TypeError:
+        shift_ok = False
+    if not shift_ok:
+        raise InputError(f"ic0: shift must be a finite number >= 0, got {shift!r}")
+    A = explicit_csr(A, what="the ic0 preconditioner")
     check_symmetric(A, method="the ic0 preconditioner")
     d = A.diagonal()
     check_positive_diagonal(d, what="the ic0 preconditioner")
