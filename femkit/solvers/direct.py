@@ -1,10 +1,14 @@
 """Direct sparse solve with SciPy's SuperLU, and a reusable factorisation.
 
 For a symmetric matrix with a positive diagonal (the SPD systems femkit assembles) the
-factorisation uses ``permc_spec="MMD_AT_PLUS_A"``, ``diag_pivot_thresh=0`` and
-``SymmetricMode`` (a symmetric ordering with diagonal pivots, about 2x faster than the
-COLAMD default on 2D Poisson per REFERENCE.md); otherwise SuperLU's defaults (COLAMD,
-partial pivoting).
+factorisation uses ``permc_spec="MMD_AT_PLUS_A"``, ``SymmetricMode`` and threshold
+pivoting with ``diag_pivot_thresh=`` :data:`DIAG_PIVOT_THRESH` (a symmetric ordering with
+diagonal pivots, about 2x faster than the COLAMD default on 2D Poisson per REFERENCE.md);
+otherwise SuperLU's defaults (COLAMD, partial pivoting). The threshold matters: a symmetric
+matrix with a positive diagonal need not be positive definite, and pure diagonal pivoting
+(threshold 0) then takes tiny pivots (``[[e, 1], [1, e]]``, cond 1, lost ``1/e`` of accuracy);
+with the threshold SuperLU swaps such a pivot out, while on SPD/M-matrices the diagonal
+always passes it (same fill, same time).
 
 Time-stepping code factors once and reuses the factor::
 
@@ -22,8 +26,12 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
 from ..errors import InputError, SingularSystemError
-from .checks import SYMMETRY_TOL, asymmetry, finish, prepare, zero_rhs_result
+from .checks import SYMMETRY_TOL, as_operator, asymmetry, finish, prepare, zero_rhs_result
 from .result import SolveResult
+
+#: SuperLU ``diag_pivot_thresh`` in symmetric mode: the diagonal is the pivot unless it is below
+#: this fraction of the largest entry of its column.
+DIAG_PIVOT_THRESH = 1e-3
 
 
 class Factor:
@@ -71,8 +79,9 @@ def factorize(A, *, spd: bool | None = None, permc_spec: str | None = None) -> F
     ----------
     A : sparse matrix or ndarray, shape (n, n)
     spd : bool, optional
-        Use the symmetric ordering and diagonal pivoting. ``None`` (default) decides
-        automatically: symmetric to 1e-10 and a positive diagonal.
+        Use the symmetric ordering and diagonal pivoting (threshold
+        :data:`DIAG_PIVOT_THRESH`). ``None`` (default) decides automatically: symmetric to
+        1e-10 and a positive diagonal.
     permc_spec : str, optional
         SuperLU column ordering overriding the default (``"MMD_AT_PLUS_A"`` for SPD,
         ``"COLAMD"`` otherwise); ``"NATURAL"`` for a matrix the caller has already permuted
@@ -94,13 +103,7 @@ def factorize(A, *, spd: bool | None = None, permc_spec: str | None = None) -> F
 
     if isinstance(A, LinearOperator):
         raise InputError("the direct solver needs an explicit matrix, not a LinearOperator")
-    if not sp.issparse(A):
-        A = np.asarray(A, dtype=np.float64)
-        if A.ndim != 2:
-            raise InputError(f"A must be a square matrix, got shape {A.shape}")
-    if A.shape[0] != A.shape[1]:
-        raise InputError(f"A must be square, got shape {A.shape}")
-    Ac = sp.csc_matrix(A, dtype=np.float64)
+    Ac = sp.csc_matrix(as_operator(A))
     Ac.sum_duplicates()
     if not np.all(np.isfinite(Ac.data)):
         raise InputError("A has non-finite entries")
@@ -110,7 +113,7 @@ def factorize(A, *, spd: bool | None = None, permc_spec: str | None = None) -> F
     try:
         if spd:
             permc = permc_spec or "MMD_AT_PLUS_A"
-            lu = splu(Ac, permc_spec=permc, diag_pivot_thresh=0.0,
+            lu = splu(Ac, permc_spec=permc, diag_pivot_thresh=DIAG_PIVOT_THRESH,
                       options=dict(SymmetricMode=True))
         else:
             permc = permc_spec or "COLAMD"
