@@ -10,8 +10,24 @@ decreases ``g`` monotonically. ``f_ext`` is every declared force except the Hook
 forces flagged constant (gravity, :meth:`~femkit.dynamics.system.MassSpringSystem.constant_force`)
 are evaluated once per step; dashpots and the other forces
 (:meth:`~femkit.dynamics.system.MassSpringSystem.variable_force`) are evaluated per iteration,
-with velocity ``(x - x_n) / h`` (explicitly). Without such forces an iteration costs two sparse
+with velocity ``(x - x_n) / h``. Without such forces an iteration costs two sparse
 products over the springs and one triangular-solve pass.
+
+Damping is split, not lagged: a constant ``n x n`` matrix ``B`` (viscous coefficients and
+Rayleigh ``alpha m`` on the diagonal, the dashpot coefficients' Laplacian
+``sum_s c_s A_s A_s^T`` and Rayleigh's ``beta L``) joins the factorised matrix, and the global
+step solves ``(M + h^2 L + h B) x = M y + h^2 (J d + f_ext + f_var(x_k)) + h B x_k``. At a fixed
+point the ``h B`` terms cancel, so the converged step is still implicit Euler with the true
+(position-dependent) damping; but the iteration no longer amplifies the damping force: the
+remainder ``h (B - C(x))`` is zero for viscous and Rayleigh-mass damping and between 0 and
+``h B`` for dashpots (``c (I - u u^T)``) and stretched springs' Rayleigh-stiffness part. (Treating
+the damping explicitly inside the iteration diverged once ``h c / m > 1``.)
+
+Penalty contact stays explicit inside the iteration (its stiffness changes with the active
+set, the matrix is factorised once); the iteration then diverges at a penetrating node when
+``h^2 k_c > m_i + h^2 L_ii``. :meth:`FastMassSpring.start` warns
+(:class:`~femkit.errors.StabilityWarning`) when a declared contact is that stiff: use
+``newton`` or ``implicit_euler`` there.
 
 Implementation
 --------------
@@ -25,9 +41,9 @@ spring differences ``x_j - x_i``) and ``G^T diag(k r)``, so ``J d = G^T diag(k r
 (lengths floored at ``system.length_floor``).
 
 Cache: the matrix depends only on ``dt``, masses, stiffnesses, rest lengths (in ``J``),
-topology and the pinned set, so the factor and the spring operators are built once and kept in
+damping coefficients, topology and the pinned set, so the factor and the spring operators are built once and kept in
 ``ctx.cache["fast_mass_spring"]``. The cache key is ``dt`` and the *identity* of the system and
-of its ``mass``, ``k``, ``rest``, ``springs``, ``pinned`` and ``forces`` attributes (the cache
+of its ``mass``, ``k``, ``rest``, ``damping``, ``springs``, ``pinned`` and ``forces`` attributes (the cache
 holds references, so identities cannot be recycled): assigning a new array invalidates it,
 modifying one of those arrays in place does not (clear ``ctx.cache`` then). No array is hashed
 per step. ``ctx.stats["factorizations"]`` counts factorisations.
@@ -48,7 +64,7 @@ from .base import (Integrator, StepContext, StepperState, box_length, check_iter
                    factorize_linear, restrict)
 from .registry import INTEGRATORS
 
-_KEY_ATTRS = ("mass", "k", "rest", "springs", "pinned", "forces")
+_KEY_ATTRS = ("mass", "k", "rest", "damping", "springs", "pinned", "forces")
 
 
 def _cache_key(system, dt: float) -> tuple:
@@ -57,6 +73,38 @@ def _cache_key(system, dt: float) -> tuple:
 
 def _same_key(a: tuple, b: tuple) -> bool:
     return a[0] == b[0] and len(a) == len(b) and all(p is q for p, q in zip(a[1:], b[1:]))
+
+
+def damping_split(system, L=None):
+    """The constant ``n x n`` damping matrix ``B`` of the split (module docstring), or ``None``
+    when nothing damps: per-node viscous coefficients (largest diagonal entry of each node's
+    block of the declared forces' ``D``) and Rayleigh ``alpha m`` on the diagonal, plus the
+    Laplacian of the dashpot coefficients and ``beta`` times the spring Laplacian ``L``."""
+    import scipy.sparse as sp
+
+    from ..jacobian import SpringPattern
+
+    n, d = system.n, system.dim
+    alpha, beta = system.rayleigh
+    diag = alpha * np.asarray(system.mass, dtype=float)
+    for f in system.forces:
+        D = None if f.constant else f.damping(system.x0)
+        if D is not None:
+            diag = diag + np.abs(D.diagonal()).reshape(n, d).max(axis=1)
+    parts = []
+    if np.any(diag > 0.0):
+        parts.append(sp.diags(diag))
+    if system.n_springs and np.any(np.asarray(system.damping) > 0.0):
+        pat = SpringPattern(n, 1, system.springs[:, 0], system.springs[:, 1])
+        parts.append(pat.assemble(np.asarray(system.damping, dtype=float).reshape(-1, 1, 1)))
+    if beta > 0.0 and system.n_springs:
+        parts.append(beta * (system.spring_laplacian() if L is None else L))
+    if not parts:
+        return None
+    B = parts[0]
+    for P in parts[1:]:
+        B = B + P
+    return B.tocsr()
 
 
 @dataclass
@@ -73,6 +121,7 @@ class _Operators:
     A_fp: object                # nf x np block of M + h^2 L
     f_const: np.ndarray         # (nf, d) constant forces on the free nodes
     floor: float
+    B_free: object = None       # nf x n rows of the damping split h B (None: no damping)
 
 
 @INTEGRATORS.register("fast_mass_spring")
@@ -89,6 +138,29 @@ class FastMassSpring(Integrator):
     def __post_init__(self):
         check_iteration_options(self.name, self.iterations, self.tol, option="iterations")
 
+    def start(self, system, x, v, t: float, dt: float, ctx: StepContext) -> StepperState:
+        """The usual start, plus a :class:`~femkit.errors.StabilityWarning` when a declared
+        penalty contact is too stiff for the local/global iteration (module docstring)."""
+        state = super().start(system, x, v, t, dt, ctx)
+        kc = max((float(f.stiffness_value) for f in system.forces
+                  if getattr(f, "kind", None) == "contact"), default=0.0)
+        if kc > 0.0 and np.any(~system.pinned):
+            free = ~system.pinned
+            lap = system.spring_laplacian().diagonal()
+            ratio = float(np.max(dt * dt * kc / (system.mass[free] + dt * dt * lap[free])))
+            if ratio > 1.0:
+                import warnings
+
+                from ...errors import StabilityWarning
+
+                warnings.warn(StabilityWarning(
+                    f"fast_mass_spring: penalty contact stiffness {kc:.4g} is explicit inside the "
+                    f"local/global iteration and too stiff for dt = {dt:.4g}: "
+                    f"h^2 k_c / (m + h^2 L_ii) = {ratio:.3g} > 1, so the iteration diverges once "
+                    "a particle penetrates; use newton or implicit_euler (or a smaller dt)"),
+                    stacklevel=2)
+        return state
+
     def _operators(self, system, dt: float, ctx: StepContext) -> _Operators:
         key = _cache_key(system, dt)
         cached = ctx.cache.get("fast_mass_spring")
@@ -99,7 +171,12 @@ class FastMassSpring(Integrator):
         free = np.flatnonzero(~system.pinned)
         pinned = np.flatnonzero(system.pinned)
         mass = np.asarray(system.mass, dtype=float)
-        A = (sp.diags(mass) + (dt * dt) * system.spring_laplacian()).tocsr()
+        L = system.spring_laplacian()
+        A = sp.diags(mass) + (dt * dt) * L
+        B = damping_split(system, L)
+        if B is not None:
+            A = A + dt * B
+        A = A.tocsr()
         G = system.difference_operators[0]
         G_free = G[:, free].tocsr()
         ops = _Operators(
@@ -113,6 +190,7 @@ class FastMassSpring(Integrator):
             A_fp=A[free][:, pinned].tocsr(),
             f_const=system.constant_force()[free],
             floor=float(system.length_floor),
+            B_free=None if B is None else (dt * B.tocsr()[free]).tocsr(),
         )
         ctx.cache["fast_mass_spring"] = (key, ops)
         return ops
@@ -147,6 +225,9 @@ class FastMassSpring(Integrator):
                 x[free] = x_free
                 rhs += system.variable_force(x, (x - xn) / h, t_new)[free]
             rhs *= h * h
+            if ops.B_free is not None:
+                x[free] = x_free
+                rhs += ops.B_free @ x            # h B x_k (the damping split)
             rhs += const
             x_new = ops.factor.solve(np.asfortranarray(rhs))
             if self.tol is not None:
