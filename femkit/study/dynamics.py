@@ -93,7 +93,7 @@ def run_dynamics_study(study, *, progress_enabled=None) -> dict:
                             "(errors are compared at common times)")
     n_common = int(round(t_end / dt_big))
     t_common = np.arange(n_common + 1) * dt_big
-    notes = []
+    notes, tables, ref_error = [], {}, 0.0
     ref = d.get("reference") or {}
     if exact is not None and ref.get("analytic", True):
         ref_x = exact(t_common)
@@ -102,11 +102,14 @@ def run_dynamics_study(study, *, progress_enabled=None) -> dict:
     else:
         rname = ref.get("integrator", "rk4")
         rdt = ref.get("dt", min(dts) / 16)
-        every = int(round(dt_big / rdt))
-        rtraj = _simulate(system, rname, {}, dt_big / every, t_end, x0, v0, every, np.inf)
+        every = max(1, int(round(dt_big / rdt)))
+        rtraj, ref_error = _reference_run(system, rname, dt_big, every, t_end, x0, v0)
         ref_x = rtraj.x
         notes.append(f"Reference: a {rname} run at dt = {dt_big / every:.3g} ({every} steps per largest dt; "
-                     f"{rtraj.steps} steps, {rtraj.wall_time:.2f} s).")
+                     f"{rtraj.steps} steps, {rtraj.wall_time:.2f} s); its own error estimate {ref_error:.3g} "
+                     f"(max over the trajectory; Richardson against the same method at twice that dt).")
+        tables["reference"] = [{"integrator": rname, "dt": dt_big / every, "steps": rtraj.steps,
+                                "wall_time": rtraj.wall_time, "error_estimate": ref_error}]
     free = ~system.pinned
     records, energy_series = [], {}
     integrators = [integrator_spec(i) for i in d["integrators"]]
@@ -147,7 +150,8 @@ def run_dynamics_study(study, *, progress_enabled=None) -> dict:
     scale = float(np.abs(ref_x[:, free] - ref_x[0, free]).max()) or 1.0
     for name, opts, label in integrators:
         rows = [r for r in records if r["integrator"] == label and r["stable"] and r["error_end"]]
-        pts = [(r["dt"], r["error_max"]) for r in rows if r["error_max"] > 1e-11 * scale]
+        # ... and runs within 10x of the reference's own error (the reference limits them, not dt)
+        pts = [(r["dt"], r["error_max"]) for r in rows if r["error_max"] > max(1e-11 * scale, 10 * ref_error)]
         if len(pts) >= 2:
             a = fit_asymptotic(*np.array(pts).T)
             fits.append({"integrator": label, "error": "max over trajectory",
@@ -155,4 +159,40 @@ def run_dynamics_study(study, *, progress_enabled=None) -> dict:
                          "dt_used": a.used.tolist(), "dt_dropped": a.dropped.tolist(),
                          "local_slopes": a.local_slopes.tolist(), "asymptotic": a.asymptotic,
                          "unstable_dt": [r["dt"] for r in records if r["integrator"] == label and not r["stable"]]})
-    return {"records": records, "fits": fits, "notes": notes, "energy": energy_series, "dts": dts}
+    limited = [r for r in records if r["stable"] and r["error_max"] is not None and r["error_max"] <= 10 * ref_error]
+    if limited:
+        notes.append(f"The reference is not converged enough for {len(limited)} run(s): their errors lie within 10x "
+                     f"of its own error estimate ({ref_error:.3g}), so they measure the reference and are left out "
+                     f"of the fitted orders; give reference.dt smaller.")
+    return {"records": records, "fits": fits, "notes": notes, "energy": energy_series, "dts": dts, "tables": tables}
+
+
+def _reference_run(system, name, dt_big, every, t_end, x0, v0):
+    """The reference trajectory at ``dt_big / every`` and its own error (max over the common times).
+
+    The error is estimated by Richardson extrapolation against the same method at twice the step
+    (``||x_h - x_2h|| / (2^p - 1)``; when ``every`` is odd, against half the step instead,
+    ``||x_h - x_h/2|| 2^p / (2^p - 1)``). A reference that blows up is an input error.
+    """
+    from ..dynamics.integrators import get_integrator
+    from ..errors import CaseFileError
+
+    p = get_integrator(name).order
+    free = ~system.pinned
+    try:
+        rtraj = _simulate(system, name, {}, dt_big / every, t_end, x0, v0, every, np.inf)
+        if every % 2 == 0:
+            other = _simulate(system, name, {}, 2 * dt_big / every, t_end, x0, v0, every // 2, np.inf)
+            factor = 1.0 / (2**p - 1)
+        else:
+            other = _simulate(system, name, {}, dt_big / every / 2, t_end, x0, v0, 2 * every, np.inf)
+            factor = 2**p / (2**p - 1)
+    except InstabilityError as exc:
+        raise CaseFileError(f"reference: the {name} reference run at dt = {dt_big / every:.3g} is unstable "
+                            f"({exc.reason or 'energy grew'}); give a smaller reference.dt") from None
+    diff = (other.x - rtraj.x)[:, free]
+    err = float(np.sqrt(np.sum(diff.reshape(len(diff), -1) ** 2, axis=1)).max()) * factor
+    if not np.isfinite(err):
+        raise CaseFileError(f"reference: the {name} reference run at dt = {dt_big / every:.3g} is not finite; "
+                            "give a smaller reference.dt")
+    return rtraj, err
