@@ -283,8 +283,9 @@ def stability_map_figure(path, rows: Sequence[dict], *, title: str) -> str:
     ax.set_xscale("log")
     from matplotlib.ticker import FixedLocator, FormatStrFormatter, NullLocator
 
-    ticks = [t for t in (0.25, 0.5, 1.0, 2.0, 2.83, 4.0, 8.0, 16.0)
-             if len(hw) and hw.min() / 1.5 <= t <= hw.max() * 1.5]
+    span = np.concatenate([hw[np.isfinite(hw) & (hw > 0)], list(bounds.values())])  # the limits get labels too
+    ticks = [t for t in (0.01, 0.03, 0.1, 0.25, 0.5, 1.0, 2.0, 2.83, 4.0, 8.0, 16.0)
+             if span.size and span.min() / 1.5 <= t <= span.max() * 1.5]
     if ticks:
         ax.xaxis.set_major_locator(FixedLocator(ticks))
         ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))

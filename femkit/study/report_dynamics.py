@@ -121,16 +121,23 @@ def build_dynamics_report(report, study, result, data, stage) -> None:
         from ..dynamics.integrators import get_integrator
         from .dynamics import integrator_spec
 
-        bounds = {}
+        from .stability import NEVER_STABLE
+
+        bounds, never = {}, []
         for item in study.data["integrators"]:
             name, opts, lab = integrator_spec(item)
-            bounds[lab] = get_integrator(name, **opts).stability_bound
+            # the scenes are undamped: methods whose region misses the imaginary axis have no limit
+            bounds[lab] = None if name in NEVER_STABLE else get_integrator(name, **opts).stability_bound
+            if name in NEVER_STABLE:
+                never.append(lab)
         for r in rows:
             r["bound"] = bounds.get(r["method"])
         F.stability_map_figure(stage / "figures" / "stability.png", rows,
                                title="Which runs survived")
         report.figure("figures/stability.png", "Survived (o) and unstable (x) runs against dt * omega_max; "
-                      "black bars: the method's theoretical limit")
+                      "black bars: the method's theoretical limit"
+                      + (f" ({', '.join(never)}: none, unstable at every dt on an undamped scene; "
+                         "the energy grows slowly at small dt)" if never else ""))
 
     report.heading("Runs")
     cols = ["integrator", "dt", "steps", "stable", "error_end", "error_max", "energy_drift", "energy_drift_max",

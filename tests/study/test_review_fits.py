@@ -44,3 +44,22 @@ def test_two_level_poisson_rate_table_shows_no_r2(tmp_path):
     table = (tmp_path / "r" / "report.md").read_text().split("## Fitted convergence rates")[1].split("##")[0]
     row = [ln for ln in table.splitlines() if ln.startswith("| direct | barycentric | L2")][0]
     assert row.split("|")[6].strip() == "-"  # R² column
+
+
+def test_dynamics_stability_map_draws_no_limit_for_never_stable_methods(tmp_path, monkeypatch):
+    """Explicit Euler / Heun / midpoint got a 'theoretical limit' bar at 2 on an undamped scene."""
+    from femkit.study import figures
+
+    seen = {}
+    real = figures.stability_map_figure
+
+    def spy(path, rows, **kw):
+        seen.update({r["method"]: r["bound"] for r in rows})
+        return real(path, rows, **kw)
+
+    monkeypatch.setattr(figures, "stability_map_figure", spy)
+    data = {"kind": "dynamics_work_precision", "warmup": 0, "scene": {"type": "harmonic_oscillator", "t_end": 1},
+            "integrators": ["explicit_euler", "heun", "velocity_verlet", "rk4"], "dt": {"k_min": 5, "k_max": 6}}
+    run_study(study_from_dict(data), tmp_path / "r")
+    assert seen["explicit_euler"] is None and seen["heun"] is None
+    assert seen["velocity_verlet"] == 2.0 and seen["rk4"] == pytest.approx(2 * np.sqrt(2))
