@@ -333,6 +333,15 @@ def zero_rhs_result(prob: Problem, *, method: str) -> SolveResult:
     )
 
 
+def nonfinite_initial_residual(res: float) -> str:
+    """Message for a non-finite initial residual ``||b - A x0||`` (``b`` and ``x0`` are checked
+    finite, so the product ``A x0`` is at fault); empty string when ``res`` is finite."""
+    if np.isfinite(res):
+        return ""
+    return (f"the initial residual ||b - A x0|| is {res}: the product A x0 is not finite "
+            f"(b and x0 are finite; check the operator); no iteration was run")
+
+
 def record_iteration(residuals: list, res: float, x: np.ndarray, callback, k: int) -> str:
     """Append ``res`` to the history and call ``callback(x)``; return a non-finite message
     (empty string when ``res`` is finite)."""

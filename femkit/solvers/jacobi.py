@@ -15,7 +15,8 @@ import numbers
 import numpy as np
 
 from ..errors import InputError
-from .checks import as_apply, check_positive_diagonal, diagonal_of, finish, prepare, zero_rhs_result
+from .checks import (as_apply, check_positive_diagonal, diagonal_of, finish,
+                     nonfinite_initial_residual, prepare, zero_rhs_result)
 from .result import SolveResult
 
 
@@ -67,8 +68,10 @@ def jacobi(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int
     r = b - matvec(x)
     res = float(np.linalg.norm(r))
     residuals = [res]
-    reason, message, k = "maxiter", "", 0
-    if res <= tol:
+    reason, message, k = "maxiter", nonfinite_initial_residual(res), 0
+    if message:
+        reason = "non-finite"
+    elif res <= tol:
         reason = "converged"
     while reason == "maxiter" and k < prob.maxiter:
         step = apply_M(r)

@@ -21,7 +21,8 @@ from typing import Callable
 import numpy as np
 from scipy.linalg.blas import daxpy
 
-from .checks import Problem, as_apply, finish, prepare, record_iteration, zero_rhs_result
+from .checks import (Problem, as_apply, finish, nonfinite_initial_residual, prepare,
+                     record_iteration, zero_rhs_result)
 from .result import SolveResult
 
 #: Smallest stagnation window: iterations without a new best residual after which the iteration
@@ -49,6 +50,10 @@ def _krylov_loop(prob: Problem, apply_M: Callable | None, *, method: str, callba
     if res <= tol:
         return finish(prob, iterations=0, residuals=residuals, reason="converged",
                       method=method, recursive_met=True)
+    bad = nonfinite_initial_residual(res)
+    if bad:
+        return finish(prob, iterations=0, residuals=residuals, reason="non-finite",
+                      message=bad, method=method)
     if apply_M is None:
         z, rz = r, rr
     else:

@@ -12,7 +12,8 @@ import math
 import numpy as np
 from scipy.linalg.blas import daxpy
 
-from .checks import as_apply, finish, prepare, record_iteration, zero_rhs_result
+from .checks import (as_apply, finish, nonfinite_initial_residual, prepare, record_iteration,
+                     zero_rhs_result)
 from .result import SolveResult
 
 
@@ -42,16 +43,19 @@ def steepest_descent(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0,
     r = prob.b - matvec(x)
     res = float(np.linalg.norm(r))
     residuals = [res]
-    reason, message, k, met = "maxiter", "", 0, res <= tol
-    if met:
+    reason, message, k, met = "maxiter", nonfinite_initial_residual(res), 0, res <= tol
+    if message:
+        reason = "non-finite"
+    elif met:
         reason = "converged"
-    while not met and k < prob.maxiter:
+    while reason == "maxiter" and k < prob.maxiter:
         z = r if apply_M is None else apply_M(r)
         q = matvec(z)
         zq = float(np.dot(z, q))
         if not zq > 0:
             reason = "breakdown" if math.isfinite(zq) else "non-finite"
-            message = f"indefinite direction: z^T A z = {zq:.3e} at iteration {k + 1}"
+            message = (f"indefinite direction: z^T A z = {zq:.3e} at iteration {k + 1}"
+                       if reason == "breakdown" else f"z^T A z = {zq} at iteration {k + 1}")
             break
         alpha = float(np.dot(r, z)) / zq
         daxpy(z, x, a=alpha)
