@@ -298,3 +298,55 @@ def stability_map_figure(path, rows: Sequence[dict], *, title: str) -> str:
     if rows:
         ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3)
     return _save(fig, path)
+
+
+def panels_figure(path, panels: Sequence[dict], *, title: str, ylabel: str) -> str:
+    """One log-log panel per stress case (its own parameter on its own x axis), methods styled alike.
+
+    ``panels``: dicts with ``title``, ``xlabel`` and ``series`` (dicts with ``label`` = method,
+    ``x``, ``y`` and optional ``ok``: a bool per point; failed points are drawn as open red-rimmed
+    markers). Each method keeps one colour and marker in every panel; one legend for all.
+    """
+    book = StyleBook()
+    ncol = min(3, max(1, len(panels)))
+    nrow = -(-len(panels) // ncol)
+    fig = _figure(3.6 * ncol + 1.8, 3.0 * nrow + 0.6)
+    axes = fig.subplots(nrow, ncol, squeeze=False).ravel()
+    handles: dict = {}
+    any_failed = False
+    for ax, p in zip(axes, panels):
+        for s in p["series"]:
+            x, y = np.asarray(s["x"], dtype=float), np.asarray(s["y"], dtype=float)
+            ok = np.asarray(s.get("ok", [True] * x.size), dtype=bool)
+            keep = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
+            if not keep.any():
+                continue
+            st = book(s["label"])
+            order = np.argsort(x[keep])
+            (line,) = ax.plot(x[keep][order], y[keep][order], **st)
+            handles.setdefault(s["label"], line)
+            bad = keep & ~ok
+            if bad.any():
+                any_failed = True
+                ax.plot(x[bad], y[bad], linestyle="none", marker="o", markersize=10, markerfacecolor="none",
+                        markeredgecolor="tab:red", markeredgewidth=1.5, zorder=4)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_title(p["title"], fontsize=10)
+        ax.set_xlabel(p["xlabel"], fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+        _readable_log_ticks(ax)
+    for ax in axes[len(panels):]:
+        ax.set_visible(False)
+    for ax in axes[::ncol]:
+        ax.set_ylabel(ylabel, fontsize=9)
+    labels = list(handles)
+    if any_failed:
+        from matplotlib.lines import Line2D
+
+        handles["failed"] = Line2D([], [], linestyle="none", marker="o", markersize=10, markerfacecolor="none",
+                                   markeredgecolor="tab:red", markeredgewidth=1.5)
+        labels.append("not converged (ringed)")
+    fig.legend(list(handles.values()), labels, loc="outside right center", fontsize=8)
+    fig.suptitle(title)
+    return _save(fig, path)

@@ -24,6 +24,11 @@ def _cell(r) -> str:
     return ", ".join(parts)
 
 
+PARAMETER_NAMES = {"poisson_contrast": "kappa contrast", "poisson_anisotropic": "aspect ratio",
+                   "poisson_scaled": "domain scale s", "poisson_degenerate": "sliver relative area eps",
+                   "poisson_fine": "unknowns"}
+
+
 def build_stability_report(report, study, result, data, stage) -> None:
     recs = result.records
     static = [r for r in recs if r["type"] != "dynamics_stiffness"]
@@ -77,8 +82,9 @@ def build_stability_report(report, study, result, data, stage) -> None:
     iters = [r for r in static if r.get("iterations") is not None and r["type"].startswith("poisson_")
              and r["type"] not in ("poisson_neumann",)]
     if iters:
-        series = []
+        panels = []
         for case in dict.fromkeys(r["case"] for r in iters):
+            series = []
             for m in methods:
                 rs = [r for r in iters if r["case"] == case and r["method"] == m]
                 try:
@@ -86,10 +92,14 @@ def build_stability_report(report, study, result, data, stage) -> None:
                 except (TypeError, ValueError):
                     continue
                 if len(xs) > 1:
-                    series.append({"label": f"{case}: {m}", "x": xs, "y": [r["iterations"] for r in rs]})
-        if series:
-            F.loglog_figure(stage / "figures" / "iterations_vs_parameter.png", series,
-                            title="Iterations vs stress parameter",
-                            xlabel="stress parameter (contrast, aspect ratio, scale, sliver size, ...)",
-                            ylabel="iterations to the requested true residual")
-            report.figure("figures/iterations_vs_parameter.png", "Iterations against each case's stress parameter")
+                    series.append({"label": m, "x": xs, "y": [r["iterations"] for r in rs],
+                                   "ok": [bool(r["survived"]) for r in rs]})
+            if series:
+                kind = next(r["type"] for r in iters if r["case"] == case)
+                panels.append({"title": case, "xlabel": PARAMETER_NAMES.get(kind, "parameter"), "series": series})
+        if panels:
+            F.panels_figure(stage / "figures" / "iterations_vs_parameter.png", panels,
+                            title="Iterations against each stress parameter", ylabel="iterations")
+            report.figure("figures/iterations_vs_parameter.png",
+                          "Iterations against each case's stress parameter (one panel per case); ringed points "
+                          "did not reach the requested true residual")
