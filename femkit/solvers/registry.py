@@ -83,9 +83,11 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     rtol, atol, maxiter, callback
         As in every method.
     preconditioner_options : dict, optional
-        Keyword arguments of the preconditioner factory (e.g. ``{"shift": 1e-2}`` for ic0).
+        Keyword arguments of the preconditioner factory (e.g. ``{"shift": 1e-2}`` for ic0);
+        an unknown name raises :class:`~femkit.errors.InputError` listing the valid ones.
     **options
-        Method-specific options (``omega`` for jacobi, ``factorization`` for direct ...).
+        Method-specific options (``omega`` for jacobi, ``factorization`` for direct ...);
+        an unknown name raises :class:`~femkit.errors.InputError` listing the valid ones.
 
     Returns
     -------
