@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import InputError, SolverError
+from ...errors import InputError, SolverError, StabilityWarning
 
 __all__ = [
     "StepContext",
@@ -54,6 +54,8 @@ __all__ = [
     "check_matrix_free",
     "check_matrix_free_options",
     "free_operator",
+    "NonlinearConvergenceWarning",
+    "note_unconverged",
 ]
 
 
@@ -162,6 +164,26 @@ class Integrator:
 
 
 # ----------------------------------------------------------------------------- iterative steps
+class NonlinearConvergenceWarning(StabilityWarning):
+    """An iterative implicit step (``newton``, ``newmark``, ``variational_symplectic``) stopped
+    at ``max_iterations`` without meeting its tolerance, so the step is not the method's exact
+    step. A :class:`~femkit.errors.StabilityWarning` subclass, so scene runs record it in
+    ``result.json``'s ``warnings``."""
+
+
+def note_unconverged(name: str, ctx: StepContext, t: float, max_iterations: int, detail: str) -> None:
+    """Count an unconverged step in ``ctx.stats["unconverged_steps"]`` and warn
+    (:class:`NonlinearConvergenceWarning`) at the first one of the run (later ones are counted)."""
+    ctx.count("unconverged_steps")
+    if ctx.stats["unconverged_steps"] == 1:
+        import warnings
+
+        warnings.warn(NonlinearConvergenceWarning(
+            f"{name}: the step ending at t = {t:.6g} stopped at max_iterations = {max_iterations} "
+            f"without meeting its tolerance ({detail}); later unconverged steps are counted in "
+            "stats['unconverged_steps']. Raise max_iterations or reduce dt"), stacklevel=3)
+
+
 def box_length(x: np.ndarray) -> float:
     """Bounding-box diagonal of ``x`` (1 when it is 0): the length ``L`` of the stopping rules
     ``||dx||_inf <= tol * L`` of the iterative implicit steps.

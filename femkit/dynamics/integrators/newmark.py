@@ -10,8 +10,11 @@ solved by Newton iterations on ``r(a+) = M a+ - f(x+, v+)`` with the Jacobian
 ``M + h^2 beta K + h gamma (D + r_M M + r_K K)`` (``K``, ``D`` at the current iterate). For linear
 forces the first iteration is the exact solution and equals SOFA's closed-form recurrence
 ``a+ = (F + h cstAcc a + cstVel v) / ((h^2 beta + h gamma r_K) K + (1 + h gamma r_M) M)``; the
-loop stops when the residual falls below ``tol`` relative to the force scale or after
-``max_iterations``. ``state.aux["a"]`` keeps the acceleration of the current state.
+loop stops when the residual falls below ``tol`` relative to the force scale (plus the
+round-off floor ``100 eps max(k L)`` of the spring forces) or after
+``max_iterations`` (then counted in ``ctx.stats["unconverged_steps"]`` with a
+:class:`~.base.NonlinearConvergenceWarning` if the residual is still above ``tol`` and the last
+correction was not already at round-off of ``a+``). ``state.aux["a"]`` keeps the acceleration of the current state.
 
 Order 2 for ``gamma = 1/2`` (1 otherwise); with ``beta = 1/4, gamma = 1/2`` unconditionally stable
 and energy conserving on linear undamped systems (``|R| = 1``).
@@ -24,8 +27,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
-from .base import Integrator, StepContext, StepperState, restrict, solve_linear
+from .base import Integrator, StepContext, StepperState, note_unconverged, restrict, solve_linear
 from .registry import INTEGRATORS
+
+
+def _roundoff_floor(system) -> float:
+    """Round-off level of the residual ``M a - f``: a spring force ``k (l - L)`` carries an
+    absolute error of a few ``eps k l``, which a tolerance relative to the *net* force (small
+    near equilibrium: a stiff spring with ``k = 1e6`` holding a unit mass) cannot beat."""
+    if not system.n_springs:
+        return 0.0
+    return 100.0 * np.finfo(float).eps * float(np.max(system.k * system.rest))
 
 
 @INTEGRATORS.register("newmark")
@@ -75,6 +87,8 @@ class Newmark(Integrator):
         x_pred = state.x.reshape(-1) + h * state.v.reshape(-1) + (h * h * (0.5 - beta)) * a
         v_pred = state.v.reshape(-1) + (h * (1.0 - gamma)) * a
         a_new = a.copy()
+        floor = _roundoff_floor(system)
+        stalled = False
         iterations = 0
         for iterations in range(1, self.max_iterations + 1):
             x_new = (x_pred + (h * h * beta) * a_new).reshape(shape)
@@ -82,17 +96,26 @@ class Newmark(Integrator):
             f = system.force(x_new, v_new, state.t + h).reshape(-1)
             r = m * a_new - f
             scale = max(np.abs(f[free]).max(initial=0.0), np.abs(m * a_new)[free].max(initial=0.0))
-            if iterations > 1 and np.abs(r[free]).max(initial=0.0) <= self.tol * max(scale, 1e-300):
+            if iterations > 1 and np.abs(r[free]).max(initial=0.0) <= self.tol * max(scale, 1e-300) + floor:
                 break
             K = system.stiffness_matrix(x_new, fix=self.fix)
             J = (1.0 + h * gamma * rm) * M + (h * h * beta + h * gamma * rk) * K
             D = system.damping_matrix(x_new)
             if D.nnz:
                 J = J + (h * gamma) * D
-            a_new[free] -= solve_linear(restrict(J, free), r[free], ctx, system=system)
+            da = solve_linear(restrict(J, free), r[free], ctx, system=system)
+            a_new[free] -= da
+            # a correction at round-off of a+ itself: Newton has nothing left to improve
+            stalled = np.abs(da).max(initial=0.0) <= 8.0 * np.finfo(float).eps * np.abs(a_new).max(initial=0.0)
         else:
             x_new = (x_pred + (h * h * beta) * a_new).reshape(shape)
             v_new = (v_pred + (h * gamma) * a_new).reshape(shape)
+            f = system.force(x_new, v_new, state.t + h).reshape(-1)
+            r = np.abs(m * a_new - f)[free].max(initial=0.0)
+            scale = max(np.abs(f[free]).max(initial=0.0), np.abs(m * a_new)[free].max(initial=0.0))
+            if r > self.tol * max(scale, 1e-300) + floor and not stalled:
+                note_unconverged(self.name, ctx, state.t + h, self.max_iterations,
+                                 f"residual {r:.3e} > tol x force scale = {self.tol * scale:.3e}")
         ctx.stats.setdefault("newton_iterations", []).append(iterations)
         a_new = a_new.reshape(shape)
         a_new[system.pinned] = 0.0

@@ -12,7 +12,10 @@ with the per-spring eigenvalue clamp ``fix="clamp"`` by default, or ``"regulariz
 is a descent direction), then backtracks (Armijo: ``g(x + t dx) <= g(x) + c t grad.dx``,
 ``t *= shrink``). It stops when ``||dx||_inf <= tol * L`` (``L`` = bounding-box diagonal of
 ``x_n``) or after ``max_iterations``; the iteration count of every step is appended to
-``ctx.stats["newton_iterations"]``.
+``ctx.stats["newton_iterations"]``, and a step stopped by ``max_iterations`` is counted in
+``ctx.stats["unconverged_steps"]`` with a :class:`~.base.NonlinearConvergenceWarning` at the
+first one. (A line search that finds no decrease leaves ``x`` in place and ends the step: at
+round-off level that is convergence.)
 
 With the ``direct`` solver and ``reuse_factorization=True`` (opt-in; the default
 ``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
@@ -43,7 +46,8 @@ import numpy as np
 
 from ...errors import InputError
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
-                   check_matrix_free_options, free_operator, restrict, solve_linear)
+                   check_matrix_free_options, free_operator, note_unconverged, restrict,
+                   solve_linear)
 from .registry import INTEGRATORS
 
 
@@ -162,8 +166,14 @@ class NewtonImplicitEuler(Integrator):
             step_size = t * np.abs(dx).max(initial=0.0)
             x, gx = x_try, g_try
             if step_size <= self.tol * length:
+                converged = True
                 break
+        else:
+            converged = False
         ctx.record("newton_iterations", iterations)
+        if not converged:
+            note_unconverged(self.name, ctx, state.t + h, self.max_iterations,
+                             f"last Newton step {step_size:.3e} > tol * L = {self.tol * length:.3e}")
         x_new = x.reshape(shape)
         v_new = ((x - xn) / h).reshape(shape)
         return StepperState(x_new, v_new, state.t + h)

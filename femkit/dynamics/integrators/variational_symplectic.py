@@ -9,7 +9,9 @@ With momentum ``p = M v`` and the midpoint ``q* = q_n + h/2 vbar``::
 
 Newton solves ``R(q*) = (4/h^2) M (q* - q_n) - F(q*) - (2/h) p_n = 0`` with the Jacobian
 ``(4/h^2) M + K + (2/h) (D + r_M M + r_K K)``, starting from ``q* = q_n + h/2 v_n``, until
-``||dq||_inf <= tol * L`` or ``max_iterations`` (linear forces: exact after one solve).
+``||dq||_inf <= tol * L`` or ``max_iterations`` (linear forces: exact after one solve; a step
+stopped by ``max_iterations`` is counted in ``ctx.stats["unconverged_steps"]`` with a
+:class:`~.base.NonlinearConvergenceWarning`).
 ``F`` contains every declared force (velocity-dependent ones see ``vbar = 2 (q* - q_n) / h``).
 
 Second order, symplectic, unconditionally stable with ``|R| = 1`` on the linear oscillator.
@@ -22,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
-                   restrict, solve_linear)
+                   note_unconverged, restrict, solve_linear)
 from .registry import INTEGRATORS
 
 
@@ -67,6 +69,10 @@ class VariationalSymplectic(Integrator):
             q[free] += dq
             if np.abs(dq).max(initial=0.0) <= self.tol * length:
                 break
+        else:
+            note_unconverged(self.name, ctx, state.t + h, self.max_iterations,
+                             f"last correction {np.abs(dq).max(initial=0.0):.3e} > tol * L = "
+                             f"{self.tol * length:.3e}")
         ctx.record("newton_iterations", iterations)
         vbar = 2.0 * (q - qn) / h
         x_new = (2.0 * q - qn).reshape(shape)
