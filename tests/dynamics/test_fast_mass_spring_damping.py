@@ -91,3 +91,30 @@ def test_fast_mass_spring_warns_when_contact_is_too_stiff_for_its_iteration():
     with warnings.catch_warnings():
         warnings.simplefilter("error", StabilityWarning)
         get_integrator("fast_mass_spring").start(soft, soft.x0, soft.v0, 0.0, 1e-2, StepContext())
+
+
+# ----------------------------------------------------------------------------- documented orders
+def _damped_spring_error(name, dt, alpha, beta):
+    """|x(1) - exact| of a unit mass on a k = 100 spring with Rayleigh damping (1-D motion)."""
+    import math
+
+    from femkit.dynamics.system import MassSpringSystem
+
+    k, c = 100.0, alpha + beta * 100.0
+    s = MassSpringSystem([[0.0, 0.0], [1.2, 0.0]], 1.0, [[0, 1]], k, rest=1.0, pinned=[0],
+                         forces=[RayleighDamping(alpha, beta)])
+    tr = simulate(s, name, dt, 1.0)
+    zeta_w, wd = c / 2.0, math.sqrt(k - c * c / 4.0)   # underdamped closed form, x(0)=0.2, v(0)=0
+    exact = 1.0 + 0.2 * math.exp(-zeta_w) * (math.cos(wd) + zeta_w / wd * math.sin(wd))
+    return abs(tr.x[-1, 1, 0] - exact)
+
+
+@pytest.mark.parametrize("name,alpha,beta,order", [
+    ("velocity_verlet", 0.5, 0.005, 2), ("newmark", 0.5, 0.005, 2),
+    ("verlet", 0.5, 0.0, 1), ("leapfrog", 0.5, 0.0, 1),
+    ("central_difference", 0.5, 0.0, 2), ("central_difference", 0.0, 0.005, 1),
+], ids=["velocity_verlet", "newmark", "verlet", "leapfrog", "central_difference-rM",
+        "central_difference-rK"])
+def test_order_with_damping_is_the_documented_one(name, alpha, beta, order):
+    ratio = _damped_spring_error(name, 2e-3, alpha, beta) / _damped_spring_error(name, 1e-3, alpha, beta)
+    assert ratio == pytest.approx(2.0 ** order, rel=0.1)

@@ -7,7 +7,8 @@ Half-step velocities; the Rayleigh mass term ``-r_M v`` is centred (trapezoidal)
     x_{n+1}   = x_n + h v_{n+1/2}
 
 with ``a_n`` every other force at ``x_n`` divided by the mass (the Rayleigh stiffness part
-``-r_K K v`` is applied explicitly with ``v_{n-1/2}``). For ``r_M = 0`` this is SOFA's
+``-r_K K v`` is applied explicitly with ``v_{n-1/2}``, which makes the method first order when
+``r_K != 0``, as do dashpots and viscous damping). For ``r_M = 0`` this is SOFA's
 ``v+ = v + h a, x+ = x + h v+``. SOFA starts with ``v_{-1/2} = v_0``, which makes the method
 only first order; femkit starts from ``v_{-1/2} = v_0 - h/2 (a_0 - r_M v_0)`` so that
 ``v_{1/2} = v_0 + h/2 a_0 + O(h^2)`` and positions are second order (without damping it then

@@ -3,8 +3,8 @@
 Start ``v_{1/2} = v_0 + h/2 a_0``; then ``x_{n+1} = x_n + h v_{n+1/2}``,
 ``v_{n+3/2} = v_{n+1/2} + h a(x_{n+1})``. ``state.v`` reports the synchronised
 ``v_{n+1} = v_{n+1/2} + h/2 a_{n+1}``; the half-step velocity is ``state.aux["v_half"]`` and is
-what velocity-dependent forces see. Kick-drift-kick core: :mod:`.kick_drift_kick`. Second
-order, symplectic; stable for ``h omega < 2``.
+what velocity-dependent forces see (with damping forces the method is then only first
+order). Kick-drift-kick core: :mod:`.kick_drift_kick`. Second order, symplectic; stable for ``h omega < 2``.
 """
 
 from __future__ import annotations

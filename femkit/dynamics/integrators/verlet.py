@@ -3,7 +3,8 @@
 The first step is the Taylor step ``x_1 = x_0 + h v_0 + h^2/2 a_0``. Velocities are never needed
 by the recurrence; ``state.v`` reports the second-order estimate
 ``v_{n+1} = (x_{n+1} - x_n) / h + h/2 a_{n+1}`` (exactly velocity Verlet's velocity in exact
-arithmetic), which is also what velocity-dependent forces see. Second order, symplectic,
+arithmetic), which is also what velocity-dependent forces see (with dashpots, viscous or
+Rayleigh damping the method is then only first order). Second order, symplectic,
 time reversible; stable for ``h omega < 2``. The closing half kick is the shared
 :mod:`.kick_drift_kick` core.
 """
