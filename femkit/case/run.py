@@ -410,6 +410,9 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     from ..timing import StageTimer
 
     stage = StageTimer()
+    target = None
+    if write:  # a bad output location is bad input: refuse it before any work is done
+        target = output_location(output_dir or case.data["output"]["dir"])
     with stage("mesh"):
         mesh = build_mesh(case)
         q = quality(mesh)
@@ -429,7 +432,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
                         n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
                         nnz=int(system.A.nnz), nullspace=_nullspace_facts(system))
     if write:
-        write_outputs(result, output_dir or case.data["output"]["dir"])
+        write_outputs(result, target)
     if not quiet:
         out = echo or print
         for line in result.summary_lines():
@@ -449,16 +452,42 @@ def _nullspace_facts(system) -> dict | None:
     return {"mode": mode, "how": how, **system.compatibility}
 
 
+#: A directory holding one of these is an earlier run that a new run may replace.
+PREVIOUS_RUN = ("result.json",)
+
+
+def output_location(directory: str | os.PathLike) -> Path:
+    """The resolved output directory, checked before the run (:func:`check_output_dir`).
+
+    Raises
+    ------
+    InputError
+        (prefixed ``output.dir``) ``directory`` is a file, lies below a file, or is a
+        non-empty directory that is not an earlier run (no ``result.json``): replacing it
+        would delete the user's files.
+    """
+    from ..io.atomic import check_output_dir
+
+    try:
+        return check_output_dir(directory, PREVIOUS_RUN)
+    except InputError as exc:
+        raise with_prefix(exc, "output.dir") from None
+
+
 def write_outputs(result: CaseResult, directory: str | os.PathLike) -> Path:
-    """Write result.json and the requested solution files into ``directory`` (atomically)."""
+    """Write result.json and the requested solution files into ``directory`` (atomically).
+
+    ``directory`` is replaced as a whole, so it must be new, empty or an earlier run
+    (:func:`output_location`).
+    """
     from ..io.atomic import atomic_directory
     from ..io.results import write_json, write_plot, write_solution
 
     opts = result.case.data["output"]
-    final = Path(directory).resolve()
+    final = output_location(directory)
     result.output_dir = final
     t0 = time.perf_counter()
-    with atomic_directory(final) as tmp:
+    with atomic_directory(final, PREVIOUS_RUN) as tmp:
         if opts["vtu"]:
             write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa)
         if opts["xdmf"]:

@@ -24,7 +24,10 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
-__all__ = ["atomic_write_text", "atomic_write_bytes", "atomic_path", "atomic_directory"]
+from ..errors import InputError
+
+__all__ = ["atomic_write_text", "atomic_write_bytes", "atomic_path", "atomic_directory",
+           "check_output_dir"]
 
 
 def _fsync_dir(path: Path) -> None:
@@ -80,15 +83,59 @@ def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8
     return atomic_write_bytes(path, text.encode(encoding))
 
 
+def check_output_dir(path: str | os.PathLike, previous: tuple[str, ...] | None = None) -> Path:
+    """Check that :func:`atomic_directory` may build ``path``; return it resolved.
+
+    Parameters
+    ----------
+    path : the output directory.
+    previous : names of files that mark a directory as an earlier run of the same kind
+        (e.g. ``("result.json",)``). When given, an existing non-empty directory holding none
+        of them is refused: replacing it would delete files femkit did not write (an output
+        directory set to ``.`` or to a project folder).
+
+    Raises
+    ------
+    InputError
+        ``path`` or one of its parents exists but is not a directory, or (with ``previous``)
+        ``path`` is a non-empty directory that is not an earlier femkit output.
+
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (d / "notes.txt").write_text("mine")
+    >>> check_output_dir(d, previous=("result.json",))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    femkit.errors.InputError: output directory ... exists and is not a femkit output ...
+    """
+    final = Path(path).resolve()
+    for p in (final, *final.parents):
+        if p.exists() and not p.is_dir():
+            where = "" if p == final else f" (its parent {p} is a file)"
+            raise InputError(f"output directory {final} is not a directory{where}; "
+                             "choose another output directory")
+    if previous is not None and final.is_dir():
+        entries = {e.name for e in final.iterdir()}
+        if entries and not entries & set(previous):
+            raise InputError(
+                f"output directory {final} exists and is not a femkit output (it holds "
+                f"{len(entries)} entries but no {' or '.join(previous)}); a run replaces its "
+                "output directory as a whole, so choose a new or empty directory")
+    return final
+
+
 @contextlib.contextmanager
-def atomic_directory(path: str | os.PathLike) -> Iterator[Path]:
+def atomic_directory(path: str | os.PathLike,
+                     previous: tuple[str, ...] | None = None) -> Iterator[Path]:
     """Build a directory under a temporary name and move it to ``path`` on success.
 
     On an exception the temporary directory is removed and ``path`` (an older run, if any)
     is left untouched. On success an existing ``path`` is moved aside, the new directory
-    renamed into place, and the old one deleted.
+    renamed into place, and the old one deleted. Before anything is created,
+    :func:`check_output_dir` (with ``previous``) refuses a ``path`` that is a file, lies below
+    a file, or (with ``previous``) is a directory of other files.
     """
-    final = Path(path).resolve()
+    final = check_output_dir(path, previous)
     final.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f"{final.name}.tmp-", dir=final.parent))
     try:

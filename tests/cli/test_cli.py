@@ -137,6 +137,7 @@ def test_rerun_replaces_older_output_and_quiet_prints_nothing(tmp_path, capsys):
     case = write(tmp_path, SMALL)
     (tmp_path / "elsewhere").mkdir()
     (tmp_path / "elsewhere" / "stale.txt").write_text("old run")
+    (tmp_path / "elsewhere" / "result.json").write_text("{}")  # an older run (not user files)
     assert main(["solve", str(case), "--output", str(tmp_path / "elsewhere"), "--quiet"]) == 0
     assert capsys.readouterr().out == ""
     assert not (tmp_path / "elsewhere" / "stale.txt").exists()
