@@ -89,29 +89,42 @@ def apply_dirichlet(K, F, nodes, values) -> DirichletSystem:
     ----------
     K : sparse matrix, shape (n, n)
     F : ndarray, shape (n,)
-    nodes : array of int
-        Dirichlet nodes (duplicates allowed if their values agree; the first is kept).
-    values : float or array of len(nodes)
-        ``g`` at ``nodes`` (use :func:`dirichlet_values` for a callable).
+    nodes : array of int, or boolean mask of shape (n,)
+        Dirichlet nodes (duplicates allowed if their values agree).
+    values : float or array of len(nodes) (of ``mask.sum()`` for a mask)
+        ``g`` at ``nodes`` (use :func:`dirichlet_values` for a callable); must be finite.
 
     Returns
     -------
     DirichletSystem
+
+    Raises
+    ------
+    InputError
+        Shapes that do not match, node ids out of range or not integers, non-finite values,
+        a node given twice with different values.
     """
     K = sp.csr_matrix(K)
     n = K.shape[0]
     F = np.asarray(F, dtype=np.float64)
     if K.shape != (n, n) or F.shape != (n,):
         raise InputError(f"K must be square and F of matching length, got {K.shape} and {F.shape}")
-    nodes = np.asarray(nodes, dtype=np.int64).ravel()
-    if nodes.size and (nodes.min() < 0 or nodes.max() >= n):
-        raise InputError(f"Dirichlet node indices out of range 0..{n - 1}")
+    nodes = _node_ids(nodes, n)
     vals = np.asarray(values, dtype=np.float64)
     vals = np.full(len(nodes), float(vals)) if vals.ndim == 0 else vals.ravel()
     if vals.shape != nodes.shape:
         raise InputError(f"{len(nodes)} Dirichlet nodes but {vals.size} values")
-    fixed, first = np.unique(nodes, return_index=True)
+    if not np.isfinite(vals).all():
+        bad = nodes[~np.isfinite(vals)]
+        raise InputError(f"Dirichlet values are not finite at {len(bad)} node(s), "
+                         f"first {bad[:10].tolist()}")
+    fixed, first, inverse = np.unique(nodes, return_index=True, return_inverse=True)
     g = vals[first]
+    clash = np.flatnonzero(vals != g[inverse])
+    if clash.size:
+        i = clash[0]
+        raise InputError(f"Dirichlet node {int(nodes[i])} is given twice with different values "
+                         f"({g[inverse[i]]:g} and {vals[i]:g}); {clash.size} such entries")
     is_fixed = np.zeros(n, dtype=bool)
     is_fixed[fixed] = True
     free = np.flatnonzero(~is_fixed)
@@ -122,3 +135,27 @@ def apply_dirichlet(K, F, nodes, values) -> DirichletSystem:
     g_full[fixed] = g
     b = F[free] - K_free @ g_full
     return DirichletSystem(A=A, b=b, free=free, fixed=fixed, values=g, n=n)
+
+
+def _node_ids(nodes, n: int) -> np.ndarray:
+    """Node ids from an integer array or a boolean mask of length ``n``; range checked."""
+    arr = np.asarray(nodes)
+    if arr.dtype == bool:
+        if arr.shape != (n,):
+            raise InputError(f"a boolean Dirichlet node mask must have shape ({n},), got {arr.shape}")
+        return np.flatnonzero(arr)
+    arr = arr.ravel()
+    if arr.size and not np.issubdtype(arr.dtype, np.integer):
+        try:
+            ints = arr.astype(np.int64)
+            exact = bool(np.all(ints == arr))
+        except (TypeError, ValueError):
+            exact = False
+        if not exact:
+            raise InputError(f"Dirichlet nodes must be integer node ids (or a boolean mask), "
+                             f"got {arr.dtype} values such as {arr[:3].tolist()}")
+        arr = ints
+    arr = arr.astype(np.int64)
+    if arr.size and (arr.min() < 0 or arr.max() >= n):
+        raise InputError(f"Dirichlet node indices out of range 0..{n - 1}")
+    return arr

@@ -42,6 +42,11 @@ def error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | Non
     Returns
     -------
     dict with keys ``L2``, ``H1_semi`` (float or None), ``max_nodal``.
+
+    Raises
+    ------
+    InputError
+        ``u`` of the wrong length, no registered rule of degree ``order``, non-finite norms.
     """
     u = np.asarray(u, dtype=np.float64)
     if u.shape != (mesh.n_points,):

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from ..registry import Registry
 
 
@@ -64,9 +65,17 @@ def get_rule(name: str) -> TriangleRule:
 
 
 def rule_for_degree(degree: int) -> TriangleRule:
-    """The cheapest registered rule exact for polynomials of total degree ``degree``."""
+    """The cheapest registered rule exact for polynomials of total degree ``degree``.
+
+    Raises
+    ------
+    InputError
+        No registered rule is exact for that degree (the highest available is named).
+    """
     rules = sorted((QUADRATURE.get(n) for n in QUADRATURE), key=lambda r: (len(r.weights), r.degree))
     for r in rules:
         if r.degree >= degree:
             return r
-    return rules[-1]
+    best = max(rules, key=lambda r: r.degree)
+    raise InputError(f"no quadrature rule of degree {degree}: the highest registered is "
+                     f"{best.name!r} (degree {best.degree})")
