@@ -23,9 +23,18 @@ _S = np.array([0.5 - 0.5 / np.sqrt(3.0), 0.5 + 0.5 / np.sqrt(3.0)])
 
 
 def tagged_edges(mesh, tags) -> np.ndarray:
-    """Boundary edges (k, 2) carrying any of ``tags`` (int, group name, or iterable; None = all)."""
+    """Boundary edges (k, 2) carrying any of ``tags``, each edge once.
+
+    ``tags`` is an int, a group name or an iterable of them; ``None`` means the whole
+    boundary, found topologically (edges of exactly one triangle), as in
+    :func:`femkit.mesh.boundary_nodes`. An edge recorded under several of the tags (generated
+    meshes tag every boundary edge with its part and with ``boundary``) is returned once, so
+    a flux is never integrated twice over it.
+    """
     if tags is None:
-        return mesh.boundary_edges
+        from ..mesh.refine import boundary_edges_topological
+
+        return boundary_edges_topological(mesh)
     if isinstance(tags, (str, int, np.integer)):
         tags = [tags]
     ids = [mesh.tag(t) for t in tags]
@@ -33,7 +42,9 @@ def tagged_edges(mesh, tags) -> np.ndarray:
     missing = [t for t, i in zip(tags, ids) if i not in present]
     if missing:
         raise MeshError(f"no boundary edges carry tag(s) {missing}; edge tags in the mesh: {sorted(present)}")
-    return mesh.boundary_edges[np.isin(mesh.boundary_tags, ids)]
+    sel = mesh.boundary_edges[np.isin(mesh.boundary_tags, ids)]
+    _, first = np.unique(np.sort(sel, axis=1), axis=0, return_index=True)
+    return sel[np.sort(first)]
 
 
 def assemble_neumann(mesh, tags: Union[int, str, Iterable, None], h: Union[float, Callable]) -> np.ndarray:
@@ -42,7 +53,8 @@ def assemble_neumann(mesh, tags: Union[int, str, Iterable, None], h: Union[float
     Parameters
     ----------
     mesh : Mesh
-    tags : int, str, iterable of them, or None (every tagged boundary edge)
+    tags : int, str, iterable of them, or None (the whole topological boundary); an edge
+        under several of the tags counts once
     h : float or callable h(x, y)
         Outward flux ``kappa du/dn``.
 
