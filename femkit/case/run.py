@@ -195,7 +195,10 @@ def neumann_load(case: Case, mesh) -> np.ndarray:
 
     F = np.zeros(mesh.n_points)
     for i, bc in enumerate(case.data["boundary"].get("neumann", [])):
-        F += assemble_neumann(mesh, bc["tags"], case.functions[f"boundary.neumann[{i}].flux"])
+        named = [t for t in bc["tags"] if not _is_whole_boundary(mesh, t)]
+        # the whole boundary (tags=None) covers every named edge: take each edge once
+        tags = named if len(named) == len(bc["tags"]) else None
+        F += assemble_neumann(mesh, tags, case.functions[f"boundary.neumann[{i}].flux"])
     return F
 
 
