@@ -35,6 +35,11 @@ RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "system", "inte
                "momentum_final", "stability", "converged", "warnings", "timings", "files")
 
 
+
+#: Files that mark a directory as an earlier scene run: only such a directory (or an empty or
+#: missing one) is replaced; anything else (``--output .``, a project folder) is refused.
+PREVIOUS_RUN = ("result.json",)
+
 def _pad3(a: np.ndarray) -> np.ndarray:
     a = np.asarray(a, dtype=np.float64)
     if a.shape[1] == 3:
@@ -154,7 +159,7 @@ def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
     final = Path(directory).resolve()
     result.output_dir = final
     files: list[str] = []
-    with atomic_directory(final) as tmp:
+    with atomic_directory(final, PREVIOUS_RUN) as tmp:
         if opts["vtu"]:
             frames = write_frames_vtu(tmp, system, traj, tri)
             write_pvd(tmp / "scene.pvd", traj.times, frames)

@@ -500,6 +500,11 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     """
     from .simulate import StabilityWarning, simulate
 
+    if write:  # refuse a bad output location before any work (never replaces user files)
+        from ..io.atomic import check_output_dir
+        from .output import PREVIOUS_RUN
+
+        check_output_dir(output_dir or case.data["output"]["dir"], PREVIOUS_RUN)
     out = echo or print
     timings: dict[str, float] = {}
     t0 = time.perf_counter()

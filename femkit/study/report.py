@@ -167,4 +167,9 @@ def staged_output(output_dir):
     """
     from ..io.atomic import atomic_directory
 
-    return atomic_directory(output_dir)
+    return atomic_directory(output_dir, PREVIOUS_REPORT)
+
+
+#: Files that mark a directory as an earlier study report: only such a directory (or an empty or
+#: missing one) is replaced; anything else (``-o .``, a project folder) is refused.
+PREVIOUS_REPORT = ("results.json", "report.md")

@@ -88,6 +88,12 @@ def run_study(study, output_dir=None, *, progress: bool | None = None, write: bo
         False runs the sweep and returns the data without writing anything.
     """
     t0 = time.perf_counter()
+    if write:  # a bad report location is refused before the sweep runs
+        from ..io.atomic import check_output_dir
+        from .report import PREVIOUS_REPORT
+
+        check_output_dir(output_dir if output_dir is not None else study.default_output(),
+                         PREVIOUS_REPORT)
     if study.kind == "poisson_convergence":
         from .poisson import run_poisson_study
         from .report_poisson import build_poisson_report as build
@@ -112,7 +118,7 @@ def run_study(study, output_dir=None, *, progress: bool | None = None, write: bo
     if not write:
         return result
     out = Path(output_dir) if output_dir is not None else study.default_output()
-    with staged_output(out) as stage:
+    with staged_output(out) as stage:  # refuses a non-report directory (never deletes user files)
         os.makedirs(stage / "figures", exist_ok=True)
         report = Report(study.title)
         report.paragraph(f"Study `{study.name}` ({study.kind}{', quick mode' if study.quick else ''}); "

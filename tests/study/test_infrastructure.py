@@ -80,11 +80,12 @@ def test_report_renders_and_replaces_atomically(tmp_path):
     from femkit.study.figures import loglog_figure
 
     out = tmp_path / "rep"
-    out.mkdir()
+    out.mkdir()  # an earlier report (it has results.json), with a file the new one won't write
+    (out / "results.json").write_text("{}")
     (out / "stale.txt").write_text("old run")
     h = 0.5 ** np.arange(1, 5)
     with staged_output(out) as stage:
-        fig = loglog_figure(stage / "figures" / "err.png",
+        loglog_figure(stage / "figures" / "err.png",
                             [{"label": "L2", "x": h, "y": h**2, "fit": fit_rate(h, h**2)}],
                             title="t", xlabel="h", ylabel="e", triangle=2, invert_x=True)
         r = Report("demo")
