@@ -17,7 +17,11 @@ BLOCKS = [(page, i, code) for page in PAGES
 @pytest.mark.parametrize("page,index,code", BLOCKS,
                          ids=[f"{p.relative_to(ROOT)}#{i}" for p, i, _ in BLOCKS])
 def test_python_block_runs(page, index, code, tmp_path):
-    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True,
+    # run in a scratch directory that sees the bundled files under their documented relative
+    # paths, so whatever an example writes (e.g. a report in out/) never lands in the repository
+    for name in ("cases", "meshes", "studies"):
+        (tmp_path / name).symlink_to(ROOT / name)
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
                           timeout=300, env={**__import__("os").environ, "MPLBACKEND": "Agg"})
     assert proc.returncode == 0, f"{page.name} block {index} failed:\n{proc.stderr[-2000:]}"
 
