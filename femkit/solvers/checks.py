@@ -153,13 +153,10 @@ def unknown_options(bad, valid, *, what: str) -> None:
 
 def check_tolerances(rtol: float, atol: float) -> None:
     """Raise :class:`InputError` unless ``rtol, atol >= 0`` are finite and not both zero."""
+    from ..validation import finite_nonnegative
+
     for label, val in (("rtol", rtol), ("atol", atol)):
-        try:
-            v = float(val)
-        except (TypeError, ValueError):
-            raise InputError(f"{label} must be a number, got {val!r}") from None
-        if not np.isfinite(v) or v < 0:
-            raise InputError(f"{label} must be finite and >= 0, got {val!r}")
+        finite_nonnegative(val, label)
     if float(rtol) == 0.0 and float(atol) == 0.0:
         raise InputError(
             "rtol and atol are both 0: the stopping rule ||b - A x|| <= 0 cannot be certified "

@@ -62,12 +62,6 @@ def as_vector(value, dim: int, name: str) -> np.ndarray:
 
 def nonnegative(value, name: str) -> float:
     """A finite float ``>= 0``; raises InputError otherwise."""
-    from ...errors import InputError
+    from ...validation import finite_nonnegative
 
-    try:
-        f = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number, got {value!r}") from None
-    if not np.isfinite(f) or f < 0.0:
-        raise InputError(f"{name} must be finite and >= 0, got {value!r}")
-    return f
+    return finite_nonnegative(value, name)
