@@ -51,7 +51,7 @@ from typing import Callable, NamedTuple, Sequence
 import numpy as np
 
 from ..errors import InputError, PureNeumannError, SingularSystemError  # noqa: F401 (re-exported)
-from ._elements import triangle_geometry
+from ._elements import select_elements, triangle_geometry
 from .coefficients import Coefficient, evaluate_callable
 from .dirichlet import DirichletSystem, apply_dirichlet, dirichlet_values
 from .load import assemble_load
@@ -67,14 +67,14 @@ NULLSPACE_MODES = ("mean_zero", "pin", "error")
 COMPATIBILITY_RTOL = 1e-3
 
 
-def node_weights(mesh) -> np.ndarray:
+def node_weights(mesh, *, elements=None) -> np.ndarray:
     """``w_i = int N_i dx`` (one third of the area of each triangle around node i); ``sum w = |Omega|``.
 
     >>> from femkit.mesh import Mesh
     >>> node_weights(Mesh(np.array([[0., 0.], [3., 0.], [0., 2.]]), np.array([[0, 1, 2]]))).tolist()
     [1.0, 1.0, 1.0]
     """
-    _, area, _, tri = triangle_geometry(mesh, None)
+    _, area, _, tri = triangle_geometry(mesh, select_elements(mesh, elements))
     return np.bincount(tri.ravel(), weights=np.repeat(area / 3.0, 3), minlength=mesh.n_points)
 
 
@@ -117,9 +117,21 @@ def check_compatibility(F_source: np.ndarray, F_flux=None, *, weights: np.ndarra
     F_flux = np.zeros_like(F_source) if F_flux is None else np.asarray(F_flux, dtype=np.float64)
     F = F_source + F_flux
     total = float(F.sum())
-    scale = float(np.abs(F_source).sum() + np.abs(F_flux).sum())
+    info = compatibility_facts(float(F_source.sum()), float(F_flux.sum()),
+                               float(np.abs(F_source).sum() + np.abs(F_flux).sum()), rtol)
+    if weights is None:
+        return F - total / len(F), info
+    weights = np.asarray(weights, dtype=np.float64)
+    return F - total * weights / weights.sum(), info
+
+
+def compatibility_facts(source_integral: float, flux_integral: float, scale: float,
+                        rtol: float = COMPATIBILITY_RTOL) -> dict:
+    """The compatibility check of :func:`check_compatibility` on the sums alone (a distributed
+    run reduces them over ranks): ``scale = sum |F_source| + sum |F_flux|``."""
+    total = source_integral + flux_integral
     rel = abs(total) / scale if scale > 0 else 0.0
-    info = {"source_integral": float(F_source.sum()), "flux_integral": float(F_flux.sum()),
+    info = {"source_integral": source_integral, "flux_integral": flux_integral,
             "relative_imbalance": rel, "rtol": float(rtol)}
     if rel > rtol:
         raise PureNeumannError(
@@ -127,10 +139,7 @@ def check_compatibility(F_source: np.ndarray, F_flux=None, *, weights: np.ndarra
             f"int h ds = {info['flux_integral']:.6g} must sum to 0 (relative imbalance "
             f"{rel:.3g} > {rtol:g}); change the source or the fluxes so they balance, or add a "
             "Dirichlet condition")
-    if weights is None:
-        return F - total / len(F), info
-    weights = np.asarray(weights, dtype=np.float64)
-    return F - total * weights / weights.sum(), info
+    return info
 
 
 class NullspaceSystem:
@@ -311,9 +320,7 @@ class PoissonProblem:
         F = assemble_load(self.mesh, self.f, rule=self.load_rule)
         t["load"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        F_flux = np.zeros(self.mesh.n_points)
-        for tags, h in self.neumann:
-            F_flux += assemble_neumann(self.mesh, tags, h)
+        F_flux = self.neumann_load()
         t["neumann"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         if self.nullspace is not None:
@@ -326,15 +333,27 @@ class PoissonProblem:
             self.timings = t
             return self.system
         F = F + F_flux
+        fixed, values = self.dirichlet_data()
+        self.system = apply_dirichlet(K, F, fixed, values)
+        t["dirichlet"] = time.perf_counter() - t0
+        self.timings = t
+        return self.system
+
+    def dirichlet_data(self) -> tuple[np.ndarray, np.ndarray]:
+        """Sorted Dirichlet node ids and their values ``g`` (later entries win on shared nodes)."""
         g = np.full(self.mesh.n_points, np.nan)
         for tags, value in self.dirichlet:
             nodes = _boundary_nodes(self.mesh, tags)
             g[nodes] = dirichlet_values(self.mesh, nodes, value)
         fixed = np.flatnonzero(~np.isnan(g))
-        self.system = apply_dirichlet(K, F, fixed, g[fixed])
-        t["dirichlet"] = time.perf_counter() - t0
-        self.timings = t
-        return self.system
+        return fixed, g[fixed]
+
+    def neumann_load(self) -> np.ndarray:
+        """``int h N_i ds`` summed over the Neumann entries, shape (n,)."""
+        F_flux = np.zeros(self.mesh.n_points)
+        for tags, h in self.neumann:
+            F_flux += assemble_neumann(self.mesh, tags, h)
+        return F_flux
 
     def solve(self, method: str = "direct", preconditioner=None, **solver_opts) -> PoissonSolution:
         """Assemble (if not done) and solve; returns ``(u, SolveResult)``.

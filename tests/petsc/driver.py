@@ -1,0 +1,54 @@
+"""MPI driver of tests/petsc: solve one bundled case with the PETSc backend, once per solver
+spec, and save on rank 0 the mesh, then per solve the gathered solution, matrix and facts.
+
+Usage: mpirun -n N .venv-petsc/bin/python tests/petsc/driver.py CASE OUT.npz SOLVERS_JSON
+SOLVERS_JSON: a list of {"method", "preconditioner", "rtol", "petsc_options"} (any may be left out).
+"""
+
+import json
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import numpy as np  # noqa: E402
+
+from problems import CASES, make_mesh, mesh_arrays  # noqa: E402
+
+
+def main(argv):
+    name, out = argv[0], argv[1]
+    specs = json.loads(argv[2]) if len(argv) > 2 else [{}]
+    from femkit.solvers.petsc import require_petsc
+    from femkit.solvers.petsc.assembly import gather_matrix
+    from femkit.solvers.petsc.failure import abort_on_error
+    from femkit.solvers.petsc.poisson import broadcast_mesh, solve_poisson
+
+    PETSc = require_petsc()
+    comm = PETSc.COMM_WORLD
+    arrays = {}
+    with abort_on_error(comm.tompi4py()):
+        mesh = broadcast_mesh(lambda: make_mesh(name), comm)
+        problem, (exact, grad) = CASES[name][1](mesh)
+        for k, spec in enumerate(specs):
+            sol = solve_poisson(problem, method=spec.get("method", "pcg"),
+                                preconditioner=spec.get("preconditioner"),
+                                rtol=spec.get("rtol", 1e-10), maxiter=spec.get("maxiter", 5000),
+                                petsc_options=spec.get("petsc_options"), exact=exact,
+                                grad_exact=grad)
+            A = gather_matrix(sol.system.A, sol.system.layout, comm)
+            if comm.getRank() == 0:
+                r = sol.result
+                facts = {"converged": r.converged, "iterations": r.iterations, "reason": r.reason,
+                         "relative_residual": r.relative_residual, "info": r.info,
+                         "method": r.method, "preconditioner": r.preconditioner,
+                         "errors": sol.errors, "timings": sol.timings, "partition": sol.partition,
+                         "residuals": r.residuals.tolist()}
+                arrays.update({f"u{k}": sol.u, f"A{k}_data": A.data, f"A{k}_indices": A.indices,
+                               f"A{k}_indptr": A.indptr, f"facts{k}": json.dumps(facts)})
+        if comm.getRank() == 0:
+            np.savez(out, n_solves=len(specs), **arrays, **mesh_arrays(mesh))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
