@@ -112,7 +112,7 @@ def solve_poisson(problem, *, method: str = "pcg", preconditioner: str | None = 
         times[stage] = times.get(stage, 0.0) + time.perf_counter() - t0
 
     mesh = problem.mesh
-    with timer("dirichlet"):
+    with timer("boundary_data"):
         if problem.nullspace is None:
             fixed, values = collective(mpi, problem.dirichlet_data)
         else:  # pure Neumann: pin one node (to pin_value in "pin" mode, else 0, then shifted)
