@@ -32,14 +32,19 @@ def naive_ranges(n: int, size: int) -> np.ndarray:
 
 def adjacency_rows(triangles: np.ndarray, start: int, end: int):
     """CSR ``(indptr, indices)`` of the node graph (mesh edges, no diagonal) for rows
-    ``start <= i < end``."""
-    e = triangles[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    e = np.concatenate([e, e[:, ::-1]])
-    e = e[(e[:, 0] >= start) & (e[:, 0] < end)]
-    key = np.unique((e[:, 0] - start) * np.int64(1 << 32) + e[:, 1])
-    rows, cols = key >> 32, key & ((1 << 32) - 1)
-    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=end - start))])
-    return indptr, cols
+    ``start <= i < end``, column indices sorted."""
+    import scipy.sparse as sp
+
+    mine = (triangles >= start) & (triangles < end)
+    tri = triangles[mine.any(axis=1)]
+    i = np.repeat(tri, 3, axis=1).ravel()  # every ordered vertex pair of each triangle
+    j = np.tile(tri, (1, 3)).ravel()
+    keep = (i >= start) & (i < end) & (i != j)
+    n = int(triangles.max()) + 1 if triangles.size else 0
+    G = sp.csr_matrix((np.ones(int(keep.sum()), dtype=np.int8), (i[keep] - start, j[keep])),
+                      shape=(end - start, n))  # duplicates summed: one entry per edge
+    G.sort_indices()
+    return G.indptr.astype(np.int64), G.indices.astype(np.int64)
 
 
 def partition_nodes(mesh, comm, *, method: str = DEFAULT_PARTITIONER) -> np.ndarray:
