@@ -2,7 +2,8 @@
 spec, and save on rank 0 the mesh, then per solve the gathered solution, matrix and facts.
 
 Usage: mpirun -n N .venv-petsc/bin/python tests/petsc/driver.py CASE OUT.npz SOLVERS_JSON
-SOLVERS_JSON: a list of {"method", "preconditioner", "rtol", "petsc_options"} (any may be left out).
+SOLVERS_JSON: a list of {"method", "preconditioner", "rtol", "petsc_options", "pvtu"} (any may be
+left out; "pvtu": true also writes solution{k}.pvtu and its pieces next to OUT).
 """
 
 import json
@@ -37,6 +38,11 @@ def main(argv):
                                 petsc_options=spec.get("petsc_options"), exact=exact,
                                 grad_exact=grad)
             A = gather_matrix(sol.system.A, sol.system.layout, comm)
+            if spec.get("pvtu"):
+                from femkit.solvers.petsc.pvtu import write_pvtu
+
+                write_pvtu(Path(out).parent, f"solution{k}", mesh, sol.u_vec, sol.system.layout,
+                           comm)
             if comm.getRank() == 0:
                 r = sol.result
                 facts = {"converged": r.converged, "iterations": r.iterations, "reason": r.reason,
