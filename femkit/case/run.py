@@ -26,7 +26,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..errors import CaseFileError, ExpressionError, InputError
-from .checks import check_geometry_spec, check_solver_spec, lookup, resolve_file, with_prefix
+from .names import check_geometry_spec, lookup, resolve_file, with_prefix
 from .expressions import compile_expression
 from .load import Case
 
@@ -65,7 +65,9 @@ def prepare_poisson(case: Case) -> None:
             raise CaseFileError(f"mesh.{bad}: only used with mesh.geometry, not with mesh.file")
     else:
         check_geometry_spec(mesh, "mesh")
-    check_solver_spec(d["solver"], "solver", default_preconditioner="amg")
+    from .specs import solver_spec
+
+    d["solver"] = solver_spec(d["solver"], "solver", default_method="pcg").to_dict()
 
     from ..fem.quadrature import QUADRATURE
 
@@ -266,14 +268,9 @@ def nullspace_system(case: Case, mesh, K, F):
 
 def solve_system(case: Case, A, b, x0=None, callback=None):
     """Solve with the case's solver settings through :func:`femkit.solvers.solve`."""
-    from ..solvers import solve
+    from .specs import SolverSpec
 
-    s = case.data["solver"]
-    pc = s["preconditioner"]
-    return solve(A, b, x0, method=s["method"], preconditioner=pc if s["method"] == "pcg" else None,
-                 rtol=s["rtol"], atol=s["atol"], maxiter=s["maxiter"], callback=callback,
-                 preconditioner_options=s.get("preconditioner_options") or None,
-                 **(s.get("options") or {}))
+    return SolverSpec(**case.data["solver"]).solve(A, b, x0, callback=callback)
 
 
 def compute_errors(case: Case, mesh, u: np.ndarray) -> dict | None:
@@ -329,7 +326,7 @@ class CaseResult:
 
     def to_dict(self) -> dict:
         """The content of ``result.json`` (keys documented in docs/case-files.md)."""
-        from .. import __version__
+        from .._version import __version__
 
         spec = self.case.data["mesh"]
         mesh_info = {k: self.quality.get(k) for k in (

@@ -7,11 +7,13 @@ values, stagnation, and the true residual at exit.
 
 from __future__ import annotations
 
+from .defaults import DEFAULT_RTOL
+
 from .pcg import pcg
 from .result import SolveResult
 
 
-def cg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | None = None,
+def cg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
        M=None, callback=None, check_symmetry: bool = True,
        stagnation_window: int | None = None,
        raise_on_breakdown: bool = False) -> SolveResult:

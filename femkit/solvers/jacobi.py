@@ -9,6 +9,8 @@ classical smoothing weight). A divergent iteration stops with ``reason="non-fini
 
 from __future__ import annotations
 
+from .defaults import DEFAULT_RTOL
+
 import math
 import numbers
 
@@ -20,7 +22,7 @@ from .checks import (as_apply, check_positive_diagonal, diagonal_of, finish,
 from .result import SolveResult
 
 
-def jacobi(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | None = None,
+def jacobi(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
            M=None, callback=None, omega: float = 1.0, diagonal=None) -> SolveResult:
     """Weighted Jacobi: ``x += omega D^-1 (b - A x)`` until ``||b - A x|| <= max(rtol ||b||, atol)``.
 

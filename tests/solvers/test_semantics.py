@@ -244,7 +244,7 @@ def test_stagnation_window(builders):
     assert "no residual decrease for 3 iterations" in res.message
     k_best = int(np.argmin(res.residuals))
     assert res.iterations - k_best == 3
-    assert cg(A, b).converged  # the default window lets it finish
+    assert cg(A, b, rtol=1e-8).converged  # the default window lets it finish
 
 
 def test_inexact_operator_true_residual_refused(builders):
