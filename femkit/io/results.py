@@ -6,51 +6,19 @@ are documented in docs/case-files.md ("Outputs").
 
 from __future__ import annotations
 
-import json
-import math
 import os
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from .atomic import atomic_path, atomic_write_text
+from .atomic import atomic_path
+from .writers import to_jsonable, write_json  # noqa: F401 (re-exported)
 
 __all__ = ["to_jsonable", "write_json", "write_solution", "write_plot", "RESULT_KEYS"]
 
 #: Top-level keys of result.json.
 RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs", "nnz",
                "solver", "converged", "errors", "timings", "expressions", "files")
-
-
-def to_jsonable(value: Any) -> Any:
-    """Convert numpy scalars/arrays, paths and ``as_dict()`` objects to JSON types (strict JSON:
-    non-finite floats become null; anything else unknown becomes its ``str``)."""
-    if isinstance(value, dict):
-        return {str(k): to_jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [to_jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return to_jsonable(value.tolist())
-    if isinstance(value, (np.bool_, bool)):
-        return bool(value)
-    if isinstance(value, (np.integer,)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        v = float(value)
-        return v if math.isfinite(v) else None
-    if isinstance(value, os.PathLike):
-        return os.fspath(value)
-    if hasattr(value, "as_dict"):
-        return to_jsonable(value.as_dict())
-    if value is None or isinstance(value, (str, int)):
-        return value
-    return str(value)
-
-
-def write_json(path: str | os.PathLike, data: dict) -> Path:
-    """Write ``data`` as indented JSON (atomically)."""
-    return atomic_write_text(path, json.dumps(to_jsonable(data), indent=2, allow_nan=False) + "\n")
 
 
 def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarray | None = None,
