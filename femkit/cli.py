@@ -109,7 +109,7 @@ def _add_check(sub) -> None:
 
 def _run_check(args) -> int:
     from .case import load_case
-    from .case.check import cross_check, format_table
+    from .case.poisson.cross_check import cross_check, format_table
 
     case = load_case(args.case)
     rows = cross_check(case)

@@ -8,7 +8,7 @@ registered solver is accepted without touching the schema.
 
 from __future__ import annotations
 
-from .specs import SOLVER_SCHEMA
+from ..specs import SOLVER_SCHEMA
 
 _NUMBER_OR_EXPR = {
     "anyOf": [{"type": "number"}, {"type": "string", "minLength": 1}],
