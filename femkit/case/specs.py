@@ -80,7 +80,8 @@ INTEGRATOR_SCHEMA: dict = {
 
 @dataclass(frozen=True)
 class IntegratorSpec:
-    """An integrator by name with its options (``integrator:`` in scenes and studies)."""
+    """An integrator by name with its options (``integrator:`` in scenes, ``integrators:`` in
+    studies); ``label`` names it in reports (default: the name, then ``key=value`` options)."""
 
     method: str
     options: dict = field(default_factory=dict)
@@ -98,7 +99,9 @@ class IntegratorSpec:
             get_integrator(d["method"], **options)
         except InputError as exc:
             raise with_prefix(exc, f"{where}.options") from None
-        return cls(d["method"], options, d.get("label") or d["method"])
+        label = d.get("label") or (d["method"] + ("" if not options else " " + ",".join(
+            f"{k}={v}" for k, v in options.items())))
+        return cls(d["method"], options, label)
 
     def build(self):
         """A fresh integrator object."""

@@ -111,8 +111,11 @@ def _prepare_nullspace(bnd: dict) -> None:
 
 # ----------------------------------------------------------------------------- stages
 
-def build_mesh(case: Case):
-    """Generate or read the mesh, refine, validate, and check every tag the case names."""
+def build_mesh(case: Case, *, h: float | None = None):
+    """Generate or read the mesh, refine, validate, and check every tag the case names.
+
+    ``h`` replaces ``mesh.h`` of a generated mesh (studies sweep it); a mesh file ignores it.
+    """
     from ...mesh import check_tags, generate, read_mesh, refine, validate
 
     spec = case.data["mesh"]
@@ -121,7 +124,7 @@ def build_mesh(case: Case):
         if "file" in spec:
             mesh = read_mesh(spec["file"])
         else:
-            mesh = generate(spec["geometry"], spec["h"], **(spec.get("params") or {}))
+            mesh = generate(spec["geometry"], spec["h"] if h is None else h, **(spec.get("params") or {}))
         mesh = validate(mesh)
     except InputError as exc:
         raise with_prefix(exc, where) from None
@@ -185,7 +188,7 @@ def _tags(mesh, tags: list):
     return named if len(named) == len(tags) else None
 
 
-def poisson_problem(case: Case, mesh):
+def poisson_problem(case: Case, mesh, *, load_rule: str | None = None):
     """The case on ``mesh`` as a :class:`femkit.fem.PoissonProblem` (the one translation).
 
     Dirichlet entries naming the whole boundary together with other tags cover both (a later
@@ -216,7 +219,7 @@ def poisson_problem(case: Case, mesh):
             extra["pin_value"] = float(np.asarray(u0).ravel()[0])
     return PoissonProblem(mesh, element_kappa(case, mesh), case.functions["source"],
                           dirichlet=dirichlet, neumann=neumann,
-                          load_rule=d["quadrature"]["load"], **extra)
+                          load_rule=load_rule or d["quadrature"]["load"], **extra)
 
 
 def is_pure_neumann(case: Case) -> bool:
