@@ -1,4 +1,4 @@
-"""Conjugate gradients (the seed's CG, section 4), the documented entry for unpreconditioned CG.
+"""Conjugate gradients (Hestenes & Stiefel 1952; Saad 2003, algorithm 6.18), the documented entry for unpreconditioned CG.
 
 It shares the loop of :mod:`femkit.solvers.pcg` with ``z = r`` (no preconditioner copy),
 so both carry the same checks: symmetry once, ``p^T A p > 0`` every iteration, non-finite

@@ -1,4 +1,4 @@
-"""Preconditioned conjugate gradients (the seed's CG with ``M ~ A^-1``), vectorised.
+"""Preconditioned conjugate gradients (Saad 2003, algorithm 9.1, with ``M ~ A^-1``), vectorised.
 
 Iteration (Saad, Alg. 9.1), ``z = M r``::
 

@@ -1,4 +1,4 @@
-"""Steepest descent (the seed's "steepest gradient method"), vectorised.
+"""Steepest descent (Saad 2003, section 5.3.1), vectorised.
 
 For SPD ``A``: ``r = b - A x``, ``alpha = (r, z) / (z, A z)`` with ``z = M r`` (``z = r``
 without preconditioner), ``x += alpha z``, ``r -= alpha A z``. One product per iteration;

@@ -139,11 +139,6 @@ def staged_output(output_dir):
     The study-side name of :func:`femkit.io.atomic.atomic_directory`: on an exception the
     temporary directory is removed and ``output_dir`` (an earlier report) is untouched.
     """
-    from ..io.atomic import atomic_directory
+    from ..io.atomic import EARLIER_REPORT, atomic_directory
 
-    return atomic_directory(output_dir, PREVIOUS_REPORT)
-
-
-#: Files that mark a directory as an earlier study report: only such a directory (or an empty or
-#: missing one) is replaced; anything else (``-o .``, a project folder) is refused.
-PREVIOUS_REPORT = ("results.json", "report.md")
+    return atomic_directory(output_dir, EARLIER_REPORT)

@@ -90,11 +90,10 @@ def run_study(study, output_dir=None, *, progress: bool | None = None, write: bo
     """
     t0 = time.perf_counter()
     if write:  # a bad report location is refused before the sweep runs
-        from ..io.atomic import check_output_dir
-        from .report import PREVIOUS_REPORT
+        from ..io.atomic import EARLIER_REPORT, check_output_dir
 
         check_output_dir(output_dir if output_dir is not None else study.default_output(),
-                         PREVIOUS_REPORT)
+                         EARLIER_REPORT)
     kind = STUDY_KINDS.get(study.kind)
     data = kind.run(study, progress_enabled=progress)
     result = StudyResult(kind=study.kind, name=study.name, records=data["records"], fits=data.get("fits", []),

@@ -10,8 +10,8 @@ from femkit.solvers import cg, get_preconditioner, pcg, solve
 from femkit.solvers.preconditioners import ic0
 
 
-def _rhs(n, seed=0):
-    return np.random.default_rng(seed).standard_normal(n)
+def _rhs(n, draw=0):
+    return np.random.default_rng(draw).standard_normal(n)
 
 
 def test_cg_iterations_double_per_halving_of_h(builders):

@@ -15,7 +15,7 @@ import numpy as np
 from ...errors import InputError, with_prefix
 from ...io.figures import new_figure, save_figure
 
-__all__ = ["write_solution", "write_plot", "write_outputs", "output_location", "PREVIOUS_RUN",
+__all__ = ["write_solution", "write_plot", "write_outputs", "output_location",
            "RESULT_KEYS"]
 
 #: Top-level keys of result.json.
@@ -61,8 +61,6 @@ def write_plot(path: str | os.PathLike, mesh, u: np.ndarray, title: str = "") ->
     return save_figure(fig, path)
 
 
-#: A directory holding one of these is an earlier run that a new run may replace.
-PREVIOUS_RUN = ("result.json",)
 
 
 def output_location(directory: str | os.PathLike) -> Path:
@@ -75,10 +73,10 @@ def output_location(directory: str | os.PathLike) -> Path:
         non-empty directory that is not an earlier run (no ``result.json``): replacing it
         would delete the user's files.
     """
-    from ...io.atomic import check_output_dir
+    from ...io.atomic import EARLIER_RUN, check_output_dir
 
     try:
-        return check_output_dir(directory, PREVIOUS_RUN)
+        return check_output_dir(directory, EARLIER_RUN)
     except InputError as exc:
         raise with_prefix(exc, "output.dir") from None
 
@@ -89,14 +87,14 @@ def write_outputs(result, directory: str | os.PathLike) -> Path:
     ``directory`` is replaced as a whole, so it must be new, empty or an earlier run
     (:func:`output_location`).
     """
-    from ...io.atomic import atomic_directory
+    from ...io.atomic import EARLIER_RUN, atomic_directory
     from ...io.writers import write_json
 
     opts = result.case.data["output"]
     final = output_location(directory)
     result.output_dir = final
     t0 = time.perf_counter()
-    with atomic_directory(final, PREVIOUS_RUN) as tmp:
+    with atomic_directory(final, EARLIER_RUN) as tmp:
         if opts["vtu"]:
             write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa)
         if opts["xdmf"]:
