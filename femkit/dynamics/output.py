@@ -152,7 +152,7 @@ def write_gif(path: str | os.PathLike, system, traj, name: str, max_frames: int 
 
 def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
     """Write every requested output of ``result`` (a SceneResult) into ``directory`` atomically."""
-    from ..io.results import write_json
+    from ..io.writers import write_json
 
     opts = result.case.data["output"]
     traj, system, tri = result.trajectory, result.system, result.triangles

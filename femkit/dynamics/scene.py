@@ -125,9 +125,10 @@ def prepare_scene(case: Case) -> None:
         raise CaseFileError(f"integrator.options: {' '.join(str(exc).split())}") from None
 
     # linear solver
-    from ..case.checks import check_solver_spec
+    from ..case.specs import solver_spec
 
-    check_solver_spec(d["linear_solver"], "linear_solver", default_preconditioner="jacobi")
+    ls_spec = solver_spec(d["linear_solver"], "linear_solver", default_method="direct")
+    d["linear_solver"] = ls_spec.to_dict()
     if integ["options"].get("matrix_free"):  # caught at load time, before anything runs
         from .integrators import StepContext
         from .integrators.base import check_matrix_free
@@ -175,7 +176,7 @@ def prepare_scene(case: Case) -> None:
 
 
 def _prepare_mesh(system: dict, base: Path) -> None:
-    from ..case.checks import check_geometry_spec, resolve_file
+    from ..case.names import check_geometry_spec, resolve_file
 
     if "file" in system:
         resolve_file(system, "system", base)
@@ -390,7 +391,7 @@ class SceneResult:
 
     def to_dict(self) -> dict:
         """The content of ``result.json`` (keys documented in docs/scenes.md)."""
-        from .. import __version__
+        from .._version import __version__
 
         tr = self.trajectory
         s = self.system

@@ -12,6 +12,8 @@ Every property named here appears in docs/scenes.md (a test checks it).
 
 from __future__ import annotations
 
+from ..case.specs import SOLVER_SCHEMA
+
 _POS = {"type": "number", "exclusiveMinimum": 0}
 _NONNEG = {"type": "number", "minimum": 0}
 _COUNT2 = {"type": "integer", "minimum": 2}
@@ -149,17 +151,7 @@ SCENE_SCHEMA: dict = {
             ],
             "x-message": "expected an integrator name or {method: name, options: {...}}",
         },
-        "linear_solver": {
-            "type": "object", "additionalProperties": False, "default": {},
-            "properties": {
-                "method": {"type": "string", "default": "direct"},
-                "preconditioner": {"type": "string"},
-                "rtol": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1,
-                         "default": 1e-10},
-                "atol": {"type": "number", "minimum": 0, "default": 0.0},
-                "maxiter": {"type": "integer", "minimum": 1},
-            },
-        },
+        "linear_solver": {**SOLVER_SCHEMA, "default": {}},
         "dt": _TIME,
         "t_end": _TIME,
         "stability": {

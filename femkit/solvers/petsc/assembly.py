@@ -100,7 +100,7 @@ def assemble_poisson(problem, layout: Layout, comm, fixed: np.ndarray, values: n
         touched = np.unique(tri)
         F_src = assemble_load(mesh, problem.f, rule=problem.load_rule, elements=own)[touched]
         mine = layout.owned
-        F_flux = problem.neumann_load()[mine] if problem.neumann else np.zeros(len(mine))
+        F_flux = problem.neumann_vector()[mine] if problem.neumann else np.zeros(len(mine))
         F = node_vector(layout, comm)
         add_nodal(F, layout, touched, F_src)
         add_nodal(F, layout, mine, F_flux)

@@ -20,6 +20,7 @@ from typing import Callable
 import numpy as np
 
 from ...errors import InputError
+from ..defaults import DEFAULT_RTOL
 from ..checks import check_symmetric, check_tolerances, explicit_csr, real_array, unknown_options
 from ..result import SolveResult
 from . import names, options as popts
@@ -67,7 +68,7 @@ def configure(ksp, method: str, preconditioner: str | None, *, omega: float = 1.
 
 
 def ksp_solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = None,
-              rtol: float = 1e-8, atol: float = 0.0, maxiter: int | None = None,
+              rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
               callback: Callable | None = None, omega: float = 1.0,
               petsc_options: dict | None = None):
     """Solve ``A x = b`` for a PETSc ``Mat``/``Vec`` pair (any communicator).
@@ -207,7 +208,7 @@ class PetscBackend:
         return names.preconditioners()
 
     def solve(self, A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = None,
-              rtol: float = 1e-8, atol: float = 0.0, maxiter: int | None = None,
+              rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
               callback: Callable | None = None, **options) -> SolveResult:
         """Same contract as :func:`femkit.solvers.solve`; extra options ``omega`` (jacobi),
         ``petsc_options`` (dict) and ``check_symmetry`` (bool, scipy input)."""

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...fem import error_norms
+from ..defaults import DEFAULT_RTOL
 from ..result import SolveResult
 from .assembly import (DistributedSystem, assemble_poisson, gather_nodal, nodal_solution,
                        values_at)
@@ -76,7 +77,7 @@ class DistributedSolution:
 
 
 def solve_poisson(problem, *, method: str = "pcg", preconditioner: str | None = None,
-                  rtol: float = 1e-8, atol: float = 0.0, maxiter: int | None = None,
+                  rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
                   petsc_options: dict | None = None, omega: float = 1.0, exact=None,
                   grad_exact=None, error_order: int = 5, gather: bool = True,
                   partitioner: str = DEFAULT_PARTITIONER, comm=None) -> DistributedSolution:
