@@ -69,7 +69,7 @@ def worker_petsc(levels: int, rtol: float, pc: str) -> dict | None:
     from femkit.fem import PoissonProblem
     from femkit.solvers.petsc import require_petsc
     from femkit.solvers.petsc.failure import abort_on_error
-    from femkit.solvers.petsc.poisson import broadcast_mesh, solve_poisson
+    from femkit.fem.distributed.poisson import broadcast_mesh, solve_poisson
 
     PETSc = require_petsc()
     comm = PETSc.COMM_WORLD

@@ -21,9 +21,9 @@ def main(argv):
     name, out = argv[0], argv[1]
     specs = json.loads(argv[2]) if len(argv) > 2 else [{}]
     from femkit.solvers.petsc import require_petsc
-    from femkit.solvers.petsc.assembly import gather_matrix
+    from femkit.fem.distributed.assembly import gather_matrix
     from femkit.solvers.petsc.failure import abort_on_error
-    from femkit.solvers.petsc.poisson import broadcast_mesh, solve_poisson
+    from femkit.fem.distributed.poisson import broadcast_mesh, solve_poisson
 
     PETSc = require_petsc()
     comm = PETSc.COMM_WORLD
@@ -39,7 +39,7 @@ def main(argv):
                                 grad_exact=grad)
             A = gather_matrix(sol.system.A, sol.system.layout, comm)
             if spec.get("pvtu"):
-                from femkit.solvers.petsc.pvtu import write_pvtu
+                from femkit.fem.distributed.pvtu import write_pvtu
 
                 write_pvtu(Path(out).parent, f"solution{k}", mesh, sol.u_vec, sol.system.layout,
                            comm)

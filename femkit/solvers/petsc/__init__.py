@@ -1,5 +1,5 @@
 """PETSc + MPI backend (petsc4py): the same solver names and :class:`SolveResult` on a
-distributed matrix, and a partitioned P1 Poisson assembly.
+distributed (or one-process) matrix.
 
 Nothing here imports petsc4py at import time: :func:`require_petsc` does, and raises
 :class:`~femkit.errors.BackendUnavailableError` (one line naming ``scripts/install-petsc.sh``)
@@ -11,15 +11,15 @@ when it cannot. Modules:
 - ``options``: ``petsc_options`` pass-through (PETSc's options database, per solve prefix);
 - ``coo``: ``MatSetPreallocationCOO`` / ``MatSetValuesCOO`` (pattern once, values many);
 - ``backend``: :class:`PetscBackend`, the :class:`~femkit.solvers.backend.LinearSolverBackend`;
-- ``partition``: node partition (PETSc MatPartitioning, PT-Scotch) and contiguous renumbering;
-- ``assembly``: each rank assembles its own elements with femkit's kernels into an MPIAIJ matrix;
-- ``poisson``: :func:`solve_poisson`, a :class:`~femkit.fem.PoissonProblem` solved on all ranks;
 - ``failure``: collective error handling (a failing rank never leaves the others hanging).
+
+The distributed Poisson problem (partition, assembly, solve, output) sits one layer up, in
+:mod:`femkit.fem.distributed`, since the solver layer knows nothing of meshes.
 """
 
 from .env import INSTALL_HINT, petsc_available, require_petsc
 
-__all__ = ["INSTALL_HINT", "petsc_available", "require_petsc", "PetscBackend", "solve_poisson"]
+__all__ = ["INSTALL_HINT", "petsc_available", "require_petsc", "PetscBackend"]
 
 
 def __getattr__(name):  # lazy: importing the package imports no petsc4py
@@ -27,8 +27,4 @@ def __getattr__(name):  # lazy: importing the package imports no petsc4py
         from .backend import PetscBackend
 
         return PetscBackend
-    if name == "solve_poisson":
-        from .poisson import solve_poisson
-
-        return solve_poisson
     raise AttributeError(name)

@@ -19,10 +19,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...fem import assemble_load, local_stiffness
-from ...fem.poisson import compatibility_facts, node_weights
-from . import coo
-from .env import require_petsc
+from ..load import assemble_load
+from ..p1_stiffness import local_stiffness
+from ..poisson import compatibility_facts, node_weights
+from ...solvers.petsc import coo
+from ...solvers.petsc.env import require_petsc
 from .partition import Layout
 
 

@@ -22,14 +22,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...fem import error_norms
-from ..defaults import DEFAULT_RTOL
-from ..result import SolveResult
+from ...solvers.defaults import DEFAULT_RTOL
+from ...solvers.petsc.backend import ksp_solve
+from ...solvers.petsc.env import require_petsc
+from ...solvers.petsc.failure import collective, from_root
+from ...solvers.result import SolveResult
+from ..norms import error_norms
 from .assembly import (DistributedSystem, assemble_poisson, gather_nodal, nodal_solution,
                        values_at)
-from .backend import ksp_solve
-from .env import require_petsc
-from .failure import collective, from_root
 from .partition import DEFAULT_PARTITIONER, build_layout, partition_nodes
 
 

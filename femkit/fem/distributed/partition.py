@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
-from .env import require_petsc
+from ...solvers.petsc.env import require_petsc
 
 #: MatPartitioning type used by default
 DEFAULT_PARTITIONER = "ptscotch"
