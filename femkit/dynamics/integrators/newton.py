@@ -20,7 +20,7 @@ round-off level that is convergence.)
 With the ``direct`` solver and ``reuse_factorization=True`` (opt-in; the default
 ``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
 earlier Newton matrix (this step's or a previous step's) is kept and later Newton systems are
-solved by PCG preconditioned with it, to the same relative residual ``ctx.rtol`` on the true
+solved by PCG preconditioned with it, to the same relative residual ``ctx.linear_solver.rtol`` on the true
 residual; the factor is renewed when a PCG solve costs more than the average cost per solve
 since the factorisation (see :func:`.base.solve_linear`; ``ctx.stats``: ``factorizations``,
 ``refactorizations``, ``linear_iterations``, ``time_pcg``).
@@ -48,10 +48,10 @@ from ...errors import InputError
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
                    check_matrix_free_options, free_operator, note_unconverged, restrict,
                    solve_linear)
-from .registry import INTEGRATORS
+from .registry import register
 
 
-@INTEGRATORS.register("newton")
+@register("newton")
 @dataclass(frozen=True)
 class NewtonImplicitEuler(Integrator):
     tol: float = 1e-10
@@ -63,7 +63,6 @@ class NewtonImplicitEuler(Integrator):
     reuse_factorization: bool = False
     matrix_free: bool = False
 
-    name = "newton"
     order = 1
     implicit = True
     symplectic = False
