@@ -1,4 +1,4 @@
-"""Matrix-free implicit steps (seed 001, matrix-free CG): the operator ``A d`` equals the
+"""Matrix-free implicit steps (matrix-free CG, Baraff & Witkin 1998; Saad 2003): the operator ``A d`` equals the
 assembled matrix times ``d``, one matrix-free step equals the assembled direct step to the
 linear solver's tolerance, solvers that need the matrix are refused, and the scene path runs.
 """

@@ -22,7 +22,7 @@ it, to ``ctx.linear_solver.rtol`` on the true residual, renewing the factor when
 the average per solve since the factorisation (:func:`.base.solve_linear`): the same step to
 that tolerance at a fraction of the cost while the matrix changes slowly. ``reuse_factorization=False``: one factorisation per step.
 
-``matrix_free=True`` (seed 001, matrix-free CG) solves the same system without assembling
+``matrix_free=True`` (matrix-free CG: Baraff & Witkin 1998; Saad 2003, section 6.7) solves the same system without assembling
 it: a ``LinearOperator`` on the free dofs applies
 ``A d = (1 + h r_M) M d + h (h + r_K) K d + h D d`` through ``system.stiffness_operator`` /
 ``system.damping_operator`` (spring geometry computed once per step, two sparse passes over
