@@ -247,3 +247,11 @@ def test_docs_cover_every_scene_key():
 
     missing = [k for k in (*RESULT_KEYS, *energy_columns(3)) if f"`{k}`" not in doc]
     assert not missing, f"output keys missing from docs/scenes.md: {missing}"
+
+
+def test_schema_and_builder_registries_name_the_same_types():
+    from femkit.case.scene.run import FORCES, SYSTEMS
+    from femkit.case.scene.schema import FORCE_TYPES, SYSTEM_TYPES
+
+    assert set(FORCES.names()) | {"dashpot"} == set(FORCE_TYPES)  # dashpot: a spring coefficient
+    assert set(SYSTEMS.names()) == set(SYSTEM_TYPES)

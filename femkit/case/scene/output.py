@@ -24,9 +24,10 @@ import numpy as np
 
 from ...io.atomic import atomic_directory, atomic_write_text
 from ...io.writers import write_csv, write_json
+from .plot import write_final_png, write_gif
 
 __all__ = ["write_scene_outputs", "write_frames_vtu", "write_frames_xdmf", "write_pvd",
-           "write_energy_csv", "energy_columns", "write_final_png", "write_gif", "RESULT_KEYS"]
+           "write_energy_csv", "energy_columns", "RESULT_KEYS"]
 
 #: Top-level keys of a scene's result.json.
 RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "system", "integrator",
@@ -130,29 +131,6 @@ def write_energy_csv(path: str | os.PathLike, traj) -> Path:
                      columns=columns, float_format=".17g")
 
 
-# ----------------------------------------------------------------------------- pictures
-
-def write_final_png(path: str | os.PathLike, system, traj, name: str, triangles=None) -> Path:
-    """The last frame (3-D view for 3-D systems) and the energy of the run as a PNG.
-
-    Thin wrapper of :func:`femkit.case.scene.plot.write_final_png` (matplotlib imported only here).
-    """
-    from .plot import write_final_png as _png
-
-    return _png(path, system, traj, name, triangles=triangles)
-
-
-def write_gif(path: str | os.PathLike, system, traj, name: str, max_frames: int = 60,
-              triangles=None) -> Path:
-    """An animated GIF of at most ``max_frames`` evenly spaced recorded frames.
-
-    Thin wrapper of :func:`femkit.case.scene.plot.write_gif`.
-    """
-    from .plot import write_gif as _gif
-
-    return _gif(path, system, traj, name, triangles=triangles, max_frames=max_frames)
-
-
 # ----------------------------------------------------------------------------- all
 
 def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
@@ -174,7 +152,7 @@ def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
             write_energy_csv(tmp / "energy.csv", traj)
             files.append("energy.csv")
         if opts["png"]:
-            write_final_png(tmp / "final.png", system, traj, result.case.name, tri)
+            write_final_png(tmp / "final.png", system, traj, result.case.name, triangles=tri)
             files.append("final.png")
         if opts["gif"]:
             write_gif(tmp / "animation.gif", system, traj, result.case.name, triangles=tri)
