@@ -80,19 +80,19 @@ def _poisson_run(case, **kwargs):
 
 
 def _scene_schema() -> dict:
-    from ..dynamics.scene_schema import SCENE_SCHEMA  # TODO(merge): case/scene/schema
+    from .scene.schema import SCENE_SCHEMA
 
     return SCENE_SCHEMA
 
 
 def _scene_prepare(case) -> None:
-    from ..dynamics.scene import prepare_scene  # TODO(merge)
+    from .scene.run import prepare_scene
 
     prepare_scene(case)
 
 
 def _scene_run(case, **kwargs):
-    from ..dynamics.scene import run_scene  # TODO(merge)
+    from .scene.run import run_scene
 
     return run_scene(case, **kwargs)
 

@@ -5,14 +5,14 @@ with the valid keys listed. The ``system`` mapping is checked per ``type`` (``ro
 ``cloth``, ``mesh``, ``single_spring``) with ``if``/``then`` branches, so the error for a
 wrong key names the keys of *that* builder. Names of integrators, linear solvers,
 preconditioners and mesh geometries are not enumerated here: they are checked against the
-live registries at load time (:func:`femkit.dynamics.scene.prepare_scene`).
+live registries at load time (:func:`femkit.case.scene.run.prepare_scene`).
 
 Every property named here appears in docs/scenes.md (a test checks it).
 """
 
 from __future__ import annotations
 
-from ..case.specs import SOLVER_SCHEMA
+from ..specs import INTEGRATOR_SCHEMA, SOLVER_SCHEMA
 
 _POS = {"type": "number", "exclusiveMinimum": 0}
 _NONNEG = {"type": "number", "minimum": 0}
@@ -142,15 +142,7 @@ SCENE_SCHEMA: dict = {
                       "additionalProperties": {"type": "number"}, "default": {}},
         "system": _SYSTEM,
         "forces": _FORCES,
-        "integrator": {
-            "anyOf": [
-                {"type": "string", "minLength": 1},
-                {"type": "object", "additionalProperties": False, "required": ["method"],
-                 "properties": {"method": {"type": "string", "minLength": 1},
-                                "options": {"type": "object", "default": {}}}},
-            ],
-            "x-message": "expected an integrator name or {method: name, options: {...}}",
-        },
+        "integrator": INTEGRATOR_SCHEMA,
         "linear_solver": {**SOLVER_SCHEMA, "default": {}},
         "dt": _TIME,
         "t_end": _TIME,
