@@ -3,7 +3,7 @@
 Usage: mpirun -n 2 .venv-petsc/bin/python tests/petsc/failure_driver.py MODE OUT
 MODE "abort": rank 1 raises RuntimeError while rank 0 waits in a PETSc collective (a norm);
 MODE "collective": rank 1's step raises InputError inside ``collective()``, so every rank
-raises the same input error (exit code 2 on all, one message).
+raises the same input error and exits 2 without MPI_Abort (rank 0 prints the one line).
 """
 
 import sys
@@ -26,7 +26,12 @@ def main(mode, out):
 
     with abort_on_error(mpi):
         if mode == "collective":
-            collective(mpi, step)
+            try:
+                collective(mpi, step)
+            except InputError as exc:  # on every rank: each exits 2, rank 0 says why (as the CLI)
+                if rank == 0:
+                    print(f"femkit: error: {exc}", file=sys.stderr)
+                sys.exit(2)
         else:
             v = PETSc.Vec().createMPI(10, comm=comm)
             if rank == 1:

@@ -17,4 +17,7 @@ def test_failing_rank_ends_the_run(mode, code, words, tmp_path):
     proc, _ = run_driver(mode, 2, tmp_path, check=False, script=HERE / "failure_driver.py")
     assert proc.returncode == code, proc.stderr
     assert words in proc.stderr
+    if mode == "collective":  # ended cleanly: one line, no MPI_Abort
+        assert "MPI_ABORT" not in proc.stderr
+        assert sum(ln.startswith("femkit: error:") for ln in proc.stderr.splitlines()) == 1
     assert not (tmp_path / f"{mode}-2.npz").exists()

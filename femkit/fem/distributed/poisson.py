@@ -28,6 +28,7 @@ from ...solvers.petsc.env import require_petsc
 from ...solvers.petsc.failure import collective, from_root
 from ...solvers.result import SolveResult
 from ..norms import error_norms
+from ..poisson import mean_shift_parts
 from .assembly import (DistributedSystem, assemble_poisson, gather_nodal, nodal_solution,
                        values_at)
 from .partition import DEFAULT_PARTITIONER, build_layout, partition_nodes
@@ -90,7 +91,8 @@ def solve_poisson(problem, *, method: str = "pcg", preconditioner: str | None = 
     method, preconditioner, rtol, atol, maxiter, petsc_options, omega
         As in :func:`.backend.ksp_solve` (femkit names mapped onto KSP/PC).
     exact, grad_exact : callable, optional
-        Exact solution and gradient: errors computed on each rank's elements and reduced.
+        Exact solution and gradient: errors computed on each rank's elements and reduced
+        (pure Neumann: modulo the constant, as :meth:`PoissonProblem.errors`).
     gather : bool
         Gather the nodal solution to rank 0 (``u``).
     partitioner : str
@@ -132,7 +134,8 @@ def solve_poisson(problem, *, method: str = "pcg", preconditioner: str | None = 
     errors = None
     if exact is not None:
         with timer("errors"):
-            errors = parallel_errors(mesh, u_vec, layout, comm, exact, grad_exact, error_order)
+            errors = parallel_errors(mesh, u_vec, layout, comm, exact, grad_exact, error_order,
+                                     modulo_constant=problem.nullspace is not None)
     u = None
     if gather:
         with timer("gather"):
@@ -156,16 +159,24 @@ def _max_op():
     return MPI.MAX
 
 
-def parallel_errors(mesh, u_vec, layout, comm, exact, grad_exact=None, order: int = 5) -> dict:
+def parallel_errors(mesh, u_vec, layout, comm, exact, grad_exact=None, order: int = 5, *,
+                    modulo_constant: bool = False) -> dict:
     """:func:`femkit.fem.error_norms` on each rank's elements, reduced over ranks (squared
     integrals summed, nodal maxima maximised); the nodes of own elements that other ranks
-    own are fetched with a VecScatter."""
+    own are fetched with a VecScatter. ``modulo_constant`` (pure Neumann): errors of
+    ``u - c`` with ``int (u - c - exact) = 0``, the integrals summed over ranks
+    (:func:`femkit.fem.poisson.mean_shift_parts`), as :meth:`PoissonProblem.errors` does."""
     from mpi4py import MPI
 
     mpi = comm.tompi4py()
     nodes = np.unique(mesh.triangles[layout.elements])
     u = np.zeros(mesh.n_points)
     u[nodes] = values_at(u_vec, layout, nodes, comm)
+    if modulo_constant:
+        parts = np.array(collective(mpi, mean_shift_parts, mesh, u, exact, order=order,
+                                    elements=layout.elements))
+        mpi.Allreduce(parts.copy(), parts, op=MPI.SUM)
+        u[nodes] -= (parts[0] - parts[1]) / parts[2]
     local = collective(mpi, error_norms, mesh, u, exact, grad_exact, order=order,
                        elements=layout.elements, squared=True)
     sums = mpi.allreduce(np.array([local["L2"], local["H1_semi"] or 0.0]), op=MPI.SUM)

@@ -10,7 +10,9 @@ Two mechanisms:
   the mesh on rank 0, evaluating the user's expressions).
 - :func:`abort_on_error` is the last resort around a whole run: an exception escaping on one
   rank prints one line and calls ``MPI_Abort`` on the communicator, which ends every rank
-  (the others may be blocked inside PETSc waiting for the failed one).
+  (the others may be blocked inside PETSc waiting for the failed one). Errors raised by
+  :func:`collective`/:func:`from_root` (marked ``collective``) are on every rank already and
+  pass through, so each rank ends normally with the same exit code.
 """
 
 from __future__ import annotations
@@ -27,12 +29,11 @@ def _reraise(comm, exc: BaseException | None):
     bad = [(r, f) for r, f in enumerate(failures) if f is not None]
     if not bad:
         return
-    if exc is not None:
-        raise exc
-    rank, (_, message, is_input) = bad[0]
-    if is_input:
-        raise InputError(message)
-    raise RankFailureError(rank, message)
+    if exc is None:
+        rank, (_, message, is_input) = bad[0]
+        exc = InputError(message) if is_input else RankFailureError(rank, message)
+    exc.collective = True  # raised on every rank: abort_on_error lets it end the run cleanly
+    raise exc
 
 
 def collective(comm, fn, *args, **kwargs):
@@ -58,9 +59,10 @@ def from_root(comm, fn, *args, **kwargs):
             result = ("error", exc)
     status, value = comm.bcast(result, root=0)
     if status == "error":
-        if comm.Get_rank() == 0 or isinstance(value, FemkitError):
-            raise value
-        raise RankFailureError(0, str(value))
+        if comm.Get_rank() != 0 and not isinstance(value, FemkitError):
+            value = RankFailureError(0, str(value))
+        value.collective = True
+        raise value
     return value
 
 
@@ -74,8 +76,8 @@ def abort_on_error(comm, *, stream=None):
     except SystemExit:
         raise
     except BaseException as exc:  # noqa: BLE001
-        if comm.Get_size() == 1:
-            raise
+        if comm.Get_size() == 1 or getattr(exc, "collective", False):
+            raise  # every rank raises it: each ends normally (the CLI prints on rank 0)
         code = 2 if isinstance(exc, InputError) else 1
         if not isinstance(exc, RankFailureError) or comm.Get_rank() == 0:
             print(f"femkit: error: rank {comm.Get_rank()}: {exc}", file=stream or sys.stderr,
