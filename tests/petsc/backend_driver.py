@@ -45,24 +45,33 @@ def main(out):
     dynamics = {}
     for name in ("implicit_euler", "newton", "newmark", "variational_symplectic"):
         for solver, pc in (("direct", "none"), ("pcg", "amg")):
-            x, stats = cloth_run(name, solver, pc, {"backend": "petsc"})
+            x, stats = cloth_run(name, solver, pc, "petsc")
             arrays[f"cloth_{name}_{solver}"] = x
             dynamics[f"{name}_{solver}"] = stats.get("linear_solves", 0)
     np.savez(out, A_data=A.data, A_indices=A.indices, A_indptr=A.indptr, b=b,
              facts=json.dumps({"solves": facts, "errors": errors, "dynamics": dynamics}), **arrays)
 
 
-def cloth_run(integrator, solver, pc, options):
-    """20 steps of a 6 x 6 cloth under gravity; final positions and the context's counters."""
+def cloth_system():
+    """A 6 x 6 cloth under gravity, pinned at two corners."""
     from femkit.dynamics.forces import Gravity
-    from femkit.dynamics.integrators import StepContext
-    from femkit.dynamics.simulate import simulate
     from femkit.dynamics.topology import cloth_grid
 
-    system = cloth_grid(6, 6, 1.0, 1.0, k_structural=500.0, k_shear=200.0, k_bending=50.0,
-                        mass=0.01, plane="xy", forces=[Gravity(9.81)])
-    ctx = StepContext(solver=solver, preconditioner=pc, rtol=1e-12, options=dict(options))
-    traj = simulate(system, integrator, 1e-2, 0.2, ctx=ctx, record_every=100)
+    return cloth_grid(6, 6, 1.0, 1.0, k_structural=500.0, k_shear=200.0, k_bending=50.0,
+                      mass=0.01, plane="xy", forces=[Gravity(9.81)])
+
+
+def cloth_run(integrator, solver, pc, backend="femkit", **integrator_options):
+    """20 steps of the cloth; final positions and the context's counters."""
+    from femkit.dynamics.integrators import StepContext
+    from femkit.dynamics.simulate import simulate
+    from femkit.solvers import SolverSpec
+
+    spec = SolverSpec.from_mapping({"method": solver, "preconditioner": pc, "rtol": 1e-12,
+                                    "backend": backend})
+    ctx = StepContext(linear_solver=spec)
+    traj = simulate(cloth_system(), integrator, 1e-2, 0.2, ctx=ctx, record_every=100,
+                    **integrator_options)
     return traj.x[-1], ctx.stats
 
 

@@ -10,15 +10,17 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from conftest import HERE, ROOT, TIMEOUT, VENV_PYTHON
+from conftest import HERE, ROOT, TIMEOUT, VENV_PYTHON, skip_reason
 
 from femkit.solvers import solve
 
-pytestmark = pytest.mark.usefixtures("needs_petsc_venv")
 
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
+    reason = skip_reason()
+    if reason:
+        pytest.skip(reason)
     out = tmp_path_factory.mktemp("backend") / "backend.npz"
     subprocess.run([str(VENV_PYTHON), str(HERE / "backend_driver.py"), str(out)], check=True,
                    timeout=TIMEOUT, cwd=ROOT, capture_output=True,
@@ -26,6 +28,7 @@ def run(tmp_path_factory):
     return np.load(out)
 
 
+@pytest.mark.usefixtures("needs_petsc_venv")
 def test_every_name_solves_like_femkit(run):
     n = len(run["A_indptr"]) - 1
     A = sp.csr_matrix((run["A_data"], run["A_indices"], run["A_indptr"]), shape=(n, n))
@@ -48,6 +51,7 @@ def test_every_name_solves_like_femkit(run):
     assert abs(its[("cg", None)] - femkit_cg) <= 2, (its, femkit_cg)
 
 
+@pytest.mark.usefixtures("needs_petsc_venv")
 def test_errors_are_femkit_errors(run):
     errors = json.loads(str(run["facts"]))["errors"]
     assert errors["asymmetric"].startswith("NotSPDError: pcg needs a symmetric positive definite")
@@ -55,6 +59,7 @@ def test_errors_are_femkit_errors(run):
     assert errors["unknown_name"].startswith("UnknownNameError: unknown petsc solver 'sd'")
 
 
+@pytest.mark.usefixtures("needs_petsc_venv")
 @pytest.mark.parametrize("integrator", ["implicit_euler", "newton", "newmark",
                                         "variational_symplectic"])
 def test_implicit_dynamics_on_the_petsc_backend(run, integrator):
@@ -66,9 +71,29 @@ def test_implicit_dynamics_on_the_petsc_backend(run, integrator):
     sys.path.insert(0, str(HERE))
     from backend_driver import cloth_run
 
-    x_ref, _ = cloth_run(integrator, "direct", "none", {})
+    x_ref, _ = cloth_run(integrator, "direct", "none")
     facts = json.loads(str(run["facts"]))["dynamics"]
     for solver in ("direct", "pcg"):
         assert facts[f"{integrator}_{solver}"] > 0  # the solves went through femkit.solvers.solve
         x = run[f"cloth_{integrator}_{solver}"]
         assert np.max(np.abs(x - x_ref)) <= 1e-8 * np.max(np.abs(x_ref)), solver
+
+
+@pytest.mark.parametrize("integrator,options,words", [
+    ("fast_mass_spring", {}, "factorisation kept for the whole run"),
+    ("implicit_euler", {"reuse_factorization": True}, "reuse_factorization keeps femkit's SuperLU"),
+    ("implicit_euler", {"matrix_free": True}, "matrix-free solves run in femkit's own solvers"),
+], ids=["fast_mass_spring", "reuse_factorization", "matrix_free"])
+def test_dynamics_paths_that_keep_femkit_refuse_petsc(integrator, options, words):
+    """No silent fallback: these paths use femkit's own factor/products, so backend petsc is an
+    input error (raised before any PETSc import, so this runs without PETSc too)."""
+    import sys
+
+    from femkit.errors import InputError
+
+    sys.path.insert(0, str(HERE))
+    from backend_driver import cloth_run
+
+    with pytest.raises(InputError, match=words):
+        cloth_run(integrator, "direct" if not options.get("matrix_free") else "cg", "none",
+                  "petsc", **options)

@@ -265,6 +265,9 @@ def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = Non
                 raise InputError("matrix-free pcg with jacobi needs the operator's diagonal")
             spec = replace(spec, preconditioner_options={**spec.preconditioner_options,
                                                          "diagonal": diagonal})
+    elif reuse_key is not None and spec.backend != "femkit":
+        raise InputError(f"reuse_factorization keeps femkit's SuperLU factor; linear_solver."
+                         f"backend {spec.backend!r} is not supported with it (use backend: femkit)")
     elif (system is not None and spec.method == "direct" and not spec.options
           and spec.backend == "femkit"):
         if reuse_key is not None:
