@@ -57,4 +57,13 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    from femkit.errors import InputError
+
+    try:
+        main(sys.argv[1:])
+    except InputError as exc:  # raised on every rank (as the CLI does: rank 0 says it, exit 2)
+        import os
+
+        if os.environ.get("OMPI_COMM_WORLD_RANK", "0") == "0":
+            print(f"femkit: error: {exc}", file=sys.stderr)
+        sys.exit(2)

@@ -25,6 +25,7 @@ from ..checks import check_symmetric, check_tolerances, explicit_csr, real_array
 from ..result import SolveResult
 from . import names, options as popts
 from .env import require_petsc
+from .failure import collective
 from .reasons import femkit_reason, reason_name
 
 #: PETSc error codes worth a word in a one-line message (petscerror.h)
@@ -135,16 +136,25 @@ def ksp_solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None 
             callback(_ksp.buildSolution().getArray().copy())
 
     ksp.setMonitor(monitor)
-    with popts.scoped(prefix, {**extra, **user}):
+    what = f"the solver set-up ({method}/{pc_name}{', petsc_options ' + ', '.join(user) if user else ''})"
+    mpi = comm.tompi4py()
+
+    def from_options():
         try:
             ksp.setFromOptions()
+        except PETSc.Error as exc:
+            raise petsc_error(exc, what) from None
+
+    with popts.scoped(prefix, {**extra, **user}):
+        # reading the options fails alike on every rank: raised on all, no MPI_Abort needed
+        collective(mpi, from_options)
+        try:
             t0 = time.perf_counter()
             ksp.setUp()
             setup = time.perf_counter() - t0
         except PETSc.Error as exc:
-            raise petsc_error(exc, f"the solver set-up ({method}/{pc_name}"
-                                   f"{', petsc_options ' + ', '.join(user) if user else ''})") from None
-        popts.check_used(prefix, user)
+            raise petsc_error(exc, what) from None
+        collective(mpi, popts.check_used, prefix, user)
         t0 = time.perf_counter()
         if bnorm == 0.0 and x0 is None:
             its, code = 0, None
