@@ -47,20 +47,21 @@ def petsc_error(exc, what: str) -> InputError:
 
 
 def configure(ksp, method: str, preconditioner: str | None, *, omega: float = 1.0,
-              petsc_options: dict | None = None) -> tuple[str, str, dict]:
-    """Set KSP/PC types from femkit names, then apply ``petsc_options`` (which win).
+              petsc_options: dict | None = None) -> tuple[str, dict, dict]:
+    """Set KSP/PC types and the norm from femkit names.
 
-    Returns ``(pc_name, prefix, user_options)``; the caller keeps the options scoped
-    (:func:`.options.scoped`) until after ``KSPSetUp`` and checks they were used.
+    Returns ``(pc_name, femkit_options, user_options)``: the PETSc options femkit's names
+    imply (e.g. ``pc_hypre_type``) and the user's ``petsc_options`` (applied after them, so
+    they win), both as PETSc option text; the caller scopes them (:func:`.options.scoped`)
+    until after ``KSPSetUp`` and checks the user's were used.
     """
     PETSc = require_petsc()
     ksp_type, pc_name, pc_type, extra = names.resolve(method, preconditioner)
     ksp.setType(ksp_type)
     pc = ksp.getPC()
     pc.setType(pc_type)
-    if ksp_type == "richardson":
-        ksp.setRichardsonScale(float(omega)) if hasattr(ksp, "setRichardsonScale") else \
-            extra.setdefault("ksp_richardson_scale", float(omega))
+    if ksp_type == "richardson":  # the damping of weighted Jacobi: x += omega D^-1 r
+        extra.setdefault("ksp_richardson_scale", float(omega))
     if ksp_type == "preonly":
         ksp.setNormType(PETSc.KSP.NormType.NONE)
     else:
@@ -261,5 +262,6 @@ def as_petsc_matrix(A, comm):
                                                  A.indices.astype(PETSc.IntType),
                                                  np.ascontiguousarray(A.data, dtype=np.float64)),
                               comm=comm)
-    M.setOption(PETSc.Mat.Option.SYMMETRIC, True) if A.shape[0] else None
+    if A.shape[0]:
+        M.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     return M
