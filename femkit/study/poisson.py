@@ -13,7 +13,6 @@ adds nested-iteration runs (see :func:`_nested_runs`).
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from .fit import fit_rate
