@@ -173,8 +173,8 @@ def ksp_solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None 
     ok = bool(np.isfinite(true_res) and true_res <= tol)
     name = "CONVERGED_ATOL" if code is None else reason_name(PETSc, code)
     reason = femkit_reason(name)
-    if method == "direct":
-        reason = "direct"
+    if method == "direct":  # as femkit's direct: 0 iterations, the initial residual only
+        reason, its, history = "direct", 0, history[:1]
     elif reason == "converged" and not ok:
         reason = "stagnation"
     if not history:
