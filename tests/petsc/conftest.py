@@ -38,7 +38,8 @@ def run_driver(case: str, ranks: int, tmp_path: Path, solvers=({},), *, mpirun=T
     """Run the driver on ``ranks`` ranks (``mpirun=False``: one plain process); return the
     CompletedProcess and the loaded .npz (or None)."""
     out = tmp_path / f"{case}-{ranks}.npz"
-    cmd = [str(VENV_PYTHON), str(script), case, str(out), json.dumps(list(solvers))]
+    payload = solvers if isinstance(solvers, dict) else list(solvers)
+    cmd = [str(VENV_PYTHON), str(script), case, str(out), json.dumps(payload)]
     if mpirun:
         cmd = [MPIRUN, "--allow-run-as-root", "--oversubscribe", "-n", str(ranks)] + cmd
     env = {**os.environ, "OMPI_MCA_rmaps_base_oversubscribe": "1", "OPENBLAS_NUM_THREADS": "1",
@@ -62,3 +63,13 @@ def needs_petsc_venv():
     reason = skip_reason()
     if reason:
         pytest.skip(reason)
+
+
+def run_batch(cases, ranks: int, tmp_path: Path, specs: dict, *, mpirun=True) -> dict:
+    """One driver launch for several cases (``specs``: case -> list of solver specs); returns
+    case -> loaded .npz."""
+    proc, data = run_driver(",".join(cases), ranks, tmp_path, specs, mpirun=mpirun)
+    if len(cases) == 1:
+        return {cases[0]: data}
+    out = tmp_path / f"{','.join(cases)}-{ranks}.npz"
+    return {c: np.load(out.with_suffix(f".{c}.npz"), allow_pickle=False) for c in cases}

@@ -1,9 +1,11 @@
-"""MPI driver of tests/petsc: solve one bundled case with the PETSc backend, once per solver
+"""MPI driver of tests/petsc: solve bundled cases with the PETSc backend, once per solver
 spec, and save on rank 0 the mesh, then per solve the gathered solution, matrix and facts.
 
-Usage: mpirun -n N .venv-petsc/bin/python tests/petsc/driver.py CASE OUT.npz SOLVERS_JSON
-SOLVERS_JSON: a list of {"method", "preconditioner", "rtol", "petsc_options", "pvtu"} (any may be
-left out; "pvtu": true also writes solution{k}.pvtu and its pieces next to OUT).
+Usage: mpirun -n N .venv-petsc/bin/python tests/petsc/driver.py CASES OUT.npz SOLVERS_JSON
+CASES: one name, or several separated by commas (one launch for all; case c is then saved to
+OUT with ``.c.npz`` for ``.npz``). SOLVERS_JSON: a list of {"method", "preconditioner", "rtol",
+"petsc_options", "pvtu"} (any may be left out; "pvtu": true also writes solution{k}.pvtu and
+its pieces next to OUT), or {case: list} per case.
 """
 
 import json
@@ -18,8 +20,14 @@ from problems import CASES, make_mesh, mesh_arrays  # noqa: E402
 
 
 def main(argv):
-    name, out = argv[0], argv[1]
+    names, out = argv[0].split(","), argv[1]
     specs = json.loads(argv[2]) if len(argv) > 2 else [{}]
+    for name in names:
+        target = out if len(names) == 1 else str(Path(out).with_suffix(f".{name}.npz"))
+        solve_case(name, target, specs[name] if isinstance(specs, dict) else specs)
+
+
+def solve_case(name, out, specs):
     from femkit.solvers.petsc import require_petsc
     from femkit.fem.distributed.assembly import gather_matrix
     from femkit.solvers.petsc.failure import abort_on_error

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from conftest import run_driver
+from conftest import run_batch, run_driver
 from problems import CASES, mesh_from_arrays
 
 
@@ -66,12 +66,29 @@ def assert_same_matrix(A_petsc, A_serial):
     assert A_petsc.nnz == A_serial.nnz
 
 
+@pytest.fixture(scope="module")
+def batch(tmp_path_factory):
+    """One driver launch per (ranks, mpirun) group of RUNS, made when first needed."""
+    done = {}
+
+    def get(case, ranks, mpirun):
+        key = (ranks, mpirun)
+        if key not in done:
+            cases = [c for c, n, m in RUNS if (n, m) == key]
+            done[key] = run_batch(cases, ranks, tmp_path_factory.mktemp(f"r{ranks}"),
+                                  {c: [{"rtol": RTOL.get(c, 1e-10)}] for c in cases},
+                                  mpirun=mpirun)
+        return done[key][case]
+
+    return get
+
+
 @pytest.mark.parametrize("case,ranks,mpirun", RUNS,
                          ids=[f"{c}-{n}rank{'s' if n > 1 else ''}{'' if m else '-no-mpirun'}"
                               for c, n, m in RUNS])
-def test_matches_serial(case, ranks, mpirun, tmp_path):
+def test_matches_serial(case, ranks, mpirun, batch):
     rtol = RTOL.get(case, 1e-10)
-    _, data = run_driver(case, ranks, tmp_path, [{"rtol": rtol}], mpirun=mpirun)
+    data = batch(case, ranks, mpirun)
     facts = json.loads(str(data["facts0"]))
     A, u_serial, res_serial, errors_serial = serial_reference(case, data, rtol=rtol)
     assert facts["converged"], facts
