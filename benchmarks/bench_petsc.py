@@ -13,6 +13,7 @@ own process (so peak memory is per run):
 - PETSc backend on 1 and 2 ranks (``mpirun -n N``), PCG + ``amg`` (hypre BoomerAMG) and
   PCG + ``amg_sa`` (GAMG).
 
+Last line: the COO assembly split into local matrices, pattern and values (one process).
 Per row: mesh (generate + refine on rank 0, broadcast), partition, assembly (COO pattern +
 stiffness values + load + Dirichlet elimination; serial: pattern + stiffness + load + Dirichlet), setup (AMG hierarchy), solve, iterations, and peak resident memory per
 rank (``ru_maxrss``). Times are the maximum over ranks. BLAS threads are pinned to 1.
@@ -93,6 +94,37 @@ def worker_petsc(levels: int, rtol: float, pc: str) -> dict | None:
                 "converged": r.converged, "peak_mb": peaks, "u_max": float(sol.u.max())}
 
 
+def coo_split(levels: int) -> str:
+    """The COO assembly's parts on one process: local matrices (numpy), the pattern
+    (MatSetPreallocationCOO, once) and the values (MatSetValuesCOO, min of 3 repeats)."""
+    import numpy as np
+
+    from femkit.fem import local_stiffness
+    from femkit.solvers.petsc import coo, require_petsc
+
+    PETSc = require_petsc()
+    mesh = make_mesh(levels)
+    t0 = time.perf_counter()
+    local = local_stiffness(mesh, 1.0)
+    t_local = time.perf_counter() - t0
+    d = mesh.triangles.astype(PETSc.IntType)
+    n = mesh.n_points
+    A = PETSc.Mat().create(comm=PETSc.COMM_SELF)
+    A.setSizes(((n, n), (n, n)))
+    A.setType("aij")
+    t0 = time.perf_counter()
+    coo.set_pattern(A, np.repeat(d, 3, axis=1).ravel(), np.tile(d, (1, 3)).ravel())
+    t_pattern = time.perf_counter() - t0
+    t_values = []
+    for _ in range(3):
+        t0 = time.perf_counter()
+        coo.set_values(A, local.reshape(-1))
+        t_values.append(time.perf_counter() - t0)
+    return (f"COO assembly, one process, {local.size:,} triplets: local matrices {t_local:.3f} s, "
+            f"pattern (MatSetPreallocationCOO, once) {t_pattern:.3f} s, values "
+            f"(MatSetValuesCOO) {min(t_values):.3f} s")
+
+
 def _max():
     from mpi4py import MPI
 
@@ -116,11 +148,14 @@ def main() -> None:
     ap.add_argument("--levels", type=int, default=6, help="refinements of the h=0.05 mesh (6: ~1.9M unknowns)")
     ap.add_argument("--rtol", type=float, default=1e-8)
     ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2])
-    ap.add_argument("--worker", choices=["serial", "petsc"], help=argparse.SUPPRESS)
+    ap.add_argument("--worker", choices=["serial", "petsc", "coo"], help=argparse.SUPPRESS)
     ap.add_argument("--pc", default="amg", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.worker == "serial":
         print(json.dumps(worker_serial(args.levels, args.rtol)))
+        return
+    if args.worker == "coo":
+        print(json.dumps({"line": coo_split(args.levels)}))
         return
     if args.worker == "petsc":
         out = worker_petsc(args.levels, args.rtol, args.pc)
@@ -145,6 +180,7 @@ def main() -> None:
               f"{ratio:21.2f}  {', '.join(f'{m:.0f}' for m in r['peak_mb'])}"
               f"{'' if r['converged'] else '  NOT CONVERGED'}")
         assert abs(r["u_max"] - base["u_max"]) <= 1e-6 * abs(base["u_max"]), (r["row"], r["u_max"])
+    print(run_row(args, ["--worker", "coo"], None)["line"])
 
 
 if __name__ == "__main__":
