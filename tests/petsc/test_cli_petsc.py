@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import os
 import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -59,6 +58,12 @@ def test_solve_backend_petsc_matches_serial(case, ranks, tmp_path):
     assert petsc["converged"] and petsc["solver"]["iterations"] == len(petsc["solver"]["residuals"]) - 1
     assert (petsc["dofs"], petsc["nnz"], petsc["mesh"]) == (serial["dofs"], serial["nnz"], serial["mesh"])
     assert set(petsc["timings"]) >= set(serial["timings"]) - {"output"}
+    assert petsc["n_dirichlet"] == serial["n_dirichlet"]
+    if serial["nullspace"] is not None:  # pure Neumann: the same constant fixing, the same data check
+        for key in ("mode", "how"):
+            assert petsc["nullspace"][key] == serial["nullspace"][key]
+        assert petsc["nullspace"]["source_integral"] == pytest.approx(
+            serial["nullspace"]["source_integral"], rel=1e-9, abs=1e-14)
     p0, u0 = read_u(tmp_path / "serial" / "solution.vtu")
     p1, u1 = read_u(tmp_path / "petsc" / "solution.vtu")
     np.testing.assert_array_equal(p0, p1)

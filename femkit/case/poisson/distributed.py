@@ -94,12 +94,8 @@ def _run(case, comm, output_dir, quiet, write, echo):
                 **{k: info[k] for k in ("pc_hypre_type", "factor_solver_type") if k in info},
                 "partition": sol.partition, "gathered": gather, "gather_limit": limit,
                 "timings_detail": dict(t), "timings_are": "the maximum over ranks per stage"}
-    nullspace = None
-    if system.mode is not None:
-        nullspace = {"mode": system.mode, "how": f"node {problem.pin_node} pinned"
-                     + (", shifted to mean zero" if system.mode == "mean_zero" else ""),
-                     **system.compatibility}
-    n_fixed = int((system.layout.dof < 0).sum())
+    nullspace = _nullspace_facts(system)
+    n_fixed = len(system.fixed)
     result = CaseResult(case=case, mesh=mesh, u=sol.u, kappa=problem.kappa, solve=res,
                         errors=sol.errors, timings=stage.times, quality=q,
                         dofs=int(system.layout.dof_offsets[-1]),

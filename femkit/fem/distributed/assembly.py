@@ -41,6 +41,12 @@ class DistributedSystem:
     weights: object = None
     compatibility: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
+    bordered: bool = False  # never: pure Neumann pins a node (as the serial iterative path)
+
+    @property
+    def fixed(self) -> np.ndarray:
+        """Original ids of the eliminated nodes (Dirichlet, or the pinned node), sorted."""
+        return np.flatnonzero(self.layout.dof < 0)
 
 
 def node_vector(layout: Layout, comm):
