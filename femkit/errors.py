@@ -11,8 +11,9 @@ Hierarchy::
     │   ├── CaseFileError          case/scene/study file: schema, keys, types, paths
     │   ├── ExpressionError        unsafe or malformed expression in a case file
     │   ├── UnknownNameError       unknown solver / preconditioner / integrator / geometry name
-    │   └── MeshError              unreadable or invalid mesh
-    │       └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
+    │   ├── MeshError              unreadable or invalid mesh
+    │   │   └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
+    │   └── AdaptivityError        bad adaptive-refinement setting (theta, target, budgets)
     ├── SolverError                a linear solver could not do what was asked
     │   ├── NotSPDError            input to CG-type method is not symmetric positive definite
     │   └── SingularSystemError    singular system (e.g. pure Neumann, inconsistent rhs)
@@ -74,6 +75,11 @@ class DegenerateMeshError(MeshError):
     def __init__(self, message: str, element_ids=()):
         self.element_ids = list(element_ids)
         super().__init__(message)
+
+
+class AdaptivityError(InputError):
+    """A bad setting of adaptive refinement: Dörfler ``theta`` outside (0, 1], a target
+    estimate <= 0, a dof / time / level budget <= 0, an unknown estimator."""
 
 
 class SolverError(FemkitError):

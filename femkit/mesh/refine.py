@@ -69,6 +69,28 @@ def boundary_nodes(mesh: Mesh, tags: Iterable | str | int | None = None) -> np.n
     return np.unique(mesh.boundary_edges[sel])
 
 
+def edge_ids(mesh: Mesh, edge_nodes: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """Index in ``edge_nodes`` (from :func:`edges`) of each node pair in ``pairs`` (k, 2), any order.
+
+    Raises :class:`~femkit.errors.MeshError` when a pair is not an edge of any triangle.
+    """
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    n = max(mesh.n_points, 1)
+    keys = edge_nodes[:, 0] * n + edge_nodes[:, 1]
+    q = pairs.min(axis=1) * n + pairs.max(axis=1)
+    pos = np.minimum(np.searchsorted(keys, q), max(len(keys) - 1, 0))
+    bad = np.flatnonzero(keys[pos] != q) if len(keys) else np.arange(len(pairs))
+    if len(bad):
+        raise MeshError(f"{len(bad)} boundary edge(s) are not edges of any triangle "
+                        f"(edge ids {', '.join(map(str, bad[:10]))})")
+    return pos
+
+
+def boundary_edge_ids(mesh: Mesh, edge_nodes: np.ndarray) -> np.ndarray:
+    """Index in ``edge_nodes`` of each tagged boundary edge of ``mesh`` (see :func:`edge_ids`)."""
+    return edge_ids(mesh, edge_nodes, mesh.boundary_edges)
+
+
 def _refine_once(mesh: Mesh) -> Mesh:
     n = mesh.n_points
     edge_nodes, tri_edges = edges(mesh)
@@ -88,14 +110,7 @@ def _refine_once(mesh: Mesh) -> Mesh:
 
     be = mesh.boundary_edges
     if len(be):
-        keys = edge_nodes[:, 0] * n + edge_nodes[:, 1]
-        q = be.min(axis=1) * n + be.max(axis=1)
-        pos = np.minimum(np.searchsorted(keys, q), len(keys) - 1)
-        bad = np.flatnonzero(keys[pos] != q)
-        if len(bad):
-            raise MeshError(f"{len(bad)} tagged boundary edge(s) are not edges of any triangle "
-                            f"(edge ids {', '.join(map(str, bad[:10]))}); cannot refine")
-        bm = n + pos
+        bm = n + boundary_edge_ids(mesh, edge_nodes)
         new_be = np.stack([np.stack([be[:, 0], bm], axis=1),
                            np.stack([bm, be[:, 1]], axis=1)], axis=1).reshape(-1, 2)
         new_bt = np.repeat(mesh.boundary_tags, 2)
