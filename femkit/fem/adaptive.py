@@ -17,7 +17,7 @@ application can plug its own pipeline in; :func:`poisson_solver` builds one from
 >>> m = Mesh(pts, np.array([[0, 1, 2], [0, 2, 3]]))
 >>> run = adaptive_solve(poisson_solver(f=1.0, method="direct"), m, theta=0.5, max_levels=4)
 >>> [lv.n_elements for lv in run.levels], run.stop_reason, run.target_met
-([2, 4, 8, 12], 'max_levels', False)
+([2, 4, 6, 8], 'max_levels', False)
 """
 
 from __future__ import annotations
