@@ -13,7 +13,7 @@ import pytest
 from femkit.errors import AdaptivityError, InputError, UnknownNameError
 from femkit.fem.adaptive import adaptive_solve, check_settings, poisson_solver
 from femkit.fem.marking import dorfler_mark
-from femkit.mesh import generate
+from femkit.mesh import generate, quality
 
 sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the case builders
 from _exact_cases import lshape_grad, lshape_u  # noqa: E402
@@ -46,6 +46,10 @@ def test_adaptive_lshape_restores_the_optimal_rate(lshape_mesh, estimator):
     assert abs(_rate(run) - 0.5) <= 0.05
     eff = [lv.effectivity for lv in run.levels]
     assert 0.5 <= min(eff) and max(eff) <= 3.0
+    assert len(run.levels) >= 15
+    # graded towards the corner, shapes kept: NVB's angle bound (42.1 deg initially, 29.8 after)
+    assert quality(run.mesh)["min_angle"] >= 0.5 * quality(lshape_mesh)["min_angle"]
+    assert np.isclose(run.mesh.areas().sum(), 3.0, rtol=1e-13)
 
 
 def test_uniform_lshape_is_limited_by_the_singularity(lshape_mesh):
