@@ -1,7 +1,8 @@
 r"""Explicit residual estimator, kappa-weighted (Verfürth 1996, 2013; Bernardi & Verfürth 2000).
 
 For P1 and element-wise constant ``kappa`` the element residual is ``f`` (``div(kappa grad u_h) = 0``
-inside each triangle), and
+inside each triangle; a callable ``kappa`` is taken at the barycentre, as the stiffness assembly does,
+so ``grad kappa . grad u_h`` is neglected), and
 
 .. math::
 
