@@ -241,7 +241,8 @@ def _stop_reason(settings: dict, rec: LevelRecord, n_levels: int) -> str | None:
 def _uniform_step(mesh):
     """Uniform red refinement as a :class:`~femkit.mesh.bisect.Bisection` (same prolongation)."""
     from ..mesh.bisect import Bisection
-    from ..mesh.refine import edges, refine
+    from ..mesh.edges import edges
+    from ..mesh.refine import refine
 
     edge_nodes, _ = edges(mesh)
     return Bisection(mesh=refine(mesh), parent=np.repeat(np.arange(mesh.n_triangles), 4),

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import InputError
 from .mesh import Mesh
-from .refine import boundary_edge_ids, edges
+from .edges import boundary_edge_ids, edges
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ import pytest
 from femkit.errors import InputError
 from femkit.mesh import Mesh, edges, generate, quality
 from femkit.mesh.bisect import bisect, closure, label_longest_edge
-from femkit.mesh.refine import boundary_edges_topological
+from femkit.mesh.edges import boundary_edges_topological
 
 
 def _corner_marks(mesh, frac=0.2):

@@ -32,7 +32,7 @@ class ElementFields:
 def element_fields(mesh, u: np.ndarray, kappa) -> ElementFields:
     """Gradients, kappa and the edge structure of ``mesh`` for the P1 function ``u``."""
     from ...errors import InputError
-    from ...mesh.refine import edges
+    from ...mesh.edges import edges
 
     u = np.asarray(u, dtype=np.float64)
     if u.shape != (mesh.n_points,):

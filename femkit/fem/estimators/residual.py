@@ -80,7 +80,7 @@ def residual_estimator(mesh, u: np.ndarray, *, kappa=1.0, f=0.0, neumann: Sequen
     ErrorEstimate
         ``parts``: ``volume``, ``jump``, ``neumann`` (each ``(m,)``, squared).
     """
-    from ...mesh.refine import edge_ids
+    from ...mesh.edges import edge_ids
     from ..neumann import tagged_edges
 
     fl = element_fields(mesh, u, kappa)
