@@ -71,8 +71,9 @@ class LevelRecord:
 class AdaptiveResult:
     """Outcome of :func:`adaptive_solve`.
 
-    ``levels`` one :class:`LevelRecord` per solved level; ``mesh``, ``u``, ``problem`` and
-    ``estimate`` (an :class:`~femkit.fem.estimators.ErrorEstimate`) of the last level;
+    ``levels`` one :class:`LevelRecord` per solved level; ``mesh``, ``u``, ``problem``,
+    ``estimate`` (an :class:`~femkit.fem.estimators.ErrorEstimate`) and ``result`` (the solver's
+    SolveResult) of the last level;
     ``target_met`` whether the estimate reached ``target``; ``stop_reason`` one of
     ``target``, ``max_dofs``, ``max_time``, ``max_levels``, ``no_marked`` (zero estimate).
     """
@@ -85,6 +86,7 @@ class AdaptiveResult:
     target_met: bool
     stop_reason: str
     settings: dict = field(default_factory=dict)
+    result: object = None
 
     @property
     def total_time(self) -> float:
@@ -222,7 +224,8 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
             callback(rec)
         if stop is not None:
             return AdaptiveResult(levels=levels, mesh=mesh, u=u, problem=problem, estimate=est,
-                                  target_met=stop == "target", stop_reason=stop, settings=settings)
+                                  target_met=stop == "target", stop_reason=stop, settings=settings,
+                                  result=result)
         x0 = step.prolong(u)
         mesh = step.mesh
 
@@ -249,32 +252,55 @@ def _uniform_step(mesh):
                      new_node_edges=edge_nodes)
 
 
+def problem_solver(make_problem: Callable, solve: Callable, method: str = "pcg") -> Callable:
+    """A ``solve_on(mesh, x0)`` for :func:`adaptive_solve` from a problem builder and a solver.
+
+    Parameters
+    ----------
+    make_problem : callable ``mesh -> PoissonProblem``
+        Builds the problem on each level's mesh (an application's own translation of its input).
+    solve : callable ``(A, b, x0) -> SolveResult``
+        The linear solver (e.g. :meth:`femkit.solvers.SolverSpec.solve`).
+    method : str
+        Solver name: the system is reduced for it (pure Neumann: bordered only for ``direct``), and
+        ``x0`` (the full nodal vector) is restricted to the system's unknowns unless it is ``direct``.
+    """
+    def solve_on(mesh, x0=None):
+        problem = make_problem(mesh)
+        system = problem.reduce(*problem.assemble_matrices(), method=method)
+        start = None
+        if x0 is not None and method != "direct":
+            start = np.asarray(x0, dtype=np.float64)[system.free]
+            if start.shape != (system.A.shape[0],):
+                start = None                      # bordered system: no nodal start
+        result = solve(system.A, system.b, start)
+        return problem, system.expand(result.x), result
+
+    return solve_on
+
+
 def poisson_solver(kappa=1.0, f=0.0, *, dirichlet: Sequence = ((None, 0.0),), neumann: Sequence = (),
                    nullspace: str | None = None, load_rule: str = "barycentric",
                    method: str = "pcg", preconditioner=None, **solver_opts) -> Callable:
     """A ``solve_on(mesh, x0)`` for :func:`adaptive_solve` from Poisson data.
 
-    Arguments as in :class:`~femkit.fem.PoissonProblem` and :meth:`~femkit.fem.PoissonProblem.solve`
+    Arguments as in :class:`~femkit.fem.PoissonProblem` and :func:`femkit.solvers.solve`
     (``kappa`` must not be a per-element array: the mesh changes; use a number, a region table or
     a callable). ``x0`` (full nodal vector) is restricted to the unknowns of the reduced system and
     handed to the solver as its initial guess.
     """
+    from ..solvers import solve
     from .poisson import PoissonProblem
 
     if isinstance(kappa, np.ndarray) and kappa.ndim > 0:
         raise AdaptivityError("kappa must be a number, a region table or a callable for adaptive "
                               "refinement (a per-element array does not follow the mesh)")
 
-    def solve_on(mesh, x0=None):
-        problem = PoissonProblem(mesh, kappa, f, dirichlet=dirichlet, neumann=neumann,
-                                 nullspace=nullspace, load_rule=load_rule)
-        opts = dict(solver_opts)
-        if x0 is not None and method != "direct":
-            system = problem.assemble(method)
-            start = np.asarray(x0, dtype=np.float64)[system.free]
-            if start.shape == (system.A.shape[0],):
-                opts["x0"] = start
-        u, result = problem.solve(method, preconditioner, **opts)
-        return problem, u, result
+    def make_problem(mesh):
+        return PoissonProblem(mesh, kappa, f, dirichlet=dirichlet, neumann=neumann,
+                              nullspace=nullspace, load_rule=load_rule)
 
-    return solve_on
+    def solve_system(A, b, x0):
+        return solve(A, b, x0, method=method, preconditioner=preconditioner, **solver_opts)
+
+    return problem_solver(make_problem, solve_system, method)
