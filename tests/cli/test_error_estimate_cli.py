@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import pytest
@@ -12,16 +13,11 @@ from femkit.cli import main
 
 ROOT = Path(__file__).parents[2]
 
-SMALL = {
-    "problem": "poisson",
-    "mesh": {"geometry": "unit_square", "h": 0.1},
-    "source": "2*pi**2*sin(pi*x)*sin(pi*y)",
-    "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
-    "exact": {"u": "sin(pi*x)*sin(pi*y)",
-              "grad": ["pi*cos(pi*x)*sin(pi*y)", "pi*sin(pi*x)*cos(pi*y)"]},
-    "solver": {"method": "direct"},
-    "output": {"dir": "out", "vtu": False},
-}
+sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the CLI tests' small case
+from test_cli import SMALL as _SMALL  # noqa: E402
+
+SMALL = {**_SMALL, "mesh": {"geometry": "unit_square", "h": 0.1}, "solver": {"method": "direct"},
+         "output": {"dir": "out", "vtu": False}}
 
 LSHAPE = yaml.safe_load((ROOT / "cases" / "poisson_lshape_adaptive.yaml").read_text())
 
