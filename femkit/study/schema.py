@@ -14,8 +14,6 @@ from ..case.specs import INTEGRATOR_SCHEMA, solver_schema
 
 POS = {"type": "number", "exclusiveMinimum": 0}
 POSINT = {"type": "integer", "minimum": 1}
-EXPR = {"oneOf": [{"type": "string", "minLength": 1}, {"type": "number"}],
-        "x-message": "must be a number or an expression of x and y"}
 
 
 def _obj(props: dict, required=(), **extra) -> dict:

@@ -66,9 +66,10 @@ def prepare_poisson(case: Case) -> None:
             raise CaseFileError(f"mesh.{bad}: only used with mesh.geometry, not with mesh.file")
     else:
         check_geometry_spec(mesh, "mesh")
+    from ...solvers.defaults import DEFAULT_METHOD
     from ..specs import solver_spec
 
-    case.solver = solver_spec(d["solver"], "solver", default_method="pcg")
+    case.solver = solver_spec(d["solver"], "solver", default_method=DEFAULT_METHOD["poisson"])
     d["solver"] = case.solver.to_dict()
 
     from ...fem.quadrature import QUADRATURE

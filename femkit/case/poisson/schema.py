@@ -137,6 +137,3 @@ POISSON_SCHEMA: dict = {
         },
     },
 }
-
-#: Load quadrature rules a case may name (checked against femkit.fem when available).
-LOAD_RULES = ("barycentric", "gauss3", "gauss6", "gauss7")
