@@ -7,7 +7,7 @@ counter-clockwise when the parent is, each with ``m`` as its newest vertex, so t
 refinement edges are the parent's two other edges (Mitchell 1991; Binev, Dahmen & DeVore 2004).
 Every triangle produced by repeated bisection is similar to one of at most four triangles per
 initial triangle (Sewell 1972; Mitchell 1991), so the minimum angle stays bounded below by a
-constant of the initial mesh, however many times one refines.
+constant of the initial mesh, however many times one refines: :func:`min_angle_bound` computes it.
 
 :func:`label_longest_edge` rotates each triangle so that its longest edge is its refinement edge
 (a valid initial labelling: the closure terminates and refines no edge more than once per call).
@@ -35,6 +35,7 @@ import numpy as np
 
 from ..errors import InputError
 from .mesh import Mesh
+from .quality import side_lengths_and_angles
 from .edges import boundary_edge_ids, edges
 
 
@@ -86,6 +87,26 @@ def label_longest_edge(mesh: Mesh) -> Mesh:
     return Mesh(points=mesh.points, triangles=tri, cell_tags=mesh.cell_tags,
                 boundary_edges=mesh.boundary_edges, boundary_tags=mesh.boundary_tags,
                 tag_names=mesh.tag_names)
+
+
+def min_angle_bound(mesh: Mesh, generations: int = 4) -> float:
+    """The minimum angle (degrees) newest-vertex bisection can ever produce from ``mesh``.
+
+    Every descendant of a labelled triangle is similar to one of its descendants of the first few
+    generations (at most four similarity classes: Sewell 1972, Mitchell 1991), so the minimum over
+    ``generations`` bisections of every triangle, each on its own, bounds all later meshes below.
+    Vectorised over the triangles (``3 * 2^generations`` angles each).
+    """
+    p = mesh.points[mesh.triangles]                       # (m, 3, 2) labelled: v0 newest
+    tris = [p]
+    cur = p
+    for _ in range(int(generations)):
+        v0, v1, v2 = cur[:, 0], cur[:, 1], cur[:, 2]
+        m = 0.5 * (v1 + v2)
+        cur = np.concatenate([np.stack([m, v0, v1], axis=1), np.stack([m, v2, v0], axis=1)])
+        tris.append(cur)
+    _, angles = side_lengths_and_angles(np.concatenate(tris))
+    return float(angles.min())
 
 
 def _marked_elements(mesh: Mesh, marked) -> np.ndarray:
