@@ -140,3 +140,26 @@ def test_unknown_estimator_lists_the_valid_ones():
 def test_per_element_kappa_array_is_refused():
     with pytest.raises(AdaptivityError, match="per-element array"):
         poisson_solver(np.ones(10))
+
+
+@pytest.mark.parametrize("method", ["pcg", "direct"])
+def test_pure_neumann_problem_refines_with_either_solver(method):
+    """The nullspace systems (pinned for PCG, bordered for direct) go through the loop too."""
+    from _exact_cases import poisson_neumann
+
+    prob, grad = poisson_neumann(0.2)
+    solve_on = poisson_solver(prob.kappa, prob.f, dirichlet=[], neumann=prob.neumann,
+                              nullspace="mean_zero", method=method)
+    run = adaptive_solve(solve_on, prob.mesh, theta=0.5, max_levels=6, grad_exact=grad)
+    err = [lv.error for lv in run.levels]
+    assert err[-1] < 0.6 * err[0]
+    assert all(0.5 <= lv.effectivity <= 3.0 for lv in run.levels)
+    assert abs(float(run.problem.system.weights @ run.u)) < 1e-10     # mean zero kept
+
+
+def test_target_on_true_error_needs_an_exact_gradient(lshape_mesh):
+    run = adaptive_solve(_lshape_solver(), lshape_mesh, target=0.05, target_on="error",
+                         grad_exact=lshape_grad)
+    assert run.target_met and run.levels[-1].error <= 0.05 < run.levels[-2].error
+    with pytest.raises(AdaptivityError, match="target_on"):
+        adaptive_solve(_lshape_solver(), lshape_mesh, target=0.05, target_on="error")
