@@ -13,6 +13,7 @@ Hierarchy::
     │   ├── UnknownNameError       unknown solver / preconditioner / integrator / geometry name
     │   ├── MeshError              unreadable or invalid mesh
     │   │   └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
+    │   ├── AdaptivityError        bad adaptive-refinement setting (theta, target, budgets)
     │   └── BackendUnavailableError  a solver backend (PETSc: petsc4py, mpi4py) cannot be
     │                              imported; the message names scripts/install-petsc.sh
     ├── SolverError                a linear solver could not do what was asked
@@ -92,6 +93,11 @@ class RankFailureError(FemkitError):
         self.rank = rank
         self.message = message
         super().__init__(f"rank {rank} failed: {message}")
+
+
+class AdaptivityError(InputError):
+    """A bad setting of adaptive refinement: Dörfler ``theta`` outside (0, 1], a target
+    estimate <= 0, a dof / time / level budget <= 0, an unknown estimator."""
 
 
 class SolverError(FemkitError):

@@ -57,6 +57,21 @@ POISSON = {
     "stop_at_discretisation_error": _obj({"fraction": {**POS, "default": 0.1}}),
 }
 
+ADAPTIVE = {
+    "problem": PROBLEM,
+    "base_case": {"type": "string"},
+    "h0": {**POS, "description": "initial mesh size of a generated mesh (default: the case's mesh.h)"},
+    "estimators": {"type": "array", "items": {"type": "string"}, "minItems": 1, "default": ["residual"]},
+    "theta": {"type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.5},
+    "target": POS,
+    "max_dofs": {"type": "integer", "exclusiveMinimum": 0},
+    "max_time": POS,
+    "max_levels": {**POSINT, "default": 40},
+    "fit_min_dofs": {**POSINT, "default": 200},
+    "solvers": {"type": "array", "items": SOLVER, "minItems": 1, "maxItems": 1,
+                "default": [{"method": "pcg", "preconditioner": "amg", "rtol": 1e-8}]},
+}
+
 SCENE = _obj({
     "type": {"enum": ["harmonic_oscillator", "single_spring", "rope"]},
     "k": {**POS, "default": 100.0},

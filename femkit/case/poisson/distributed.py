@@ -9,7 +9,9 @@ solves with the PETSc backend; errors against ``exact`` are reduced over ranks. 
 the same outputs as a serial run (``result.json`` with ``backend: petsc`` and a ``parallel``
 section: ranks, KSP/PC used, partition; every stage time the maximum over ranks) and
 ``solution.vtu`` gathered on rank 0 when the mesh has at most :data:`GATHER_LIMIT` nodes
-(``output.gather_limit``), else ``solution.pvtu`` with one ``.vtu`` piece per rank.
+(``output.gather_limit``), else ``solution.pvtu`` with one ``.vtu`` piece per rank. The error
+estimate (``error_estimate``, ``effectivity``) is computed on rank 0 from the gathered solution
+(serially), and left out above the gather limit. ``adaptive:`` runs on the femkit backend only.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from __future__ import annotations
 import os
 from typing import Any, Callable
 
+from ...errors import InputError
 from ..load import Case
 
 #: Largest number of mesh nodes whose solution is gathered on rank 0 (solution.vtu); above it
@@ -55,6 +58,9 @@ def _run(case, comm, output_dir, quiet, write, echo):
 
     mpi = comm.tompi4py()
     rank, size = comm.getRank(), comm.getSize()
+    if case.data.get("adaptive"):  # the same check on every rank: all exit 2, rank 0 says it
+        raise InputError("adaptive: adaptive refinement runs on the femkit backend only; remove "
+                         "adaptive or use solver.backend: femkit")
     stage = StageTimer()
     target = None
     if write:
@@ -94,13 +100,23 @@ def _run(case, comm, output_dir, quiet, write, echo):
                 **{k: info[k] for k in ("pc_hypre_type", "factor_solver_type") if k in info},
                 "partition": sol.partition, "gathered": gather, "gather_limit": limit,
                 "timings_detail": dict(t), "timings_are": "the maximum over ranks per stage"}
+    estimate = effectivity = indicators = None
+    if sol.u is not None:  # rank 0, gathered: the serial estimator on the whole solution
+        from .estimate import estimate_facts
+
+        with stage("estimate"):
+            estimate, effectivity, est = estimate_facts(case, problem, sol.u, exact_gradient(case))
+        indicators = est.indicators
+    elif rank == 0:
+        parallel["not_computed"] = ["error_estimate (needs the gathered solution)"]
     nullspace = _nullspace_facts(system)
     n_fixed = len(system.fixed)
     result = CaseResult(case=case, mesh=mesh, u=sol.u, kappa=problem.kappa, solve=res,
                         errors=sol.errors, timings=stage.times, quality=q,
                         dofs=int(system.layout.dof_offsets[-1]),
                         n_dirichlet=0 if system.mode is not None else n_fixed, nnz=nnz,
-                        nullspace=nullspace, parallel=parallel)
+                        nullspace=nullspace, parallel=parallel, error_estimate=estimate,
+                        effectivity=effectivity, indicators=indicators)
     if write:
         _write(result, target, sol, mesh, problem, comm, gather)
     if not quiet and rank == 0:
