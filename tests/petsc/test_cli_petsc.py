@@ -59,6 +59,9 @@ def test_solve_backend_petsc_matches_serial(case, ranks, tmp_path):
     assert (petsc["dofs"], petsc["nnz"], petsc["mesh"]) == (serial["dofs"], serial["nnz"], serial["mesh"])
     assert set(petsc["timings"]) >= set(serial["timings"]) - {"output"}
     assert petsc["n_dirichlet"] == serial["n_dirichlet"]
+    # the error estimate (computed on rank 0 from the gathered solution) matches the serial one
+    assert petsc["error_estimate"]["energy"] == pytest.approx(serial["error_estimate"]["energy"],
+                                                              rel=1e-6)
     if serial["nullspace"] is not None:  # pure Neumann: the same constant fixing, the same data check
         for key in ("mode", "how"):
             assert petsc["nullspace"][key] == serial["nullspace"][key]
