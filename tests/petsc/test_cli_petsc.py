@@ -138,3 +138,13 @@ def test_solver_spec_errors_at_load(solver, words, tmp_path, capsys):
 
     assert main(["solve", str(path), "--output", str(tmp_path / "out")]) == 2
     assert words in capsys.readouterr().err
+
+
+@pytest.mark.usefixtures("needs_petsc_venv")
+def test_adaptive_case_refuses_the_petsc_backend(tmp_path):
+    proc = femkit(["solve", ROOT / "cases" / "poisson_lshape_adaptive.yaml", "--backend", "petsc",
+                   "--output", tmp_path / "out"], check=False)
+    assert proc.returncode == 2
+    assert proc.stderr.strip() == ("femkit: error: adaptive: adaptive refinement runs on the femkit "
+                                   "backend only; remove adaptive or use solver.backend: femkit")
+    assert not (tmp_path / "out").exists()
