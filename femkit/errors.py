@@ -11,8 +11,10 @@ Hierarchy::
     │   ├── CaseFileError          case/scene/study file: schema, keys, types, paths
     │   ├── ExpressionError        unsafe or malformed expression in a case file
     │   ├── UnknownNameError       unknown solver / preconditioner / integrator / geometry name
-    │   └── MeshError              unreadable or invalid mesh
-    │       └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
+    │   ├── MeshError              unreadable or invalid mesh
+    │   │   └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
+    │   └── HierarchyError         geometric multigrid (gmg, fmg) asked for without a matching
+    │                              nested mesh hierarchy (the message names amg_rs)
     ├── SolverError                a linear solver could not do what was asked
     │   ├── NotSPDError            input to CG-type method is not symmetric positive definite
     │   └── SingularSystemError    singular system (e.g. pure Neumann, inconsistent rhs)
@@ -74,6 +76,12 @@ class DegenerateMeshError(MeshError):
     def __init__(self, message: str, element_ids=()):
         self.element_ids = list(element_ids)
         super().__init__(message)
+
+
+class HierarchyError(InputError):
+    """Geometric multigrid (preconditioner ``gmg``, method ``fmg``) was asked for without a nested
+    mesh hierarchy, or with one that does not match the system; the message names the algebraic
+    alternative (``amg_rs``)."""
 
 
 class SolverError(FemkitError):

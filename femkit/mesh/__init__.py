@@ -1,18 +1,22 @@
-"""Meshes: the record, gmsh generation, meshio I/O, validation, refinement, quality.
+"""Meshes: the record, gmsh generation, meshio I/O, validation, refinement, nested hierarchies,
+renumbering, quality.
 
 Importing this package is cheap: gmsh and meshio are imported inside the functions that need
 them (generation and file I/O).
 """
 
 from .geometries import GEOMETRIES, generate, geo_file
+from .hierarchy import MeshHierarchy
 from .io import read_mesh, write_mesh
 from .mesh import Mesh
 from .quality import quality
-from .refine import boundary_edges_topological, boundary_nodes, edges, refine
+from .refine import boundary_edges_topological, boundary_nodes, edges, refine, refine_once
+from .renumber import permute_nodes, rcm_permutation, renumber
 from .validate import check_tags, orient_ccw, remove_unreferenced, validate
 
 __all__ = [
     "Mesh", "generate", "GEOMETRIES", "geo_file", "read_mesh", "write_mesh", "validate",
     "check_tags", "remove_unreferenced", "orient_ccw", "refine", "quality", "boundary_nodes",
-    "boundary_edges_topological", "edges",
+    "boundary_edges_topological", "edges", "refine_once", "MeshHierarchy", "renumber",
+    "rcm_permutation", "permute_nodes",
 ]
