@@ -173,8 +173,8 @@ def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | 
     if mg is None:
         if hierarchy is None:
             raise _hierarchy_error("method 'fmg'")
-        mg = Multigrid(prob.A, hierarchy, free=free, sweeps=sweeps,
-                       omega=DEFAULT_OMEGA if omega is None else omega)
+        mg = Multigrid(prob.A, hierarchy, free=free, sweeps=sweeps,  # symmetry checked above
+                       omega=DEFAULT_OMEGA if omega is None else omega, check_symmetry=False)
     elif mg.levels[-1].A.shape != prob.A.shape:
         raise InputError(f"fmg: M was built for {mg.levels[-1].A.shape}, A is {prob.A.shape}")
     top = mg.n_levels - 1

@@ -29,9 +29,9 @@ from ...errors import HierarchyError, InputError
 from ..checks import check_positive_diagonal, check_symmetric, explicit_csr
 from .base import Preconditioner
 
-#: Over-relaxation of the smoothing sweeps. Measured V(2,2) energy-norm factors (asymptotic, 5 to 7
+#: Over-relaxation of the smoothing sweeps. Measured V(2,2) energy-norm factors (asymptotic, 7
 #: levels from gmsh meshes of h = 0.5): unit square 0.114 / 0.100, L-shape 0.170 / 0.133 for
-#: omega = 1 / 1.2; 1.1 and 1.3 are worse than 1.2 (docs/methods.md). Forward SOR before and
+#: omega = 1 / 1.2; 1.1, 1.25 and 1.3 are no better (docs/methods.md). Forward SOR before and
 #: backward SOR after the coarse correction keep the cycle symmetric for any omega.
 DEFAULT_OMEGA = 1.2
 
@@ -55,8 +55,8 @@ class _Level:
         A.sum_duplicates()
         A.sort_indices()
         self.A = A
-        self.indptr = A.indptr.astype(np.int64)
-        self.indices = A.indices.astype(np.int64)
+        self.indptr = A.indptr        # scipy's index dtype (int32 below 2^31 entries): half the
+        self.indices = A.indices      # memory traffic of int64 in the sweeps
         self.data = A.data
         d = A.diagonal()
         check_positive_diagonal(d, what="the gmg preconditioner (a level operator)")
@@ -85,6 +85,9 @@ class Multigrid:
     coarse_operators : list of sparse matrices, optional
         The operators of levels ``0 .. L-1`` on their free nodes (coarsest first), e.g.
         rediscretised; default Galerkin ``P^T A P``.
+    check_symmetry : bool
+        Check ``A`` for symmetry (:class:`~femkit.errors.NotSPDError`); the ``gmg`` factory and
+        ``fmg`` skip it when PCG / ``fmg`` already checked (it costs ~ten sparse products).
 
     Attributes
     ----------
@@ -103,7 +106,7 @@ class Multigrid:
     """
 
     def __init__(self, A, hierarchy, *, free=None, sweeps: int = 2, coarse_operators=None,
-                 omega: float = DEFAULT_OMEGA):
+                 omega: float = DEFAULT_OMEGA, check_symmetry: bool = True):
         from ...mesh.hierarchy import MeshHierarchy
         from ..direct import factorize
 
@@ -122,7 +125,8 @@ class Multigrid:
             raise InputError(f"gmg: omega must be a number in (0, 2) (SOR converges for SPD "
                              f"matrices only there), got {omega!r}")
         A = explicit_csr(A, what="the gmg preconditioner")
-        check_symmetric(A, method="the gmg preconditioner")
+        if check_symmetry:
+            check_symmetric(A, method="the gmg preconditioner")
         n_fine = hierarchy.finest.n_points
         if free is None:
             free = np.ones(n_fine, dtype=bool)
@@ -235,6 +239,7 @@ def build(A, *, hierarchy=None, free=None, sweeps: int = 2, omega: float = DEFAU
     -------
     Preconditioner
         ``info``: see :class:`Multigrid` (``hierarchy``: the :class:`Multigrid` object itself).
+        ``A``'s symmetry is not checked here: :func:`femkit.solvers.pcg` checks it once.
 
     Examples
     --------
@@ -255,7 +260,7 @@ def build(A, *, hierarchy=None, free=None, sweeps: int = 2, omega: float = DEFAU
         raise _hierarchy_error("preconditioner 'gmg'")
     t0 = time.perf_counter()
     mg = Multigrid(A, hierarchy, free=free, sweeps=sweeps, coarse_operators=coarse_operators,
-                   omega=omega)
+                   omega=omega, check_symmetry=False)  # pcg checks A once
     info = dict(mg.info)
     info["hierarchy"] = mg
     return Preconditioner("gmg", mg.vcycle, mg.levels[-1].A.shape[0],
