@@ -222,6 +222,7 @@ def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | 
         r = rhs[lvl] - A_l @ x
         r0 = r.copy()
         x_start = x.copy()
+        started = bool(np.any(x_start))  # else eta measures the solution, not an error
         finest = lvl == top
         if finest:
             residuals.append(float(np.linalg.norm(r)))
@@ -251,14 +252,16 @@ def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | 
                 if res_norm <= prob.tolerance:
                     stopped_by, reason, met = "residual rule", "converged", True
                     break
-            if not finest and (target == "residual" or not credible) and cycles[lvl] >= 2:
+            if not finest and (target == "residual" or not credible or not started) \
+                    and cycles[lvl] >= 2:
                 break  # a start for the next level is all a lower level is for here
-            if target == "discretisation" and credible and alg <= fraction * eta:
+            if target == "discretisation" and credible and started and alg <= fraction * eta:
                 if finest:
                     stopped_by, reason, met = "discretisation-error estimate", "converged", True
                 break
-        etas[lvl] = eta
-        if lvl >= 2 and not eta <= ESTIMATE_DECAY * etas[lvl - 1]:
+        # a start of zeros (the coarser level had no free node) estimates nothing
+        etas[lvl] = eta if started else float("nan")
+        if math.isfinite(etas[lvl - 1]) and not eta <= ESTIMATE_DECAY * etas[lvl - 1]:
             credible = False  # from now on only the residual rule stops
         if finest:
             prob.x = x
