@@ -50,6 +50,17 @@ def prolongation(n_coarse: int, edge_nodes: np.ndarray) -> sp.csr_matrix:
     return sp.csr_matrix((data, indices, indptr), shape=(n_coarse + n_edges, n_coarse))
 
 
+def interleave_permutation(n_coarse: int, edge_nodes: np.ndarray) -> np.ndarray:
+    """Fine-level order keeping a locality-ordered coarse level local: every coarse node is
+    followed by the midpoints of its edges to higher-numbered nodes (``perm[j]`` = old id of new
+    node ``j``; old ids as :func:`femkit.mesh.refine` numbers them). A stable merge of two sorted
+    sequences, O(n); the children of a coarse triangle stay contiguous, so elements need no sort.
+    """
+    key = np.concatenate([np.arange(n_coarse, dtype=np.int64),
+                          np.asarray(edge_nodes[:, 0], dtype=np.int64)])
+    return np.argsort(key, kind="stable")
+
+
 @dataclass(frozen=True, eq=False)
 class MeshHierarchy:
     """Nested meshes, coarsest first, and the prolongations between consecutive levels.
@@ -65,8 +76,10 @@ class MeshHierarchy:
         ``injections[l][i]`` is the node of level ``l + 1`` that coarse node ``i`` becomes
         (``arange(n_l)`` without renumbering: the coarse nodes come first).
     renumbering : str
-        ``"none"`` or ``"rcm"`` (every level renumbered by reverse Cuthill-McKee,
-        :mod:`femkit.mesh.renumber`; prolongations and injections follow).
+        ``"none"`` or ``"rcm"`` (the coarsest level renumbered by reverse Cuthill-McKee,
+        :mod:`femkit.mesh.renumber`, every finer level by :func:`interleave_permutation`;
+        prolongations and injections follow).
+
     """
 
     meshes: tuple
@@ -86,7 +99,13 @@ class MeshHierarchy:
             Number of refinements (``>= 0``); the hierarchy has ``levels + 1`` meshes and its
             finest mesh equals ``refine(coarse, levels)`` (node for node when ``renumber="none"``).
         renumber : {"none", "rcm"}
-            Renumber every level for locality (see :func:`femkit.mesh.renumber.renumber`).
+            Number every level for memory locality: reverse Cuthill-McKee on the coarse mesh
+            (:func:`femkit.mesh.renumber.renumber`), then each refinement's midpoints right after
+            their edge's lower node (:func:`interleave_permutation`; RCM on every fine level costs
+            more than it saves). ``"none"``: refinement's own numbering, coarse nodes first.
+            Gauss-Seidel smooths in storage order, so the numbering changes the V-cycle slightly
+            (V(2,2) factor at 7 levels, L-shape: 0.133 with ``"none"``, 0.147 with ``"rcm"``),
+            while ``"rcm"`` makes a cycle 2.6x faster at 3.7M elements (docs/benchmarks.md).
 
         Raises
         ------
@@ -105,8 +124,8 @@ class MeshHierarchy:
             P = prolongation(n_c, edge_nodes)
             inj = np.arange(n_c, dtype=np.int64)
             if renumber != "none":
-                _, perm = _renumber(fine, renumber)
-                fine = permute_nodes(fine, perm)
+                perm = interleave_permutation(n_c, edge_nodes)
+                fine = permute_nodes(fine, perm, sort_elements=False)
                 inv = np.empty_like(perm)
                 inv[perm] = np.arange(len(perm))
                 P, inj = P[perm], inv[:n_c]

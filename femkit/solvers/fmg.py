@@ -220,8 +220,10 @@ def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | 
         else:
             x = P @ x
         r = rhs[lvl] - A_l @ x
+        # ||x - x0||_A^2 = (x - x0).(r0 - r) = x.r0 - x.r - x0.r0 + x0.r: dot products, no copies
         r0 = r.copy()
         x_start = x.copy()
+        s00 = float(x_start @ r0)
         started = bool(np.any(x_start))  # else eta measures the solution, not an error
         finest = lvl == top
         if finest:
@@ -240,7 +242,7 @@ def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | 
                 rho = max(rho, min(dA / prev_d, 0.99))
             prev_d = dA
             alg = rho / (1.0 - rho) * dA
-            eta = math.sqrt(max(float((x - x_start) @ (r0 - r)), 0.0) / 3.0)
+            eta = math.sqrt(max(float(x @ r0) - float(x @ r) - s00 + float(x_start @ r), 0.0) / 3.0)
             if finest:
                 res_norm = float(np.linalg.norm(r))
                 residuals.append(res_norm)

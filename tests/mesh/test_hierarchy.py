@@ -127,3 +127,18 @@ def test_bad_inputs_raise_specific_errors(lshape):
     with pytest.raises(InputError, match="shape"):
         H.level_free(np.ones(3, dtype=bool))
     assert len(rcm_permutation(lshape)) == lshape.n_points
+
+
+def test_rcm_hierarchy_is_a_renumbering_of_the_plain_one(lshape):
+    plain = MeshHierarchy.from_refinement(lshape, 3)
+    ren = MeshHierarchy.from_refinement(lshape, 3, renumber="rcm")
+    for a, b in zip(plain.meshes, ren.meshes):
+        key = lambda p: np.lexsort(p.T)  # noqa: E731
+        np.testing.assert_array_equal(a.points[key(a.points)], b.points[key(b.points)])
+        assert b.areas().sum() == pytest.approx(a.areas().sum(), rel=1e-14) and np.all(b.areas() > 0)
+
+    def bandwidth(m):
+        K = sp.coo_matrix(assemble_stiffness(m))
+        return int(np.abs(K.row - K.col).max())
+
+    assert bandwidth(ren.finest) < bandwidth(plain.finest) / 3   # 237 vs 805

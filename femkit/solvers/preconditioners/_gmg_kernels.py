@@ -61,3 +61,4 @@ def add_matvec(indptr, indices, data, u, y):  # pragma: no cover - compiled
             acc += data[t] * u[indices[t]]
         y[i] += acc
 
+
