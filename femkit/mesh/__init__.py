@@ -5,18 +5,20 @@ Importing this package is cheap: gmsh and meshio are imported inside the functio
 them (generation and file I/O).
 """
 
+from .edges import boundary_edges_topological, boundary_nodes, edges
 from .geometries import GEOMETRIES, generate, geo_file
 from .hierarchy import MeshHierarchy
 from .io import read_mesh, write_mesh
 from .mesh import Mesh
 from .quality import quality
-from .refine import boundary_edges_topological, boundary_nodes, edges, refine, refine_once
+from .refine import refine, refine_once
 from .renumber import permute_nodes, rcm_permutation, renumber
+from .structured import grid_triangles, structured_mesh
 from .validate import check_tags, orient_ccw, remove_unreferenced, validate
 
 __all__ = [
     "Mesh", "generate", "GEOMETRIES", "geo_file", "read_mesh", "write_mesh", "validate",
     "check_tags", "remove_unreferenced", "orient_ccw", "refine", "quality", "boundary_nodes",
-    "boundary_edges_topological", "edges", "refine_once", "MeshHierarchy", "renumber",
-    "rcm_permutation", "permute_nodes",
+    "boundary_edges_topological", "edges", "structured_mesh", "grid_triangles", "refine_once",
+    "MeshHierarchy", "renumber", "rcm_permutation", "permute_nodes",
 ]
