@@ -107,12 +107,13 @@ class Multigrid:
 
     def __init__(self, A, hierarchy, *, free=None, sweeps: int = 2, coarse_operators=None,
                  omega: float = DEFAULT_OMEGA, check_symmetry: bool = True):
-        from ...mesh.hierarchy import MeshHierarchy
         from ..direct import factorize
 
         if hierarchy is None:
             raise _hierarchy_error("geometric multigrid")
-        if not isinstance(hierarchy, MeshHierarchy):
+        # duck-typed: the solver layer does not import femkit.mesh (docs/architecture.md)
+        if not all(hasattr(hierarchy, a) for a in ("level_free", "free_prolongations",
+                                                   "prolongate", "finest")):
             raise HierarchyError(f"hierarchy must be a femkit.mesh.MeshHierarchy, got "
                                  f"{type(hierarchy).__name__}; {ALTERNATIVE}")
         if isinstance(sweeps, bool) or not isinstance(sweeps, (int, np.integer)) or sweeps < 1:
