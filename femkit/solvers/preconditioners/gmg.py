@@ -45,6 +45,14 @@ def _hierarchy_error(what: str) -> HierarchyError:
                           f"from uniform refinement), none was given; {ALTERNATIVE}")
 
 
+def _unsigned(index: np.ndarray) -> np.ndarray:
+    """An index array viewed as unsigned (no copy): numba then skips the negative-index
+    wrap-around test on every ``x[indices[t]]``, which made the sweeps 2x slower than SciPy's
+    SpMV (and 2.5x slower than with this view). scipy's own dtype is kept (int32 below 2^31
+    entries: half the memory traffic of int64)."""
+    return index.view(np.uint32 if index.dtype == np.int32 else np.uint64)
+
+
 class _Level:
     """One level: CSR arrays of ``A_l``, its inverse diagonal and work vectors."""
 
@@ -55,8 +63,8 @@ class _Level:
         A.sum_duplicates()
         A.sort_indices()
         self.A = A
-        self.indptr = A.indptr        # scipy's index dtype (int32 below 2^31 entries): half the
-        self.indices = A.indices      # memory traffic of int64 in the sweeps
+        self.indptr = _unsigned(A.indptr)
+        self.indices = _unsigned(A.indices)
         self.data = A.data
         d = A.diagonal()
         check_positive_diagonal(d, what="the gmg preconditioner (a level operator)")
@@ -143,6 +151,7 @@ class Multigrid:
         P = hierarchy.free_prolongations(frees[-1])
         self.prolongations = P
         self.restrictions = [p.T.tocsr() for p in P]
+        self._p_arrays = [(_unsigned(p.indptr), _unsigned(p.indices), p.data) for p in P]
         ops = [A]
         if coarse_operators is None:
             for lvl in range(len(P) - 1, -1, -1):
@@ -210,8 +219,7 @@ class Multigrid:
         for lvl in range(1, top + 1):
             L = self.levels[lvl]
             x = out if lvl == top else L.x
-            P = self.prolongations[lvl - 1]
-            add_matvec(P.indptr, P.indices, P.data, xc, x)
+            add_matvec(*self._p_arrays[lvl - 1], xc, x)
             gs_sweeps(L.indptr, L.indices, L.data, L.inv_diag, rhs[lvl], x, nu, False)
             xc = x
         return out
