@@ -4,7 +4,7 @@ Run by hand (not in CI)::
 
     python benchmarks/bench_multigrid.py                   # refinements 8 and 9: ~0.46M, ~1.8M unknowns
     python benchmarks/bench_multigrid.py --levels 8 9 10   # + ~7.3M (needs ~10 GB, a quiet machine)
-    python benchmarks/bench_multigrid.py --memory 9        # peak RSS of whole pipelines, 1.8M
+    python benchmarks/bench_multigrid.py --memory 8        # peak RSS of whole runs, ~2.2M unknowns
 
 Problem: ``-Laplace u = f`` on the unit square, ``u = sin(pi x) sin(pi y)``, homogeneous Dirichlet,
 P1 on a gmsh mesh (h = 0.5) refined uniformly ``k`` times; every solver gets the same matrix.
@@ -18,9 +18,9 @@ units of one SpMV ``A @ x`` of the same run; peak memory is the tracemalloc peak
 ``smoothed_aggregation_solver`` with defaults, ``ml.solve(b, tol=rtol, accel="cg")``. femkit runs
 skip the one-off symmetry check (pyamg has none). BLAS threads are pinned to 1.
 
-``--memory k`` runs two whole pipelines in fresh processes and compares their peak RSS: femkit
-(generate, hierarchy, assemble, Dirichlet, fmg) against scikit-fem (``MeshTri().refined``, basis,
-assembly, condense) + pyamg RS-PCG at the same number of unknowns.
+``--memory k`` compares the peak RSS of two whole runs in fresh processes on the same mesh (gmsh
+unit square h = 0.2 refined k times; k = 8: ~2.2M unknowns): ``femkit solve`` of an fmg case file
+against scikit-fem (basis, assembly, condense) + pyamg RS-PCG.
 """
 
 from __future__ import annotations
@@ -240,28 +240,35 @@ def locality(levels: int, repeat: int):
                                                 med["none"], med["rcm"])))
 
 
-FEMKIT_PIPELINE = """
-import numpy as np, resource, time
-from femkit.mesh import MeshHierarchy, boundary_nodes, generate
-from femkit.fem import apply_dirichlet, assemble_load, assemble_stiffness
-from femkit.solvers import solve
-t0 = time.perf_counter()
-H = MeshHierarchy.from_refinement(generate("unit_square", 0.5), {k})
-m = H.finest
-f = lambda x, y: 2 * np.pi ** 2 * np.sin(np.pi * x) * np.sin(np.pi * y)
-s = apply_dirichlet(assemble_stiffness(m), assemble_load(m, f), boundary_nodes(m), 0.0)
-r = solve(s.A, s.b, method="fmg", hierarchy=H, free=s.free)
-print(s.A.shape[0], r.converged, time.perf_counter() - t0,
-      resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+CASE = """problem: poisson
+name: memory_fmg
+mesh: {{geometry: unit_square, h: {h}, refine: {k}}}
+coefficient: 1.0
+source: "2 * pi**2 * sin(pi * x) * sin(pi * y)"
+boundary:
+  dirichlet:
+    - {{tags: [boundary], value: 0}}
+quadrature: {{load: barycentric}}
+solver: {{method: fmg}}
+output: {{dir: out, vtu: false, plot: false}}
+"""
+
+SAVE_MESH = """
+import numpy as np
+from femkit.mesh import generate, refine
+m = refine(generate("unit_square", {h}), {k})
+np.savez({path!r}, points=m.points, triangles=m.triangles)
 """
 
 SKFEM_PIPELINE = """
-import numpy as np, resource, time
+import numpy as np, time
 import pyamg
-from skfem import Basis, BilinearForm, ElementTriP1, LinearForm, MeshTri, condense, solve
+from skfem import Basis, BilinearForm, ElementTriP1, LinearForm, MeshTri, condense
 from skfem.helpers import dot, grad
 t0 = time.perf_counter()
-m = MeshTri().refined({k})
+d = np.load({path!r})
+m = MeshTri(d["points"].T.copy(), d["triangles"].T.copy(), sort_t=False)
+del d
 basis = Basis(m, ElementTriP1())
 lap = BilinearForm(lambda u, v, w: dot(grad(u), grad(v)))
 load = LinearForm(lambda v, w: 2 * np.pi ** 2 * np.sin(np.pi * w.x[0]) * np.sin(np.pi * w.x[1]) * v)
@@ -269,28 +276,52 @@ A, b = lap.assemble(basis), load.assemble(basis)
 Ac, bc, xc, I = condense(A, b, D=basis.get_dofs())
 ml = pyamg.ruge_stuben_solver(Ac.tocsr())
 x = ml.solve(bc, tol=1e-8, accel="cg")
-print(Ac.shape[0], bool(np.linalg.norm(bc - Ac @ x) <= 1e-8 * np.linalg.norm(bc)),
-      time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+print(Ac.shape[0], time.perf_counter() - t0)
+"""
+
+MEASURE = """
+import resource, subprocess, sys, time
+t0 = time.perf_counter()
+p = subprocess.run(sys.argv[1:], capture_output=True, text=True)
+assert p.returncode == 0, p.stderr
+print(p.stdout.strip().splitlines()[-1] if p.stdout.strip() else "",
+      "|", time.perf_counter() - t0, "|", resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024)
 """
 
 
-def memory(k_femkit: int):
-    """Peak RSS of the two whole pipelines at about the same size (scikit-fem's ``refined(k)`` of
-    its 2-triangle square has ~4^k unknowns: its level is the one nearest femkit's unknown count)."""
+def memory(k: int, h: float = 0.2):
+    """Peak RSS of two whole runs on the same mesh (gmsh unit square ``h`` refined ``k`` times),
+    each in a fresh process: ``femkit solve`` of an fmg case file (mesh generation, hierarchy,
+    assembly of every level, fmg, result.json) against scikit-fem (basis, assembly, condense) +
+    pyamg RS-PCG (rtol 1e-8) reading the mesh from a file written beforehand (not measured)."""
+    import tempfile
+    from pathlib import Path
+
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
-    out = {}
-    fem = subprocess.run([sys.executable, "-c", FEMKIT_PIPELINE.format(k=k_femkit)],
-                         capture_output=True, text=True, env=env, check=True).stdout.split()
-    n = int(fem[0])
-    k_sk = int(round(np.log2(np.sqrt(n))))
-    sk = subprocess.run([sys.executable, "-c", SKFEM_PIPELINE.format(k=k_sk)],
-                        capture_output=True, text=True, env=env, check=True).stdout.split()
-    out["femkit"], out["skfem+pyamg"] = fem, sk
-    print(f"\n=== peak RSS of the whole pipeline (fresh processes) ===")
-    for label, (nn, ok, t, mb) in out.items():
-        print(f"{label:12s} n = {int(nn):,}: converged {ok}, {float(t):.2f} s, peak RSS {float(mb):.0f} MB")
-    print(f"ratio femkit / scikit-fem+pyamg (peak RSS per unknown): "
-          f"{(float(fem[3]) / int(fem[0])) / (float(sk[3]) / int(sk[0])):.3f}")
+    with tempfile.TemporaryDirectory() as tmp:
+        case = Path(tmp) / "case.yaml"
+        case.write_text(CASE.format(h=h, k=k))
+        mesh = str(Path(tmp) / "mesh.npz")
+        subprocess.run([sys.executable, "-c", SAVE_MESH.format(h=h, k=k, path=mesh)], env=env,
+                       check=True)
+        runs = {
+            "femkit solve (fmg)": [sys.executable, "-m", "femkit.cli", "solve", str(case), "-q"],
+            "scikit-fem + pyamg RS": [sys.executable, "-c", SKFEM_PIPELINE.format(path=mesh)],
+        }
+        out = {}
+        for label, cmd in runs.items():
+            res = subprocess.run([sys.executable, "-c", MEASURE] + cmd, capture_output=True,
+                                 text=True, env=env, cwd=tmp, check=True).stdout.split("|")
+            out[label] = (float(res[1]), float(res[2]))
+        import json
+
+        dofs = json.loads((Path(tmp) / "out" / "result.json").read_text())["dofs"]
+    print(f"\n=== peak RSS of the whole run, unit square h = {h} refined {k} times, "
+          f"{dofs:,} unknowns (fresh processes) ===")
+    for label, (t, mb) in out.items():
+        print(f"{label:24s} wall {t:7.2f} s, peak RSS {mb:7.0f} MB")
+    a, b = out["femkit solve (fmg)"][1], out["scikit-fem + pyamg RS"][1]
+    print(f"ratio femkit / scikit-fem+pyamg: {a / b:.3f} (goal < 1)")
 
 
 def main(argv=None):
@@ -304,7 +335,7 @@ def main(argv=None):
                     help="only compare numberings at K refinements: hierarchy, first-call "
                          "assembly, SpMV, one V-cycle, fmg")
     ap.add_argument("--memory", type=int, default=None, metavar="K",
-                    help="only compare whole-pipeline peak RSS at K refinements")
+                    help="only compare the peak RSS of whole runs at K refinements of h = 0.2")
     args = ap.parse_args(argv)
     if args.memory is not None:
         memory(args.memory)
