@@ -159,7 +159,9 @@ def bench(levels: int, repeat: int, renumber: str = "none"):
         s.state = None
     # timed, interleaved (rotating the order every round)
     runs = {s.name: [] for s in sol}
+    spmvs = [spmv]
     for rnd in range(repeat):
+        spmvs.append(spmv_time(A))  # the unit, measured in every round (the load drifts)
         order = sol[rnd % len(sol):] + sol[:rnd % len(sol)]
         for s in order:
             t0 = time.perf_counter()
@@ -182,6 +184,8 @@ def bench(levels: int, repeat: int, renumber: str = "none"):
         rows[name].update(setup=statistics.median(r[0] for r in rs),
                           solve=statistics.median(r[1] for r in rs), iters=rs[-1][2],
                           err=rs[-1][3] / e_disc, res=rs[-1][4])
+    spmv = statistics.median(spmvs)
+    print(f"SpMV (median over the rounds) {spmv * 1e3:.2f} ms")
     rs_total = rows["pyamg RS (cg)"]["setup"] + rows["pyamg RS (cg)"]["solve"]
     print(f"{'solver':20s} {'rtol':>7s} {'it':>4s} {'setup s':>8s} {'solve s':>8s} {'total s':>8s} "
           f"{'SpMV(solve)':>11s} {'SpMV(total)':>11s} {'us/unknown':>10s} {'/ pyamg RS':>10s} "
