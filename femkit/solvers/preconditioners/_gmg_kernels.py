@@ -11,18 +11,27 @@ from __future__ import annotations
 import numba
 
 
+@numba.njit(cache=True, inline="always")
+def _relax(indptr, indices, data, inv_diag, b, x, i):  # pragma: no cover - compiled
+    """One Gauss-Seidel (SOR) update of row ``i``."""
+    acc = b[i]
+    for t in range(indptr[i], indptr[i + 1]):
+        acc -= data[t] * x[indices[t]]
+    x[i] += acc * inv_diag[i]
+
+
 @numba.njit(cache=True)
 def gs_sweeps(indptr, indices, data, inv_diag, b, x, sweeps, forward):  # pragma: no cover
     """``sweeps`` Gauss-Seidel (SOR) sweeps on ``A x = b``, in place: rows in increasing order
     (``forward``) or decreasing order (the adjoint sweep in the ``A`` inner product)."""
     n = b.shape[0]
     for _ in range(sweeps):
-        for k in range(n):
-            i = k if forward else n - 1 - k
-            acc = b[i]
-            for t in range(indptr[i], indptr[i + 1]):
-                acc -= data[t] * x[indices[t]]
-            x[i] += acc * inv_diag[i]
+        if forward:
+            for i in range(n):
+                _relax(indptr, indices, data, inv_diag, b, x, i)
+        else:
+            for i in range(n - 1, -1, -1):
+                _relax(indptr, indices, data, inv_diag, b, x, i)
 
 
 @numba.njit(cache=True)
