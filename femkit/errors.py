@@ -13,8 +13,9 @@ Hierarchy::
     │   ├── UnknownNameError       unknown solver / preconditioner / integrator / geometry name
     │   ├── MeshError              unreadable or invalid mesh
     │   │   └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
-    │   └── HierarchyError         geometric multigrid (gmg, fmg) asked for without a matching
-    │                              nested mesh hierarchy (the message names amg_rs)
+    │   ├── HierarchyError         geometric multigrid (gmg, fmg) asked for without a matching
+    │   │                          nested mesh hierarchy (the message names amg_rs)
+    │   └── AdaptivityError        bad adaptive-refinement setting (theta, target, budgets)
     ├── SolverError                a linear solver could not do what was asked
     │   ├── NotSPDError            input to CG-type method is not symmetric positive definite
     │   └── SingularSystemError    singular system (e.g. pure Neumann, inconsistent rhs)
@@ -82,6 +83,11 @@ class HierarchyError(InputError):
     """Geometric multigrid (preconditioner ``gmg``, method ``fmg``) was asked for without a nested
     mesh hierarchy, or with one that does not match the system; the message names the algebraic
     alternative (``amg_rs``)."""
+
+
+class AdaptivityError(InputError):
+    """A bad setting of adaptive refinement: Dörfler ``theta`` outside (0, 1], a target
+    estimate <= 0, a dof / time / level budget <= 0, an unknown estimator."""
 
 
 class SolverError(FemkitError):

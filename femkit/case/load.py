@@ -58,7 +58,6 @@ class Case:
     base_dir: Path
     path: Path | None = None
     functions: dict = field(default_factory=dict)
-    extras: dict = field(default_factory=dict)
     solver: Any = None
 
     def run(self, output_dir: str | os.PathLike | None = None, quiet: bool = False,

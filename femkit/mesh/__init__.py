@@ -1,10 +1,11 @@
-"""Meshes: the record, gmsh generation, meshio I/O, validation, refinement, nested hierarchies,
-renumbering, quality.
+"""Meshes: the record, gmsh generation, meshio I/O, validation, uniform and adaptive
+(newest-vertex bisection) refinement, nested hierarchies, renumbering, quality.
 
 Importing this package is cheap: gmsh and meshio are imported inside the functions that need
 them (generation and file I/O).
 """
 
+from .bisect import Bisection, bisect, label_longest_edge
 from .edges import boundary_edges_topological, boundary_nodes, edges
 from .geometries import GEOMETRIES, generate, geo_file
 from .hierarchy import MeshHierarchy
@@ -19,6 +20,7 @@ from .validate import check_tags, orient_ccw, remove_unreferenced, validate
 __all__ = [
     "Mesh", "generate", "GEOMETRIES", "geo_file", "read_mesh", "write_mesh", "validate",
     "check_tags", "remove_unreferenced", "orient_ccw", "refine", "quality", "boundary_nodes",
-    "boundary_edges_topological", "edges", "structured_mesh", "grid_triangles", "refine_once",
-    "MeshHierarchy", "renumber", "rcm_permutation", "permute_nodes",
+    "boundary_edges_topological", "edges", "structured_mesh", "grid_triangles",
+    "bisect", "label_longest_edge", "Bisection", "refine_once", "MeshHierarchy", "renumber",
+    "rcm_permutation", "permute_nodes",
 ]

@@ -37,23 +37,35 @@ import numpy as np
 
 from ..._version import __version__
 from ...dynamics import topology
-from ...dynamics.forces import GroundContact, Gravity, RayleighDamping, SphereContact, ViscousDamping
+from ...dynamics.forces import (
+    Gravity,
+    GroundContact,
+    RayleighDamping,
+    SphereContact,
+    ViscousDamping,
+)
 from ...dynamics.integrators import StepContext, get_integrator
 from ...dynamics.integrators.base import check_matrix_free
 from ...dynamics.simulate import StabilityWarning, simulate
 from ...dynamics.stability import estimate_omega_max
-from ...errors import (CaseFileError, ExpressionError, InputError, InstabilityError,
-                       UnknownNameError, with_prefix)
-from ...io.atomic import check_output_dir
+from ...errors import (
+    CaseFileError,
+    ExpressionError,
+    InputError,
+    InstabilityError,
+    UnknownNameError,
+    with_prefix,
+)
+from ...io.atomic import EARLIER_RUN, check_output_dir
 from ...mesh import generate, grid_triangles, read_mesh, validate
 from ...registry import Registry
+from ...solvers.defaults import DEFAULT_METHOD
 from ...solvers.spec import SolverSpec
 from ...timing import StageTimer
 from ..expressions import compile_expression
 from ..load import Case
 from ..names import check_geometry_spec, resolve_file
 from ..specs import IntegratorSpec, solver_spec
-from ...io.atomic import EARLIER_RUN
 from .output import write_scene_outputs
 
 __all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "build_context",
@@ -121,7 +133,8 @@ def prepare_scene(case: Case) -> None:
     d["integrator"] = {"method": integ.method, "options": dict(integ.options)}
 
     # linear solver
-    ls_spec = solver_spec(d["linear_solver"], "linear_solver", default_method="direct")
+    case.solver = ls_spec = solver_spec(d["linear_solver"], "linear_solver",
+                                        default_method=DEFAULT_METHOD["mass_spring"])
     d["linear_solver"] = ls_spec.to_dict()
     if integ.options.get("matrix_free"):  # caught at load time, before anything runs
         try:
