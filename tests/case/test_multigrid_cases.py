@@ -58,3 +58,23 @@ def test_multigrid_without_refinement_is_one_line_error_naming_amg_rs(solver, ba
     assert proc.returncode == 2
     assert proc.stderr.strip().count("\n") == 0 and "amg_rs" in proc.stderr
     assert "refine" in proc.stderr
+
+
+def test_multigrid_with_adaptive_refinement_is_refused(base_case, write_case):
+    d = _case(base_case, {"method": "fmg"}, 2)
+    d["adaptive"] = {"target": 0.01}
+    with pytest.raises(HierarchyError, match="adaptive refinement.*amg_rs"):
+        femkit.load_case(write_case(d))
+
+
+def test_fmg_on_a_pure_neumann_case_matches_amg():
+    from pathlib import Path
+
+    path = Path(__file__).parents[2] / "cases" / "poisson_neumann.yaml"
+    mesh = {"h": 0.25, "refine": 3}
+    fmg = femkit.load_case(path, mesh=mesh, solver={"method": "fmg", "preconditioner": "none"})
+    amg = femkit.load_case(path, mesh=mesh)
+    r_fmg, r_amg = fmg.run(write=False, quiet=True), amg.run(write=False, quiet=True)
+    assert r_fmg.converged and r_fmg.solve.info["stopped_by"] == "discretisation-error estimate"
+    # stopped at the discretisation error: the same error as the rtol 1e-10 solve, to 1%
+    assert r_fmg.errors["L2"] == pytest.approx(r_amg.errors["L2"], rel=1e-2)
