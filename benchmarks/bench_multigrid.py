@@ -5,6 +5,8 @@ Run by hand (not in CI)::
     python benchmarks/bench_multigrid.py                   # refinements 8 and 9: ~0.46M, ~1.8M unknowns
     python benchmarks/bench_multigrid.py --levels 8 9 10   # + ~7.3M (needs ~10 GB, a quiet machine)
     python benchmarks/bench_multigrid.py --memory 8        # peak RSS of whole runs, ~2.2M unknowns
+    python benchmarks/bench_multigrid.py --vcycle          # V(2,2) factors vs omega, 3 and 7 levels
+    python benchmarks/bench_multigrid.py --locality 9      # numbering: none vs rcm
 
 Problem: ``-Laplace u = f`` on the unit square, ``u = sin(pi x) sin(pi y)``, homogeneous Dirichlet,
 P1 on a gmsh mesh (h = 0.5) refined uniformly ``k`` times; every solver gets the same matrix.
@@ -328,6 +330,36 @@ def memory(k: int, h: float = 0.2):
     print(f"ratio femkit / scikit-fem+pyamg: {a / b:.3f} (goal < 1)")
 
 
+def vcycle_factors(omegas, levels=(3, 7), steps: int = 30):
+    """Asymptotic energy-norm contraction of the V(2,2)-cycle's error propagator ``I - M A``
+    (power iteration) on gmsh meshes (h = 0.5) of the unit square, L-shape and annulus, for each
+    relaxation factor and number of levels (meshes): the table of docs/methods.md, section 5."""
+    import math
+
+    from femkit.fem import apply_dirichlet, assemble_stiffness
+    from femkit.mesh import MeshHierarchy, boundary_nodes, generate
+    from femkit.solvers.preconditioners.gmg import Multigrid
+
+    print(f"\n=== V(2,2) energy-norm factor, {steps} power steps ===")
+    print(f"{'geometry':12s} {'levels':>6s} " + " ".join(f"{'w=' + str(w):>7s}" for w in omegas))
+    for geometry in ("unit_square", "l_shape", "annulus"):
+        for nlev in levels:
+            H = MeshHierarchy.from_refinement(generate(geometry, 0.5), nlev - 1)
+            m = H.finest
+            s = apply_dirichlet(assemble_stiffness(m), np.zeros(m.n_points), boundary_nodes(m), 0.0)
+            row = []
+            for w in omegas:
+                mg = Multigrid(s.A, H, free=s.free, omega=w)
+                e = np.random.default_rng(0).standard_normal(s.A.shape[0])
+                rho = 0.0
+                for _ in range(steps):
+                    e /= math.sqrt(e @ (s.A @ e))
+                    e = e - mg.vcycle(s.A @ e)
+                    rho = math.sqrt(e @ (s.A @ e))
+                row.append(rho)
+            print(f"{geometry:12s} {nlev:6d} " + " ".join(f"{r:7.3f}" for r in row))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--levels", type=int, nargs="+", default=[8, 9],
@@ -338,6 +370,9 @@ def main(argv=None):
     ap.add_argument("--locality", type=int, default=None, metavar="K",
                     help="only compare numberings at K refinements: hierarchy, first-call "
                          "assembly, SpMV, one V-cycle, fmg")
+    ap.add_argument("--vcycle", action="store_true",
+                    help="only print V(2,2) factors for --omegas at 3 and 7 levels")
+    ap.add_argument("--omegas", type=float, nargs="+", default=[1.0, 1.1, 1.2, 1.25, 1.3])
     ap.add_argument("--memory", type=int, default=None, metavar="K",
                     help="only compare the peak RSS of whole runs at K refinements of h = 0.2")
     args = ap.parse_args(argv)
@@ -346,6 +381,9 @@ def main(argv=None):
         return
     if args.locality is not None:
         locality(args.locality, args.repeat)
+        return
+    if args.vcycle:
+        vcycle_factors(args.omegas)
         return
     per_unknown = {}
     for k in args.levels:
