@@ -13,6 +13,8 @@ Hierarchy::
     │   ├── UnknownNameError       unknown solver / preconditioner / integrator / geometry name
     │   ├── MeshError              unreadable or invalid mesh
     │   │   └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
+    │   ├── HierarchyError         geometric multigrid (gmg, fmg) asked for without a matching
+    │   │                          nested mesh hierarchy (the message names amg_rs)
     │   ├── AdaptivityError        bad adaptive-refinement setting (theta, target, budgets)
     │   └── BackendUnavailableError  a solver backend (PETSc: petsc4py, mpi4py) cannot be
     │                              imported; the message names scripts/install-petsc.sh
@@ -93,6 +95,12 @@ class RankFailureError(FemkitError):
         self.rank = rank
         self.message = message
         super().__init__(f"rank {rank} failed: {message}")
+
+
+class HierarchyError(InputError):
+    """Geometric multigrid (preconditioner ``gmg``, method ``fmg``) was asked for without a nested
+    mesh hierarchy, or with one that does not match the system; the message names the algebraic
+    alternative (``amg_rs``)."""
 
 
 class AdaptivityError(InputError):
