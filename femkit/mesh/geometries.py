@@ -35,22 +35,13 @@ import numpy as np
 
 from ..errors import InputError, MeshError
 from ..registry import Registry
+from ..validation import mesh_size as _check_h
 from .mesh import Mesh
 
 GEOMETRIES: Registry[Callable[..., Mesh]] = Registry("geometry")
 
 #: gmsh element type numbers
 _GMSH_LINE, _GMSH_TRIANGLE = 1, 2
-
-
-def _check_h(h) -> float:
-    try:
-        hv = float(h)
-    except (TypeError, ValueError):
-        raise InputError(f"mesh size h must be a positive number, got {h!r}") from None
-    if not (math.isfinite(hv) and hv > 0):
-        raise InputError(f"mesh size h must be a positive finite number, got {h!r}")
-    return hv
 
 
 def _positive(name: str, value) -> float:
