@@ -11,8 +11,10 @@ Hierarchy::
     │   ├── CaseFileError          case/scene/study file: schema, keys, types, paths
     │   ├── ExpressionError        unsafe or malformed expression in a case file
     │   ├── UnknownNameError       unknown solver / preconditioner / integrator / geometry name
-    │   └── MeshError              unreadable or invalid mesh
-    │       └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
+    │   ├── MeshError              unreadable or invalid mesh
+    │   │   └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
+    │   └── BudgetExceededError    predicted memory / time / steps / output above a limit
+    │                              (before the run; ``force`` overrides)
     ├── SolverError                a linear solver could not do what was asked
     │   ├── NotSPDError            input to CG-type method is not symmetric positive definite
     │   └── SingularSystemError    singular system (e.g. pure Neumann, inconsistent rhs)
@@ -73,6 +75,24 @@ class DegenerateMeshError(MeshError):
 
     def __init__(self, message: str, element_ids=()):
         self.element_ids = list(element_ids)
+        super().__init__(message)
+
+
+class BudgetExceededError(InputError):
+    """A run's predicted cost exceeds a limit (available memory, or a stated budget).
+
+    Raised before the run starts (:func:`femkit.cost.check_budget`); the one-line message gives
+    the predicted sizes and cost, the limit and what to change. Attributes: ``what``
+    (``memory``, ``time``, ``steps`` or ``output``), ``predicted``, ``limit`` (bytes, seconds,
+    steps, bytes) and ``plan`` (the :class:`femkit.cost.Plan`).
+    """
+
+    def __init__(self, message: str, what: str = "", predicted: float = 0.0, limit: float = 0.0,
+                 plan=None):
+        self.what = what
+        self.predicted = predicted
+        self.limit = limit
+        self.plan = plan
         super().__init__(message)
 
 
