@@ -1,0 +1,80 @@
+"""Stop cleanly on SIGINT / SIGTERM: a flag the long loops check between units of work.
+
+:func:`stop_on_signals` installs handlers that only set a :class:`StopFlag`; a loop (the time
+steps of :func:`femkit.dynamics.simulate.simulate`, the jobs of a study) checks the flag
+between steps, stops, and returns what it computed so far, which the caller writes (frames,
+energy, ``result.json`` with ``interrupted: true``) before exiting with :func:`exit_code`
+(``128 + signal number``: 130 for SIGINT, 143 for SIGTERM). A second SIGINT while the flag is
+already set raises :class:`KeyboardInterrupt` at once, for a user who does not want to wait.
+
+Handlers are installed only in the main thread (Python's rule); elsewhere the flag works but
+never fires by itself. The previous handlers are restored on exit.
+
+>>> flag = StopFlag()
+>>> bool(flag), flag.request(15), bool(flag), flag.name, exit_code(flag)
+(False, None, True, 'SIGTERM', 143)
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from typing import Iterator
+
+__all__ = ["StopFlag", "stop_on_signals", "exit_code"]
+
+
+class StopFlag:
+    """Set when a stop was requested; ``signum`` says by which signal (``None``: not set)."""
+
+    def __init__(self) -> None:
+        self.signum: int | None = None
+
+    def request(self, signum: int = signal.SIGINT) -> None:
+        """Ask the running loop to stop after its current unit of work."""
+        self.signum = int(signum)
+
+    def __bool__(self) -> bool:
+        return self.signum is not None
+
+    def __call__(self) -> bool:  # usable as a ``stop()`` callable
+        return self.signum is not None
+
+    @property
+    def name(self) -> str | None:
+        """``"SIGINT"``, ``"SIGTERM"`` ... (``None`` when not set)."""
+        if self.signum is None:
+            return None
+        try:
+            return signal.Signals(self.signum).name
+        except ValueError:
+            return f"signal {self.signum}"
+
+
+def exit_code(flag: StopFlag) -> int:
+    """The shell's exit code for a run stopped by ``flag``'s signal: ``128 + signum``."""
+    return 128 + int(flag.signum or signal.SIGINT)
+
+
+@contextlib.contextmanager
+def stop_on_signals(signals=(signal.SIGINT, signal.SIGTERM)) -> Iterator[StopFlag]:
+    """Within the block, the given signals set the yielded :class:`StopFlag` instead of killing."""
+    flag = StopFlag()
+    if threading.current_thread() is not threading.main_thread():
+        yield flag
+        return
+
+    def handler(signum, frame):
+        if flag and signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        flag.request(signum)
+
+    previous = {}
+    for s in signals:
+        previous[s] = signal.signal(s, handler)
+    try:
+        yield flag
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
