@@ -64,8 +64,8 @@ def predict_triangles(geometry: str, h: float, params: dict | None = None, *,
                       constants: dict | None = None) -> float:
     """Triangles gmsh generates for ``geometry`` at target size ``h`` (before refinement).
 
-    >>> round(predict_triangles("unit_square", 0.01), -2)
-    23200.0
+    >>> 22_000 < predict_triangles("unit_square", 0.01) < 25_000   # gmsh makes 23,258
+    True
     """
     c = (constants or load_constants())["mesh"]
     area, length = domain_measures(geometry, **(params or {}))
