@@ -3,8 +3,8 @@
 Each configuration is planned (:func:`femkit.cost.plan_poisson`) and then run in a fresh
 process (:func:`femkit.cost.probe.measure_poisson_subprocess`: the library pipeline, stage by
 stage, peak resident memory from VmHWM). Predicted seconds are scaled by the machine speed
-measured in the same run (:func:`femkit.cost.machine_speed`), so a loaded machine does not
-count against the model. Ratios are predicted / measured; targets (issue 12): triangles within
+measured just before and after each run (:func:`femkit.cost.machine_speed`, median of the
+probe: the current load included), so a loaded machine does not count against the model. Ratios are predicted / measured; targets (issue 12): triangles within
 15 %, peak memory within 30 %, time within a factor 2.
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_cost_model.py            # up to ~3.8M triangles
@@ -55,9 +55,10 @@ def main(argv=None) -> int:
         plan = plan_poisson(method=method, **plan_kw)
         if plan.sizes["triangles"] > args.max_triangles:
             continue
-        speed = machine_speed()
-        plan = plan_poisson(method=method, speed=speed, **plan_kw)
+        before = machine_speed(statistic="median")
         run = measure_poisson_subprocess(**kw)
+        speed = (before * machine_speed(statistic="median")) ** 0.5
+        plan = plan_poisson(method=method, speed=speed, **plan_kw)
         measured_peak = run["baseline_bytes"] + run["peak_bytes"]
         measured_time = sum(s["seconds"] for s in run["stages"].values())
         r_tri = plan.sizes["triangles"] / run["n_triangles"]
