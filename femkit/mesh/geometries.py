@@ -409,7 +409,7 @@ def geo_file(path: str | os.PathLike, h: float | None = None) -> Mesh:
         return _mesh_from_gmsh(gmsh)
 
 
-def generate(geometry: str, h: float, **params) -> Mesh:
+def generate(geometry: str, h: float, *, check_memory: bool = True, **params) -> Mesh:
     """Generate a mesh of a named geometry from :data:`GEOMETRIES`.
 
     Parameters
@@ -418,6 +418,8 @@ def generate(geometry: str, h: float, **params) -> Mesh:
         ``l_shape``, ``rectangle``, ``square_with_inclusion``, ``unit_square``)
     h : target (maximal) element size
     **params : geometry parameters (e.g. ``r_inner`` for ``annulus``)
+    check_memory : refuse, before gmsh starts, a mesh whose predicted memory exceeds the
+        available memory (:func:`femkit.cost.check_mesh_fits`)
 
     Raises
     ------
@@ -425,6 +427,8 @@ def generate(geometry: str, h: float, **params) -> Mesh:
         Unknown geometry (the message lists the valid ones).
     InputError
         Bad or unknown parameters.
+    BudgetExceededError
+        ``h`` so small that the mesh cannot fit in memory (the message says which ``h`` fits).
     """
     factory = GEOMETRIES.get(geometry)
     import inspect
@@ -436,4 +440,8 @@ def generate(geometry: str, h: float, **params) -> Mesh:
         valid = [n for n in sig.parameters if n != "h"]
         raise InputError(f"geometry {geometry!r}: {exc}; valid parameters: "
                          f"{', '.join(valid) or '(none)'}") from None
+    if check_memory:
+        from ..cost.budget import check_mesh_fits
+
+        check_mesh_fits(geometry, _check_h(h), params=params)
     return factory(h, **params)

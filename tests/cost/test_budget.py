@@ -102,3 +102,27 @@ def test_bad_sizes(bad):
 def test_units():
     assert parse_bytes("1.5k") == 1500 and parse_bytes("3 MiB") == 3 * 2 ** 20
     assert parse_seconds("1d") == 86400.0
+
+
+def test_generate_refuses_before_gmsh_starts():
+    """The library safety net: femkit.mesh.generate checks the available memory first."""
+    import subprocess
+    import sys
+
+    code = ("import sys, time; from femkit.mesh import generate\n"
+            "t = time.perf_counter()\n"
+            "try:\n    generate('unit_square', 1e-5)\n"
+            "except Exception as e:\n    print(type(e).__name__, '|', e)\n"
+            "print(time.perf_counter() - t < 5, 'gmsh' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         timeout=60)
+    first, last = out.stdout.strip().splitlines()
+    assert first.startswith("BudgetExceededError | unit_square h=1e-05: predicted peak memory")
+    assert "use h >= " in first
+    assert last == "True False"
+
+
+def test_generate_check_can_be_switched_off():
+    from femkit.mesh import generate
+
+    assert generate("unit_square", 0.2, check_memory=False).n_triangles > 0
