@@ -7,6 +7,12 @@ energy, ``result.json`` with ``interrupted: true``) before exiting with :func:`e
 (``128 + signal number``: 130 for SIGINT, 143 for SIGTERM). A second SIGINT while the flag is
 already set raises :class:`KeyboardInterrupt` at once, for a user who does not want to wait.
 
+An iterative linear solve stops the same way through its per-iteration callback
+(:func:`stopping_callback`): the callback raises :class:`Interrupted` carrying the last
+iterate, which the caller may write as a partial (not converged) result. A direct
+factorisation runs in compiled code and cannot be stopped midway: the flag is seen when it
+returns.
+
 Handlers are installed only in the main thread (Python's rule); elsewhere the flag works but
 never fires by itself. The previous handlers are restored on exit.
 
@@ -22,7 +28,7 @@ import signal
 import threading
 from typing import Iterator
 
-__all__ = ["StopFlag", "stop_on_signals", "exit_code"]
+__all__ = ["StopFlag", "stop_on_signals", "exit_code", "Interrupted", "stopping_callback"]
 
 
 class StopFlag:
@@ -78,3 +84,41 @@ def stop_on_signals(signals=(signal.SIGINT, signal.SIGTERM)) -> Iterator[StopFla
     finally:
         for s, h in previous.items():
             signal.signal(s, h)
+
+
+class Interrupted(Exception):
+    """A run stopped on request; ``x`` is the last iterate (iterative solves) or ``None``,
+    ``iteration`` how many iterations were done, ``flag`` the :class:`StopFlag` that fired."""
+
+    def __init__(self, flag: StopFlag, x=None, iteration: int = 0):
+        self.flag, self.x, self.iteration = flag, x, iteration
+        super().__init__(f"interrupted by {flag.name or 'a stop request'} at iteration {iteration}")
+
+
+def stopping_callback(flag: StopFlag, callback=None):
+    """A solver callback that raises :class:`Interrupted` (with the iterate) once ``flag`` is set.
+
+    >>> import numpy as np, scipy.sparse as sp
+    >>> from femkit.solvers import solve
+    >>> A = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(50, 50), format="csr")
+    >>> flag = StopFlag()
+    >>> def stop_at_5(x, count=[0]):
+    ...     count[0] += 1
+    ...     if count[0] == 5:
+    ...         flag.request(15)
+    >>> try:
+    ...     solve(A, np.ones(50), method="cg", callback=stopping_callback(flag, stop_at_5))
+    ... except Interrupted as exc:
+    ...     print(exc, exc.x.shape)
+    interrupted by SIGTERM at iteration 5 (50,)
+    """
+    count = [0]
+
+    def cb(xk):
+        count[0] += 1
+        if callback is not None:
+            callback(xk)
+        if flag:
+            raise Interrupted(flag, xk.copy(), count[0])
+
+    return cb
