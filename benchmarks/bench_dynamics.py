@@ -47,6 +47,7 @@ import time  # noqa: E402
 
 from femkit.dynamics.forces import Gravity  # noqa: E402
 from femkit.dynamics.integrators import StepContext, get_integrator  # noqa: E402
+from femkit.solvers import SolverSpec
 from femkit.dynamics.topology import cloth_grid  # noqa: E402
 
 _SPLIT = ("time_permute", "time_factorization", "time_solve", "time_pcg")
@@ -55,7 +56,7 @@ _SPLIT = ("time_permute", "time_factorization", "time_solve", "time_pcg")
 def _time_steps(system, name, dt, repeats, *, solver="direct", preconditioner="none",
                 **opts) -> dict:
     """Median seconds per step after a warm-up, factorisations and the time split per step."""
-    ctx = StepContext(solver=solver, preconditioner=preconditioner)
+    ctx = StepContext(SolverSpec(solver, preconditioner))
     integ = get_integrator(name, **opts)
     s = integ.start(system, system.x0, system.v0, 0.0, dt, ctx)
     s = integ.step(system, s, dt, ctx)  # warm-up: one-time factorisation / ordering

@@ -18,11 +18,12 @@ from .pcg import pcg
 from .preconditioners.base import Preconditioner
 from .registry import (PRECONDITIONERS, SOLVERS, get_preconditioner, get_solver, solve)
 from .result import REASONS, SolveResult
+from .spec import SolverSpec
 from .steepest_descent import steepest_descent
 
 __all__ = [
     "PRECONDITIONERS", "SOLVERS", "REASONS", "Factor", "FemkitBackend", "LinearSolverBackend",
-    "Preconditioner", "SolveResult", "cg", "direct",
+    "Preconditioner", "SolveResult", "SolverSpec", "cg", "direct",
     "factorize", "get_preconditioner", "get_solver", "jacobi", "pcg", "solve",
     "steepest_descent",
 ]

@@ -62,7 +62,7 @@ import numpy as np
 
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
                    factorize_linear, restrict)
-from .registry import INTEGRATORS
+from .registry import register
 
 _KEY_ATTRS = ("mass", "k", "rest", "damping", "springs", "pinned", "forces")
 
@@ -124,13 +124,12 @@ class _Operators:
     B_free: object = None       # nf x n rows of the damping split h B (None: no damping)
 
 
-@INTEGRATORS.register("fast_mass_spring")
+@register("fast_mass_spring")
 @dataclass(frozen=True)
 class FastMassSpring(Integrator):
     iterations: int = 10
     tol: float | None = None
 
-    name = "fast_mass_spring"
     order = 1
     implicit = True
     symplectic = False
