@@ -30,7 +30,7 @@ import numpy as np  # noqa: E402
 from femkit.cost.constants import load_constants  # noqa: E402
 from femkit.cost.geometry import domain_measures  # noqa: E402
 from femkit.cost.poisson import fixed_bytes, solver_key  # noqa: E402
-from femkit.cost.probe import measure_poisson_subprocess  # noqa: E402
+from femkit.cost.probe import child_env, measure_poisson_subprocess  # noqa: E402
 
 
 def _import_cost(module: str) -> tuple[float, float]:
@@ -38,7 +38,8 @@ def _import_cost(module: str) -> tuple[float, float]:
     code = ("import time, json; from femkit.cost.probe import preload; preload(); "
             "from femkit.cost.memory import current_rss; a = current_rss(); t = time.perf_counter(); "
             f"import {module}; t = time.perf_counter() - t; print(json.dumps([current_rss() - a, t]))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env=child_env())
     b, s = json.loads(out.stdout.strip().splitlines()[-1])
     return float(b), float(s)
 

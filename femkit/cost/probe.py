@@ -23,7 +23,7 @@ import numpy as np
 
 from .memory import current_rss, peak_rss, reset_peak_rss
 
-__all__ = ["measure_poisson", "measure_poisson_subprocess", "preload"]
+__all__ = ["measure_poisson", "measure_poisson_subprocess", "preload", "child_env"]
 
 
 def preload() -> None:
@@ -130,10 +130,20 @@ def _png(path: str, mesh, u) -> None:
     fig.savefig(path, format="png")
 
 
+def child_env() -> dict:
+    """Environment of a measuring child process: BLAS on one thread, and this femkit first on
+    the path (the child imports the same femkit as the parent, installed or not)."""
+    import femkit
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(femkit.__file__)))
+    path = os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH", "")) if p)
+    return dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
+                MPLBACKEND="Agg", PYTHONPATH=path)
+
+
 def measure_poisson_subprocess(timeout: float = 600.0, **kwargs) -> dict:
     """:func:`measure_poisson` in a fresh Python process (BLAS pinned to one thread)."""
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
-               MPLBACKEND="Agg")
+    env = child_env()
     code = ("import json, sys; from femkit.cost.probe import measure_poisson; "
             "print(json.dumps(measure_poisson(**json.loads(sys.argv[1]))))")
     out = subprocess.run([sys.executable, "-c", code, json.dumps(kwargs)], capture_output=True,

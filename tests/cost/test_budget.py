@@ -50,7 +50,10 @@ def test_mesh_generation_checked_before_gmsh():
             "try:\n    check_budget(plan_mesh('unit_square', 1e-5), Limits(memory=2**33))\n"
             "except Exception as e:\n    print(type(e).__name__)\n"
             "print(sorted(m for m in ('gmsh', 'numpy', 'scipy') if m in sys.modules))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    from femkit.cost.probe import child_env
+
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env=child_env())
     assert out.stdout.split() == ["BudgetExceededError", "[]"]
 
 
@@ -114,8 +117,10 @@ def test_generate_refuses_before_gmsh_starts():
             "try:\n    generate('unit_square', 1e-5)\n"
             "except Exception as e:\n    print(type(e).__name__, '|', e)\n"
             "print(time.perf_counter() - t < 5, 'gmsh' in sys.modules)")
+    from femkit.cost.probe import child_env
+
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                         timeout=60)
+                         timeout=60, env=child_env())
     first, last = out.stdout.strip().splitlines()
     assert first.startswith("BudgetExceededError | unit_square h=1e-05: predicted peak memory")
     assert "use h >= " in first

@@ -71,8 +71,10 @@ def test_signal_from_outside_stops_a_simulation_cleanly(tmp_path):
         "                    progress=bar, check_stability=False)\n"
         "print(json.dumps(traj.summary()), flush=True)\n"
         "sys.exit(exit_code(flag) if flag else 0)\n")
+    from femkit.cost.probe import child_env
+
     proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True, env=child_env())
     assert proc.stdout.readline().strip() == "started"
     time.sleep(1.0)
     proc.send_signal(signal.SIGTERM)
