@@ -28,7 +28,8 @@ import signal
 import threading
 from typing import Iterator
 
-__all__ = ["StopFlag", "stop_on_signals", "exit_code", "Interrupted", "stopping_callback"]
+__all__ = ["StopFlag", "stop_on_signals", "exit_code", "Interrupted", "stopping_callback",
+           "active_flag"]
 
 
 class StopFlag:
@@ -63,6 +64,15 @@ def exit_code(flag: StopFlag) -> int:
     return 128 + int(flag.signum or signal.SIGINT)
 
 
+_ACTIVE: list[StopFlag] = []
+
+
+def active_flag() -> StopFlag | None:
+    """The flag of the innermost :func:`stop_on_signals` block now running (None outside any):
+    how loops deep inside a run (a study's sweep) see a stop request without it being passed."""
+    return _ACTIVE[-1] if _ACTIVE else None
+
+
 @contextlib.contextmanager
 def stop_on_signals(signals=(signal.SIGINT, signal.SIGTERM)) -> Iterator[StopFlag]:
     """Within the block, the given signals set the yielded :class:`StopFlag` instead of killing."""
@@ -70,6 +80,7 @@ def stop_on_signals(signals=(signal.SIGINT, signal.SIGTERM)) -> Iterator[StopFla
     if threading.current_thread() is not threading.main_thread():
         yield flag
         return
+    _ACTIVE.append(flag)
 
     def handler(signum, frame):
         if flag and signum == signal.SIGINT:
@@ -82,17 +93,20 @@ def stop_on_signals(signals=(signal.SIGINT, signal.SIGTERM)) -> Iterator[StopFla
     try:
         yield flag
     finally:
+        _ACTIVE.remove(flag)
         for s, h in previous.items():
             signal.signal(s, h)
 
 
 class Interrupted(Exception):
     """A run stopped on request; ``x`` is the last iterate (iterative solves) or ``None``,
-    ``iteration`` how many iterations were done, ``flag`` the :class:`StopFlag` that fired."""
+    ``iteration`` how many iterations were done, ``stage`` where a staged run stopped,
+    ``flag`` the :class:`StopFlag` that fired."""
 
-    def __init__(self, flag: StopFlag, x=None, iteration: int = 0):
-        self.flag, self.x, self.iteration = flag, x, iteration
-        super().__init__(f"interrupted by {flag.name or 'a stop request'} at iteration {iteration}")
+    def __init__(self, flag: StopFlag, x=None, iteration: int = 0, stage: str = "", where: str = ""):
+        self.flag, self.x, self.iteration, self.stage = flag, x, iteration, stage
+        where = where or (f"after the {stage} stage" if stage else f"at iteration {iteration}")
+        super().__init__(f"interrupted by {flag.name or 'a stop request'} {where}")
 
 
 def stopping_callback(flag: StopFlag, callback=None):

@@ -278,8 +278,9 @@ def plan_poisson(*, geometry: str | None = None, h: float | None = None, refine:
         "benchmarks/calibrate_cost.py (constants: femkit/cost/constants.json, overridable)",
     ]
     if _stages is None and key != "direct":
-        assumptions.append(f"{key}: iterations ~ {c['iterations'][key]['coefficient']:.3g} "
-                           f"n^{c['iterations'][key]['exponent']:.2g} at rtol 1e-8")
+        it = c["iterations"][key]
+        assumptions.append(f"{key}: iterations ~ {it['coefficient']:.3g} n^{it['exponent']:.2g} "
+                           f"at rtol 1e-8, x log(1/rtol)/log(1e8) for rtol {rtol:g}")
     if speed != 1.0:
         assumptions.append(f"this machine measured {speed:.2g}x the calibration machine's time")
     assumptions += notes

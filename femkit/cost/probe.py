@@ -133,9 +133,8 @@ def _png(path: str, mesh, u) -> None:
 def child_env() -> dict:
     """Environment of a measuring child process: BLAS on one thread, and this femkit first on
     the path (the child imports the same femkit as the parent, installed or not)."""
-    import femkit
-
-    root = os.path.dirname(os.path.dirname(os.path.abspath(femkit.__file__)))
+    here = os.path.abspath(__file__)  # <root>/femkit/cost/probe.py
+    root = os.path.dirname(os.path.dirname(os.path.dirname(here)))
     path = os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH", "")) if p)
     return dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
                 MPLBACKEND="Agg", PYTHONPATH=path)

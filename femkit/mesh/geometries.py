@@ -62,7 +62,8 @@ def _gmsh_session(name: str) -> Iterator[object]:
 
     owner = not gmsh.isInitialized()
     if owner:
-        gmsh.initialize(argv=[], readConfigFiles=False, run=False, interruptible=False)
+        with _python_signal_handlers():
+            gmsh.initialize(argv=[], readConfigFiles=False, run=False, interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.Verbosity", 0)
@@ -79,6 +80,26 @@ def _gmsh_session(name: str) -> Iterator[object]:
         else:
             with contextlib.suppress(Exception):
                 gmsh.model.remove()
+
+
+@contextlib.contextmanager
+def _python_signal_handlers() -> Iterator[None]:
+    """Put Python's SIGINT/SIGTERM handlers back after gmsh's initialisation, which installs
+    its own at the C level (a SIGTERM would then kill the process instead of reaching
+    :func:`femkit.interrupt.stop_on_signals`)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for s, handler in saved.items():
+            if handler is not None:
+                signal.signal(s, handler)
 
 
 def _set_size(gmsh, h: float) -> None:

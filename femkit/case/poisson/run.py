@@ -27,6 +27,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ...errors import CaseFileError, ExpressionError, InputError
+from ...interrupt import Interrupted
 from ..expressions import compile_expression
 from ..load import Case
 from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
@@ -70,6 +71,9 @@ def prepare_poisson(case: Case) -> None:
 
     case.solver = solver_spec(d["solver"], "solver", default_method="pcg")
     d["solver"] = case.solver.to_dict()
+    from ..specs import limits_spec
+
+    case.extras["limits"] = limits_spec(d.get("limits"))
 
     from ...fem.quadrature import QUADRATURE
 
@@ -120,16 +124,18 @@ def build_mesh(case: Case, *, h: float | None = None):
 
     spec = case.data["mesh"]
     where = f"mesh.file {spec['file']}" if "file" in spec else f"mesh.geometry {spec['geometry']}"
+    check = not case.extras.get("force", False)  # --force also passes the library's memory checks
     try:
         if "file" in spec:
             mesh = read_mesh(spec["file"])
         else:
-            mesh = generate(spec["geometry"], spec["h"] if h is None else h, **(spec.get("params") or {}))
+            mesh = generate(spec["geometry"], spec["h"] if h is None else h, check_memory=check,
+                            **(spec.get("params") or {}))
         mesh = validate(mesh)
     except InputError as exc:
         raise with_prefix(exc, where) from None
     if spec.get("refine"):
-        mesh = refine(mesh, spec["refine"])
+        mesh = refine(mesh, spec["refine"], check_memory=check)
     bnd = case.data["boundary"]
     for kind in ("dirichlet", "neumann"):
         for i, bc in enumerate(bnd.get(kind, [])):
@@ -267,6 +273,7 @@ class CaseResult:
     output_dir: Path | None = None
     files: list = field(default_factory=list)
     nullspace: dict | None = None
+    interrupted: str | None = None
 
     @property
     def converged(self) -> bool:
@@ -297,6 +304,7 @@ class CaseResult:
             "nnz": self.nnz,
             "solver": self.solve.summary(),
             "converged": self.converged,
+            "interrupted": self.interrupted is not None,
             "errors": self.errors,
             "timings": dict(self.timings),
             "expressions": {k: f.source for k, f in self.case.functions.items()},
@@ -362,16 +370,25 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         from .output import output_location
 
         target = output_location(output_dir or case.data["output"]["dir"])
+    stop = case.extras.get("stop")
+
+    def check_stop(where: str) -> None:  # a signal during a stage stops after it
+        if stop:
+            raise Interrupted(stop, stage=where)
+
     with stage("mesh"):
         mesh = build_mesh(case)
         q = quality(mesh)
+    check_stop("mesh")
     problem = poisson_problem(case, mesh)
     with stage("assembly"):
         K, F = problem.assemble_matrices()
+    check_stop("assembly")
     with stage("boundary"):
         system = problem.reduce(K, F, case.solver.method)
+    check_stop("boundary")
     with stage("solve"):
-        res = case.solver.solve(system.A, system.b)
+        res = _solve(case, system, stop)
         u = system.expand(res.x)
     errors = None
     if "exact.u" in case.functions:
@@ -380,7 +397,8 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     result = CaseResult(case=case, mesh=mesh, u=u, kappa=problem.kappa, solve=res, errors=errors,
                         timings=stage.times, quality=q, dofs=int(system.A.shape[0]),
                         n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
-                        nnz=int(system.A.nnz), nullspace=_nullspace_facts(system))
+                        nnz=int(system.A.nnz), nullspace=_nullspace_facts(system),
+                        interrupted=stop.name if res.reason == "interrupted" else None)
     if write:
         from .output import write_outputs
 
@@ -390,6 +408,28 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         for line in result.summary_lines():
             out(line)
     return result
+
+
+def _solve(case: Case, system, stop):
+    """Solve the reduced system; a stop request during an iterative solve ends it with the last
+    iterate as a not-converged result (``reason: interrupted``) that is written like any other."""
+    if stop is None:
+        return case.solver.solve(system.A, system.b)
+    from ...interrupt import stopping_callback
+    from ...solvers.result import SolveResult
+
+    try:
+        return case.solver.solve(system.A, system.b, callback=stopping_callback(stop))
+    except Interrupted as exc:
+        r = system.b - system.A @ exc.x
+        bn = float(np.linalg.norm(system.b))
+        s = case.solver
+        return SolveResult(x=exc.x, converged=False, iterations=exc.iteration,
+                           residuals=np.array([]), reason="interrupted",
+                           message=f"interrupted by {stop.name} after {exc.iteration} iterations",
+                           true_residual=float(np.linalg.norm(r)), rhs_norm=bn,
+                           tolerance=max(s.rtol * bn, s.atol), method=s.method,
+                           preconditioner=s.preconditioner)
 
 
 def _nullspace_facts(system) -> dict | None:
