@@ -22,14 +22,16 @@ OVERRIDE = "--force"
 
 
 def plan_poisson_case(case: Case, *, measure: bool = True) -> Plan:
-    """The plan of a Poisson case (``measure`` is unused: the model needs no run)."""
-    from ..cost import msh_triangle_count
+    """The plan of a Poisson case; with ``measure`` its seconds are scaled by this machine's
+    speed now (:func:`femkit.cost.machine_speed`, ~0.25 s of probing)."""
+    from ..cost import machine_speed, msh_triangle_count
 
     d = case.data
     spec = d["mesh"]
     out = d["output"]
     outputs = tuple(k for k, on in (("vtu", out["vtu"]), ("xdmf", out["xdmf"]), ("png", out["plot"])) if on)
     common = dict(refine=spec.get("refine", 0), method=case.solver.method,
+                  speed=machine_speed() if measure else 1.0,
                   preconditioner=case.solver.preconditioner, rtol=case.solver.rtol,
                   outputs=outputs, errors="exact.u" in case.functions)
     if "file" in spec:
@@ -76,7 +78,7 @@ def check_case(case: Case, *, max_memory: float | None = None, force: bool = Fal
 
     Limits: the file's ``limits:``, ``max_memory`` (bytes, ``--max-memory``) and the available
     memory. Steps and memory are checked on the model alone (immediately, however large the
-    run); a time limit on a scene first measures a batch of steps. With ``force`` the
+    run); a time limit first measures: the machine's speed (Poisson) or a batch of steps (scenes). With ``force`` the
     violations are printed as warnings on stderr and the run goes on (also past the
     library's own memory checks: ``case.extras["force"]``).
 

@@ -282,7 +282,7 @@ def plan_poisson(*, geometry: str | None = None, h: float | None = None, refine:
         assumptions.append(f"{key}: iterations ~ {it['coefficient']:.3g} n^{it['exponent']:.2g} "
                            f"at rtol 1e-8, x log(1/rtol)/log(1e8) for rtol {rtol:g}")
     if speed != 1.0:
-        assumptions.append(f"this machine measured {speed:.2g}x the calibration machine's time")
+        assumptions.append(f"this machine now takes {speed:.2f}x the calibration machine's time (speed probe)")
     assumptions += notes
     plan = Plan("poisson", title + (f", {key}" if _stages is None else ""), sizes, stages,
                 c["bytes"]["baseline"], assumptions)
