@@ -112,7 +112,7 @@ def _run_solve(args) -> int:
         return EXIT_OK
     check_case(case, max_memory=_max_memory(args), force=args.force)
     with stop_on_signals() as stop:
-        case.extras["stop"] = stop
+        case.run_options["stop"] = stop
         result = case.run(output_dir=args.output, quiet=args.quiet)
     if getattr(result, "interrupted", None):
         print(f"femkit: interrupted by {result.interrupted}; what was computed is written to "

@@ -13,6 +13,7 @@ Hierarchy::
     │   ├── UnknownNameError       unknown solver / preconditioner / integrator / geometry name
     │   ├── MeshError              unreadable or invalid mesh
     │   │   └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
+    │   ├── AdaptivityError        bad adaptive-refinement setting (theta, target, budgets)
     │   └── BudgetExceededError    predicted memory / time / steps / output above a limit
     │                              (before the run; ``force`` overrides)
     ├── SolverError                a linear solver could not do what was asked
@@ -76,6 +77,11 @@ class DegenerateMeshError(MeshError):
     def __init__(self, message: str, element_ids=()):
         self.element_ids = list(element_ids)
         super().__init__(message)
+
+
+class AdaptivityError(InputError):
+    """A bad setting of adaptive refinement: Dörfler ``theta`` outside (0, 1], a target
+    estimate <= 0, a dof / time / level budget <= 0, an unknown estimator."""
 
 
 class BudgetExceededError(InputError):

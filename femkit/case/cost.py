@@ -4,7 +4,7 @@
 problem type (``PROBLEMS[...].plan``); :func:`check_case` checks it against the case's
 ``limits:``, the command line's ``--max-memory`` and the available memory, refusing with
 :class:`~femkit.errors.BudgetExceededError` (exit code 2, one line) unless forced. Run options
-travel in ``case.extras``: ``limits`` (:class:`femkit.cost.Limits`, from the file), ``force``
+travel in ``case.run_options``: ``limits`` (:class:`femkit.cost.Limits`, from the file), ``force``
 (skip every budget, also the library's own memory checks) and ``stop`` (a
 :class:`femkit.interrupt.StopFlag` the runners check between steps and iterations).
 """
@@ -41,6 +41,9 @@ def plan_poisson_case(case: Case, *, measure: bool = True) -> Plan:
     else:
         plan = plan_poisson(geometry=spec["geometry"], h=spec["h"], params=spec.get("params"), **common)
     plan.title = f"{case.name}: {plan.title}"
+    if d.get("adaptive"):
+        plan.assumptions.append("adaptive refinement: only the first level is costed; the "
+                                "adaptive budgets (max_dofs, max_time, max_levels) bound the rest")
     return plan
 
 
@@ -80,17 +83,17 @@ def check_case(case: Case, *, max_memory: float | None = None, force: bool = Fal
     memory. Steps and memory are checked on the model alone (immediately, however large the
     run); a time limit first measures: the machine's speed (Poisson) or a batch of steps (scenes). With ``force`` the
     violations are printed as warnings on stderr and the run goes on (also past the
-    library's own memory checks: ``case.extras["force"]``).
+    library's own memory checks: ``case.run_options["force"]``).
 
     Raises
     ------
     BudgetExceededError
         A limit is exceeded and ``force`` is false.
     """
-    limits = case.extras.get("limits") or Limits()
+    limits = case.run_options.get("limits") or Limits()
     if max_memory is not None:
         limits = limits.merged(Limits(memory=max_memory))
-    case.extras["force"] = bool(force)
+    case.run_options["force"] = bool(force)
     say = echo or (lambda line: print(line, file=sys.stderr))
     untimed = Limits(limits.memory, None, limits.steps, limits.output, limits.check_available)
     plan = plan_case(case, measure=False)

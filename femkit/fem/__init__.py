@@ -9,7 +9,7 @@ from .coefficients import element_coefficient
 from .dirichlet import DirichletSystem, apply_dirichlet, dirichlet_values
 from .load import assemble_load
 from .neumann import assemble_neumann
-from .norms import error_norms
+from .norms import energy_error, error_norms
 from .p1_stiffness import assemble_stiffness, local_stiffness
 from .poisson import PoissonProblem, PoissonSolution
 from .quadrature import QUADRATURE, TriangleRule, get_rule
@@ -17,6 +17,6 @@ from .sparsity import SparsityPattern
 
 __all__ = [
     "assemble_stiffness", "local_stiffness", "assemble_load", "assemble_neumann", "apply_dirichlet",
-    "dirichlet_values", "DirichletSystem", "error_norms", "element_coefficient", "PoissonProblem",
+    "dirichlet_values", "DirichletSystem", "error_norms", "energy_error", "element_coefficient", "PoissonProblem",
     "PoissonSolution", "SparsityPattern", "QUADRATURE", "TriangleRule", "get_rule",
 ]

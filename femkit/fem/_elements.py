@@ -60,3 +60,15 @@ def check_areas(area: np.ndarray, idx: np.ndarray | None) -> None:
             f"{len(ids)} triangle(s) with zero or non-finite area, first ids: {ids[:10].tolist()}",
             element_ids=ids.tolist(),
         )
+
+
+def p1_gradients(e: np.ndarray, signed: np.ndarray, ue: np.ndarray) -> np.ndarray:
+    """Constant gradient (m, 2) of the P1 function with vertex values ``ue`` (m, 3) on each triangle.
+
+    ``grad N_a = (-e_a,y, e_a,x) / (2 A_signed)``: the edge opposite ``a`` turned towards vertex ``a``
+    (``e``, ``signed`` from :func:`triangle_geometry`).
+    """
+    inv = 1.0 / (2.0 * signed)
+    gx = -np.einsum("ma,ma->m", ue, e[:, :, 1]) * inv
+    gy = np.einsum("ma,ma->m", ue, e[:, :, 0]) * inv
+    return np.stack([gx, gy], axis=1)

@@ -19,7 +19,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import InputError
-from ._elements import triangle_geometry
+from ._elements import p1_gradients, triangle_geometry
 from .coefficients import evaluate_callable
 from .quadrature import rule_for_degree
 
@@ -60,19 +60,50 @@ def error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | Non
     nodal = u - evaluate_callable(exact, mesh.points[:, 0], mesh.points[:, 1], name="exact")
     out = {"L2": l2, "H1_semi": None, "max_nodal": float(np.max(np.abs(nodal))) if len(u) else 0.0}
     if grad_exact is not None:
-        # grad N_a = (-e_a,y, e_a,x) / (2 A_signed): the edge opposite a turned towards vertex a
-        inv = 1.0 / (2.0 * signed)
-        gx = -np.einsum("ma,ma->m", ue, e[:, :, 1]) * inv
-        gy = np.einsum("ma,ma->m", ue, e[:, :, 0]) * inv
-        g = grad_exact(x, y)
-        try:
-            gxe = np.broadcast_to(np.asarray(g[0], dtype=np.float64), x.shape)
-            gye = np.broadcast_to(np.asarray(g[1], dtype=np.float64), x.shape)
-        except (TypeError, IndexError, ValueError) as exc:
-            raise InputError(f"grad_exact(x, y) must return (du/dx, du/dy): {exc}") from None
-        dx, dy = gx[:, None] - gxe, gy[:, None] - gye
-        out["H1_semi"] = float(np.sqrt(np.sum(area * ((dx * dx + dy * dy) @ rule.weights))))
+        sq = _gradient_error_sq(mesh, u, grad_exact, rule, (e, area, signed, tri), (x, y))
+        out["H1_semi"] = float(np.sqrt(np.sum(sq)))
     for k, v in out.items():
         if v is not None and not np.isfinite(v):
             raise InputError(f"error norm {k} is not finite (exact solution or u not finite)")
     return out
+
+
+def _gradient_error_sq(mesh, u, grad_exact, rule, geometry=None, xy=None) -> np.ndarray:
+    """Per element ``int_T |grad u - grad u_h|^2`` by the quadrature ``rule``."""
+    e, area, signed, tri = triangle_geometry(mesh, None) if geometry is None else geometry
+    x, y = rule.physical_points(mesh, tri) if xy is None else xy
+    g_h = p1_gradients(e, signed, u[tri])
+    g = grad_exact(x, y)
+    try:
+        gxe = np.broadcast_to(np.asarray(g[0], dtype=np.float64), x.shape)
+        gye = np.broadcast_to(np.asarray(g[1], dtype=np.float64), x.shape)
+    except (TypeError, IndexError, ValueError) as exc:
+        raise InputError(f"grad_exact(x, y) must return (du/dx, du/dy): {exc}") from None
+    dx, dy = g_h[:, 0, None] - gxe, g_h[:, 1, None] - gye
+    return area * ((dx * dx + dy * dy) @ rule.weights)
+
+
+def energy_error(mesh, u: np.ndarray, grad_exact: Callable, kappa=1.0, *, order: int = 5,
+                 per_element: bool = False):
+    """Energy-norm error ``(int kappa |grad(u - u_h)|^2)^(1/2)`` of the P1 function ``u``.
+
+    ``kappa`` as in :func:`~femkit.fem.coefficients.element_coefficient` (barycentre values, as
+    the stiffness assembly uses); with ``kappa = 1`` it is the H1 seminorm of
+    :func:`error_norms`. ``per_element=True`` returns the (m,) element contributions
+    ``(int_T kappa |grad e|^2)^(1/2)`` instead of the global number.
+
+    >>> import numpy as np
+    >>> from femkit.mesh import Mesh
+    >>> m = Mesh(np.array([[0., 0.], [1., 0.], [0., 1.]]), np.array([[0, 1, 2]]))
+    >>> energy_error(m, np.zeros(3), lambda x, y: (1 + 0 * x, 0 * y), kappa=4.0)   # sqrt(4 * 1/2)
+    1.4142135623730951
+    """
+    from .coefficients import element_coefficient
+
+    u = np.asarray(u, dtype=np.float64)
+    if u.shape != (mesh.n_points,):
+        raise InputError(f"u must have one value per node, shape ({mesh.n_points},), got {u.shape}")
+    sq = element_coefficient(mesh, kappa) * _gradient_error_sq(mesh, u, grad_exact, rule_for_degree(order))
+    if not np.isfinite(sq).all():
+        raise InputError("energy error is not finite (exact gradient or u not finite)")
+    return np.sqrt(sq) if per_element else float(np.sqrt(sq.sum()))

@@ -1,9 +1,11 @@
-"""Meshes: the record, gmsh generation, meshio I/O, validation, refinement, quality.
+"""Meshes: the record, gmsh generation, meshio I/O, validation, uniform and adaptive
+(newest-vertex bisection) refinement, quality.
 
 Importing this package is cheap: gmsh and meshio are imported inside the functions that need
 them (generation and file I/O).
 """
 
+from .bisect import Bisection, bisect, label_longest_edge
 from .geometries import GEOMETRIES, generate, geo_file
 from .io import read_mesh, write_mesh
 from .mesh import Mesh
@@ -17,4 +19,5 @@ __all__ = [
     "Mesh", "generate", "GEOMETRIES", "geo_file", "read_mesh", "write_mesh", "validate",
     "check_tags", "remove_unreferenced", "orient_ccw", "refine", "quality", "boundary_nodes",
     "boundary_edges_topological", "edges", "structured_mesh", "grid_triangles",
+    "bisect", "label_longest_edge", "Bisection",
 ]

@@ -13,9 +13,10 @@ from typing import Iterable
 
 import numpy as np
 
+from ..errors import MeshError
 from .mesh import Mesh
 
-__all__ = ["edges", "boundary_edges_topological", "boundary_nodes"]
+__all__ = ["edges", "boundary_edges_topological", "boundary_nodes", "edge_ids", "boundary_edge_ids"]
 
 
 def _local_edges(tri: np.ndarray) -> np.ndarray:
@@ -67,3 +68,25 @@ def boundary_nodes(mesh: Mesh, tags: Iterable | str | int | None = None) -> np.n
     nums = check_tags(mesh, tags, kind="boundary")
     sel = np.isin(mesh.boundary_tags, nums)
     return np.unique(mesh.boundary_edges[sel])
+
+
+def edge_ids(mesh: Mesh, edge_nodes: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """Index in ``edge_nodes`` (from :func:`edges`) of each node pair in ``pairs`` (k, 2), any order.
+
+    Raises :class:`~femkit.errors.MeshError` when a pair is not an edge of any triangle.
+    """
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    n = max(mesh.n_points, 1)
+    keys = edge_nodes[:, 0] * n + edge_nodes[:, 1]
+    q = pairs.min(axis=1) * n + pairs.max(axis=1)
+    pos = np.minimum(np.searchsorted(keys, q), max(len(keys) - 1, 0))
+    bad = np.flatnonzero(keys[pos] != q) if len(keys) else np.arange(len(pairs))
+    if len(bad):
+        raise MeshError(f"{len(bad)} boundary edge(s) are not edges of any triangle "
+                        f"(edge ids {', '.join(map(str, bad[:10]))})")
+    return pos
+
+
+def boundary_edge_ids(mesh: Mesh, edge_nodes: np.ndarray) -> np.ndarray:
+    """Index in ``edge_nodes`` of each tagged boundary edge of ``mesh`` (see :func:`edge_ids`)."""
+    return edge_ids(mesh, edge_nodes, mesh.boundary_edges)

@@ -14,6 +14,20 @@ import numpy as np
 from .mesh import Mesh
 
 
+def side_lengths_and_angles(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Side lengths and angles (degrees) of triangles given by their corners ``p`` (m, 3, 2).
+
+    Column k of both is the side opposite / the angle at vertex k (law of cosines); degenerate
+    triangles give NaN angles.
+    """
+    e = p[:, [2, 0, 1]] - p[:, [1, 2, 0]]                # edge opposite vertex k
+    lens = np.sqrt(np.einsum("ijk,ijk->ij", e, e))       # (m, 3)
+    a, b, c = lens, lens[:, [1, 2, 0]], lens[:, [2, 0, 1]]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cosang = np.clip((b * b + c * c - a * a) / (2.0 * b * c), -1.0, 1.0)
+        return lens, np.degrees(np.arccos(cosang))
+
+
 def quality(mesh: Mesh) -> dict:
     """Mesh size and shape numbers.
 
@@ -29,18 +43,12 @@ def quality(mesh: Mesh) -> dict:
     """
     from .edges import edges
 
-    p = mesh.points[mesh.triangles]                      # (m, 3, 2)
-    e = p[:, [2, 0, 1]] - p[:, [1, 2, 0]]                # edge opposite vertex k
-    lens = np.sqrt(np.einsum("ijk,ijk->ij", e, e))       # (m, 3)
+    lens, ang = side_lengths_and_angles(mesh.points[mesh.triangles])
     area = mesh.areas()
     edge_nodes, _ = edges(mesh)
     d = mesh.points[edge_nodes[:, 1]] - mesh.points[edge_nodes[:, 0]]
     unique_len = np.hypot(d[:, 0], d[:, 1])
-    # angle at vertex k from the law of cosines (a = opposite side)
-    a, b, c = lens, lens[:, [1, 2, 0]], lens[:, [2, 0, 1]]
     with np.errstate(divide="ignore", invalid="ignore"):
-        cosang = np.clip((b * b + c * c - a * a) / (2.0 * b * c), -1.0, 1.0)
-        ang = np.degrees(np.arccos(cosang))
         s = 0.5 * lens.sum(axis=1)
         circum = lens.prod(axis=1) / (4.0 * area)
         inr = area / s

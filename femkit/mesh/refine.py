@@ -12,8 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import MeshError
-from .edges import edges
+from .edges import boundary_edge_ids, edges
 from .mesh import Mesh
 
 
@@ -36,14 +35,7 @@ def _refine_once(mesh: Mesh) -> Mesh:
 
     be = mesh.boundary_edges
     if len(be):
-        keys = edge_nodes[:, 0] * n + edge_nodes[:, 1]
-        q = be.min(axis=1) * n + be.max(axis=1)
-        pos = np.minimum(np.searchsorted(keys, q), len(keys) - 1)
-        bad = np.flatnonzero(keys[pos] != q)
-        if len(bad):
-            raise MeshError(f"{len(bad)} tagged boundary edge(s) are not edges of any triangle "
-                            f"(edge ids {', '.join(map(str, bad[:10]))}); cannot refine")
-        bm = n + pos
+        bm = n + boundary_edge_ids(mesh, edge_nodes)
         new_be = np.stack([np.stack([be[:, 0], bm], axis=1),
                            np.stack([bm, be[:, 1]], axis=1)], axis=1).reshape(-1, 2)
         new_bt = np.repeat(mesh.boundary_tags, 2)

@@ -23,20 +23,20 @@ SIDES = {"bottom": 1, "right": 2, "top": 3, "left": 4}
 __all__ = ["grid_triangles", "structured_mesh", "SIDES"]
 
 
-def grid_triangles(nx: int, ny: int, *, diagonal: str = "right") -> np.ndarray:
+def grid_triangles(nx: int, ny: int, *, diagonal: str = "uniform") -> np.ndarray:
     """Triangles of an ``nx x ny`` grid of *points* numbered row by row (``i + nx j``), CCW.
 
-    ``diagonal="right"`` cuts every cell along the same diagonal; ``"alternating"`` flips it on
+    ``diagonal="uniform"`` cuts every cell along the same diagonal; ``"alternating"`` flips it on
     every other cell (a criss-cross pattern without a preferred direction).
     """
     if nx < 2 or ny < 2:
         raise ValueError(f"a grid needs at least 2 x 2 points, got {nx} x {ny}")
-    if diagonal not in ("right", "alternating"):
-        raise ValueError(f"diagonal must be 'right' or 'alternating', got {diagonal!r}")
+    if diagonal not in ("uniform", "alternating"):
+        raise ValueError(f"diagonal must be 'uniform' or 'alternating', got {diagonal!r}")
     i, j = np.meshgrid(np.arange(nx - 1), np.arange(ny - 1), indexing="xy")
     a = (j * nx + i).ravel()
     b, c, d = a + 1, a + nx + 1, a + nx
-    if diagonal == "right":
+    if diagonal == "uniform":
         return np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])]).astype(np.int64)
     flip = ((i + j) % 2 == 1).ravel()[:, None]
     t_a = np.where(flip, np.column_stack([a, b, d]), np.column_stack([a, b, c]))
@@ -45,7 +45,7 @@ def grid_triangles(nx: int, ny: int, *, diagonal: str = "right") -> np.ndarray:
 
 
 def structured_mesh(nx: int, ny: int, width: float = 1.0, height: float = 1.0, *,
-                    diagonal: str = "right", origin=(0.0, 0.0)) -> Mesh:
+                    diagonal: str = "uniform", origin=(0.0, 0.0)) -> Mesh:
     """``nx x ny`` cells of ``[x0, x0 + width] x [y0, y0 + height]``, two triangles per cell.
 
     The four sides are tagged ``bottom``/``right``/``top``/``left`` (:data:`SIDES`).

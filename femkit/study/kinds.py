@@ -138,8 +138,52 @@ def _stability_report(*args) -> None:
     build_stability_report(*args)
 
 
+# ----------------------------------------------------------------------------- adaptive
+
+def _adaptive_check(study) -> None:
+    from ..fem.adaptive import check_settings
+    from ..fem.estimators import ESTIMATORS
+    from ..case.names import lookup
+
+    d = study.data
+    if ("problem" in d) == ("base_case" in d):
+        raise CaseFileError("adaptive: give exactly one of 'problem' (inline) or 'base_case' (a case file)")
+    if "max_dofs" not in d:
+        raise CaseFileError("(top level): missing required key 'max_dofs' (the budget of both refinements)")
+    for i, name in enumerate(d["estimators"]):
+        lookup(ESTIMATORS, name, f"estimators[{i}]")
+    check_settings(theta=d["theta"], target=d.get("target"), max_dofs=d["max_dofs"],
+                   max_time=d.get("max_time"), max_levels=d["max_levels"])
+    if "base_case" in d:
+        p = study.resolve(d["base_case"])
+        if not p.is_file():
+            raise CaseFileError(f"base_case: file not found: {p}")
+        study.files.append(p)
+    from .problem import study_problem
+
+    study_problem(study, need_exact=False)
+
+
+def _adaptive_run(study, progress_enabled=None) -> dict:
+    from .adaptive import run_adaptive_study
+
+    return run_adaptive_study(study, progress_enabled=progress_enabled)
+
+
+def _adaptive_report(*args) -> None:
+    from .adaptive import build_adaptive_report
+
+    build_adaptive_report(*args)
+
+
+def _adaptive_summary(result) -> list[str]:
+    from .adaptive import adaptive_summary
+
+    return adaptive_summary(result)
+
+
 def _register() -> None:
-    from .schema import DYNAMICS, POISSON, STABILITY
+    from .schema import ADAPTIVE, DYNAMICS, POISSON, STABILITY
 
     STUDY_KINDS.register("poisson_convergence", StudyKind(
         POISSON, _poisson_check, _poisson_run, _poisson_report, _poisson_summary))
@@ -147,6 +191,8 @@ def _register() -> None:
         DYNAMICS, _dynamics_check, _dynamics_run, _dynamics_report, _fit_lines))
     STUDY_KINDS.register("stability", StudyKind(
         STABILITY, _stability_check, _stability_run, _stability_report, _fit_lines))
+    STUDY_KINDS.register("adaptive", StudyKind(
+        ADAPTIVE, _adaptive_check, _adaptive_run, _adaptive_report, _adaptive_summary))
 
 
 _register()

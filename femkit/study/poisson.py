@@ -13,8 +13,6 @@ adds nested-iteration runs (see :func:`_nested_runs`).
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
 from .fit import fit_rate
@@ -23,30 +21,30 @@ from .timing import StageTimer, time_call
 
 
 def _meshes(study, spec, timer_list):
-    """The mesh levels: uniform refinements of one mesh, or one gmsh mesh per h."""
+    """The mesh levels: uniform refinements of one mesh, or one gmsh mesh per h; the time of
+    each level is appended to ``timer_list``."""
     from ..mesh import refine
 
     lv = study.data["levels"]
     meshes = []
+    timer = StageTimer()
+
+    def timed(level, make):
+        with timer(level):
+            meshes.append(make())
+        timer_list.append(timer.times[level])
+
     if "h" in lv:
         hs = list(lv["h"])
         if "max_level" in lv:
             hs = hs[: lv["max_level"] + 1]
-        for h in hs:
-            t0 = time.perf_counter()
-            meshes.append(spec.base_mesh(h))
-            timer_list.append(time.perf_counter() - t0)
+        for i, h in enumerate(hs):
+            timed(i, lambda h=h: spec.base_mesh(h))
     else:
         count = lv["count"] if "max_level" not in lv else min(lv["count"], lv["max_level"] + 1)
-        t0 = time.perf_counter()
-        m = spec.base_mesh(lv["h0"])
-        timer_list.append(time.perf_counter() - t0)
-        meshes.append(m)
-        for _ in range(count - 1):
-            t0 = time.perf_counter()
-            m = refine(m, 1)
-            timer_list.append(time.perf_counter() - t0)
-            meshes.append(m)
+        timed(0, lambda: spec.base_mesh(lv["h0"]))
+        for i in range(1, count):
+            timed(i, lambda: refine(meshes[-1], 1))
     return meshes
 
 

@@ -46,8 +46,12 @@ class StudyProblem:
         return compute_errors(self.case, problem, u, order=order)
 
 
-def study_problem(study) -> StudyProblem:
-    """The study's Poisson case: inline ``problem:`` (prefixed errors) or ``base_case:``."""
+def study_problem(study, *, need_exact: bool = True) -> StudyProblem:
+    """The study's Poisson case: inline ``problem:`` (prefixed errors) or ``base_case:``.
+
+    ``need_exact``: a convergence study needs ``exact``; an adaptive study measures the estimate
+    without one.
+    """
     from ..case import load_case
     from ..case.load import case_from_dict
 
@@ -59,7 +63,7 @@ def study_problem(study) -> StudyProblem:
         data = {"problem": "poisson", **d["problem"]}
         mesh = dict(data.get("mesh") or {})
         if "geometry" in mesh and "h" not in mesh:  # the levels give the sizes
-            lv = d["levels"]
+            lv = d.get("levels") or {"h0": d.get("h0")}
             mesh["h"] = lv["h"][0] if "h" in lv else lv["h0"]
         data["mesh"] = mesh
         try:
@@ -69,6 +73,6 @@ def study_problem(study) -> StudyProblem:
         where = "problem"
     if case.problem != "poisson":
         raise CaseFileError(f"{where} is a {case.problem!r} case; a convergence study needs 'poisson'")
-    if "exact.u" not in case.functions:
+    if need_exact and "exact.u" not in case.functions:
         raise CaseFileError(f"{where} gives no exact solution; a convergence study needs 'exact'")
     return StudyProblem(case)

@@ -14,8 +14,6 @@ from ..case.specs import INTEGRATOR_SCHEMA, solver_schema
 
 POS = {"type": "number", "exclusiveMinimum": 0}
 POSINT = {"type": "integer", "minimum": 1}
-EXPR = {"oneOf": [{"type": "string", "minLength": 1}, {"type": "number"}],
-        "x-message": "must be a number or an expression of x and y"}
 
 
 def _obj(props: dict, required=(), **extra) -> dict:
@@ -57,6 +55,21 @@ POISSON = {
     "error_order": {**POSINT, "default": 5},
     "reference": {"enum": ["none", "scikit-fem"], "default": "none"},
     "stop_at_discretisation_error": _obj({"fraction": {**POS, "default": 0.1}}),
+}
+
+ADAPTIVE = {
+    "problem": PROBLEM,
+    "base_case": {"type": "string"},
+    "h0": {**POS, "description": "initial mesh size of a generated mesh (default: the case's mesh.h)"},
+    "estimators": {"type": "array", "items": {"type": "string"}, "minItems": 1, "default": ["residual"]},
+    "theta": {"type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.5},
+    "target": POS,
+    "max_dofs": {"type": "integer", "exclusiveMinimum": 0},
+    "max_time": POS,
+    "max_levels": {**POSINT, "default": 40},
+    "fit_min_dofs": {**POSINT, "default": 200},
+    "solvers": {"type": "array", "items": SOLVER, "minItems": 1, "maxItems": 1,
+                "default": [{"method": "pcg", "preconditioner": "amg", "rtol": 1e-8}]},
 }
 
 SCENE = _obj({

@@ -34,7 +34,6 @@ from ..errors import FemkitError, InstabilityError, SingularSystemError
 from ..mesh.structured import structured_mesh
 from .progress import progress
 
-
 # ----------------------------------------------------------------------------- meshes
 
 def _poisson_system(mesh, kappa, f, g=0.0):

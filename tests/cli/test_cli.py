@@ -120,7 +120,7 @@ def test_normal_run_writes_result_json_and_vtu(tmp_path, capsys):
         assert key in res
     assert res["converged"] is True and res["solver"]["converged"] is True
     assert res["errors"]["L2"] < 0.1 and res["errors"]["H1_semi"] < 1.0
-    assert set(res["timings"]) == {"mesh", "assembly", "boundary", "solve", "errors", "output"}
+    assert set(res["timings"]) == {"mesh", "assembly", "boundary", "solve", "errors", "estimate", "output"}
     assert res["mesh"]["n_triangles"] > 0 and res["mesh"]["h_max"] > 0
     assert res["solver"]["residuals"][0] > res["solver"]["true_residual"]
     import meshio

@@ -129,7 +129,11 @@ def cross_check(case: Case) -> list[CheckRow]:
     pure = is_pure_neumann(case)
     if pure:
         # u is defined up to a constant: skfem pins node 0, both compared at mean zero
-        from ...fem.poisson import check_compatibility, node_weights, pure_neumann_system
+        from ...fem.poisson import (
+            check_compatibility,
+            node_weights,
+            pure_neumann_system,
+        )
 
         w = node_weights(mesh)
         F_sk = check_compatibility(F_sk, weights=w, rtol=case.data["boundary"]["compatibility_rtol"])[0]

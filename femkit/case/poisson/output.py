@@ -20,7 +20,8 @@ __all__ = ["write_solution", "write_plot", "write_outputs", "output_location",
 
 #: Top-level keys of result.json.
 RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs", "nnz",
-               "solver", "converged", "errors", "timings", "expressions", "files")
+               "solver", "converged", "errors", "error_estimate", "effectivity", "adaptive",
+               "timings", "expressions", "files")
 
 
 def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarray | None = None,
@@ -44,23 +45,38 @@ def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarr
     return target
 
 
-def write_plot(path: str | os.PathLike, mesh, u: np.ndarray, title: str = "") -> Path:
-    """Save a filled-contour PNG of ``u`` with a colour bar (matplotlib, Agg backend)."""
+def write_plot(path: str | os.PathLike, mesh, u: np.ndarray, title: str = "",
+               indicators: np.ndarray | None = None, estimator: str = "") -> Path:
+    """Save a PNG of ``u`` with a colour bar (matplotlib, Agg backend); with ``indicators`` a second
+    panel shows the element error indicators ``eta_T`` on a logarithmic colour scale."""
+    from matplotlib.colors import LogNorm
     from matplotlib.tri import Triangulation
 
     tri = Triangulation(mesh.points[:, 0], mesh.points[:, 1], mesh.triangles)
-    fig = new_figure(6, 5, dpi=120)
-    ax = fig.add_subplot()
+    panels = 1 if indicators is None else 2
+    fig = new_figure(6 * panels, 5, dpi=120)
+    ax = fig.add_subplot(1, panels, 1)
     art = ax.tripcolor(tri, np.asarray(u, dtype=np.float64), shading="gouraud", cmap="viridis")
     fig.colorbar(art, ax=ax, label="u")
-    ax.set_aspect("equal")
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
     ax.set_title(title, fontsize=9)
+    axes = [ax]
+    if indicators is not None:
+        eta = np.asarray(indicators, dtype=np.float64)
+        pos = eta[eta > 0]
+        lo = pos.min() if pos.size else 1e-300
+        hi = max(eta.max(), lo * 10)
+        ax2 = fig.add_subplot(1, panels, 2)
+        art2 = ax2.tripcolor(tri, facecolors=np.maximum(eta, lo), cmap="magma",
+                             norm=LogNorm(vmin=max(lo, hi * 1e-8), vmax=hi))
+        fig.colorbar(art2, ax=ax2, label="error indicator eta_T (log scale)")
+        ax2.set_title(f"{estimator} indicators: estimate {np.sqrt(np.sum(eta ** 2)):.3e}", fontsize=9)
+        axes.append(ax2)
+    for a in axes:
+        a.set_aspect("equal")
+        a.set_xlabel("x")
+        a.set_ylabel("y")
     fig.tight_layout()
     return save_figure(fig, path)
-
-
 
 
 def output_location(directory: str | os.PathLike) -> Path:
@@ -102,7 +118,9 @@ def write_outputs(result, directory: str | os.PathLike) -> Path:
         if opts["plot"]:
             title = (f"{result.case.name}: {result.mesh.n_triangles} triangles, "
                      f"h_max = {result.quality.get('h_max', float('nan')):.3g}")
-            write_plot(tmp / "solution.png", result.mesh, result.u, title)
+            est = result.error_estimate or {}
+            write_plot(tmp / "solution.png", result.mesh, result.u, title,
+                       indicators=result.indicators, estimator=est.get("estimator", ""))
         result.files = sorted({p.name for p in tmp.iterdir()} | {"result.json"})
         result.timings["output"] = time.perf_counter() - t0  # up to result.json itself
         write_json(tmp / "result.json", result.to_dict())

@@ -67,13 +67,14 @@ def prepare_poisson(case: Case) -> None:
             raise CaseFileError(f"mesh.{bad}: only used with mesh.geometry, not with mesh.file")
     else:
         check_geometry_spec(mesh, "mesh")
+    from ...solvers.defaults import DEFAULT_METHOD
     from ..specs import solver_spec
 
-    case.solver = solver_spec(d["solver"], "solver", default_method="pcg")
+    case.solver = solver_spec(d["solver"], "solver", default_method=DEFAULT_METHOD["poisson"])
     d["solver"] = case.solver.to_dict()
     from ..specs import limits_spec
 
-    case.extras["limits"] = limits_spec(d.get("limits"))
+    case.run_options["limits"] = limits_spec(d.get("limits"))
 
     from ...fem.quadrature import QUADRATURE
 
@@ -94,6 +95,17 @@ def prepare_poisson(case: Case) -> None:
         for i, g in enumerate(exact.get("grad") or []):
             # Gradients of singular solutions blow up at a corner node: no finiteness check.
             _compile(case, f"exact.grad[{i}]", g, check_finite=False)
+
+    from ...fem.estimators import ESTIMATORS
+
+    lookup(ESTIMATORS, d["estimator"], "estimator")
+    if d.get("adaptive"):
+        from ...fem.adaptive import check_settings
+
+        try:
+            check_settings(**d["adaptive"], estimator=d["estimator"])
+        except InputError as exc:
+            raise with_prefix(exc, "adaptive") from None
 
     out = d["output"]
     out["dir"] = str((base / out.get("dir", os.path.join("runs", case.name))).resolve())
@@ -124,7 +136,7 @@ def build_mesh(case: Case, *, h: float | None = None):
 
     spec = case.data["mesh"]
     where = f"mesh.file {spec['file']}" if "file" in spec else f"mesh.geometry {spec['geometry']}"
-    check = not case.extras.get("force", False)  # --force also passes the library's memory checks
+    check = not case.run_options.get("force", False)  # --force also passes the library's memory checks
     try:
         if "file" in spec:
             mesh = read_mesh(spec["file"])
@@ -273,6 +285,10 @@ class CaseResult:
     output_dir: Path | None = None
     files: list = field(default_factory=list)
     nullspace: dict | None = None
+    error_estimate: dict | None = None
+    effectivity: float | None = None
+    indicators: np.ndarray | None = None
+    adaptive: dict | None = None
     interrupted: str | None = None
 
     @property
@@ -306,6 +322,9 @@ class CaseResult:
             "converged": self.converged,
             "interrupted": self.interrupted is not None,
             "errors": self.errors,
+            "error_estimate": self.error_estimate,
+            "effectivity": self.effectivity,
+            "adaptive": self.adaptive,
             "timings": dict(self.timings),
             "expressions": {k: f.source for k, f in self.case.functions.items()},
             "files": list(self.files),
@@ -336,6 +355,18 @@ class CaseResult:
         if self.errors is not None:
             lines.append("errors    " + ", ".join(f"{k} {v:.4e}" for k, v in self.errors.items()
                                                   if v is not None))
+        if self.error_estimate is not None:
+            e = self.error_estimate
+            eff = f", effectivity {self.effectivity:.3f}" if self.effectivity is not None else ""
+            lines.append(f"estimate  energy-norm error ~ {e['energy']:.4e} ({e['estimator']} "
+                         f"estimator{eff})")
+        if self.adaptive is not None:
+            a = self.adaptive
+            met = ("target met" if a["target_met"] else
+                   f"target NOT met: stopped by {a['stop_reason']}" if a.get("target") is not None
+                   else f"stopped by {a['stop_reason']}")
+            lines.append(f"adaptive  {len(a['levels'])} levels, theta {a['theta']:g}, "
+                         f"{a['levels'][0]['dofs']} -> {a['levels'][-1]['dofs']} dofs; {met}")
         lines.append("time      " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timings.items()))
         if self.output_dir is not None:
             lines.append(f"output    {self.output_dir} ({', '.join(self.files)})")
@@ -370,7 +401,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         from .output import output_location
 
         target = output_location(output_dir or case.data["output"]["dir"])
-    stop = case.extras.get("stop")
+    stop = case.run_options.get("stop")
 
     def check_stop(where: str) -> None:  # a signal during a stage stops after it
         if stop:
@@ -378,26 +409,42 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
 
     with stage("mesh"):
         mesh = build_mesh(case)
-        q = quality(mesh)
     check_stop("mesh")
-    problem = poisson_problem(case, mesh)
-    with stage("assembly"):
-        K, F = problem.assemble_matrices()
-    check_stop("assembly")
-    with stage("boundary"):
-        system = problem.reduce(K, F, case.solver.method)
-    check_stop("boundary")
-    with stage("solve"):
-        res = _solve(case, system, stop)
-        u = system.expand(res.x)
+    grad = exact_gradient(case)
+    run = est = None
+    if case.data.get("adaptive"):
+        from .estimate import solve_adaptive
+
+        with stage("adaptive"):
+            run = solve_adaptive(case, mesh)
+        mesh, problem, u, res, est = run.mesh, run.problem, run.u, run.result, run.estimate
+        system = problem.system
+    else:
+        problem = poisson_problem(case, mesh)
+        with stage("assembly"):
+            K, F = problem.assemble_matrices()
+        check_stop("assembly")
+        with stage("boundary"):
+            system = problem.reduce(K, F, case.solver.method)
+        check_stop("boundary")
+        with stage("solve"):
+            res = _solve(case, system, stop)
+            u = system.expand(res.x)
+    q = quality(mesh)
     errors = None
     if "exact.u" in case.functions:
         with stage("errors"):
             errors = compute_errors(case, problem, u)
+    from .estimate import adaptive_facts, estimate_facts
+
+    with stage("estimate"):
+        estimate, effectivity, est = estimate_facts(case, problem, u, grad, est)
     result = CaseResult(case=case, mesh=mesh, u=u, kappa=problem.kappa, solve=res, errors=errors,
                         timings=stage.times, quality=q, dofs=int(system.A.shape[0]),
                         n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
                         nnz=int(system.A.nnz), nullspace=_nullspace_facts(system),
+                        error_estimate=estimate, effectivity=effectivity, indicators=est.indicators,
+                        adaptive=adaptive_facts(run) if run is not None else None,
                         interrupted=stop.name if res.reason == "interrupted" else None)
     if write:
         from .output import write_outputs

@@ -52,6 +52,23 @@ _COEFFICIENT = {
                  "{regions: {name: value}, default: value}",
 }
 
+_POSITIVE = {"type": "number", "exclusiveMinimum": 0}
+
+_ADAPTIVE = {
+    "type": "object",
+    "additionalProperties": False,
+    "properties": {
+        "target": _POSITIVE,
+        "theta": {"type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.5},
+        "max_dofs": {"type": "integer", "exclusiveMinimum": 0},
+        "max_time": _POSITIVE,
+        "max_levels": {"type": "integer", "exclusiveMinimum": 0, "default": 30},
+    },
+    "anyOf": [{"required": ["target"]}, {"required": ["max_dofs"]}, {"required": ["max_time"]}],
+    "x-prefer-deeper": False,
+    "x-message": "give at least one of target, max_dofs, max_time",
+}
+
 POISSON_SCHEMA: dict = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "title": "femkit Poisson case: -div(kappa grad u) = f",
@@ -100,6 +117,10 @@ POISSON_SCHEMA: dict = {
                 "grad": {"type": "array", "minItems": 2, "maxItems": 2, "items": _NUMBER_OR_EXPR},
             },
         },
+        # error estimator of result.json and of adaptive refinement (checked against the
+        # femkit.fem.estimators registry at load time)
+        "estimator": {"type": "string", "minLength": 1, "default": "residual"},
+        "adaptive": _ADAPTIVE,
         "quadrature": {
             "type": "object", "additionalProperties": False, "default": {},
             "properties": {"load": {"type": "string", "default": "barycentric"}},
@@ -117,6 +138,3 @@ POISSON_SCHEMA: dict = {
         },
     },
 }
-
-#: Load quadrature rules a case may name (checked against femkit.fem when available).
-LOAD_RULES = ("barycentric", "gauss3", "gauss6", "gauss7")

@@ -37,24 +37,36 @@ import numpy as np
 
 from ..._version import __version__
 from ...dynamics import topology
-from ...dynamics.forces import GroundContact, Gravity, RayleighDamping, SphereContact, ViscousDamping
+from ...dynamics.forces import (
+    Gravity,
+    GroundContact,
+    RayleighDamping,
+    SphereContact,
+    ViscousDamping,
+)
 from ...dynamics.integrators import StepContext, get_integrator
 from ...dynamics.integrators.base import check_matrix_free
 from ...dynamics.simulate import StabilityWarning, simulate
 from ...dynamics.stability import estimate_omega_max
-from ...errors import (CaseFileError, ExpressionError, InputError, InstabilityError,
-                       UnknownNameError, with_prefix)
-from ...io.atomic import check_output_dir
+from ...errors import (
+    CaseFileError,
+    ExpressionError,
+    InputError,
+    InstabilityError,
+    UnknownNameError,
+    with_prefix,
+)
+from ...io.atomic import EARLIER_RUN, check_output_dir
 from ...mesh import generate, grid_triangles, read_mesh, validate
 from ...progress import Progress
 from ...registry import Registry
+from ...solvers.defaults import DEFAULT_METHOD
 from ...solvers.spec import SolverSpec
 from ...timing import StageTimer
 from ..expressions import compile_expression
 from ..load import Case
 from ..names import check_geometry_spec, resolve_file
 from ..specs import IntegratorSpec, limits_spec, solver_spec
-from ...io.atomic import EARLIER_RUN
 from .output import write_scene_outputs
 
 __all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "build_context",
@@ -122,9 +134,10 @@ def prepare_scene(case: Case) -> None:
     d["integrator"] = {"method": integ.method, "options": dict(integ.options)}
 
     # linear solver
-    ls_spec = solver_spec(d["linear_solver"], "linear_solver", default_method="direct")
+    case.solver = ls_spec = solver_spec(d["linear_solver"], "linear_solver",
+                                        default_method=DEFAULT_METHOD["mass_spring"])
     d["linear_solver"] = ls_spec.to_dict()
-    case.extras["limits"] = limits_spec(d.get("limits"))
+    case.run_options["limits"] = limits_spec(d.get("limits"))
     if integ.options.get("matrix_free"):  # caught at load time, before anything runs
         try:
             check_matrix_free(integ.method, StepContext(ls_spec))
@@ -370,7 +383,7 @@ class SceneResult:
         """The signal that stopped the run early (``"SIGTERM"`` ...), else None."""
         if not getattr(self.trajectory, "interrupted", False):
             return None
-        stop = self.case.extras.get("stop")
+        stop = self.case.run_options.get("stop")
         return getattr(stop, "name", None) or "a stop request"
 
     @property
@@ -499,7 +512,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     output_dir : overrides ``output.dir``.
     quiet : print nothing (no summary, no progress) when true. Progress: a tqdm bar when stderr
         is a terminal, else one line per 10 % of the steps or per minute (elapsed, remaining).
-        A stop request (``case.extras["stop"]``, set by SIGINT/SIGTERM under ``femkit solve``)
+        A stop request (``case.run_options["stop"]``, set by SIGINT/SIGTERM under ``femkit solve``)
         ends the run after the current step; the frames so far are written as usual, with
         ``interrupted: true`` in result.json.
     write : write the outputs (atomically) when true.
@@ -522,7 +535,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
         ctx = build_context(case)
         every = output_every(case)
     st = case.data["stability"]
-    stop = case.extras.get("stop")
+    stop = case.run_options.get("stop")
     # a tqdm bar on a terminal, else one line per 10 % or per minute on stderr (logs, batch jobs)
     progress = Progress(n_steps(case), f"scene {case.name}", unit="step", quiet=quiet)
 

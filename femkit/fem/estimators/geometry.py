@@ -1,0 +1,47 @@
+"""Per-element quantities both estimators need: gradients, fluxes, edges and their roles."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._elements import p1_gradients, triangle_geometry
+from ..coefficients import element_coefficient
+
+
+@dataclass(frozen=True)
+class ElementFields:
+    """Geometry and the discrete solution's element-wise data.
+
+    ``e`` (m, 3, 2) edge vectors (``e[:, k]`` opposite local vertex k, from vertex k+1 to k+2),
+    ``area`` (m,), ``grad`` (m, 2) = grad u_h, ``kappa`` (m,) barycentre values,
+    ``edge_nodes`` (E, 2) and ``tri_edges`` (m, 3) from :func:`femkit.mesh.edges`,
+    ``edge_count`` (E,) how many triangles share each edge (1 = boundary, 2 = interior).
+    """
+
+    e: np.ndarray
+    area: np.ndarray
+    grad: np.ndarray
+    kappa: np.ndarray
+    edge_nodes: np.ndarray
+    tri_edges: np.ndarray
+    edge_count: np.ndarray
+
+
+def element_fields(mesh, u: np.ndarray, kappa) -> ElementFields:
+    """Gradients, kappa and the edge structure of ``mesh`` for the P1 function ``u``."""
+    from ...errors import InputError
+    from ...mesh.edges import edges
+
+    u = np.asarray(u, dtype=np.float64)
+    if u.shape != (mesh.n_points,):
+        raise InputError(f"u must have one value per node, shape ({mesh.n_points},), got {u.shape}")
+    if not np.isfinite(u).all():
+        raise InputError("u has non-finite values: no error estimate for it")
+    e, area, signed, tri = triangle_geometry(mesh, None)
+    grad = p1_gradients(e, signed, u[tri])
+    kap = element_coefficient(mesh, kappa)
+    edge_nodes, te = edges(mesh)
+    count = np.bincount(te.ravel(), minlength=len(edge_nodes))
+    return ElementFields(e, area, grad, kap, edge_nodes, te, count)
