@@ -15,12 +15,13 @@ alive during that stage; the run's peak is the largest stage peak.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Callable
 
 from .memory import format_bytes
 
-__all__ = ["Stage", "Plan", "format_seconds"]
+__all__ = ["Stage", "Plan", "format_seconds", "round_up", "round_down"]
 
 
 @dataclass
@@ -153,3 +154,25 @@ def format_seconds(s: float) -> str:
     if s < 86400 * 365 * 2:
         return f"{s / 86400:.3g} d"
     return f"{s / (86400 * 365):.3g} years"
+
+
+def round_up(x: float) -> str:
+    """Two significant digits, rounded up (a suggested lower bound that still fits).
+
+    >>> round_up(0.0003312), round_up(2e-6), round_up(0.0591)
+    ('0.00034', '2e-06', '0.06')
+    """
+    e = math.floor(math.log10(x)) - 1
+    return f"{math.ceil(round(x / 10 ** e, 9)) * 10 ** e:.2g}"
+
+
+def round_down(x: float) -> str:
+    """Two significant digits, rounded down (a suggested upper bound that still fits).
+
+    >>> round_down(0.0169), round_down(0.0)
+    ('0.016', '0')
+    """
+    if x <= 0:
+        return "0"
+    e = math.floor(math.log10(x)) - 1
+    return f"{math.floor(round(x / 10 ** e, 9)) * 10 ** e:.2g}"

@@ -40,8 +40,7 @@ from ..errors import InputError
 from ..validation import mesh_size as _check_h
 from .constants import load_constants
 from .geometry import domain_measures
-from .memory import format_bytes
-from .plan import Plan, Stage, format_seconds
+from .plan import Plan, Stage, round_up
 
 __all__ = ["predict_triangles", "mesh_sizes", "plan_mesh", "plan_poisson", "solver_key",
            "predict_iterations"]
@@ -326,19 +325,9 @@ def _suggester(kw: dict):
             while hi / lo > 1.01:
                 mid = math.sqrt(lo * hi)
                 lo, hi = (lo, mid) if fits(h=mid) else (mid, hi)
-            tips.append(f"h >= {_round_up(hi)}" + (f" (with refine {r})" if r else ""))
+            tips.append(f"h >= {round_up(hi)}" + (f" (with refine {r})" if r else ""))
         elif kw["triangles"] is not None and not tips:
             tips.append("a coarser mesh file")
         return " or ".join(tips)
 
     return suggest
-
-
-def _round_up(x: float) -> str:
-    """Two significant digits, rounded up so that the suggested value fits."""
-    e = math.floor(math.log10(x)) - 1
-    return f"{math.ceil(x / 10 ** e) * 10 ** e:.2g}"
-
-
-# re-exported helpers used in messages
-__all__ += ["format_bytes", "format_seconds"]

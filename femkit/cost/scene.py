@@ -23,7 +23,7 @@ import time
 
 from ..errors import InputError
 from .constants import load_constants
-from .plan import Plan, Stage, format_seconds
+from .plan import Plan, Stage, format_seconds, round_down, round_up
 
 __all__ = ["plan_scene", "measure_step_seconds", "record_every"]
 
@@ -115,28 +115,16 @@ def plan_scene(*, n_nodes: int, n_springs: int, dim: int, dt: float, t_end: floa
 
     def suggest(what: str, limit: float) -> str:
         if what == "steps":
-            return (f"dt >= {_up(dt * steps / limit)} or t_end <= {_down(t0 + limit * dt)}")
+            return (f"dt >= {round_up(dt * steps / limit)} or t_end <= {round_down(t0 + limit * dt)}")
         if what == "time":
             k = limit / max(plan.seconds, 1e-300)
-            return f"dt >= {_up(dt / k)} or t_end <= {_down(t0 + (t_end - t0) * k)}"
+            return f"dt >= {round_up(dt / k)} or t_end <= {round_down(t0 + (t_end - t0) * k)}"
         if what in ("output", "memory"):
             return "fewer frames (output.frames / output.every) or fewer output kinds"
         return ""
 
     plan.suggest = suggest
     return plan
-
-
-def _up(x: float) -> str:
-    e = math.floor(math.log10(x)) - 1
-    return f"{math.ceil(x / 10 ** e) * 10 ** e:.2g}"
-
-
-def _down(x: float) -> str:
-    if x <= 0:
-        return "0"
-    e = math.floor(math.log10(x)) - 1
-    return f"{math.floor(x / 10 ** e) * 10 ** e:.2g}"
 
 
 def measure_step_seconds(system, integrator, dt: float, *, ctx=None, batch: int = 20,
