@@ -25,7 +25,7 @@ from typing import Iterable, Iterator, TypeVar
 
 from .cost.plan import format_seconds
 
-__all__ = ["Progress", "progress"]
+__all__ = ["Progress", "progress", "StageProgress"]
 
 T = TypeVar("T")
 
@@ -160,3 +160,49 @@ def progress(items: Iterable[T], *, total: int | None = None, desc: str = "", un
             bar.update()
     finally:
         bar.close()
+
+
+class StageProgress:
+    """Progress of a run made of stages whose durations were predicted (a :class:`femkit.cost.Plan`).
+
+    After each stage, :meth:`done` prints ``desc: assembly done, elapsed 12 s, remaining ~30 s``
+    on stderr, the remaining time being the predicted time of the stages left, scaled by how
+    the elapsed time compares with its prediction. Only for runs predicted to take at least
+    ``min_seconds`` (a short run stays silent), never when ``quiet``.
+
+    >>> import io
+    >>> out = io.StringIO()
+    >>> clock = iter([0.0, 10.0, 30.0]).__next__
+    >>> sp = StageProgress([("mesh", 5.0), ("solve", 15.0)], "demo", stream=out, min_seconds=0,
+    ...                    clock=clock)
+    >>> sp.done("mesh"); sp.done("solve")
+    >>> out.getvalue().splitlines()
+    ['demo: mesh done, elapsed 10 s, remaining ~30 s', 'demo: solve done, elapsed 30 s']
+    """
+
+    def __init__(self, stages, desc: str, *, quiet: bool = False, stream=None,
+                 min_seconds: float = 30.0, clock=time.monotonic):
+        self.predicted = {name: float(sec) for name, sec in stages}
+        self.total = sum(self.predicted.values())
+        self.desc, self.clock = desc, clock
+        self.stream = stream if stream is not None else sys.stderr
+        self.active = not quiet and self.total >= min_seconds
+        self.start = clock()
+        self.done_predicted = 0.0
+
+    def done(self, stage: str, *also: str) -> None:
+        """Report that ``stage`` finished, with the planned stages ``also`` that the run did
+        inside it (e.g. ``done("mesh", "refine")``) and every planned stage before them."""
+        if not self.active:
+            return
+        elapsed = self.clock() - self.start
+        names = list(self.predicted)
+        last = max((names.index(n) for n in (stage, *also) if n in self.predicted), default=-1)
+        for name in names[: last + 1]:
+            self.done_predicted += self.predicted.pop(name)
+        left = sum(self.predicted.values())
+        line = f"{self.desc}: {stage} done, elapsed {format_seconds(elapsed)}"
+        if left > 0:
+            pace = elapsed / self.done_predicted if self.done_predicted > 0 else 1.0
+            line += f", remaining ~{format_seconds(left * pace)}"
+        print(line, file=self.stream, flush=True)

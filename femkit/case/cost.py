@@ -5,8 +5,10 @@ problem type (``PROBLEMS[...].plan``); :func:`check_case` checks it against the 
 ``limits:``, the command line's ``--max-memory`` and the available memory, refusing with
 :class:`~femkit.errors.BudgetExceededError` (exit code 2, one line) unless forced. Run options
 travel in ``case.run_options``: ``limits`` (:class:`femkit.cost.Limits`, from the file), ``force``
-(skip every budget, also the library's own memory checks) and ``stop`` (a
-:class:`femkit.interrupt.StopFlag` the runners check between steps and iterations).
+(skip every budget, also the library's own memory checks), ``stop`` (a
+:class:`femkit.interrupt.StopFlag` the runners check between steps and iterations) and
+``plan`` (set by :func:`check_case`: a Poisson run predicted to last 30 s or more prints a
+line on stderr after each stage with the elapsed and the predicted remaining time).
 """
 
 from __future__ import annotations
@@ -104,4 +106,5 @@ def check_case(case: Case, *, max_memory: float | None = None, force: bool = Fal
                                  force=force, override=OVERRIDE)
     for w in warnings:
         say(f"femkit: warning: {w.replace(f' (or {OVERRIDE} to run anyway)', '')} ({OVERRIDE} given)")
+    case.run_options["plan"] = plan  # long Poisson runs report each stage against it
     return plan
