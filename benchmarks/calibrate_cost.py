@@ -193,7 +193,7 @@ def fit(c: dict, runs: list[dict], min_fit: float) -> None:
         return float(np.median(vals))
 
     refined = [r for r in big if r["refine"] > 0]  # gmsh's own memory is small in these
-    for st in ("refine", "quality", "boundary", "errors"):
+    for st in ("refine", "quality", "boundary", "errors", "estimate"):
         b[f"{st}_per_triangle"] = round(per_tri(st, refined), 1)
     b["assembly_numpy_per_triangle"] = round(per_tri("assembly", [r for r in refined if r["n_triangles"] < 200_000]), 1)
     b["assembly_per_triangle"] = round(per_tri("assembly", [r for r in refined if r["n_triangles"] >= 200_000]), 1)
@@ -206,7 +206,7 @@ def fit(c: dict, runs: list[dict], min_fit: float) -> None:
         sel = [r for r in sel if stage in r["stages"]]
         return power_law([r["n_triangles"] for r in sel], [r["stages"][stage]["seconds"] - fixed for r in sel])
 
-    for st in ("refine", "quality", "boundary", "errors"):
+    for st in ("refine", "quality", "boundary", "errors", "estimate"):
         s[st] = time_law(st, refined)
     vtu_runs = [r for r in big if r["outputs"] == ["vtu"]]
     b["output_per_triangle"] = round(per_tri("output", [r for r in vtu_runs if r["refine"] > 0]), 1)

@@ -113,7 +113,8 @@ def _solver_constants(key: str, c: dict) -> tuple[str, list[str]]:
 COMPILED_FROM = 200_000
 
 #: Stages in pipeline order (the names the probe measures).
-STAGES = ("mesh", "refine", "quality", "assembly", "boundary", "setup", "solve", "errors", "output")
+STAGES = ("mesh", "refine", "quality", "assembly", "boundary", "setup", "solve", "errors",
+          "estimate", "output")
 
 
 def fixed_bytes(stage: str, *, gmsh: bool, compiled: bool, amg: bool, png: bool,
@@ -129,7 +130,7 @@ def fixed_bytes(stage: str, *, gmsh: bool, compiled: bool, amg: bool, png: bool,
     i = STAGES.index(stage)
     retained = b["gmsh_retained"] * b["gmsh_per_triangle"] * generated if gmsh and i > 0 else 0.0
     return (retained + b["gmsh_import"] * gmsh + b["numba_import"] * (compiled and i >= 3)
-            + b["pyamg_import"] * (amg and i >= 5) + b["matplotlib_import"] * (png and i >= 8))
+            + b["pyamg_import"] * (amg and i >= 5) + b["matplotlib_import"] * (png and i >= 9))
 
 
 def plan_mesh(geometry: str | None = None, h: float | None = None, refine: int = 0, *,
@@ -143,7 +144,8 @@ def plan_mesh(geometry: str | None = None, h: float | None = None, refine: int =
     """
     c = constants or load_constants()
     p = plan_poisson(geometry=geometry, h=h, refine=refine, params=params, triangles=triangles,
-                     outputs=(), errors=False, constants=c, _stages=("mesh", "refine"))
+                     outputs=(), errors=False, estimate=False, constants=c,
+                     _stages=("mesh", "refine"))
     p.kind = "mesh"
     return p
 
@@ -151,7 +153,8 @@ def plan_mesh(geometry: str | None = None, h: float | None = None, refine: int =
 def plan_poisson(*, geometry: str | None = None, h: float | None = None, refine: int = 0,
                  params: dict | None = None, triangles: float | None = None,
                  method: str = "pcg", preconditioner: str | None = "amg_sa", rtol: float = 1e-8,
-                 outputs=("vtu",), errors: bool = True, constants: dict | None = None,
+                 outputs=("vtu",), errors: bool = True, estimate: bool = True,
+                 constants: dict | None = None,
                  speed: float = 1.0, _stages: tuple | None = None) -> Plan:
     """Predict sizes, time, peak memory and output of a Poisson run.
 
@@ -164,6 +167,7 @@ def plan_poisson(*, geometry: str | None = None, h: float | None = None, refine:
     method, preconditioner, rtol : the solver (as in :func:`femkit.solvers.solve`).
     outputs : files written, any of ``"vtu"``, ``"xdmf"``, ``"png"``.
     errors : error norms against an exact solution are computed.
+    estimate : the a posteriori error estimate is computed (every ``femkit solve`` does).
     constants : the model constants (default :func:`load_constants`).
     speed : seconds multiplier of this machine against the calibration machine
         (:func:`femkit.cost.machine_speed`); 1 = as calibrated.
@@ -253,6 +257,9 @@ def plan_poisson(*, geometry: str | None = None, h: float | None = None, refine:
     if errors:
         stages.append(stage("errors", _power(s["errors"], m), b["errors_per_triangle"],
                             "error norms"))
+    if estimate:
+        stages.append(stage("estimate", _power(s["estimate"], m), b["estimate_per_triangle"],
+                            "a posteriori error estimate (residual)"))
     if outs:
         secs = sum(_power(s[k], m) for k in outs) + (s["png_fixed"] if "png" in outs else 0.0)
         out = sum(c["output_bytes"][f"{k}_per_triangle"] * m for k in outs if k != "png")
@@ -288,7 +295,7 @@ def plan_poisson(*, geometry: str | None = None, h: float | None = None, refine:
     plan.suggest = _suggester(dict(geometry=geometry, h=h, refine=refine, params=params,
                                    triangles=triangles, method=method,
                                    preconditioner=preconditioner, rtol=rtol, outputs=outs,
-                                   errors=errors, constants=c, speed=speed, _stages=_stages))
+                                   errors=errors, estimate=estimate, constants=c, speed=speed, _stages=_stages))
     return plan
 
 

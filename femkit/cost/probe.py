@@ -90,6 +90,11 @@ def measure_poisson(geometry: str = "unit_square", h: float = 0.05, refine: int 
     u = system.expand(res.x)
     if errors:
         stage("errors", lambda: error_norms(mesh, u, exact))
+    from femkit.fem import PoissonProblem
+    from femkit.fem.estimators import estimate
+
+    problem = PoissonProblem(mesh, np.ones(mesh.n_triangles), source)  # u = 0 on the boundary
+    stage("estimate", lambda: estimate(problem, u, "residual"))
     out_bytes = 0
     with tempfile.TemporaryDirectory() as tmp:
         def write():
