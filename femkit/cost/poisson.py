@@ -16,7 +16,8 @@ Per stage (the names :func:`femkit.cost.probe.measure_poisson` measures): ``mesh
 peak per generated triangle plus the import of its library; or reading a file), ``refine``,
 ``quality``, ``assembly`` (pattern, matrix, load; compiled kernels from 200,000 triangles),
 ``boundary`` (Dirichlet elimination: a reduced copy), ``setup`` (preconditioner or sparse
-factorisation), ``solve``, ``errors``, ``output`` (vtu / xdmf / png). Each stage's peak is
+factorisation), ``solve``, ``errors``, ``estimate`` (the residual error estimate), ``output``
+(vtu / xdmf / png). Each stage's peak is
 ``bytes_per_triangle[stage] * m`` of everything alive then (the pipeline keeps the mesh and
 the matrices), calibrated on measured runs; the direct solver adds ``bytes.direct``
 (``a n^p`` in the unknowns: SuperLU's factors and work space, which grow faster than its
