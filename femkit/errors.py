@@ -13,6 +13,8 @@ Hierarchy::
     │   ├── UnknownNameError       unknown solver / preconditioner / integrator / geometry name
     │   ├── MeshError              unreadable or invalid mesh
     │   │   └── DegenerateMeshError  zero/near-zero-area triangles (ids attached)
+    │   ├── HierarchyError         geometric multigrid (gmg, fmg) asked for without a matching
+    │   │                          nested mesh hierarchy (the message names amg_rs)
     │   ├── AdaptivityError        bad adaptive-refinement setting (theta, target, budgets)
     │   └── BudgetExceededError    predicted memory / time / steps / output above a limit
     │                              (before the run; ``force`` overrides)
@@ -77,6 +79,12 @@ class DegenerateMeshError(MeshError):
     def __init__(self, message: str, element_ids=()):
         self.element_ids = list(element_ids)
         super().__init__(message)
+
+
+class HierarchyError(InputError):
+    """Geometric multigrid (preconditioner ``gmg``, method ``fmg``) was asked for without a nested
+    mesh hierarchy, or with one that does not match the system; the message names the algebraic
+    alternative (``amg_rs``)."""
 
 
 class AdaptivityError(InputError):

@@ -103,10 +103,13 @@ def predict_iterations(key: str, unknowns: float, rtol: float = 1e-8, *,
 
 
 def _solver_constants(key: str, c: dict) -> tuple[str, list[str]]:
-    """The calibrated key for ``key`` and an assumption when none is calibrated."""
+    """The calibrated key for ``key`` and an assumption when none is calibrated: multigrid
+    (``gmg``, ``fmg``: iterations independent of ``h``) is costed as Ruge-Stueben AMG, anything
+    else as Jacobi-PCG (pessimistic)."""
     if key in c["bytes"]["solve_per_triangle"]:
         return key, []
-    return "pcg+jacobi", [f"no calibration for solver {key!r}: costed as pcg + jacobi"]
+    like = "pcg+amg_rs" if ("gmg" in key or key == "fmg") else "pcg+jacobi"
+    return like, [f"no calibration for solver {key!r}: costed as {like}"]
 
 
 #: Triangles from which assembly uses compiled kernels: ``femkit.fem.sparsity.NUMBA_THRESHOLD``

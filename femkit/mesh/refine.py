@@ -16,7 +16,13 @@ from .edges import boundary_edge_ids, edges
 from .mesh import Mesh
 
 
-def _refine_once(mesh: Mesh) -> Mesh:
+def refine_once(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
+    """One level of red refinement, and the coarse edges whose midpoints are the new nodes.
+
+    Returns ``(fine, edge_nodes)``: fine node ``n + e`` is the midpoint of coarse edge
+    ``edge_nodes[e]`` (:func:`edges` order), so a nested prolongation needs no second edge search
+    (:class:`femkit.mesh.hierarchy.MeshHierarchy`).
+    """
     n = mesh.n_points
     edge_nodes, tri_edges = edges(mesh)
     mid = mesh.points[edge_nodes].mean(axis=1)
@@ -41,8 +47,9 @@ def _refine_once(mesh: Mesh) -> Mesh:
         new_bt = np.repeat(mesh.boundary_tags, 2)
     else:
         new_be, new_bt = be, mesh.boundary_tags
-    return Mesh(points=points, triangles=children, cell_tags=cell_tags,
+    fine = Mesh(points=points, triangles=children, cell_tags=cell_tags,
                 boundary_edges=new_be, boundary_tags=new_bt, tag_names=mesh.tag_names)
+    return fine, edge_nodes
 
 
 def refine(mesh: Mesh, levels: int = 1, *, check_memory: bool = True) -> Mesh:
@@ -62,5 +69,5 @@ def refine(mesh: Mesh, levels: int = 1, *, check_memory: bool = True) -> Mesh:
 
         check_mesh_fits(triangles=mesh.n_triangles, refine=int(levels))
     for _ in range(int(levels)):
-        mesh = _refine_once(mesh)
+        mesh, _ = refine_once(mesh)
     return mesh

@@ -1,7 +1,8 @@
 """Solver and preconditioner registries, and :func:`solve`, the high-level entry.
 
-``SOLVERS``: ``jacobi``, ``sd``, ``cg``, ``pcg``, ``direct``. ``PRECONDITIONERS``: ``none``,
-``jacobi``, ``ic0``, ``amg_sa``, ``amg_rs`` and ``amg`` (= ``amg_sa``). Preconditioner
+``SOLVERS``: ``jacobi``, ``sd``, ``cg``, ``pcg``, ``direct``, ``fmg``. ``PRECONDITIONERS``:
+``none``, ``jacobi``, ``ic0``, ``amg_sa``, ``amg_rs``, ``amg`` (= ``amg_sa``) and ``gmg``
+(geometric multigrid; needs ``hierarchy=``). Preconditioner
 factories are ``build(A, **opts) -> Preconditioner`` (or ``None`` for ``none``); importing
 this module imports neither pyamg nor numba.
 """
@@ -18,9 +19,11 @@ from ..registry import Registry
 from .cg import cg
 from .checks import check_options
 from .direct import direct
+from .fmg import fmg
 from .jacobi import jacobi
 from .pcg import pcg
 from .preconditioners import amg as _amg
+from .preconditioners import gmg as _gmg
 from .preconditioners import ic0 as _ic0
 from .preconditioners import jacobi as _pjacobi
 from .result import SolveResult
@@ -34,6 +37,7 @@ SOLVERS.register("sd", steepest_descent)
 SOLVERS.register("cg", cg)
 SOLVERS.register("pcg", pcg)
 SOLVERS.register("direct", direct)
+SOLVERS.register("fmg", fmg)
 
 
 def _no_preconditioner(A, **opts):
@@ -49,6 +53,7 @@ PRECONDITIONERS.register("ic0", _ic0.build)
 PRECONDITIONERS.register("amg_sa", _amg.build_sa)
 PRECONDITIONERS.register("amg_rs", _amg.build_rs)
 PRECONDITIONERS.register("amg", _amg.build)
+PRECONDITIONERS.register("gmg", _gmg.build)
 
 
 
@@ -141,7 +146,7 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     elapsed = time.perf_counter() - t0
     res.method = method
     res.preconditioner = pc_name
-    if method == "direct":  # the factorisation time is the method's own setup_time
+    if method in ("direct", "fmg"):  # their own setup_time: the factorisation, the multigrid
         res.solve_time = elapsed - res.setup_time
     else:
         res.setup_time = setup

@@ -88,4 +88,16 @@ class SolveResult:
             "setup_time": float(self.setup_time),
             "solve_time": float(self.solve_time),
             "residuals": [float(r) for r in np.asarray(self.residuals)],
+            **self._multigrid_summary(),
         }
+
+    def _multigrid_summary(self) -> dict:
+        """``{"multigrid": {...}}`` for fmg / gmg runs (levels, cycles, error estimates), else {}."""
+        info = self.info.get("preconditioner_info", {}) if self.preconditioner == "gmg" else self.info
+        if self.method != "fmg" and self.preconditioner != "gmg":
+            return {}
+        keys = ("levels", "sizes", "operator_complexity", "coarse", "sweeps", "omega",
+                "cycles_per_level", "algebraic_error_estimate", "discretisation_error_estimate",
+                "rho", "stopped_by", "estimate_credible", "target", "fraction", "coarse_rhs")
+        return {"multigrid": {k: (None if isinstance(info[k], float) and not np.isfinite(info[k])
+                                  else info[k]) for k in keys if k in info}}

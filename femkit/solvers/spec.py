@@ -99,6 +99,12 @@ class SolverSpec:
                    maxiter=d.get("maxiter"), options=options,
                    preconditioner_options=pc_options, label=label)
 
+    @property
+    def needs_hierarchy(self) -> bool:
+        """Geometric multigrid (``method: fmg`` or ``preconditioner: gmg``): the caller passes a
+        :class:`~femkit.mesh.MeshHierarchy` (``hierarchy=``, ``free=``) at solve time."""
+        return self.method == "fmg" or self.preconditioner == "gmg"
+
     def to_dict(self) -> dict:
         """The spec as a mapping (what ``result.json`` and the validated case data hold)."""
         return asdict(self)
@@ -114,14 +120,18 @@ class SolverSpec:
     def solve(self, A, b, x0=None, *, callback: Callable | None = None, **overrides):
         """Solve ``A x = b`` with this spec: the one translator to :func:`femkit.solvers.solve`.
 
-        ``overrides`` (e.g. ``atol``) replace the spec's own stopping-rule values.
+        ``overrides`` (e.g. ``atol``) replace the spec's own stopping-rule values;
+        ``options=`` / ``preconditioner_options=`` add run-time objects to the spec's own (the
+        mesh hierarchy of geometric multigrid, see :attr:`needs_hierarchy`).
         """
         from ..solvers import solve
 
+        pc_options = {**self.preconditioner_options, **overrides.pop("preconditioner_options", {})}
+        options = {**self.options, **overrides.pop("options", {})}
         kw = dict(rtol=self.rtol, atol=self.atol, maxiter=self.maxiter)
         kw.update(overrides)
         return solve(A, b, x0, method=self.method,
                      preconditioner=self.preconditioner if self.method == "pcg" else None,
                      callback=callback,
-                     preconditioner_options=self.preconditioner_options or None,
-                     **kw, **self.options)
+                     preconditioner_options=pc_options or None,
+                     **kw, **options)

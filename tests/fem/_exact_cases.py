@@ -1,7 +1,8 @@
 """The bundled Poisson cases with an exact solution (cases/*.yaml with ``exact:``), built through the
 library API: mesh, kappa, f, boundary data, exact u and grad u. Each builder takes the mesh size h.
 
-The data are those of the case files (unit_square, lshape, annulus, poisson_neumann, plate_mesh_file);
+The data are those of the case files (unit_square, lshape, annulus, poisson_neumann, plate_mesh_file,
+fmg_unit_square);
 tests/fem/test_estimators.py checks that every case file with ``exact:`` has a builder here.
 """
 
@@ -69,4 +70,7 @@ def plate_mesh_file(h):
 
 
 CASES = {"unit_square": unit_square, "lshape": lshape, "annulus": annulus,
-         "poisson_neumann": poisson_neumann, "plate_mesh_file": plate_mesh_file}
+         "poisson_neumann": poisson_neumann, "plate_mesh_file": plate_mesh_file,
+         # cases/poisson_fmg_unit_square.yaml: the unit square's problem, solved by fmg on a
+         # refined mesh (the solver and the mesh levels differ, not the data)
+         "fmg_unit_square": unit_square}

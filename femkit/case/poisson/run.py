@@ -33,8 +33,8 @@ from ..expressions import compile_expression
 from ..load import Case
 from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
 
-__all__ = ["prepare_poisson", "run_poisson", "build_mesh", "element_kappa", "poisson_problem",
-           "compute_errors", "CaseResult"]
+__all__ = ["prepare_poisson", "run_poisson", "build_mesh", "build_mesh_levels",
+           "multigrid_inputs", "element_kappa", "poisson_problem", "compute_errors", "CaseResult"]
 
 
 # ----------------------------------------------------------------------------- prepare
@@ -76,6 +76,16 @@ def prepare_poisson(case: Case) -> None:
     from ..specs import limits_spec
 
     case.run_options["limits"] = limits_spec(d.get("limits"))
+    if case.solver.needs_hierarchy and (not mesh.get("refine") or d.get("adaptive")):
+        from ...errors import HierarchyError
+
+        what = "method 'fmg'" if case.solver.method == "fmg" else "preconditioner 'gmg'"
+        if d.get("adaptive"):
+            raise HierarchyError(f"solver: {what} needs uniformly refined nested meshes, which "
+                                 f"adaptive refinement does not make; use method pcg with "
+                                 f"preconditioner amg_rs")
+        raise HierarchyError(f"solver: {what} needs nested meshes: give the mesh 'refine: k' "
+                             f"(k >= 1), or use method pcg with preconditioner amg_rs")
 
     from ...fem.quadrature import QUADRATURE
 
@@ -128,12 +138,25 @@ def _prepare_nullspace(bnd: dict) -> None:
 
 # ----------------------------------------------------------------------------- stages
 
+#: Refined meshes with at least this many triangles are renumbered for memory locality
+#: (reverse Cuthill-McKee on the coarse mesh, midpoints next to their edges: see
+#: :class:`femkit.mesh.MeshHierarchy`); at 3.7M triangles assembly is 1.6-3x and an fmg solve
+#: 2-3x faster, at 0.9M it makes no difference (docs/benchmarks.md).
+RENUMBER_MIN_TRIANGLES = 2_000_000
+
+
 def build_mesh(case: Case, *, h: float | None = None):
     """Generate or read the mesh, refine, validate, and check every tag the case names.
 
     ``h`` replaces ``mesh.h`` of a generated mesh (studies sweep it); a mesh file ignores it.
     """
-    from ...mesh import check_tags, generate, read_mesh, refine, validate
+    return build_mesh_levels(case, h=h)[0]
+
+
+def build_mesh_levels(case: Case, *, h: float | None = None):
+    """:func:`build_mesh` and the :class:`~femkit.mesh.MeshHierarchy` of its refinement when the
+    case's solver is geometric multigrid (``None`` otherwise): ``(mesh, hierarchy)``."""
+    from ...mesh import MeshHierarchy, check_tags, generate, read_mesh, refine, validate
 
     spec = case.data["mesh"]
     where = f"mesh.file {spec['file']}" if "file" in spec else f"mesh.geometry {spec['geometry']}"
@@ -147,8 +170,20 @@ def build_mesh(case: Case, *, h: float | None = None):
         mesh = validate(mesh)
     except InputError as exc:
         raise with_prefix(exc, where) from None
-    if spec.get("refine"):
-        mesh = refine(mesh, spec["refine"], check_memory=check)
+    hierarchy = None
+    k = spec.get("refine") or 0
+    if k and check:  # before numpy allocates the finer levels
+        from ...cost.budget import check_mesh_fits
+
+        check_mesh_fits(triangles=mesh.n_triangles, refine=k)
+    if k:
+        big = mesh.n_triangles * 4 ** k >= RENUMBER_MIN_TRIANGLES
+        if big or case.solver.needs_hierarchy:
+            levels = MeshHierarchy.from_refinement(mesh, k, renumber="rcm" if big else "none")
+            mesh = levels.finest
+            hierarchy = levels if case.solver.needs_hierarchy else None
+        else:
+            mesh = refine(mesh, k, check_memory=False)
     bnd = case.data["boundary"]
     for kind in ("dirichlet", "neumann"):
         for i, bc in enumerate(bnd.get(kind, [])):
@@ -164,7 +199,24 @@ def build_mesh(case: Case, *, h: float | None = None):
             check_tags(mesh, list(coef["regions"]), kind="cell")
         except InputError as exc:
             raise with_prefix(exc, "coefficient.regions") from None
-    return mesh
+    return mesh, hierarchy
+
+
+def multigrid_inputs(case: Case, hierarchy, system) -> dict:
+    """What geometric multigrid needs at solve time, as :meth:`SolverSpec.solve` overrides:
+    the hierarchy and the free nodes; for ``fmg`` with Dirichlet conditions also the reduced
+    systems of the coarser meshes (their own right-hand sides and Dirichlet values, see
+    :func:`femkit.solvers.fmg.fmg`). Empty for every other solver."""
+    spec = case.solver
+    if not spec.needs_hierarchy:
+        return {}
+    mg = {"hierarchy": hierarchy, "free": system.free}
+    if spec.method != "fmg":
+        return {"preconditioner_options": mg}
+    if not is_pure_neumann(case):
+        mg["levels"] = [poisson_problem(case, m).assemble(spec.method)
+                        for m in hierarchy.meshes[:-1]]
+    return {"options": mg}
 
 
 def _is_whole_boundary(mesh, tag) -> bool:
@@ -413,7 +465,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
             raise Interrupted(stop, stage=where)
 
     with stage("mesh"):
-        mesh = build_mesh(case)
+        mesh, hierarchy = build_mesh_levels(case)
     check_stop("mesh")
     grad = exact_gradient(case)
     run = est = None
@@ -432,8 +484,10 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         with stage("boundary"):
             system = problem.reduce(K, F, case.solver.method)
         check_stop("boundary")
+        with stage("assembly"):  # the coarser levels' systems (fmg only): added to the stage
+            mg = multigrid_inputs(case, hierarchy, system)
         with stage("solve"):
-            res = _solve(case, system, stop)
+            res = _solve(case, system, stop, **mg)
             u = system.expand(res.x)
         report.done("solve")
     q = quality(mesh)
@@ -463,16 +517,17 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     return result
 
 
-def _solve(case: Case, system, stop):
-    """Solve the reduced system; a stop request during an iterative solve ends it with the last
-    iterate as a not-converged result (``reason: interrupted``) that is written like any other."""
+def _solve(case: Case, system, stop, **mg):
+    """Solve the reduced system (``mg``: multigrid inputs); a stop request during an iterative
+    solve ends it with the last iterate as a not-converged result (``reason: interrupted``)
+    that is written like any other."""
     if stop is None:
-        return case.solver.solve(system.A, system.b)
+        return case.solver.solve(system.A, system.b, **mg)
     from ...interrupt import stopping_callback
     from ...solvers.result import SolveResult
 
     try:
-        return case.solver.solve(system.A, system.b, callback=stopping_callback(stop))
+        return case.solver.solve(system.A, system.b, callback=stopping_callback(stop), **mg)
     except Interrupted as exc:
         r = system.b - system.A @ exc.x
         bn = float(np.linalg.norm(system.b))

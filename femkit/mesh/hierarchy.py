@@ -1,0 +1,198 @@
+"""Nested meshes from uniform red refinement and their P1 prolongations (geometric multigrid).
+
+Red refinement nests the P1 spaces ``V_0 ⊂ V_1 ⊂ ... ⊂ V_L``: a coarse node is a fine node, and
+a new node, the midpoint of a coarse edge, takes the mean of the edge's end values. That is the
+prolongation ``P_l: V_l -> V_{l+1}``, exact on every coarse P1 function (Briggs, Henson and McCormick,
+*A Multigrid Tutorial*, 2nd ed., SIAM 2000, ch. 10; Trottenberg, Oosterlee and Schüller,
+*Multigrid*, 2001): the identity on the coarse nodes and two weights ``1/2`` per midpoint, built
+once per level from the edge list the refinement produced (no search).
+
+Dirichlet elimination keeps the free nodes only (:func:`femkit.fem.apply_dirichlet`); a fixed
+fine node carries a zero correction, so the free-dof prolongation is ``P_l[free_{l+1}][:, free_l]``
+(:meth:`MeshHierarchy.free_prolongations`), and a coarse node is free when the fine node it
+becomes is free (:meth:`MeshHierarchy.level_free`).
+
+>>> import numpy as np
+>>> from femkit.mesh import Mesh
+>>> m = Mesh(points=np.array([[0., 0.], [1., 0.], [0., 1.]]), triangles=np.array([[0, 1, 2]]))
+>>> H = MeshHierarchy.from_refinement(m, 2)
+>>> H.n_levels, [mesh.n_points for mesh in H.meshes], H.prolongations[0].shape
+(3, [3, 6, 15], (6, 3))
+>>> u = H.coarsest.points @ [2.0, -1.0] + 0.5          # a linear function: reproduced exactly
+>>> bool(np.allclose(H.prolongate(u, 0), H.meshes[1].points @ [2.0, -1.0] + 0.5))
+True
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import InputError
+from .mesh import Mesh
+from .refine import refine_once
+
+
+def prolongation(n_coarse: int, edge_nodes: np.ndarray) -> sp.csr_matrix:
+    """P1 prolongation of one red refinement: ``(n_coarse + E, n_coarse)`` CSR.
+
+    Row ``i < n_coarse`` is the unit vector ``e_i``; row ``n_coarse + e`` has ``1/2`` at both
+    nodes of ``edge_nodes[e]`` (the nesting of :func:`femkit.mesh.refine`).
+    """
+    n_edges = len(edge_nodes)
+    indptr = np.concatenate([np.arange(n_coarse + 1, dtype=np.int64),
+                             n_coarse + 2 * np.arange(1, n_edges + 1, dtype=np.int64)])
+    indices = np.concatenate([np.arange(n_coarse, dtype=np.int64),
+                              np.asarray(edge_nodes, dtype=np.int64).ravel()])
+    data = np.concatenate([np.ones(n_coarse), np.full(2 * n_edges, 0.5)])
+    return sp.csr_matrix((data, indices, indptr), shape=(n_coarse + n_edges, n_coarse))
+
+
+def interleave_permutation(n_coarse: int, edge_nodes: np.ndarray) -> np.ndarray:
+    """Fine-level order keeping a locality-ordered coarse level local: every coarse node is
+    followed by the midpoints of its edges to higher-numbered nodes (``perm[j]`` = old id of new
+    node ``j``; old ids as :func:`femkit.mesh.refine` numbers them). A stable merge of two sorted
+    sequences, O(n); the children of a coarse triangle stay contiguous, so elements need no sort.
+    """
+    key = np.concatenate([np.arange(n_coarse, dtype=np.int64),
+                          np.asarray(edge_nodes[:, 0], dtype=np.int64)])
+    return np.argsort(key, kind="stable")
+
+
+@dataclass(frozen=True, eq=False)
+class MeshHierarchy:
+    """Nested meshes, coarsest first, and the prolongations between consecutive levels.
+
+    Attributes
+    ----------
+    meshes : tuple of Mesh
+        ``meshes[0]`` the coarsest, ``meshes[-1]`` the finest (the mesh a case solves on).
+    prolongations : tuple of csr_matrix
+        ``prolongations[l]`` maps nodal values on level ``l`` to level ``l + 1``,
+        shape ``(n_{l+1}, n_l)``; built once.
+    injections : tuple of ndarray
+        ``injections[l][i]`` is the node of level ``l + 1`` that coarse node ``i`` becomes
+        (``arange(n_l)`` without renumbering: the coarse nodes come first).
+    renumbering : str
+        ``"none"`` or ``"rcm"`` (the coarsest level renumbered by reverse Cuthill-McKee,
+        :mod:`femkit.mesh.renumber`, every finer level by :func:`interleave_permutation`;
+        prolongations and injections follow).
+
+    """
+
+    meshes: tuple
+    prolongations: tuple
+    injections: tuple
+    renumbering: str = "none"
+
+    @classmethod
+    def from_refinement(cls, coarse: Mesh, levels: int, *, renumber: str = "none") -> "MeshHierarchy":
+        """Refine ``coarse`` uniformly ``levels`` times, keeping every level.
+
+        Parameters
+        ----------
+        coarse : Mesh
+            Level 0 (generated or read).
+        levels : int
+            Number of refinements (``>= 0``); the hierarchy has ``levels + 1`` meshes and its
+            finest mesh equals ``refine(coarse, levels)`` (node for node when ``renumber="none"``).
+        renumber : {"none", "rcm"}
+            Number every level for memory locality: reverse Cuthill-McKee on the coarse mesh
+            (:func:`femkit.mesh.renumber.renumber`), then each refinement's midpoints right after
+            their edge's lower node (:func:`interleave_permutation`; RCM on every fine level costs
+            more than it saves). ``"none"``: refinement's own numbering, coarse nodes first.
+            Gauss-Seidel smooths in storage order, so the numbering changes the V-cycle slightly
+            (V(2,2) factor at 7 levels, L-shape: 0.133 with ``"none"``, 0.147 with ``"rcm"``),
+            while ``"rcm"`` makes a cycle 2.6x faster at 3.7M elements (docs/benchmarks.md).
+
+        Raises
+        ------
+        InputError
+            ``levels`` not a non-negative integer.
+        """
+        from .renumber import permute_nodes, renumber as _renumber
+
+        if isinstance(levels, bool) or int(levels) != levels or levels < 0:
+            raise InputError(f"levels must be a non-negative integer, got {levels!r}")
+        mesh, _ = _renumber(coarse, renumber)
+        meshes, prols, injs = [mesh], [], []
+        for _ in range(int(levels)):
+            n_c = mesh.n_points
+            fine, edge_nodes = refine_once(mesh)
+            P = prolongation(n_c, edge_nodes)
+            inj = np.arange(n_c, dtype=np.int64)
+            if renumber != "none":
+                perm = interleave_permutation(n_c, edge_nodes)
+                fine = permute_nodes(fine, perm, sort_elements=False)
+                inv = np.empty_like(perm)
+                inv[perm] = np.arange(len(perm))
+                P, inj = P[perm], inv[:n_c]
+            meshes.append(fine)
+            prols.append(P.tocsr())
+            injs.append(inj)
+            mesh = fine
+        return cls(tuple(meshes), tuple(prols), tuple(injs), renumber)
+
+    @property
+    def n_levels(self) -> int:
+        """Number of meshes (refinements + 1)."""
+        return len(self.meshes)
+
+    @property
+    def finest(self) -> Mesh:
+        return self.meshes[-1]
+
+    @property
+    def coarsest(self) -> Mesh:
+        return self.meshes[0]
+
+    def prolongate(self, u: np.ndarray, level: int) -> np.ndarray:
+        """Interpolate full nodal values ``u`` on ``level`` to ``level + 1`` (``P_level @ u``)."""
+        return self.prolongations[level] @ np.asarray(u, dtype=np.float64)
+
+    def level_free(self, free) -> list[np.ndarray]:
+        """Free node ids of every level (coarsest first) from the finest level's free set.
+
+        ``free``: sorted node ids of the finest mesh (``DirichletSystem.free``) or a boolean mask
+        of its nodes. A coarse node is free when the fine node it becomes is free.
+
+        Raises
+        ------
+        InputError
+            ``free`` is not a mask of the finest mesh's nodes nor valid node ids.
+        """
+        mask = self._free_mask(free)
+        out = [np.flatnonzero(mask)]
+        for inj in reversed(self.injections):
+            mask = mask[inj]
+            out.append(np.flatnonzero(mask))
+        return out[::-1]
+
+    def free_prolongations(self, free) -> list[sp.csr_matrix]:
+        """``P_l[free_{l+1}][:, free_l]`` for every level (Dirichlet nodes eliminated)."""
+        frees = self.level_free(free)
+        return [P[frees[lvl + 1]][:, frees[lvl]].tocsr()
+                for lvl, P in enumerate(self.prolongations)]
+
+    def _free_mask(self, free) -> np.ndarray:
+        n = self.finest.n_points
+        arr = np.asarray(free)
+        if arr.dtype == bool:
+            if arr.shape != (n,):
+                raise InputError(f"a free-node mask must have shape ({n},) (the finest mesh's "
+                                 f"nodes), got {arr.shape}")
+            return arr.copy()
+        if arr.size and not np.issubdtype(arr.dtype, np.integer):
+            raise InputError(f"free must be node ids (integers) or a boolean mask, got {arr.dtype}")
+        arr = arr.astype(np.int64).ravel()
+        if arr.size and (arr.min() < 0 or arr.max() >= n):
+            raise InputError(f"free node ids out of range 0..{n - 1} (the finest mesh's nodes)")
+        mask = np.zeros(n, dtype=bool)
+        mask[arr] = True
+        return mask
+
+    def __repr__(self) -> str:
+        sizes = ", ".join(str(m.n_points) for m in self.meshes)
+        return f"MeshHierarchy(levels={self.n_levels}, nodes=[{sizes}], renumbering={self.renumbering!r})"
