@@ -78,6 +78,10 @@ def _add_solve(sub) -> None:
     p.add_argument("-o", "--output", metavar="DIR",
                    help="output directory (default: output.dir of the case, resolved against "
                         "the case file's directory)")
+    p.add_argument("--backend", metavar="NAME",
+                   help="linear-solver backend, replacing solver.backend of the case: femkit "
+                        "(default) or petsc (PETSc + MPI: run as 'mpirun -n N femkit solve CASE "
+                        "--backend petsc'; set up with scripts/install-petsc.sh)")
     _add_cost_flags(p)
 
 
@@ -106,7 +110,8 @@ def _run_solve(args) -> int:
     from .case.cost import check_case, plan_case
     from .interrupt import exit_code, stop_on_signals
 
-    case = load_case(args.case)
+    overrides = {"solver": {"backend": args.backend}} if args.backend else {}
+    case = load_case(args.case, **overrides)
     if args.dry_run:
         print(plan_case(case).render())
         return EXIT_OK
@@ -124,8 +129,9 @@ def _run_solve(args) -> int:
         # a run that failed for a reason of its own (e.g. an unstable integration) has already
         # printed that reason; only a plain non-convergence is named here
         what = "run failed" if getattr(result, "failure", None) else "solver did not converge"
-        print(f"femkit: {what}; results written to {where} (marked converged: false)",
-              file=sys.stderr)
+        if _mpi_rank() == 0:
+            print(f"femkit: {what}; results written to {where} (marked converged: false)",
+                  file=sys.stderr)
         return EXIT_FAILED
     return EXIT_OK
 
@@ -193,13 +199,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     from .interrupt import Interrupted
 
     handler = getattr(args, "handler", None) or getattr(args, "func")  # func: femkit.study.cli style
+    speaks = _mpi_rank() == 0  # under mpirun every rank raises the same error: rank 0 says it
     try:
         return int(handler(args))
     except InputError as exc:
-        print(f"femkit: error: {_one_line(exc)}", file=sys.stderr)
+        if speaks:
+            print(f"femkit: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except FemkitError as exc:
-        print(f"femkit: failed: {_one_line(exc)}", file=sys.stderr)
+        if speaks:
+            print(f"femkit: failed: {_one_line(exc)}", file=sys.stderr)
         return EXIT_FAILED
     except Interrupted as exc:  # stopped between stages: nothing was written
         print(f"femkit: {exc}; nothing written", file=sys.stderr)
@@ -207,6 +216,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("femkit: interrupted", file=sys.stderr)
         return 130
+
+
+def _mpi_rank() -> int:
+    """This process's MPI rank from the launcher's environment (0 outside mpirun)."""
+    import os
+
+    for var in ("OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"):
+        if os.environ.get(var, "").isdigit():
+            return int(os.environ[var])
+    return 0
 
 
 def _one_line(exc: BaseException) -> str:

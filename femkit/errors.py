@@ -16,14 +16,17 @@ Hierarchy::
     │   ├── HierarchyError         geometric multigrid (gmg, fmg) asked for without a matching
     │   │                          nested mesh hierarchy (the message names amg_rs)
     │   ├── AdaptivityError        bad adaptive-refinement setting (theta, target, budgets)
-    │   └── BudgetExceededError    predicted memory / time / steps / output above a limit
-    │                              (before the run; ``force`` overrides)
+    │   ├── BudgetExceededError    predicted memory / time / steps / output above a limit
+    │   │                          (before the run; ``force`` overrides)
+    │   └── BackendUnavailableError  a solver backend (PETSc: petsc4py, mpi4py) cannot be
+    │                              imported; the message names scripts/install-petsc.sh
     ├── SolverError                a linear solver could not do what was asked
     │   ├── NotSPDError            input to CG-type method is not symmetric positive definite
     │   └── SingularSystemError    singular system (e.g. pure Neumann, inconsistent rhs)
     │       └── PureNeumannError   pure-Neumann data violating int f + int h = 0, or
     │                              nullspace: error (also an InputError: exit code 2)
-    └── InstabilityError           a time integrator blew up (method, step, time, energy ratio, dt_crit)
+    ├── InstabilityError           a time integrator blew up (method, step, time, energy ratio, dt_crit)
+    └── RankFailureError           another MPI rank of a distributed run failed (its rank and message)
 
 Warnings (not errors; the run goes on)::
 
@@ -79,6 +82,21 @@ class DegenerateMeshError(MeshError):
     def __init__(self, message: str, element_ids=()):
         self.element_ids = list(element_ids)
         super().__init__(message)
+
+
+class BackendUnavailableError(InputError):
+    """A solver backend cannot be used here (e.g. ``backend="petsc"`` without petsc4py):
+    the one-line message says what is missing and how to install it."""
+
+
+class RankFailureError(FemkitError):
+    """Another rank of a distributed (MPI) run failed; ``rank`` is the first failing rank and
+    ``message`` its error. Raised on every rank, so none is left waiting in a collective call."""
+
+    def __init__(self, rank: int, message: str):
+        self.rank = rank
+        self.message = message
+        super().__init__(f"rank {rank} failed: {message}")
 
 
 class HierarchyError(InputError):

@@ -56,6 +56,8 @@ def solver_schema(*, label: bool = False) -> dict:
         "maxiter": {"type": ["integer", "null"], "minimum": 1},
         "options": {"type": "object"},
         "preconditioner_options": {"type": "object"},
+        "backend": {"type": "string", "minLength": 1},
+        "petsc_options": {"type": "object"},
     }
     if label:
         props["label"] = {"type": "string", "minLength": 1}

@@ -19,13 +19,13 @@ from typing import Callable
 import numpy as np
 
 from ..errors import InputError
-from ._elements import p1_gradients, triangle_geometry
+from ._elements import p1_gradients, select_elements, triangle_geometry
 from .coefficients import evaluate_callable
 from .quadrature import rule_for_degree
 
 
 def error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | None = None, *,
-                order: int = 5) -> dict:
+                order: int = 5, elements=None, squared: bool = False) -> dict:
     """L2, H1-seminorm and max nodal errors of the P1 function ``u`` against ``exact``.
 
     Parameters
@@ -38,6 +38,12 @@ def error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | Non
         Without it ``H1_semi`` is ``None``.
     order : int
         Polynomial degree the quadrature must integrate exactly (a rule of at least this degree).
+    elements : index array or boolean mask, optional
+        Integrate over these elements only and take ``max_nodal`` over their nodes (a
+        partition: only the values of ``u`` at those nodes are read).
+    squared : bool
+        Return ``L2`` and ``H1_semi`` squared (integrals that sum over a partition of the
+        elements, as a distributed run reduces them).
 
     Returns
     -------
@@ -52,16 +58,19 @@ def error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | Non
     if u.shape != (mesh.n_points,):
         raise InputError(f"u must have one value per node, shape ({mesh.n_points},), got {u.shape}")
     rule = rule_for_degree(order)
-    e, area, signed, tri = triangle_geometry(mesh, None)
+    root = (lambda v: v) if squared else np.sqrt
+    e, area, signed, tri = triangle_geometry(mesh, select_elements(mesh, elements))
     ue = u[tri]  # (m, 3)
     x, y = rule.physical_points(mesh, tri)
     diff = ue @ rule.points.T - evaluate_callable(exact, x, y, name="exact")
-    l2 = float(np.sqrt(np.sum(area * ((diff * diff) @ rule.weights))))
-    nodal = u - evaluate_callable(exact, mesh.points[:, 0], mesh.points[:, 1], name="exact")
-    out = {"L2": l2, "H1_semi": None, "max_nodal": float(np.max(np.abs(nodal))) if len(u) else 0.0}
+    l2 = float(root(np.sum(area * ((diff * diff) @ rule.weights))))
+    nodes = slice(None) if elements is None else np.unique(tri)
+    pts = mesh.points[nodes]
+    nodal = u[nodes] - evaluate_callable(exact, pts[:, 0], pts[:, 1], name="exact")
+    out = {"L2": l2, "H1_semi": None, "max_nodal": float(np.max(np.abs(nodal))) if nodal.size else 0.0}
     if grad_exact is not None:
         sq = _gradient_error_sq(mesh, u, grad_exact, rule, (e, area, signed, tri), (x, y))
-        out["H1_semi"] = float(np.sqrt(np.sum(sq)))
+        out["H1_semi"] = float(root(np.sum(sq)))
     for k, v in out.items():
         if v is not None and not np.isfinite(v):
             raise InputError(f"error norm {k} is not finite (exact solution or u not finite)")

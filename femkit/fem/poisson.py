@@ -52,7 +52,7 @@ import numpy as np
 from ..errors import InputError, PureNeumannError, SingularSystemError  # noqa: F401 (re-exported)
 from ..mesh.edges import boundary_nodes
 from ..timing import StageTimer
-from ._elements import triangle_geometry
+from ._elements import select_elements, triangle_geometry
 from .coefficients import Coefficient, evaluate_callable
 from .dirichlet import DirichletSystem, apply_dirichlet, dirichlet_values
 from .load import assemble_load
@@ -68,14 +68,14 @@ NULLSPACE_MODES = ("mean_zero", "pin", "error")
 COMPATIBILITY_RTOL = 1e-3
 
 
-def node_weights(mesh) -> np.ndarray:
+def node_weights(mesh, *, elements=None) -> np.ndarray:
     """``w_i = int N_i dx`` (one third of the area of each triangle around node i); ``sum w = |Omega|``.
 
     >>> from femkit.mesh import Mesh
     >>> node_weights(Mesh(np.array([[0., 0.], [3., 0.], [0., 2.]]), np.array([[0, 1, 2]]))).tolist()
     [1.0, 1.0, 1.0]
     """
-    _, area, _, tri = triangle_geometry(mesh, None)
+    _, area, _, tri = triangle_geometry(mesh, select_elements(mesh, elements))
     return np.bincount(tri.ravel(), weights=np.repeat(area / 3.0, 3), minlength=mesh.n_points)
 
 
@@ -118,9 +118,21 @@ def check_compatibility(F_source: np.ndarray, F_flux=None, *, weights: np.ndarra
     F_flux = np.zeros_like(F_source) if F_flux is None else np.asarray(F_flux, dtype=np.float64)
     F = F_source + F_flux
     total = float(F.sum())
-    scale = float(np.abs(F_source).sum() + np.abs(F_flux).sum())
+    info = compatibility_facts(float(F_source.sum()), float(F_flux.sum()),
+                               float(np.abs(F_source).sum() + np.abs(F_flux).sum()), rtol)
+    if weights is None:
+        return F - total / len(F), info
+    weights = np.asarray(weights, dtype=np.float64)
+    return F - total * weights / weights.sum(), info
+
+
+def compatibility_facts(source_integral: float, flux_integral: float, scale: float,
+                        rtol: float = COMPATIBILITY_RTOL) -> dict:
+    """The compatibility check of :func:`check_compatibility` on the sums alone (a distributed
+    run reduces them over ranks): ``scale = sum |F_source| + sum |F_flux|``."""
+    total = source_integral + flux_integral
     rel = abs(total) / scale if scale > 0 else 0.0
-    info = {"source_integral": float(F_source.sum()), "flux_integral": float(F_flux.sum()),
+    info = {"source_integral": source_integral, "flux_integral": flux_integral,
             "relative_imbalance": rel, "rtol": float(rtol)}
     if rel > rtol:
         raise PureNeumannError(
@@ -128,10 +140,7 @@ def check_compatibility(F_source: np.ndarray, F_flux=None, *, weights: np.ndarra
             f"int h ds = {info['flux_integral']:.6g} must sum to 0 (relative imbalance "
             f"{rel:.3g} > {rtol:g}); change the source or the fluxes so they balance, or add a "
             "Dirichlet condition")
-    if weights is None:
-        return F - total / len(F), info
-    weights = np.asarray(weights, dtype=np.float64)
-    return F - total * weights / weights.sum(), info
+    return info
 
 
 class NullspaceSystem:
@@ -218,14 +227,23 @@ def mean_shift(mesh, u: np.ndarray, exact: Callable, *, order: int = 5) -> float
     >>> round(mean_shift(m, np.array([3., 4., 3.]), lambda x, y: x), 12)
     3.0
     """
+    uh, ue, area = mean_shift_parts(mesh, u, exact, order=order)
+    return (uh - ue) / area
+
+
+def mean_shift_parts(mesh, u: np.ndarray, exact: Callable, *, order: int = 5,
+                     elements=None) -> tuple[float, float, float]:
+    """``(int u_h, int u, area)`` over the selected elements: the integrals :func:`mean_shift`
+    combines, which a distributed run sums over ranks first (``u`` is read only at the
+    selected elements' nodes)."""
     from .quadrature import rule_for_degree
 
     rule = rule_for_degree(order)
-    _, area, _, tri = triangle_geometry(mesh, None)
+    _, area, _, tri = triangle_geometry(mesh, select_elements(mesh, elements))
     x, y = rule.physical_points(mesh, tri)
     exact_integral = float(area @ (evaluate_callable(exact, x, y, name="exact") @ rule.weights))
-    w = node_weights(mesh)
-    return (float(w @ np.asarray(u, dtype=np.float64)) - exact_integral) / float(area.sum())
+    uh_integral = float((area / 3.0) @ np.asarray(u, dtype=np.float64)[tri].sum(axis=1))
+    return uh_integral, exact_integral, float(area.sum())
 
 
 class PoissonSolution(NamedTuple):
@@ -315,9 +333,7 @@ class PoissonProblem:
         with t("load"):
             F = assemble_load(self.mesh, self.f, rule=self.load_rule)
         with t("neumann"):
-            F_flux = np.zeros(self.mesh.n_points)
-            for tags, h in self.neumann:
-                F_flux += assemble_neumann(self.mesh, tags, h)
+            F_flux = self.neumann_vector()
         self.neumann_load = F_flux
         return K, F + F_flux
 
@@ -329,6 +345,13 @@ class PoissonProblem:
             g[nodes] = dirichlet_values(self.mesh, nodes, value)
         fixed = np.flatnonzero(~np.isnan(g))
         return fixed, g[fixed]
+
+    def neumann_vector(self) -> np.ndarray:
+        """``int h N_i ds`` summed over the Neumann entries, shape (n,)."""
+        F_flux = np.zeros(self.mesh.n_points)
+        for tags, h in self.neumann:
+            F_flux += assemble_neumann(self.mesh, tags, h)
+        return F_flux
 
     def reduce(self, K, F, method: str = "direct") -> DirichletSystem | NullspaceSystem:
         """The system a solver gets: Dirichlet nodes eliminated (SPD), or, pure Neumann, the

@@ -1,15 +1,18 @@
-"""The contract a scale-out linear-solver backend implements (design note; no PETSc code).
+"""The contract a linear-solver backend implements, and the registry of backends.
 
-femkit's own solvers (:func:`femkit.solvers.solve`) are the reference backend. A PETSc
-backend would map femkit names onto KSP/PC types (``cg``/``pcg`` -> ``KSPCG``, ``direct``
+femkit's own solvers (:func:`femkit.solvers.solve`) are the reference backend (``femkit``);
+``petsc`` is :class:`femkit.solvers.petsc.PetscBackend` (imported only when asked for).
+:data:`BACKENDS` maps the names to factories; ``solve(..., backend="petsc")`` uses it.
+The PETSc backend maps femkit names onto KSP/PC types (``cg``/``pcg`` -> ``KSPCG``, ``direct``
 -> ``KSPPREONLY`` + ``PCLU``/``PCCHOLESKY``, ``jacobi`` -> ``PCJACOBI``, ``ic0`` ->
-``PCICC`` with zero levels, ``amg_sa`` -> ``PCGAMG``, ``amg_rs`` -> ``PCHYPRE`` BoomerAMG),
+``PCBJACOBI`` + ``PCICC`` with zero levels, ``amg_sa`` -> ``PCGAMG``, ``amg``/``amg_rs`` ->
+``PCHYPRE`` BoomerAMG),
 set ``KSPSetTolerances(rtol, atol, maxits)`` with the same unpreconditioned-residual norm
 (``KSP_NORM_UNPRECONDITIONED``) so the stopping rule ``||b - A x|| <= max(rtol ||b||, atol)``
 matches, and translate ``KSPConvergedReason`` into :data:`femkit.solvers.result.REASONS`
 (``DIVERGED_INDEFINITE_MAT``/``_PC`` -> ``breakdown``, ``DIVERGED_ITS`` -> ``maxiter``,
-``DIVERGED_NANORINF`` -> ``non-finite``, ``DIVERGED_BREAKDOWN`` -> ``breakdown``). It must
-still recompute the true residual at exit and set ``converged`` from it.
+``DIVERGED_NANORINF`` -> ``non-finite``, ``DIVERGED_BREAKDOWN`` -> ``breakdown``). It
+recomputes the true residual at exit and sets ``converged`` from it.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from typing import Callable, Protocol, runtime_checkable
 
 import numpy as np
 
+from ..registry import Registry
 from .result import SolveResult
 
 
@@ -65,3 +69,15 @@ class FemkitBackend:
         from .registry import solve
 
         return solve(A, b, x0, **kwargs)
+
+
+def _petsc_backend() -> LinearSolverBackend:
+    from .petsc.backend import PetscBackend  # lazy: petsc4py only when asked for
+
+    return PetscBackend()
+
+
+#: backend name -> factory returning a :class:`LinearSolverBackend`
+BACKENDS: Registry = Registry("solver backend")
+BACKENDS.register("femkit", FemkitBackend)
+BACKENDS.register("petsc", _petsc_backend)

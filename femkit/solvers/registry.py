@@ -69,7 +69,8 @@ def get_preconditioner(name: str) -> Callable:
 
 def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = None,
           rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None, callback=None,
-          preconditioner_options: dict | None = None, **options) -> SolveResult:
+          preconditioner_options: dict | None = None, backend: str = "femkit",
+          **options) -> SolveResult:
     """Solve ``A x = b`` with a registered method and preconditioner, by name.
 
     Stopping rule of the iterative methods: ``||b - A x|| <= max(rtol ||b||, atol)``,
@@ -90,6 +91,11 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     preconditioner_options : dict, optional
         Keyword arguments of the preconditioner factory (e.g. ``{"shift": 1e-2}`` for ic0);
         an unknown name raises :class:`~femkit.errors.InputError` listing the valid ones.
+    backend : str
+        A name in :data:`femkit.solvers.backend.BACKENDS`: ``femkit`` (these solvers) or
+        ``petsc`` (the same names on PETSc KSP/PC, one process; options ``omega``,
+        ``petsc_options``; needs petsc4py, else
+        :class:`~femkit.errors.BackendUnavailableError`).
     **options
         Method-specific options (``omega`` for jacobi, ``factorization`` for direct ...);
         an unknown name raises :class:`~femkit.errors.InputError` listing the valid ones.
@@ -108,6 +114,15 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     >>> r.converged, r.method, r.preconditioner
     (True, 'pcg', 'jacobi')
     """
+    if backend != "femkit":
+        from .backend import BACKENDS
+
+        factory = BACKENDS.get(backend)
+        if preconditioner_options:
+            raise InputError(f"preconditioner_options are not used by the {backend} backend "
+                             f"(pass PETSc options with petsc_options)")
+        return factory().solve(A, b, x0, method=method, preconditioner=preconditioner, rtol=rtol,
+                               atol=atol, maxiter=maxiter, callback=callback, **options)
     fn = SOLVERS.get(method)
     if "M" in options:
         raise InputError("solve() takes the preconditioner by name (preconditioner=...), not M=")

@@ -34,7 +34,13 @@ class SolverSpec:
         (``preconditioner`` is ``"none"`` for every method but ``pcg``).
     rtol, atol, maxiter : the stopping rule ``||b - A x|| <= max(rtol ||b||, atol)``.
     options, preconditioner_options : keyword arguments of the method / preconditioner factory.
-    label : how reports name this solver (default ``method`` or ``method+preconditioner``).
+    label : how reports name this solver (default ``method`` or ``method+preconditioner``,
+        with `` (petsc)`` appended on the PETSc backend).
+    backend : ``femkit`` (these solvers) or ``petsc`` (the same names on PETSc KSP/PC,
+        :mod:`femkit.solvers.petsc`; ``options`` then takes only ``omega``).
+    petsc_options : PETSc options passed through (``{"pc_hypre_boomeramg_strong_threshold":
+        0.5}``, as ``-pc_hypre_boomeramg_strong_threshold 0.5`` on PETSc's command line);
+        ``backend: petsc`` only.
     """
 
     method: str
@@ -45,6 +51,8 @@ class SolverSpec:
     options: dict = field(default_factory=dict)
     preconditioner_options: dict = field(default_factory=dict)
     label: str = ""
+    backend: str = "femkit"
+    petsc_options: dict = field(default_factory=dict)
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, Any] | None, where: str = "solver", *,
@@ -88,16 +96,28 @@ class SolverSpec:
                                 f"{method!r} (drop it or use method: pcg)")
         options = dict(d.get("options") or {})
         pc_options = dict(d.get("preconditioner_options") or {})
-        options_of(fn, options, "options", exclude=("rtol", "atol", "maxiter", "M", "callback"))
-        if pc_options and pc == "none":
-            raise InputError(f"{where}.preconditioner_options: no preconditioner is used")
-        options_of(factory, pc_options, "preconditioner_options")
-        label = d.get("label") or (method if pc == "none" else f"{method}+{pc}")
+        backend = d.get("backend") or "femkit"
+        petsc_options = dict(d.get("petsc_options") or {})
+        from .backend import BACKENDS
+
+        lookup(BACKENDS, backend, "backend")
+        if backend == "petsc":
+            _check_petsc(method, pc, options, pc_options, petsc_options, where)
+        else:
+            if petsc_options:
+                raise InputError(f"{where}.petsc_options: only used with backend: petsc")
+            options_of(fn, options, "options", exclude=("rtol", "atol", "maxiter", "M", "callback"))
+            if pc_options and pc == "none":
+                raise InputError(f"{where}.preconditioner_options: no preconditioner is used")
+            options_of(factory, pc_options, "preconditioner_options")
+        label = d.get("label") or ((method if pc == "none" else f"{method}+{pc}")
+                                   + (f" ({backend})" if backend != "femkit" else ""))
         return cls(method=method, preconditioner=pc,
                    rtol=float(d.get("rtol", DEFAULT_RTOL)),
                    atol=float(d.get("atol", DEFAULT_ATOL)),
                    maxiter=d.get("maxiter"), options=options,
-                   preconditioner_options=pc_options, label=label)
+                   preconditioner_options=pc_options, label=label, backend=backend,
+                   petsc_options=petsc_options)
 
     @property
     def needs_hierarchy(self) -> bool:
@@ -130,8 +150,37 @@ class SolverSpec:
         options = {**self.options, **overrides.pop("options", {})}
         kw = dict(rtol=self.rtol, atol=self.atol, maxiter=self.maxiter)
         kw.update(overrides)
+        if self.backend != "femkit":
+            kw.update(backend=self.backend, petsc_options=self.petsc_options or None)
         return solve(A, b, x0, method=self.method,
                      preconditioner=self.preconditioner if self.method == "pcg" else None,
                      callback=callback,
                      preconditioner_options=pc_options or None,
                      **kw, **options)
+
+
+def _check_petsc(method: str, pc: str, options: dict, pc_options: dict, petsc_options: dict,
+                 where: str) -> None:
+    """Load-time checks of a ``backend: petsc`` spec (no petsc4py needed): names PETSc offers,
+    ``options`` only ``omega`` (the jacobi iteration), no ``preconditioner_options``, and
+    ``petsc_options`` keys and values PETSc's options database can hold."""
+    from .petsc import names
+    from .petsc.options import normalise
+
+    try:
+        names.resolve(method, pc)
+    except UnknownNameError as exc:
+        raise with_prefix(exc, f"{where}.{'method' if exc.kind.endswith('solver') else 'preconditioner'}") from None
+    except InputError as exc:
+        raise with_prefix(exc, f"{where}.preconditioner") from None
+    bad = sorted(set(options) - ({"omega"} if method == "jacobi" else set()))
+    if bad:
+        raise InputError(f"{where}.options: {', '.join(bad)} not used by the petsc backend "
+                         f"(PETSc settings go in petsc_options)")
+    if pc_options:
+        raise InputError(f"{where}.preconditioner_options: not used by the petsc backend "
+                         f"(PETSc settings go in petsc_options)")
+    try:
+        normalise(petsc_options)
+    except InputError as exc:
+        raise with_prefix(exc, f"{where}.petsc_options") from None

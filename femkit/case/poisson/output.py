@@ -21,7 +21,7 @@ __all__ = ["write_solution", "write_plot", "write_outputs", "output_location",
 #: Top-level keys of result.json.
 RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs", "nnz",
                "solver", "converged", "errors", "error_estimate", "effectivity", "adaptive",
-               "timings", "expressions", "files")
+               "timings", "expressions", "files", "backend", "parallel")
 
 
 def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarray | None = None,
@@ -97,11 +97,14 @@ def output_location(directory: str | os.PathLike) -> Path:
         raise with_prefix(exc, "output.dir") from None
 
 
-def write_outputs(result, directory: str | os.PathLike) -> Path:
+def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None) -> Path:
     """Write result.json and the requested solution files into ``directory`` (atomically).
 
     ``directory`` is replaced as a whole, so it must be new, empty or an earlier run
-    (:func:`output_location`).
+    (:func:`output_location`). ``write_pieces(tmp)`` (a distributed run whose solution is
+    too large to gather) writes ``solution.pvtu`` and its pieces instead of ``solution.vtu``;
+    the xdmf and png outputs need the gathered solution (``result.u``) and are left out
+    without it (listed in ``result.parallel["not_written"]``).
     """
     from ...io.atomic import EARLIER_RUN, atomic_directory
     from ...io.writers import write_json
@@ -111,11 +114,16 @@ def write_outputs(result, directory: str | os.PathLike) -> Path:
     result.output_dir = final
     t0 = time.perf_counter()
     with atomic_directory(final, EARLIER_RUN) as tmp:
-        if opts["vtu"]:
+        if opts["vtu"] and write_pieces is not None:
+            write_pieces(tmp)
+        elif opts["vtu"]:
             write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa)
-        if opts["xdmf"]:
+        if result.u is None:
+            result.parallel["not_written"] = [f"solution.{e}" for e, k in
+                                              (("xdmf", "xdmf"), ("png", "plot")) if opts[k]]
+        elif opts["xdmf"]:
             write_solution(tmp / "solution.xdmf", result.mesh, result.u, result.kappa)
-        if opts["plot"]:
+        if opts["plot"] and result.u is not None:
             title = (f"{result.case.name}: {result.mesh.n_triangles} triangles, "
                      f"h_max = {result.quality.get('h_max', float('nan')):.3g}")
             est = result.error_estimate or {}

@@ -342,6 +342,7 @@ class CaseResult:
     effectivity: float | None = None
     indicators: np.ndarray | None = None
     adaptive: dict | None = None
+    parallel: dict | None = None
     interrupted: str | None = None
 
     @property
@@ -381,6 +382,8 @@ class CaseResult:
             "timings": dict(self.timings),
             "expressions": {k: f.source for k, f in self.case.functions.items()},
             "files": list(self.files),
+            "backend": self.case.solver.backend,
+            "parallel": self.parallel,
         }
 
     def summary_lines(self) -> list[str]:
@@ -445,6 +448,10 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     CaseResult
         ``converged`` false is not an exception: the results are still written.
     """
+    if case.solver.backend == "petsc":  # the same case on PETSc + MPI
+        from .distributed import run_poisson_petsc
+
+        return run_poisson_petsc(case, output_dir, quiet=quiet, write=write, echo=echo)
     from ...mesh import quality
     from ...timing import StageTimer
 

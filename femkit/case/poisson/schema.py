@@ -134,6 +134,7 @@ POISSON_SCHEMA: dict = {
                 "vtu": {"type": "boolean", "default": True},
                 "xdmf": {"type": "boolean", "default": False},
                 "plot": {"type": "boolean", "default": False},
+                "gather_limit": {"type": "integer", "minimum": 0},
             },
         },
     },

@@ -265,7 +265,11 @@ def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = Non
                 raise InputError("matrix-free pcg with jacobi needs the operator's diagonal")
             spec = replace(spec, preconditioner_options={**spec.preconditioner_options,
                                                          "diagonal": diagonal})
-    elif system is not None and spec.method == "direct" and not spec.options:
+    elif reuse_key is not None and spec.backend != "femkit":
+        raise InputError(f"reuse_factorization keeps femkit's SuperLU factor; linear_solver."
+                         f"backend {spec.backend!r} is not supported with it (use backend: femkit)")
+    elif (system is not None and spec.method == "direct" and not spec.options
+          and spec.backend == "femkit"):
         if reuse_key is not None:
             return _solve_reusing_factor(A, b, ctx, reuse_key, x0)
         return _solve_direct_reusing_ordering(A, b, ctx)
@@ -383,6 +387,10 @@ def factorize_linear(A, ctx: StepContext):
     """
     from ...solvers import factorize
 
+    if ctx.linear_solver.backend != "femkit":
+        raise InputError(f"a factorisation kept for the whole run uses femkit's SuperLU; "
+                         f"linear_solver.backend {ctx.linear_solver.backend!r} is not supported "
+                         f"here (use backend: femkit)")
     ctx.count("factorizations")
     return factorize(A)
 
@@ -407,6 +415,9 @@ def check_matrix_free(name: str, ctx: StepContext) -> None:
     femkit.errors.InputError: implicit_euler: matrix-free needs an iterative solver: cg or pcg (jacobi); got linear solver 'direct'
     """
     spec = ctx.linear_solver
+    if spec.backend != "femkit":
+        raise InputError(f"{name}: matrix-free solves run in femkit's own solvers; linear_solver."
+                         f"backend {spec.backend!r} needs the assembled matrix")
     allowed = MATRIX_FREE_SOLVERS.get(spec.method)
     if allowed is None:
         raise InputError(f"{name}: {MATRIX_FREE_MESSAGE}; got linear solver {spec.method!r}")
