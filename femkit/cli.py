@@ -7,7 +7,9 @@ Exit codes (every subcommand):
   0  success
   1  the computation ran but failed its goal (solver did not converge; a cross-check
      exceeded its tolerance; a solver/integrator error)
-  2  bad input (case file, expression, name, mesh); one line on stderr, nothing written
+  2  bad input (case file, expression, name, mesh), or a predicted cost above a budget
+     (memory, time, steps, output; --force overrides); one line on stderr, nothing written
+  130/143  stopped by SIGINT/SIGTERM: what was computed is written, marked interrupted: true
 
 Adding a subcommand: write ``_add_<name>(sub)`` that declares its parser and sets
 ``handler`` (or ``func``; a function ``args -> int``), then append it to :data:`SUBCOMMANDS`.
@@ -25,12 +27,16 @@ _EPILOG = """\
 exit codes:
   0  success
   1  ran, but did not reach its goal (solver not converged, check out of tolerance)
-  2  bad input (case file, expression, solver name, mesh); a one-line message on
-     stderr and no output written
+  2  bad input (case file, expression, solver name, mesh), or a predicted cost
+     above a budget (--force runs anyway); a one-line message on stderr and no
+     output written
+  130, 143  stopped by SIGINT / SIGTERM; what was computed is written (result.json
+     with interrupted: true)
 
 examples:
   femkit solve cases/poisson_unit_square.yaml
   femkit solve cases/poisson_lshape.yaml --output runs/lshape --quiet
+  femkit solve cases/poisson_unit_square.yaml --dry-run
   femkit check cases/poisson_unit_square.yaml
 
 Case-file reference: docs/case-files.md; command line: docs/cli.md.
@@ -76,14 +82,47 @@ def _add_solve(sub) -> None:
                    help="linear-solver backend, replacing solver.backend of the case: femkit "
                         "(default) or petsc (PETSc + MPI: run as 'mpirun -n N femkit solve CASE "
                         "--backend petsc'; set up with scripts/install-petsc.sh)")
+    _add_cost_flags(p)
+
+
+def _add_cost_flags(p: argparse.ArgumentParser) -> None:
+    """``--dry-run``, ``--max-memory``, ``--force`` (shared by ``solve`` and ``study``)."""
+    p.add_argument("--dry-run", action="store_true",
+                   help="print the predicted cost (sizes, time, peak memory, output per stage, "
+                        "with the assumptions) and exit without running")
+    p.add_argument("--max-memory", metavar="SIZE",
+                   help="memory budget, e.g. 4GiB or 500MB (default: the available memory; "
+                        "a case file's limits: {memory: ...} also applies)")
+    p.add_argument("--force", action="store_true",
+                   help="run even when the predicted cost exceeds a budget (warnings on stderr)")
+
+
+def _max_memory(args) -> float | None:
+    if getattr(args, "max_memory", None) is None:
+        return None
+    from .cost import parse_bytes
+
+    return parse_bytes(args.max_memory, "--max-memory")
 
 
 def _run_solve(args) -> int:
     from .case import load_case
+    from .case.cost import check_case, plan_case
+    from .interrupt import exit_code, stop_on_signals
 
     overrides = {"solver": {"backend": args.backend}} if args.backend else {}
     case = load_case(args.case, **overrides)
-    result = case.run(output_dir=args.output, quiet=args.quiet)
+    if args.dry_run:
+        print(plan_case(case).render())
+        return EXIT_OK
+    check_case(case, max_memory=_max_memory(args), force=args.force)
+    with stop_on_signals() as stop:
+        case.run_options["stop"] = stop
+        result = case.run(output_dir=args.output, quiet=args.quiet)
+    if getattr(result, "interrupted", None):
+        print(f"femkit: interrupted by {result.interrupted}; what was computed is written to "
+              f"{getattr(result, 'output_dir', None)} (marked interrupted: true)", file=sys.stderr)
+        return exit_code(stop)
     converged = bool(getattr(result, "converged", True))
     if not converged:
         where = getattr(result, "output_dir", None)
@@ -157,6 +196,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     from .errors import FemkitError, InputError
+    from .interrupt import Interrupted
 
     handler = getattr(args, "handler", None) or getattr(args, "func")  # func: femkit.study.cli style
     speaks = _mpi_rank() == 0  # under mpirun every rank raises the same error: rank 0 says it
@@ -170,6 +210,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         if speaks:
             print(f"femkit: failed: {_one_line(exc)}", file=sys.stderr)
         return EXIT_FAILED
+    except Interrupted as exc:  # stopped between stages: nothing was written
+        print(f"femkit: {exc}; nothing written", file=sys.stderr)
+        return 128 + int(exc.flag.signum or 2)
     except KeyboardInterrupt:
         print("femkit: interrupted", file=sys.stderr)
         return 130

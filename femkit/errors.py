@@ -16,6 +16,8 @@ Hierarchy::
     │   ├── HierarchyError         geometric multigrid (gmg, fmg) asked for without a matching
     │   │                          nested mesh hierarchy (the message names amg_rs)
     │   ├── AdaptivityError        bad adaptive-refinement setting (theta, target, budgets)
+    │   ├── BudgetExceededError    predicted memory / time / steps / output above a limit
+    │   │                          (before the run; ``force`` overrides)
     │   └── BackendUnavailableError  a solver backend (PETSc: petsc4py, mpi4py) cannot be
     │                              imported; the message names scripts/install-petsc.sh
     ├── SolverError                a linear solver could not do what was asked
@@ -106,6 +108,24 @@ class HierarchyError(InputError):
 class AdaptivityError(InputError):
     """A bad setting of adaptive refinement: Dörfler ``theta`` outside (0, 1], a target
     estimate <= 0, a dof / time / level budget <= 0, an unknown estimator."""
+
+
+class BudgetExceededError(InputError):
+    """A run's predicted cost exceeds a limit (available memory, or a stated budget).
+
+    Raised before the run starts (:func:`femkit.cost.check_budget`); the one-line message gives
+    the predicted sizes and cost, the limit and what to change. Attributes: ``what``
+    (``memory``, ``time``, ``steps`` or ``output``), ``predicted``, ``limit`` (bytes, seconds,
+    steps, bytes) and ``plan`` (the :class:`femkit.cost.Plan`).
+    """
+
+    def __init__(self, message: str, what: str = "", predicted: float = 0.0, limit: float = 0.0,
+                 plan=None):
+        self.what = what
+        self.predicted = predicted
+        self.limit = limit
+        self.plan = plan
+        super().__init__(message)
 
 
 class SolverError(FemkitError):

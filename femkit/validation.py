@@ -24,3 +24,18 @@ def finite_nonnegative(value, name: str) -> float:
     if not math.isfinite(f) or f < 0.0:
         raise InputError(f"{name} must be finite and >= 0, got {value!r}")
     return f
+
+
+def mesh_size(h) -> float:
+    """A target mesh size ``h``: a positive finite number (:class:`InputError` otherwise).
+
+    >>> mesh_size("0.05")
+    0.05
+    """
+    try:
+        hv = float(h)
+    except (TypeError, ValueError):
+        raise InputError(f"mesh size h must be a positive number, got {h!r}") from None
+    if not (math.isfinite(hv) and hv > 0):
+        raise InputError(f"mesh size h must be a positive finite number, got {h!r}")
+    return hv

@@ -50,6 +50,10 @@ class Case:
         each with ``.source`` holding its text. Replace an entry to swap a piece.
     solver : SolverSpec or None
         The validated ``solver`` (``linear_solver`` in scenes): built once at load time.
+    run_options : dict
+        How to run it (:mod:`femkit.case.cost`): ``limits`` (:class:`femkit.cost.Limits` from
+        the ``limits:`` key, set at load time), ``force`` (skip every budget) and ``stop`` (a
+        :class:`femkit.interrupt.StopFlag` the runners check between steps and iterations).
     """
 
     data: dict
@@ -59,6 +63,7 @@ class Case:
     path: Path | None = None
     functions: dict = field(default_factory=dict)
     solver: Any = None
+    run_options: dict = field(default_factory=dict)
 
     def run(self, output_dir: str | os.PathLike | None = None, quiet: bool = False,
             write: bool = True, echo=None):

@@ -7,7 +7,7 @@ functions below, no import strings), so listing problem types imports nothing he
 
 Adding a problem type is one registration::
 
-    register_problem("my_problem", schema=MY_SCHEMA, prepare=prepare, run=run)
+    register_problem("my_problem", schema=MY_SCHEMA, prepare=prepare, run=run, plan=plan)
 
 ``run(case, output_dir=None, quiet=False, write=True, echo=None)`` returns a result with
 ``converged``; ``femkit solve`` dispatches on the ``problem`` key through this registry and
@@ -34,6 +34,7 @@ class ProblemType:
     schema: Any
     prepare: Callable
     run: Callable
+    plan: Callable | None = None
 
     def get_schema(self) -> dict:
         return self.schema() if callable(self.schema) else self.schema
@@ -49,9 +50,14 @@ class ProblemType:
 PROBLEMS: Registry = Registry("problem")
 
 
-def register_problem(name: str, schema: Any, prepare: Callable, run: Callable) -> ProblemType:
-    """Register a problem type; a name registered twice raises ValueError."""
-    return PROBLEMS.register(name, ProblemType(schema, prepare, run))
+def register_problem(name: str, schema: Any, prepare: Callable, run: Callable,
+                     plan: Callable | None = None) -> ProblemType:
+    """Register a problem type; a name registered twice raises ValueError.
+
+    ``plan(case, measure=True) -> femkit.cost.Plan`` predicts a run's cost (``--dry-run``,
+    budgets); without it such cases are run unchecked.
+    """
+    return PROBLEMS.register(name, ProblemType(schema, prepare, run, plan))
 
 
 def get_problem(name: Any) -> ProblemType:
@@ -97,5 +103,17 @@ def _scene_run(case, **kwargs):
     return run_scene(case, **kwargs)
 
 
-register_problem("poisson", _poisson_schema, _poisson_prepare, _poisson_run)
-register_problem("mass_spring", _scene_schema, _scene_prepare, _scene_run)
+def _poisson_plan(case, **kwargs):
+    from .cost import plan_poisson_case
+
+    return plan_poisson_case(case, **kwargs)
+
+
+def _scene_plan(case, **kwargs):
+    from .cost import plan_scene_case
+
+    return plan_scene_case(case, **kwargs)
+
+
+register_problem("poisson", _poisson_schema, _poisson_prepare, _poisson_run, _poisson_plan)
+register_problem("mass_spring", _scene_schema, _scene_prepare, _scene_run, _scene_plan)

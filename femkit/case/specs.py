@@ -29,7 +29,7 @@ from ..solvers.spec import SolverSpec
 from .names import lookup, with_prefix
 
 __all__ = ["SolverSpec", "IntegratorSpec", "SOLVER_SCHEMA", "INTEGRATOR_SCHEMA", "solver_schema",
-           "solver_spec"]
+           "solver_spec", "LIMITS_SCHEMA", "limits_spec"]
 
 
 def solver_spec(data: Mapping[str, Any] | None, where: str, *,
@@ -66,6 +66,28 @@ def solver_schema(*, label: bool = False) -> dict:
 
 #: The solver fragment of case and scene files (``solver:``, ``linear_solver:``).
 SOLVER_SCHEMA: dict = solver_schema()
+
+_SIZE = {"anyOf": [{"type": "number", "exclusiveMinimum": 0}, {"type": "string", "minLength": 1}],
+         "x-message": "expected a positive number or a string with a unit, like 2GiB or 10min"}
+
+#: The budget fragment of case and scene files (``limits:``): memory and output in bytes
+#: (``2GiB``, ``500MB``), time in seconds (``10min``, ``2h``), steps a count.
+LIMITS_SCHEMA: dict = {
+    "type": "object", "additionalProperties": False,
+    "properties": {"memory": _SIZE, "time": _SIZE, "output": _SIZE,
+                   "steps": {"type": "number", "exclusiveMinimum": 0}},
+}
+
+
+def limits_spec(data: Mapping[str, Any] | None, where: str = "limits"):
+    """The :class:`femkit.cost.Limits` of a ``limits:`` mapping; a bad size is a CaseFileError."""
+    from ..cost import Limits
+
+    try:
+        return Limits.from_mapping(data, where)
+    except InputError as exc:
+        raise CaseFileError(str(exc)) from None
+
 
 #: The integrator fragment: a name, or ``{method: name, options: {...}}``.
 INTEGRATOR_SCHEMA: dict = {

@@ -61,7 +61,6 @@ not growth was detected before the run ended.
 from __future__ import annotations
 
 import math
-import sys
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -84,7 +83,9 @@ class Trajectory:
     instability (then ``reason`` says why); ``omega_max``/``dt_crit`` are the stability estimates
     (``None`` when not computed); ``dt_exceeds_critical`` is ``dt > dt_crit`` (``None`` when
     ``dt_crit`` was not computed), true even when the run ended before any growth was seen; ``stats`` holds the integrator counters (factorisations,
-    linear solves, Newton iterations); ``momentum`` ``(m, d)``.
+    linear solves, Newton iterations); ``momentum`` ``(m, d)``. ``interrupted`` is true when
+    the run was stopped on request (``stop``, e.g. SIGTERM) before ``t_end``: the trajectory
+    then holds every recorded step so far and the state at the stop (``completed`` false).
     """
 
     method: str
@@ -103,6 +104,7 @@ class Trajectory:
     energy_scale: float = 1.0
     dt_exceeds_critical: bool | None = None
     stats: dict = field(default_factory=dict)
+    interrupted: bool = False
 
     @property
     def energy_drift(self) -> float:
@@ -115,7 +117,8 @@ class Trajectory:
         return {
             "method": self.method, "dt": self.dt, "steps": int(self.steps),
             "recorded": int(len(self.times)), "wall_time": float(self.wall_time),
-            "completed": bool(self.completed), "reason": self.reason,
+            "completed": bool(self.completed), "interrupted": bool(self.interrupted),
+            "reason": self.reason,
             "omega_max": self.omega_max, "dt_crit": self.dt_crit,
             "dt_exceeds_critical": self.dt_exceeds_critical,
             "energy_drift": self.energy_drift,
@@ -217,8 +220,8 @@ class _GrowthMonitor:
 
 def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | None = None,
              record_every: int = 1, energy_growth_limit: float = 100.0,
-             check_stability: bool = True, check_every: int = 10, progress: bool = False,
-             x0=None, v0=None, t0: float = 0.0, **integrator_options) -> Trajectory:
+             check_stability: bool = True, check_every: int = 10, progress=False,
+             stop=None, x0=None, v0=None, t0: float = 0.0, **integrator_options) -> Trajectory:
     """Integrate ``system`` from ``t0`` to ``t_end`` with fixed step ``dt``.
 
     Parameters
@@ -239,8 +242,14 @@ def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | 
         docstring); ``inf`` disables both energy rules (finiteness is always checked).
     check_stability : bool
         For explicit methods: estimate ``omega_max`` and warn when ``dt`` exceeds the critical step.
-    progress : bool
-        Show a tqdm progress bar (only when stderr is a terminal).
+    progress : bool or femkit.progress.Progress
+        Report progress on stderr (:class:`femkit.progress.Progress`: a tqdm bar on a
+        terminal, one line per 10 % or per minute otherwise); or a ``Progress`` to update.
+    stop : callable, optional
+        ``stop() -> bool`` checked between steps (e.g. a
+        :class:`femkit.interrupt.StopFlag`); when true the run ends early and returns the
+        trajectory so far with ``interrupted=True`` and ``completed=False`` (the state at the
+        stop is recorded; ``reason`` names the signal when ``stop`` has a ``name``).
     x0, v0, t0 : initial state (default the system's ``x0``, ``v0`` and 0).
 
     Returns
@@ -292,10 +301,10 @@ def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | 
     rec.add(state.t, state.x, state.v, e0)
 
     bar = None
-    if progress and sys.stderr.isatty():
-        from tqdm import tqdm
+    if progress is not None and progress is not False:
+        from ..progress import Progress
 
-        bar = tqdm(total=n_steps, desc=method, unit="step", leave=False)
+        bar = progress if isinstance(progress, Progress) else Progress(n_steps, method, unit="step")
     start = time.perf_counter()
     last_recorded = 0
     exceeds = None if dt_crit is None else bool(dt > dt_crit)
@@ -309,8 +318,12 @@ def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | 
                             completed=False, reason=reason, **common)
         raise InstabilityError(method, step, t, ratio, dt, dt_crit, reason, partial)
 
+    stopped_at = None
     try:
         for step in range(1, n_steps + 1):
+            if stop is not None and stop():
+                stopped_at = step - 1
+                break
             new = integrator.step(system, state, dt, ctx)
             if not (np.isfinite(new.x).all() and np.isfinite(new.v).all()):
                 fail(step, new.t, math.inf, "non-finite state", state)
@@ -333,5 +346,13 @@ def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | 
                 bar.update(1)
     finally:
         if bar is not None:
-            bar.close()
+            by = getattr(stop, "name", None) or "a stop request"
+            bar.close(interrupted=by if stopped_at is not None else None)
+    if stopped_at is not None:
+        if last_recorded != stopped_at:
+            rec.add(state.t, state.x, state.v, system.energies(state.x, state.v))
+        by = getattr(stop, "name", None)
+        return rec.build(method, dt, stopped_at, time.perf_counter() - start, completed=False,
+                         interrupted=True, reason=f"interrupted{' by ' + by if by else ''} at "
+                         f"step {stopped_at} of {n_steps}", **common)
     return rec.build(method, dt, n_steps, time.perf_counter() - start, **common)

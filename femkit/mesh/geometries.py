@@ -35,22 +35,13 @@ import numpy as np
 
 from ..errors import InputError, MeshError
 from ..registry import Registry
+from ..validation import mesh_size as _check_h
 from .mesh import Mesh
 
 GEOMETRIES: Registry[Callable[..., Mesh]] = Registry("geometry")
 
 #: gmsh element type numbers
 _GMSH_LINE, _GMSH_TRIANGLE = 1, 2
-
-
-def _check_h(h) -> float:
-    try:
-        hv = float(h)
-    except (TypeError, ValueError):
-        raise InputError(f"mesh size h must be a positive number, got {h!r}") from None
-    if not (math.isfinite(hv) and hv > 0):
-        raise InputError(f"mesh size h must be a positive finite number, got {h!r}")
-    return hv
 
 
 def _positive(name: str, value) -> float:
@@ -71,7 +62,8 @@ def _gmsh_session(name: str) -> Iterator[object]:
 
     owner = not gmsh.isInitialized()
     if owner:
-        gmsh.initialize(argv=[], readConfigFiles=False, run=False, interruptible=False)
+        with _python_signal_handlers():
+            gmsh.initialize(argv=[], readConfigFiles=False, run=False, interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.Verbosity", 0)
@@ -88,6 +80,26 @@ def _gmsh_session(name: str) -> Iterator[object]:
         else:
             with contextlib.suppress(Exception):
                 gmsh.model.remove()
+
+
+@contextlib.contextmanager
+def _python_signal_handlers() -> Iterator[None]:
+    """Put Python's SIGINT/SIGTERM handlers back after gmsh's initialisation, which installs
+    its own at the C level (a SIGTERM would then kill the process instead of reaching
+    :func:`femkit.interrupt.stop_on_signals`)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for s, handler in saved.items():
+            if handler is not None:
+                signal.signal(s, handler)
 
 
 def _set_size(gmsh, h: float) -> None:
@@ -418,7 +430,7 @@ def geo_file(path: str | os.PathLike, h: float | None = None) -> Mesh:
         return _mesh_from_gmsh(gmsh)
 
 
-def generate(geometry: str, h: float, **params) -> Mesh:
+def generate(geometry: str, h: float, *, check_memory: bool = True, **params) -> Mesh:
     """Generate a mesh of a named geometry from :data:`GEOMETRIES`.
 
     Parameters
@@ -427,6 +439,8 @@ def generate(geometry: str, h: float, **params) -> Mesh:
         ``l_shape``, ``rectangle``, ``square_with_inclusion``, ``unit_square``)
     h : target (maximal) element size
     **params : geometry parameters (e.g. ``r_inner`` for ``annulus``)
+    check_memory : refuse, before gmsh starts, a mesh whose predicted memory exceeds the
+        available memory (:func:`femkit.cost.check_mesh_fits`)
 
     Raises
     ------
@@ -434,6 +448,8 @@ def generate(geometry: str, h: float, **params) -> Mesh:
         Unknown geometry (the message lists the valid ones).
     InputError
         Bad or unknown parameters.
+    BudgetExceededError
+        ``h`` so small that the mesh cannot fit in memory (the message says which ``h`` fits).
     """
     factory = GEOMETRIES.get(geometry)
     import inspect
@@ -445,4 +461,8 @@ def generate(geometry: str, h: float, **params) -> Mesh:
         valid = [n for n in sig.parameters if n != "h"]
         raise InputError(f"geometry {geometry!r}: {exc}; valid parameters: "
                          f"{', '.join(valid) or '(none)'}") from None
+    if check_memory:
+        from ..cost.budget import check_mesh_fits
+
+        check_mesh_fits(geometry, _check_h(h), params=params)
     return factory(h, **params)

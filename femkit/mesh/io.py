@@ -13,6 +13,8 @@ sidecar ``<file>.tags.json`` (``{name: tag}``), which :func:`read_mesh` reads ba
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import os
 from pathlib import Path
@@ -61,10 +63,12 @@ def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
 
     fmt = "gmsh" if p.lower().endswith(".msh") else None
     try:
-        mio = meshio.read(p, file_format=fmt)
-    except (Exception, SystemExit) as exc:  # meshio raises ReadError, KeyError, ValueError ...
-        # (and sys.exit() when several readers fail), so catch all of them here
-        raise MeshError(f"cannot read mesh file {p}: {type(exc).__name__}: {exc}") from None
+        # meshio prints its own complaints and calls sys.exit() when a reader fails: keep
+        # its output off the user's terminal and turn every failure into one MeshError line
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            mio = meshio.read(p, file_format=fmt)
+    except (Exception, SystemExit):  # ReadError, KeyError, ValueError, UnicodeDecodeError, exit
+        raise MeshError(unreadable_message(p)) from None
 
     types = [c.type for c in mio.cells]
     tri_blocks, tri_tags, line_blocks, line_tags = [], [], [], []
@@ -128,6 +132,58 @@ def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
     if compact:
         mesh = remove_unreferenced(mesh)
     return orient_ccw(mesh)
+
+
+#: What each extension must hold, for the messages of unreadable files.
+_EXPECTED = {
+    ".msh": "a gmsh mesh (.msh, ASCII or binary, format 2.2 or 4.1)",
+    ".vtu": "a VTK XML unstructured grid (.vtu)",
+    ".xdmf": "an XDMF mesh (.xdmf with its .h5)",
+    ".vtk": "a legacy VTK file (.vtk)",
+}
+
+
+def _msh_cause(head: bytes, tail: bytes) -> str:
+    """The likely reason a .msh file failed to parse, from its first and last bytes."""
+    first = head.lstrip().split(b"\n", 1)[0].strip()
+    if first != b"$MeshFormat":
+        if b"\0" in head or not head.isascii():
+            return "it holds binary data that does not start with $MeshFormat; not a gmsh file?"
+        return f"it starts with {first[:40].decode('ascii', 'replace')!r}, not $MeshFormat; not a gmsh file?"
+    last = tail.rstrip().rsplit(b"\n", 1)[-1].strip()
+    if not last.startswith(b"$End"):
+        return "its last section is not closed by an $End... line: truncated?"
+    return "a section holds fewer or malformed entries than its header announces: truncated or edited by hand?"
+
+
+def unreadable_message(path: str) -> str:
+    """One line for a mesh file that meshio cannot parse: the file, what was expected, the
+    likely cause (empty, truncated, not this format), without internal exception names.
+
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp(); p = os.path.join(d, "empty.msh"); open(p, "w").close()
+    >>> unreadable_message(p).split(": ", 1)[1]
+    'not a valid gmsh mesh (.msh, ASCII or binary, format 2.2 or 4.1): the file is empty'
+    """
+    ext = Path(path).suffix.lower()
+    expected = _EXPECTED.get(ext, f"a mesh file meshio reads as {ext or 'its extension'}")
+    size = os.path.getsize(path)
+    if size == 0:
+        cause = "the file is empty"
+    else:
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+            fh.seek(max(size - 4096, 0))
+            tail = fh.read()
+        if ext == ".msh":
+            cause = _msh_cause(head, tail)
+        elif ext in (".vtu", ".xdmf"):
+            closed = tail.rstrip().endswith(b">")
+            cause = ("not well-formed XML" + ("" if closed else ": it ends mid-element, truncated?")
+                     if head.lstrip().startswith(b"<") else "it is not XML")
+        else:
+            cause = "it could not be parsed (truncated, or another format?)"
+    return f"{path}: not a valid {expected.replace('a ', '', 1).replace('an ', '', 1)}: {cause}"
 
 
 def _groups(mio) -> dict[str, tuple[int, int]]:

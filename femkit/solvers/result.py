@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 #: Values ``SolveResult.reason`` can take.
-REASONS = ("converged", "maxiter", "breakdown", "stagnation", "non-finite", "direct")
+REASONS = ("converged", "maxiter", "breakdown", "stagnation", "non-finite", "direct", "interrupted")
 
 
 @dataclass
@@ -35,7 +35,8 @@ class SolveResult:
         Residual 2-norm history, ``residuals[0]`` being the initial residual
         ``||b - A x0||``; one entry per iteration after that.
     reason : str
-        One of :data:`REASONS`; ``"breakdown"`` covers ``p^T A p <= 0`` and ``r^T z <= 0``.
+        One of :data:`REASONS`; ``"breakdown"`` covers ``p^T A p <= 0`` and ``r^T z <= 0``;
+        ``"interrupted"``: stopped on request (a signal) by its caller, ``x`` the last iterate.
     message : str
         Human-readable detail of ``reason``.
     true_residual : float

@@ -35,7 +35,31 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("-o", "--output", help="report directory (default: the file's output: key, "
                    "else femkit-out/<name> beside the study file)")
     p.add_argument("--quick", action="store_true", help="apply the file's quick: block (small sizes)")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--no-progress", "-q", "--quiet", dest="no_progress", action="store_true",
+                   help="no progress (a bar on a terminal, else one line per 10 %% of the runs "
+                        "or per minute on stderr)")
+    p.add_argument("--dry-run", action="store_true",
+                   help="print the predicted cost of the sweep and exit without running it")
+    p.add_argument("--max-memory", metavar="SIZE",
+                   help="memory budget, e.g. 4GiB (default: the available memory)")
+    p.add_argument("--force", action="store_true",
+                   help="run even when the predicted cost exceeds a budget")
+
+
+def _check_cost(study, args) -> bool:
+    """``--dry-run``: print the plan (True: done); else refuse a sweep that cannot fit."""
+    from ..cost import Limits, check_budget, parse_bytes
+    from .cost import plan_study
+
+    plan = plan_study(study)
+    if getattr(args, "dry_run", False):
+        print(plan.render())
+        return True
+    max_memory = getattr(args, "max_memory", None)
+    limits = Limits(memory=None if max_memory is None else parse_bytes(max_memory, "--max-memory"))
+    for w in check_budget(plan, limits, force=getattr(args, "force", False), override="--force"):
+        print(f"femkit study: warning: {w} (--force given)", file=sys.stderr)
+    return False
 
 
 def cli_main(args) -> int:
@@ -49,18 +73,28 @@ def cli_main(args) -> int:
     from .load import load_study
     from .run import run_study
 
-    try:
-        study = load_study(args.study, quick=args.quick)
-        result = run_study(study, args.output, progress=False if args.no_progress else None)
-    except InputError as exc:
-        print(f"femkit study: error: {exc}", file=sys.stderr)
-        return 2
-    print(f"{study.kind} '{study.name}': {len(result.records)} runs in {result.elapsed:.1f} s")
-    from .kinds import STUDY_KINDS
+    from ..interrupt import Interrupted, stop_on_signals
 
-    for line in STUDY_KINDS.get(study.kind).summary(result):
-        print(f"  {line}")
-    for line in result.notes:
-        print(f"  note: {line}")
-    print(f"report: {result.output_dir / 'report.html'}")
-    return 0
+    with stop_on_signals():  # until the end: a signal after the sweep must not kill the summary
+        try:
+            study = load_study(args.study, quick=args.quick)
+            if _check_cost(study, args):
+                return 0
+            result = run_study(study, args.output, progress=False if args.no_progress else None)
+        except InputError as exc:
+            print(f"femkit study: error: {exc}", file=sys.stderr)
+            return 2
+        except Interrupted as exc:
+            out = args.output if args.output is not None else study.default_output()
+            print(f"femkit study: {exc}; nothing written, the earlier report in {out} (if any) is "
+                  "kept as it was", file=sys.stderr)
+            return 128 + int(exc.flag.signum or 2)
+        print(f"{study.kind} '{study.name}': {len(result.records)} runs in {result.elapsed:.1f} s")
+        from .kinds import STUDY_KINDS
+
+        for line in STUDY_KINDS.get(study.kind).summary(result):
+            print(f"  {line}")
+        for line in result.notes:
+            print(f"  note: {line}")
+        print(f"report: {result.output_dir / 'report.html'}")
+        return 0

@@ -1,19 +1,29 @@
-"""Progress bar over a sweep: tqdm on stderr, silent when stderr is not a terminal."""
+"""Progress over a sweep's runs, and the point where a stop request ends the sweep.
+
+The display is femkit's one progress helper (:mod:`femkit.progress`: a tqdm bar on a
+terminal, one line per 10 % or per minute otherwise, nothing when disabled). Between runs a
+stop request (SIGINT/SIGTERM under ``femkit study``: :func:`femkit.interrupt.active_flag`)
+raises :class:`femkit.interrupt.Interrupted` naming the run that was about to start, so the
+report directory is not replaced: the earlier report stays as it was.
+"""
 
 from __future__ import annotations
 
-import sys
-from typing import Iterable, TypeVar
+from typing import Iterable, Iterator, TypeVar
 
 T = TypeVar("T")
 
 
-def progress(items: Iterable[T], *, total: int | None = None, desc: str = "", enabled: bool | None = None) -> Iterable[T]:
-    """Wrap ``items`` in a tqdm bar when ``enabled`` (default: stderr is a TTY); else return them as is."""
-    if enabled is None:
-        enabled = bool(getattr(sys.stderr, "isatty", lambda: False)())
-    if not enabled:
-        return items
-    from tqdm import tqdm
+def progress(items: Iterable[T], *, total: int | None = None, desc: str = "",
+             enabled: bool | None = None) -> Iterator[T]:
+    """Yield ``items`` with progress reported (``enabled=False``: silent); stop on request."""
+    from ..interrupt import Interrupted, active_flag
+    from ..progress import progress as report
 
-    return tqdm(items, total=total, desc=desc, leave=False, file=sys.stderr)
+    flag = active_flag()
+    items = list(items)
+    n = len(items) if total is None else total
+    for i, item in enumerate(report(items, total=n, desc=desc, unit="run", enabled=enabled)):
+        if flag:
+            raise Interrupted(flag, where=f"before run {i + 1} of {n} ({i} done)")
+        yield item

@@ -27,6 +27,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ...errors import CaseFileError, ExpressionError, InputError
+from ...interrupt import Interrupted
+from ...progress import StageProgress
 from ..expressions import compile_expression
 from ..load import Case
 from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
@@ -71,6 +73,9 @@ def prepare_poisson(case: Case) -> None:
 
     case.solver = solver_spec(d["solver"], "solver", default_method=DEFAULT_METHOD["poisson"])
     d["solver"] = case.solver.to_dict()
+    from ..specs import limits_spec
+
+    case.run_options["limits"] = limits_spec(d.get("limits"))
     if case.solver.needs_hierarchy and (not mesh.get("refine") or d.get("adaptive")):
         from ...errors import HierarchyError
 
@@ -155,16 +160,22 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
 
     spec = case.data["mesh"]
     where = f"mesh.file {spec['file']}" if "file" in spec else f"mesh.geometry {spec['geometry']}"
+    check = not case.run_options.get("force", False)  # --force also passes the library's memory checks
     try:
         if "file" in spec:
             mesh = read_mesh(spec["file"])
         else:
-            mesh = generate(spec["geometry"], spec["h"] if h is None else h, **(spec.get("params") or {}))
+            mesh = generate(spec["geometry"], spec["h"] if h is None else h, check_memory=check,
+                            **(spec.get("params") or {}))
         mesh = validate(mesh)
     except InputError as exc:
         raise with_prefix(exc, where) from None
     hierarchy = None
     k = spec.get("refine") or 0
+    if k and check:  # before numpy allocates the finer levels
+        from ...cost.budget import check_mesh_fits
+
+        check_mesh_fits(triangles=mesh.n_triangles, refine=k)
     if k:
         big = mesh.n_triangles * 4 ** k >= RENUMBER_MIN_TRIANGLES
         if big or case.solver.needs_hierarchy:
@@ -172,7 +183,7 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
             mesh = levels.finest
             hierarchy = levels if case.solver.needs_hierarchy else None
         else:
-            mesh = refine(mesh, k)
+            mesh = refine(mesh, k, check_memory=False)
     bnd = case.data["boundary"]
     for kind in ("dirichlet", "neumann"):
         for i, bc in enumerate(bnd.get(kind, [])):
@@ -332,6 +343,7 @@ class CaseResult:
     indicators: np.ndarray | None = None
     adaptive: dict | None = None
     parallel: dict | None = None
+    interrupted: str | None = None
 
     @property
     def converged(self) -> bool:
@@ -362,6 +374,7 @@ class CaseResult:
             "nnz": self.nnz,
             "solver": self.solve.summary(),
             "converged": self.converged,
+            "interrupted": self.interrupted is not None,
             "errors": self.errors,
             "error_estimate": self.error_estimate,
             "effectivity": self.effectivity,
@@ -448,8 +461,19 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         from .output import output_location
 
         target = output_location(output_dir or case.data["output"]["dir"])
+    stop = case.run_options.get("stop")
+    plan = case.run_options.get("plan")
+    report = StageProgress([(st.name, st.seconds) for st in plan.stages] if plan else [],
+                           case.name, quiet=quiet)
+
+    def check_stop(where: str) -> None:  # a signal during a stage stops after it
+        report.done(where, *(("refine",) if where == "mesh" else ()))  # mesh includes refine
+        if stop:
+            raise Interrupted(stop, stage=where)
+
     with stage("mesh"):
         mesh, hierarchy = build_mesh_levels(case)
+    check_stop("mesh")
     grad = exact_gradient(case)
     run = est = None
     if case.data.get("adaptive"):
@@ -463,13 +487,16 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         problem = poisson_problem(case, mesh)
         with stage("assembly"):
             K, F = problem.assemble_matrices()
+        check_stop("assembly")
         with stage("boundary"):
             system = problem.reduce(K, F, case.solver.method)
+        check_stop("boundary")
         with stage("assembly"):  # the coarser levels' systems (fmg only): added to the stage
             mg = multigrid_inputs(case, hierarchy, system)
         with stage("solve"):
-            res = case.solver.solve(system.A, system.b, **mg)
+            res = _solve(case, system, stop, **mg)
             u = system.expand(res.x)
+        report.done("solve")
     q = quality(mesh)
     errors = None
     if "exact.u" in case.functions:
@@ -484,7 +511,8 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
                         n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
                         nnz=int(system.A.nnz), nullspace=_nullspace_facts(system),
                         error_estimate=estimate, effectivity=effectivity, indicators=est.indicators,
-                        adaptive=adaptive_facts(run) if run is not None else None)
+                        adaptive=adaptive_facts(run) if run is not None else None,
+                        interrupted=stop.name if res.reason == "interrupted" else None)
     if write:
         from .output import write_outputs
 
@@ -494,6 +522,29 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         for line in result.summary_lines():
             out(line)
     return result
+
+
+def _solve(case: Case, system, stop, **mg):
+    """Solve the reduced system (``mg``: multigrid inputs); a stop request during an iterative
+    solve ends it with the last iterate as a not-converged result (``reason: interrupted``)
+    that is written like any other."""
+    if stop is None:
+        return case.solver.solve(system.A, system.b, **mg)
+    from ...interrupt import stopping_callback
+    from ...solvers.result import SolveResult
+
+    try:
+        return case.solver.solve(system.A, system.b, callback=stopping_callback(stop), **mg)
+    except Interrupted as exc:
+        r = system.b - system.A @ exc.x
+        bn = float(np.linalg.norm(system.b))
+        s = case.solver
+        return SolveResult(x=exc.x, converged=False, iterations=exc.iteration,
+                           residuals=np.array([]), reason="interrupted",
+                           message=f"interrupted by {stop.name} after {exc.iteration} iterations",
+                           true_residual=float(np.linalg.norm(r)), rhs_norm=bn,
+                           tolerance=max(s.rtol * bn, s.atol), method=s.method,
+                           preconditioner=s.preconditioner)
 
 
 def _nullspace_facts(system) -> dict | None:

@@ -8,7 +8,7 @@ registered solver is accepted without touching the schema.
 
 from __future__ import annotations
 
-from ..specs import SOLVER_SCHEMA
+from ..specs import SOLVER_SCHEMA, LIMITS_SCHEMA
 
 _NUMBER_OR_EXPR = {
     "anyOf": [{"type": "number"}, {"type": "string", "minLength": 1}],
@@ -126,6 +126,7 @@ POISSON_SCHEMA: dict = {
             "properties": {"load": {"type": "string", "default": "barycentric"}},
         },
         "solver": {**SOLVER_SCHEMA, "default": {}},
+        "limits": LIMITS_SCHEMA,
         "output": {
             "type": "object", "additionalProperties": False, "default": {},
             "properties": {

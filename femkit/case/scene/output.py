@@ -31,7 +31,7 @@ __all__ = ["write_scene_outputs", "write_frames_vtu", "write_frames_xdmf", "writ
 
 #: Top-level keys of a scene's result.json.
 RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "system", "integrator",
-               "linear_solver", "dt", "t_end", "steps", "steps_planned", "t_reached", "frames",
+               "linear_solver", "dt", "t_end", "steps", "steps_planned", "interrupted", "t_reached", "frames",
                "output_every", "wall_time", "step_time", "energy", "final_state",
                "momentum_final", "stability", "converged", "warnings", "timings", "files")
 

@@ -58,6 +58,7 @@ from ...errors import (
 )
 from ...io.atomic import EARLIER_RUN, check_output_dir
 from ...mesh import generate, grid_triangles, read_mesh, validate
+from ...progress import Progress
 from ...registry import Registry
 from ...solvers.defaults import DEFAULT_METHOD
 from ...solvers.spec import SolverSpec
@@ -65,7 +66,7 @@ from ...timing import StageTimer
 from ..expressions import compile_expression
 from ..load import Case
 from ..names import check_geometry_spec, resolve_file
-from ..specs import IntegratorSpec, solver_spec
+from ..specs import IntegratorSpec, limits_spec, solver_spec
 from .output import write_scene_outputs
 
 __all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "build_context",
@@ -136,6 +137,7 @@ def prepare_scene(case: Case) -> None:
     case.solver = ls_spec = solver_spec(d["linear_solver"], "linear_solver",
                                         default_method=DEFAULT_METHOD["mass_spring"])
     d["linear_solver"] = ls_spec.to_dict()
+    case.run_options["limits"] = limits_spec(d.get("limits"))
     if integ.options.get("matrix_free"):  # caught at load time, before anything runs
         try:
             check_matrix_free(integ.method, StepContext(ls_spec))
@@ -377,6 +379,14 @@ class SceneResult:
         return self.instability is None
 
     @property
+    def interrupted(self) -> str | None:
+        """The signal that stopped the run early (``"SIGTERM"`` ...), else None."""
+        if not getattr(self.trajectory, "interrupted", False):
+            return None
+        stop = self.case.run_options.get("stop")
+        return getattr(stop, "name", None) or "a stop request"
+
+    @property
     def failure(self) -> str | None:
         """One-line reason of the failure (None when stable)."""
         return None if self.instability is None else " ".join(str(self.instability).split())
@@ -431,6 +441,7 @@ class SceneResult:
             "t_end": float(self.case.data["t_end"]),
             "steps": int(tr.steps),
             "steps_planned": n_steps(self.case),
+            "interrupted": self.interrupted is not None,
             "t_reached": float(tr.times[-1]),
             "frames": int(len(tr.times)),
             "output_every": int(self.every),
@@ -471,7 +482,8 @@ class SceneResult:
             lines.append(f"solver    {ls['method']}{pc}: {ls['linear_solves']} solves, "
                          f"{ls['iterations']} iterations, {ls['factorizations']} factorisations")
         step_ms = "" if d["step_time"] is None else f" ({1e3 * d['step_time']:.3g} ms/step)"
-        lines.append(f"steps     {d['steps']} of {d['steps_planned']}, {d['frames']} frames, "
+        stopped = f" (interrupted by {self.interrupted})" if self.interrupted else ""
+        lines.append(f"steps     {d['steps']} of {d['steps_planned']}{stopped}, {d['frames']} frames, "
                      f"wall time {d['wall_time']:.3f} s{step_ms}")
         lines.append(f"energy    drift {d['energy']['drift']:+.3e} (relative to scale "
                      f"{d['energy']['scale']:.3e}), max deviation {d['energy']['max_deviation']:.3e}")
@@ -498,8 +510,11 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     ----------
     case : a scene from :func:`femkit.case.load_case`.
     output_dir : overrides ``output.dir``.
-    quiet : print nothing (and show no progress bar) when true. The progress bar also needs
-        stderr to be a terminal.
+    quiet : print nothing (no summary, no progress) when true. Progress: a tqdm bar when stderr
+        is a terminal, else one line per 10 % of the steps or per minute (elapsed, remaining).
+        A stop request (``case.run_options["stop"]``, set by SIGINT/SIGTERM under ``femkit solve``)
+        ends the run after the current step; the frames so far are written as usual, with
+        ``interrupted: true`` in result.json.
     write : write the outputs (atomically) when true.
     echo : printing function (default :func:`print`).
 
@@ -520,7 +535,9 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
         ctx = build_context(case)
         every = output_every(case)
     st = case.data["stability"]
-    progress = (not quiet) and sys.stderr.isatty()
+    stop = case.run_options.get("stop")
+    # a tqdm bar on a terminal, else one line per 10 % or per minute on stderr (logs, batch jobs)
+    progress = Progress(n_steps(case), f"scene {case.name}", unit="step", quiet=quiet)
 
     caught: list[str] = []
     instability = None
@@ -530,7 +547,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
             traj = simulate(system, integrator, case.data["dt"], case.data["t_end"], ctx=ctx,
                             record_every=every, energy_growth_limit=st["energy_growth_limit"],
                             check_stability=st["check"], check_every=st["check_every"],
-                            progress=progress)
+                            progress=progress, stop=stop)
         except InstabilityError as exc:
             instability = exc
             traj = exc.partial

@@ -12,7 +12,7 @@ Every property named here appears in docs/scenes.md (a test checks it).
 
 from __future__ import annotations
 
-from ..specs import INTEGRATOR_SCHEMA, SOLVER_SCHEMA
+from ..specs import INTEGRATOR_SCHEMA, SOLVER_SCHEMA, LIMITS_SCHEMA
 
 _POS = {"type": "number", "exclusiveMinimum": 0}
 _NONNEG = {"type": "number", "minimum": 0}
@@ -144,6 +144,7 @@ SCENE_SCHEMA: dict = {
         "forces": _FORCES,
         "integrator": INTEGRATOR_SCHEMA,
         "linear_solver": {**SOLVER_SCHEMA, "default": {}},
+        "limits": LIMITS_SCHEMA,
         "dt": _TIME,
         "t_end": _TIME,
         "stability": {

@@ -1,0 +1,274 @@
+"""Fit the cost model's constants (femkit/cost/constants.json) from measured runs on this machine.
+
+Every run is :func:`femkit.cost.probe.measure_poisson` in a fresh process (BLAS on one thread):
+per stage the wall time and the peak resident memory above the start (VmHWM reset per stage).
+The fit follows the model in femkit/cost/poisson.py: per stage ``fixed + a * triangles`` with
+the fixed part the libraries loaded by then (gmsh, numba, pyamg, matplotlib: measured here by
+importing them), ``a`` the median over the runs with at least ``--min-fit`` triangles;
+iteration counts ``c n^p`` fitted in log-log over two sizes; gmsh's triangle count by least
+squares over every bundled geometry.
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/calibrate_cost.py              # print the constants
+    OPENBLAS_NUM_THREADS=1 python benchmarks/calibrate_cost.py --write ~/.config/femkit/cost.json
+    OPENBLAS_NUM_THREADS=1 python benchmarks/calibrate_cost.py --quick      # smaller runs (~1 min)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+from femkit.cost.constants import load_constants  # noqa: E402
+from femkit.cost.geometry import domain_measures  # noqa: E402
+from femkit.cost.poisson import fixed_bytes, solver_key  # noqa: E402
+from femkit.cost.probe import child_env, measure_poisson_subprocess  # noqa: E402
+
+
+def _import_cost(module: str) -> tuple[float, float]:
+    """(bytes, seconds) of importing ``module`` after femkit's baseline imports (fresh process)."""
+    code = ("import time, json; from femkit.cost.probe import preload; preload(); "
+            "from femkit.cost.memory import current_rss; a = current_rss(); t = time.perf_counter(); "
+            f"import {module}; t = time.perf_counter() - t; print(json.dumps([current_rss() - a, t]))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env=child_env())
+    b, s = json.loads(out.stdout.strip().splitlines()[-1])
+    return float(b), float(s)
+
+
+def fit_triangle_count(hs=(0.04, 0.02, 0.01)) -> dict:
+    """Least squares ``m = c_A A/h^2 + c_L L/h`` over the bundled geometries; boundary edges / (L/h)."""
+    from femkit.mesh import GEOMETRIES, boundary_edges_topological, generate
+
+    rows, rhs, bfrac = [], [], []
+    for g in GEOMETRIES.names():
+        area, length = domain_measures(g)
+        for h in hs:
+            mesh = generate(g, h)
+            rows.append([area / h ** 2, length / h])
+            rhs.append(mesh.n_triangles)
+            if g == "unit_square":
+                bfrac.append(len(boundary_edges_topological(mesh)) / (length / h))
+    coef, *_ = np.linalg.lstsq(np.array(rows), np.array(rhs, float), rcond=None)
+    pred = np.array(rows) @ coef
+    worst = float(np.max(np.abs(pred / np.array(rhs) - 1)))
+    print(f"triangle count: c_A {coef[0]:.4f}, c_L {coef[1]:.4f}; worst relative error {worst:.3f} "
+          f"over {len(rhs)} meshes (h = {hs})")
+    return {"triangles_per_area_h2": round(float(coef[0]), 4),
+            "triangles_per_length_h": round(float(coef[1]), 4),
+            "boundary_edges_per_length_h": round(float(np.median(bfrac)), 4)}
+
+
+def power_law(sizes, seconds, lo: float = 0.8, hi: float = 1.5) -> dict:
+    """Least-squares ``seconds = coefficient * size^exponent`` in log-log (exponent clipped)."""
+    x, y = np.log(np.asarray(sizes, float)), np.log(np.maximum(np.asarray(seconds, float), 1e-6))
+    p = float(np.clip(np.polyfit(x, y, 1)[0], lo, hi)) if len(set(sizes)) > 1 else 1.0
+    a = float(np.exp(np.median(y - p * x)))
+    return {"coefficient": a, "exponent": round(p, 3)}
+
+
+def _flags(run, c) -> dict:
+    key = solver_key(run["method"], run["preconditioner"])
+    return dict(gmsh=True, compiled=run["n_triangles"] >= 200_000, generated=run["n_generated"],
+                amg=key.startswith("pcg+amg"), png="png" in run["outputs"], constants=c)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--quick", action="store_true", help="smaller runs (largest 373k triangles)")
+    ap.add_argument("--min-fit", type=float, default=80_000, help="fit per-triangle constants on runs this big")
+    ap.add_argument("--write", help="write the fitted constants (complete JSON) to this file")
+    ap.add_argument("--runs", help="also dump the raw measurements (JSON) to this file")
+    ap.add_argument("--from-runs", help="fit from measurements dumped earlier with --runs (no runs)")
+    args = ap.parse_args(argv)
+
+    c = load_constants()
+    if args.from_runs:
+        with open(args.from_runs) as fh:
+            saved = json.load(fh)
+        c["mesh"].update(saved["mesh"])
+        imports, runs = saved["imports"], saved["runs"]
+    else:
+        c["mesh"].update(fit_triangle_count())
+        imports = {}
+        for mod, key in (("numba", "numba_import"), ("pyamg", "pyamg_import"),
+                         ("matplotlib.pyplot", "matplotlib_import")):
+            imports[key] = _import_cost(mod)
+            print(f"import {mod}: {imports[key][0] / 2**20:.1f} MiB, {imports[key][1]:.2f} s")
+        runs = measure(args)
+    for key, (nbytes, secs) in imports.items():
+        c["bytes"][key] = round(nbytes, -5)
+        if key in c["seconds"]:
+            c["seconds"][key] = round(secs, 3)
+    fit(c, runs, args.min_fit)
+    from femkit.cost.speed import speed_probe
+
+    c["reference"]["speed_probe_seconds"] = round(speed_probe(), 4)
+
+    def rnd(d):
+        return {k: (rnd(v) if isinstance(v, dict) else (float(f"{v:.4g}") if isinstance(v, float) else v))
+                for k, v in d.items()}
+
+    c = rnd(c)
+    text = json.dumps(c, indent=2)
+    print(text)
+    if args.write:
+        with open(os.path.expanduser(args.write), "w") as fh:
+            fh.write(text + "\n")
+        print(f"written to {args.write}")
+    if args.runs:
+        with open(args.runs, "w") as fh:
+            json.dump({"mesh": c["mesh"], "imports": imports, "runs": runs}, fh, indent=1)
+    return 0
+
+
+def measure(args) -> list[dict]:
+    """The calibration runs (each in a fresh process)."""
+    top = 3 if args.quick else 4
+    runs = []
+
+    def run(**kw):
+        r = measure_poisson_subprocess(**kw)
+        runs.append(r)
+        st = ", ".join(f"{k} {v['seconds']:.2f} s/{v['peak_bytes'] / 2**20:.0f} MiB" for k, v in r["stages"].items())
+        print(f"{kw}: {r['n_triangles']:,} triangles, {r['iterations']} it: {st}", flush=True)
+        return r
+
+    # gmsh: a small run for the fixed costs, larger ones for the cost per triangle
+    run(geometry="unit_square", h=0.05, refine=0)
+    for h in ((0.006,) if args.quick else (0.004, 0.0028)):
+        run(geometry="unit_square", h=h, refine=0)
+    # the pipeline with the default solver, up to ~1.5M triangles
+    for r in range(2, top + 1):
+        run(geometry="unit_square", h=0.02, refine=r)
+    # other solvers at two sizes (iteration growth)
+    for method, pc in (("pcg", "amg_rs"), ("pcg", "ic0"), ("pcg", "jacobi"), ("cg", None), ("direct", None)):
+        for r in (1, 2) if args.quick else (2, 3):
+            run(geometry="unit_square", h=0.02, refine=r, method=method, preconditioner=pc or "none",
+                errors=False)
+    for method in ("jacobi", "sd"):
+        for h in (0.1, 0.05):
+            run(geometry="unit_square", h=h, refine=0, method=method, preconditioner="none", errors=False,
+                outputs=())
+    for kind in ("xdmf", "png"):
+        run(geometry="unit_square", h=0.02, refine=2, outputs=(kind,), errors=False)
+    return runs
+
+
+def fit(c: dict, runs: list[dict], min_fit: float) -> None:
+    """Fill ``c`` (the constants) from the measured ``runs`` (see the module docstring)."""
+    s, b = c["seconds"], c["bytes"]
+    c["bytes"]["baseline"] = round(float(np.median([r["baseline_bytes"] for r in runs])), -5)
+    # gmsh: fixed (import + initialise) from the smallest run, per triangle from the
+    # generation-only runs
+    smalls = [r for r in runs if r["n_generated"] < 10_000]
+    s["gmsh_fixed"] = round(float(np.median([r["stages"]["mesh"]["seconds"] for r in smalls])), 3)
+    b["gmsh_import"] = round(float(np.median([r["stages"]["mesh"]["peak_bytes"] for r in smalls])), -5)
+    gm = [r for r in runs if r["refine"] == 0 and r["n_generated"] >= min_fit]
+    # gmsh's time grows faster than linearly: seconds = fixed + a m^p
+    s["gmsh"] = power_law([r["n_generated"] for r in gm],
+                          [r["stages"]["mesh"]["seconds"] - s["gmsh_fixed"] for r in gm], hi=2.0)
+    b["gmsh_per_triangle"] = float(np.median([(r["stages"]["mesh"]["peak_bytes"] - b["gmsh_import"]) / r["n_generated"] for r in gm]))
+    b["gmsh_retained"] = 0.0
+
+    big = [r for r in runs if r["n_triangles"] >= min_fit]
+
+    def per_tri(stage, sel=None, what="peak_bytes"):
+        vals = []
+        for r in (sel if sel is not None else big):
+            if stage not in r["stages"]:
+                continue
+            v = r["stages"][stage][what]
+            if what == "peak_bytes":
+                v -= fixed_bytes(stage, **_flags(r, c))
+            vals.append(v / r["n_triangles"])
+        return float(np.median(vals))
+
+    refined = [r for r in big if r["refine"] > 0]  # gmsh's own memory is small in these
+    for st in ("refine", "quality", "boundary", "errors", "estimate"):
+        b[f"{st}_per_triangle"] = round(per_tri(st, refined), 1)
+    b["assembly_numpy_per_triangle"] = round(per_tri("assembly", [r for r in refined if r["n_triangles"] < 200_000]), 1)
+    b["assembly_per_triangle"] = round(per_tri("assembly", [r for r in refined if r["n_triangles"] >= 200_000]), 1)
+    # what gmsh leaves resident after a large generation (seen in the next stage, quality)
+    b["gmsh_retained"] = round(float(np.median([
+        (r["stages"]["quality"]["peak_bytes"] - fixed_bytes("quality", **_flags(r, c))
+         - b["quality_per_triangle"] * r["n_triangles"]) / (b["gmsh_per_triangle"] * r["n_generated"])
+        for r in gm])), 3)
+    def time_law(stage, sel, fixed=0.0):
+        sel = [r for r in sel if stage in r["stages"]]
+        return power_law([r["n_triangles"] for r in sel], [r["stages"][stage]["seconds"] - fixed for r in sel])
+
+    for st in ("refine", "quality", "boundary", "errors", "estimate"):
+        s[st] = time_law(st, refined)
+    vtu_runs = [r for r in big if r["outputs"] == ["vtu"]]
+    b["output_per_triangle"] = round(per_tri("output", [r for r in vtu_runs if r["refine"] > 0]), 1)
+    for kind in ("vtu", "xdmf", "png"):
+        sel = [r for r in big if r["outputs"] == [kind]]
+        if kind == "png":  # matplotlib's import is paid once per run
+            s["png_fixed"] = c["seconds"]["matplotlib_import"] if "matplotlib_import" in c["seconds"] else s["png_fixed"]
+        s[kind] = time_law("output", sel, s["png_fixed"] if kind == "png" else 0.0)
+        if kind != "png":
+            c["output_bytes"][f"{kind}_per_triangle"] = round(float(np.median([r["output_bytes"] / r["n_triangles"] for r in sel])), 2)
+    c["output_bytes"]["png"] = round(float(np.median([r["output_bytes"] for r in big if r["outputs"] == ["png"]])), -3)
+    # assembly: numpy path below 200k triangles, compiled path (fixed load + per triangle) above
+    s["assembly_numpy"] = time_law("assembly", [r for r in big if r["n_triangles"] < 200_000])
+    comp = sorted({r["n_triangles"]: r for r in big if r["n_triangles"] >= 200_000}.values(), key=lambda r: r["n_triangles"])
+    if len(comp) >= 2:
+        (m1, t1), (m2, t2) = [(r["n_triangles"], r["stages"]["assembly"]["seconds"]) for r in comp[-2:]]
+        slope = (t2 - t1) / (m2 - m1)
+        s["assembly"] = {"coefficient": slope, "exponent": 1.0}
+        s["numba_load"] = round(max(t1 - slope * m1, 0.0), 3)
+    # solvers
+    by_key: dict[str, list] = {}
+    for r in runs:
+        by_key.setdefault(solver_key(r["method"], r["preconditioner"]), []).append(r)
+    for key, rs in by_key.items():
+        rs = sorted(rs, key=lambda r: r["dofs"])
+        sel = [r for r in rs if r["n_triangles"] >= min_fit] or rs[-1:]
+        small_only = rs[-1]["n_triangles"] < min_fit  # memory too small to fit: set below
+        b["solve_per_triangle"][key] = None if small_only else round(float(np.median(
+            [(max(r["stages"]["solve"]["peak_bytes"] - fixed_bytes("solve", **_flags(r, c)), 0))
+             / r["n_triangles"] for r in sel])), 1)
+        if key == "direct":
+            # what is alive is the boundary stage's state; the LU (factors + SuperLU's work
+            # space) on top of it grows like a power of the unknowns
+            b["solve_per_triangle"][key] = b["boundary_per_triangle"]
+            b["direct"] = power_law([r["dofs"] for r in rs],
+                                    [r["stages"]["solve"]["peak_bytes"] - r["stages"]["boundary"]["peak_bytes"]
+                                     for r in rs], lo=1.0, hi=2.5)
+            (n1, t1), (n2, t2) = [(r["dofs"], r["setup_seconds"]) for r in rs[-2:]]
+            p = math.log(t2 / t1) / math.log(n2 / n1)
+            s["direct_exponent"] = round(p, 3)
+            s["direct_coefficient"] = t2 / n2 ** p
+            (n1, f1), (n2, f2) = [(r["dofs"], r["fill"]) for r in rs[-2:]]
+            c["fill"]["direct_exponent"] = round(math.log(f2 / f1) / math.log(n2 / n1), 3)
+            c["fill"]["direct_coefficient"] = f2 / n2 ** c["fill"]["direct_exponent"]
+            s["direct_solve_per_fill"] = float(np.median([r["solve_seconds"] / r["fill"] for r in rs]))
+            continue
+        r1, r2 = rs[0], rs[-1]
+        p = math.log(r2["iterations"] / r1["iterations"]) / math.log(r2["dofs"] / r1["dofs"])
+        p = min(max(p, 0.0), 1.2)
+        c["iterations"][key] = {"coefficient": round(r2["iterations"] / r2["dofs"] ** p, 4), "exponent": round(p, 3)}
+        s["iteration_per_nonzero"][key] = float(np.median([r["solve_seconds"] / (r["iterations"] * r["nnz"]) for r in sel]))
+        pc = key.split("+", 1)[1] if "+" in key else "none"
+        if pc in s["setup_per_nonzero"]:
+            s["setup_per_nonzero"][pc] = float(np.median([r["setup_seconds"] / r["nnz"] for r in sel]))
+    for key, v in b["solve_per_triangle"].items():
+        if v is None:  # jacobi / sd hold the same vectors as cg
+            b["solve_per_triangle"][key] = b["solve_per_triangle"]["cg"]
+    if "cg" in c["iterations"]:
+        c["iterations"]["pcg+none"] = dict(c["iterations"]["cg"])
+        s["iteration_per_nonzero"]["pcg+none"] = s["iteration_per_nonzero"]["cg"]
+        b["solve_per_triangle"]["pcg+none"] = b["solve_per_triangle"]["cg"]
+
+
+if __name__ == "__main__":
+    sys.exit(main())

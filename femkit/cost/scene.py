@@ -1,0 +1,148 @@
+"""Cost model of a mass-spring scene: steps, frames, memory, output and time.
+
+* steps ``= round((t_end - t0) / dt)``; frames recorded ``= floor(steps / every) + 1`` plus the
+  last step (what :func:`femkit.dynamics.simulate.simulate` keeps in memory and the scene writes);
+* memory: the recorded trajectory (positions, velocities: ``2 d`` floats per node and frame,
+  plus energies and momentum), the system (``bytes.system_per_spring``) and, for implicit
+  integrators, the matrices and their factorisation (``scene.implicit_bytes_per_spring``);
+* output: per frame ``frame_file_bytes_fixed`` plus ``..._per_node`` and ``..._per_spring``
+  (``.vtu`` frames or XDMF), ``energy.csv`` per frame, a GIF of at most 60 frames (fitted on
+  the bundled scenes: rope, soft disk, hanging cloth, Liu's cloth, within 17 %);
+* time: ``steps x`` the seconds of one step, measured on a first batch of steps
+  (:func:`measure_step_seconds`) when given, else the calibrated per-spring constant.
+
+>>> p = plan_scene(n_nodes=100, n_springs=300, dim=3, dt=1e-9, t_end=2.0, frames=50)
+>>> p.steps, p.sizes["frames"]
+(2000000000, 51)
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+from ..errors import InputError
+from .constants import load_constants
+from .plan import Plan, Stage, format_seconds, round_down, round_up
+
+__all__ = ["plan_scene", "measure_step_seconds", "record_every"]
+
+_FLOAT = 8
+
+
+def record_every(steps: int, *, frames: int | None = None, every: int | None = None,
+                 interval: float | None = None, dt: float | None = None) -> int:
+    """Steps between recorded frames (``every``, ``round(interval / dt)`` or ``ceil(steps / frames)``)."""
+    if every is not None:
+        return max(int(every), 1)
+    if interval is not None and dt:
+        return max(1, int(round(interval / dt)))
+    if frames:
+        return max(1, math.ceil(steps / int(frames)))
+    return 1
+
+
+def plan_scene(*, n_nodes: int, n_springs: int, dim: int, dt: float, t_end: float,
+               t0: float = 0.0, frames: int | None = None, every: int | None = None,
+               interval: float | None = None, outputs=("vtu", "energy_csv"),
+               method: str = "", implicit: bool = False, step_seconds: float | None = None,
+               name: str = "scene", constants: dict | None = None, speed: float = 1.0) -> Plan:
+    """Predict a scene's cost (see the module docstring).
+
+    Parameters
+    ----------
+    n_nodes, n_springs, dim : the system's size
+    dt, t_end, t0 : the time grid
+    frames, every, interval : output cadence (as in scene files)
+    outputs : any of ``vtu``, ``xdmf``, ``energy_csv``, ``png``, ``gif``
+    method, implicit : the integrator (name for the title; implicit ones cost more per step)
+    step_seconds : measured seconds per step (first batch); ``None`` = calibrated constant
+    speed : seconds multiplier of this machine (used only without ``step_seconds``)
+
+    Raises
+    ------
+    InputError
+        Non-positive or non-finite ``dt``, ``t_end < t0``.
+    """
+    c = constants or load_constants()
+    sc = c["scene"]
+    dt, t_end = float(dt), float(t_end)
+    if not (math.isfinite(dt) and dt > 0):
+        raise InputError(f"dt must be a positive finite number, got {dt}")
+    if not (math.isfinite(t_end) and t_end >= t0):
+        raise InputError(f"t_end must be finite and >= t0 = {t0}, got {t_end}")
+    n, s, d = int(n_nodes), int(n_springs), int(dim)
+    steps = int(round((t_end - t0) / dt))
+    every_n = record_every(steps, frames=frames, every=every, interval=interval, dt=dt)
+    recorded = steps // every_n + 1 + (1 if steps % every_n else 0)
+    frame_mem = (2 * d * n + 5 + d) * _FLOAT
+    measured = step_seconds is not None
+    per_step = (float(step_seconds) if measured else
+                speed * (sc["step_seconds_fixed"] + (sc["implicit_step_seconds_per_spring"] if implicit
+                                                     else sc["step_seconds_per_spring"]) * s))
+    sys_bytes = (sc["system_bytes_per_spring"] + (sc["implicit_bytes_per_spring"] if implicit else 0.0)) * s
+    traj_bytes = frame_mem * recorded
+    stages = [Stage("simulate", per_step * steps, sys_bytes + traj_bytes,
+                    detail=f"{steps:,} steps of {method or 'the integrator'}, "
+                    f"{format_seconds(per_step)} per step ({'measured' if measured else 'model'})")]
+    outs = tuple(outputs or ())
+    unknown = sorted(set(outs) - {"vtu", "xdmf", "energy_csv", "png", "gif"})
+    if unknown:
+        raise InputError(f"unknown scene output(s) {unknown}; valid: energy_csv, gif, png, vtu, xdmf")
+    frame_file = (sc["frame_file_bytes_fixed"] + sc["frame_file_bytes_per_node"] * n
+                  + sc["frame_file_bytes_per_spring"] * s)
+    out_bytes = 0.0
+    if "vtu" in outs:
+        out_bytes += frame_file * recorded
+    if "xdmf" in outs:
+        out_bytes += frame_file * recorded
+    if "energy_csv" in outs:
+        out_bytes += sc["energy_csv_bytes_per_frame"] * recorded
+    if "gif" in outs:
+        out_bytes += sc["gif_bytes_per_frame"] * min(recorded, 60)
+    if "png" in outs:
+        out_bytes += c["output_bytes"]["png"]
+    if outs:
+        secs = sc["frame_write_seconds_per_byte"] * out_bytes * speed
+        stages.append(Stage("output", secs, sys_bytes + traj_bytes + frame_file, out_bytes,
+                            detail=f"{recorded:,} frames: {', '.join(outs)}"))
+    sizes = {"nodes": n, "springs": s, "steps": steps, "frames": recorded}
+    assumptions = [f"steps = (t_end - t0) / dt = {t_end - t0:g} / {dt:g}; a frame every {every_n} steps",
+                   "time per step " + ("measured on a first batch of steps" if measured else
+                                       "from the calibrated per-spring constant (femkit/cost/constants.json)")]
+    plan = Plan("scene", f"{name}: {method or 'integrator'}, dt={dt:g}, t_end={t_end:g}", sizes, stages,
+                c["bytes"]["baseline"], assumptions)
+
+    def suggest(what: str, limit: float) -> str:
+        if what == "steps":
+            return (f"dt >= {round_up(dt * steps / limit)} or t_end <= {round_down(t0 + limit * dt)}")
+        if what == "time":
+            k = limit / max(plan.seconds, 1e-300)
+            return f"dt >= {round_up(dt / k)} or t_end <= {round_down(t0 + (t_end - t0) * k)}"
+        if what in ("output", "memory"):
+            return "fewer frames (output.frames / output.every) or fewer output kinds"
+        return ""
+
+    plan.suggest = suggest
+    return plan
+
+
+def measure_step_seconds(system, integrator, dt: float, *, ctx=None, batch: int = 20,
+                         max_seconds: float = 1.0, **integrator_options) -> float:
+    """Seconds per step of ``integrator`` on ``system``, timed on a first batch of steps.
+
+    One warm-up step first (imports, symbolic factorisations, caches of ``ctx``: paid once per
+    run, not per step), then up to ``batch`` steps (stopping early after ``max_seconds``) from
+    the system's initial state without stability checks.
+    """
+    from ..dynamics.integrators import StepContext
+    from ..dynamics.simulate import simulate
+
+    ctx = ctx if ctx is not None else StepContext()
+    quiet = dict(check_stability=False, energy_growth_limit=math.inf, **integrator_options)
+    simulate(system, integrator, dt, dt, ctx=ctx, **quiet)
+    budget_end = time.perf_counter() + float(max_seconds)
+    t0 = time.perf_counter()
+    traj = simulate(system, integrator, dt, batch * dt, ctx=ctx, record_every=batch,
+                    stop=lambda: time.perf_counter() > budget_end, **quiet)
+    return (time.perf_counter() - t0) / max(traj.steps, 1)

@@ -1,0 +1,138 @@
+"""Stop cleanly on SIGINT / SIGTERM: a flag the long loops check between units of work.
+
+:func:`stop_on_signals` installs handlers that only set a :class:`StopFlag`; a loop (the time
+steps of :func:`femkit.dynamics.simulate.simulate`, the jobs of a study) checks the flag
+between steps, stops, and returns what it computed so far, which the caller writes (frames,
+energy, ``result.json`` with ``interrupted: true``) before exiting with :func:`exit_code`
+(``128 + signal number``: 130 for SIGINT, 143 for SIGTERM). A second SIGINT while the flag is
+already set raises :class:`KeyboardInterrupt` at once, for a user who does not want to wait.
+
+An iterative linear solve stops the same way through its per-iteration callback
+(:func:`stopping_callback`): the callback raises :class:`Interrupted` carrying the last
+iterate, which the caller may write as a partial (not converged) result. A direct
+factorisation runs in compiled code and cannot be stopped midway: the flag is seen when it
+returns.
+
+Handlers are installed only in the main thread (Python's rule); elsewhere the flag works but
+never fires by itself. The previous handlers are restored on exit.
+
+>>> flag = StopFlag()
+>>> bool(flag), flag.request(15), bool(flag), flag.name, exit_code(flag)
+(False, None, True, 'SIGTERM', 143)
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from typing import Iterator
+
+__all__ = ["StopFlag", "stop_on_signals", "exit_code", "Interrupted", "stopping_callback",
+           "active_flag"]
+
+
+class StopFlag:
+    """Set when a stop was requested; ``signum`` says by which signal (``None``: not set)."""
+
+    def __init__(self) -> None:
+        self.signum: int | None = None
+
+    def request(self, signum: int = signal.SIGINT) -> None:
+        """Ask the running loop to stop after its current unit of work."""
+        self.signum = int(signum)
+
+    def __bool__(self) -> bool:
+        return self.signum is not None
+
+    def __call__(self) -> bool:  # usable as a ``stop()`` callable
+        return self.signum is not None
+
+    @property
+    def name(self) -> str | None:
+        """``"SIGINT"``, ``"SIGTERM"`` ... (``None`` when not set)."""
+        if self.signum is None:
+            return None
+        try:
+            return signal.Signals(self.signum).name
+        except ValueError:
+            return f"signal {self.signum}"
+
+
+def exit_code(flag: StopFlag) -> int:
+    """The shell's exit code for a run stopped by ``flag``'s signal: ``128 + signum``."""
+    return 128 + int(flag.signum or signal.SIGINT)
+
+
+_ACTIVE: list[StopFlag] = []
+
+
+def active_flag() -> StopFlag | None:
+    """The flag of the innermost :func:`stop_on_signals` block now running (None outside any):
+    how loops deep inside a run (a study's sweep) see a stop request without it being passed."""
+    return _ACTIVE[-1] if _ACTIVE else None
+
+
+@contextlib.contextmanager
+def stop_on_signals(signals=(signal.SIGINT, signal.SIGTERM)) -> Iterator[StopFlag]:
+    """Within the block, the given signals set the yielded :class:`StopFlag` instead of killing."""
+    flag = StopFlag()
+    if threading.current_thread() is not threading.main_thread():
+        yield flag
+        return
+    _ACTIVE.append(flag)
+
+    def handler(signum, frame):
+        if flag and signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        flag.request(signum)
+
+    previous = {}
+    for s in signals:
+        previous[s] = signal.signal(s, handler)
+    try:
+        yield flag
+    finally:
+        _ACTIVE.remove(flag)
+        for s, h in previous.items():
+            signal.signal(s, h)
+
+
+class Interrupted(Exception):
+    """A run stopped on request; ``x`` is the last iterate (iterative solves) or ``None``,
+    ``iteration`` how many iterations were done, ``stage`` where a staged run stopped,
+    ``flag`` the :class:`StopFlag` that fired."""
+
+    def __init__(self, flag: StopFlag, x=None, iteration: int = 0, stage: str = "", where: str = ""):
+        self.flag, self.x, self.iteration, self.stage = flag, x, iteration, stage
+        where = where or (f"after the {stage} stage" if stage else f"at iteration {iteration}")
+        super().__init__(f"interrupted by {flag.name or 'a stop request'} {where}")
+
+
+def stopping_callback(flag: StopFlag, callback=None):
+    """A solver callback that raises :class:`Interrupted` (with the iterate) once ``flag`` is set.
+
+    >>> import numpy as np, scipy.sparse as sp
+    >>> from femkit.solvers import solve
+    >>> A = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(50, 50), format="csr")
+    >>> flag = StopFlag()
+    >>> def stop_at_5(x, count=[0]):
+    ...     count[0] += 1
+    ...     if count[0] == 5:
+    ...         flag.request(15)
+    >>> try:
+    ...     solve(A, np.ones(50), method="cg", callback=stopping_callback(flag, stop_at_5))
+    ... except Interrupted as exc:
+    ...     print(exc, exc.x.shape)
+    interrupted by SIGTERM at iteration 5 (50,)
+    """
+    count = [0]
+
+    def cb(xk):
+        count[0] += 1
+        if callback is not None:
+            callback(xk)
+        if flag:
+            raise Interrupted(flag, xk.copy(), count[0])
+
+    return cb

@@ -1,0 +1,59 @@
+"""Progress lines without a terminal: one per 10 % or per minute, with elapsed and remaining time."""
+
+import io
+
+from femkit.progress import Progress, progress
+
+
+class FakeClock:
+    def __init__(self):
+        self.t = 0.0
+
+    def __call__(self):
+        return self.t
+
+
+def test_ten_lines_for_a_full_run_with_remaining_time():
+    clock = FakeClock()
+    out = io.StringIO()
+    bar = Progress(2000, "scene cloth", mode="lines", stream=out, clock=clock)
+    for _ in range(2000):
+        clock.t += 0.01  # 0.01 s per step: 20 s in all
+        bar.update()
+    bar.close()
+    lines = out.getvalue().splitlines()
+    assert len(lines) == 10
+    assert lines[0] == "scene cloth: 10% (200/2000 steps), elapsed 2 s, remaining ~18 s"
+    assert lines[-1] == "scene cloth: 100% (2000/2000 steps), elapsed 20 s"
+
+
+def test_a_line_per_minute_when_ten_percent_takes_longer():
+    clock = FakeClock()
+    out = io.StringIO()
+    bar = Progress(100_000, "slow", mode="lines", stream=out, clock=clock)
+    for _ in range(2000):  # 2 % of the work in 3.3 min: three minute marks, no 10 % mark
+        clock.t += 0.1
+        bar.update()
+    lines = out.getvalue().splitlines()
+    assert len(lines) == 3
+    assert lines[0] == "slow: 1% (600/100000 steps), elapsed 1 min, remaining ~2.8 h"
+
+
+def test_quiet_prints_nothing_and_interruption_is_reported():
+    out = io.StringIO()
+    bar = Progress(10, "x", quiet=True, stream=out)
+    bar.update(5)
+    bar.close("SIGTERM")
+    assert out.getvalue() == ""
+    out = io.StringIO()
+    bar = Progress(10, "x", mode="auto", stream=out)  # StringIO is not a terminal: lines
+    assert bar.mode == "lines"
+    bar.update(5)
+    bar.close("SIGTERM")
+    assert out.getvalue().splitlines()[-1].endswith("interrupted by SIGTERM")
+
+
+def test_progress_iterator():
+    out = io.StringIO()
+    assert list(progress(range(20), desc="study", stream=out, mode="lines")) == list(range(20))
+    assert out.getvalue().count("\n") == 10 and "(20/20 jobs)" in out.getvalue()
