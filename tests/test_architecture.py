@@ -109,3 +109,15 @@ def test_the_checker_sees_lazy_and_relative_imports():
     assert _forbidden(names, APPLICATION) == ["femkit.case.load", "femkit.case.load.load_case"]
     assert IMPORT_STRING.match("femkit.dynamics.scene:run_scene") is None
     assert IMPORT_STRING.match("femkit.case.scene.run:run_scene")
+
+
+def test_sources_cite_publications_not_documents_outside_the_repository():
+    """The repository stands alone: no module or test refers to the lecture source documents kept
+    outside it, by their name or by ``../shared`` (docs/methods.md lists the real sources)."""
+    root = PKG.parent
+    words = ("se" + "ed", "../" + "shared")
+    bad = [f"{p.relative_to(root)}:{i + 1}"
+           for d in (PKG, root / "tests") for p in d.rglob("*.py")
+           for i, line in enumerate(p.read_text(encoding="utf-8").splitlines())
+           if any(w in line for w in words)]
+    assert not bad

@@ -70,7 +70,7 @@ ESTIMATE_DECAY = 0.9
 MAX_LEVEL_CYCLES = 20
 
 
-def _contraction(mg, *, max_size: int = 20000, steps: int = 6, seed: int = 0) -> float:
+def _contraction(mg, *, max_size: int = 20000, steps: int = 6, draw: int = 0) -> float:
     """Energy-norm contraction of the V-cycle error propagator ``I - M A`` on the finest level
     with at most ``max_size`` unknowns (level >= 1), by ``steps`` power steps from a random start."""
     lvl = 0
@@ -80,7 +80,7 @@ def _contraction(mg, *, max_size: int = 20000, steps: int = 6, seed: int = 0) ->
     if lvl == 0:
         return 0.0
     A = mg.levels[lvl].A
-    e = np.random.default_rng(seed).standard_normal(A.shape[0])
+    e = np.random.default_rng(draw).standard_normal(A.shape[0])
     rho = 0.0
     for _ in range(steps):
         Ae = A @ e
