@@ -113,7 +113,7 @@ def test_the_checker_sees_lazy_and_relative_imports():
 
 def test_sources_cite_publications_not_documents_outside_the_repository():
     """The repository stands alone: no module or test refers to the lecture source documents kept
-    outside it, by their name or by ``../shared`` (docs/methods.md lists the real sources)."""
+    outside it, by their name or by their relative path (docs/methods.md lists the real sources)."""
     root = PKG.parent
     words = ("se" + "ed", "../" + "shared")
     bad = [f"{p.relative_to(root)}:{i + 1}"
