@@ -1,6 +1,7 @@
 """Solver and preconditioner registries, and :func:`solve`, the high-level entry.
 
-``SOLVERS``: ``jacobi``, ``sd``, ``cg``, ``pcg``, ``direct``. ``PRECONDITIONERS``: ``none``,
+``SOLVERS``: ``jacobi``, ``sd``, ``cg``, ``pcg``, ``direct`` (SuperLU), ``cholesky`` (CHOLMOD,
+SPD only). ``PRECONDITIONERS``: ``none``,
 ``jacobi``, ``ic0``, ``amg_sa``, ``amg_rs`` and ``amg`` (= ``amg_sa``). Preconditioner
 factories are ``build(A, **opts) -> Preconditioner`` (or ``None`` for ``none``); importing
 this module imports neither pyamg nor numba.
@@ -15,6 +16,7 @@ from ..errors import InputError
 from ..registry import Registry
 from .cg import cg
 from .checks import check_options
+from .cholesky import cholesky
 from .direct import direct
 from .jacobi import jacobi
 from .pcg import pcg
@@ -32,6 +34,7 @@ SOLVERS.register("sd", steepest_descent)
 SOLVERS.register("cg", cg)
 SOLVERS.register("pcg", pcg)
 SOLVERS.register("direct", direct)
+SOLVERS.register("cholesky", cholesky)
 
 
 def _no_preconditioner(A, **opts):
@@ -141,8 +144,7 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     elapsed = time.perf_counter() - t0
     res.method = method
     res.preconditioner = pc_name
-    if method == "direct":
-        res.setup_time = res.setup_time
+    if method in ("direct", "cholesky"):
         res.solve_time = elapsed - res.setup_time
     else:
         res.setup_time = setup

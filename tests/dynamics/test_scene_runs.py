@@ -174,4 +174,6 @@ def test_cloths_keep_pins_and_fall(runs):
     liu = json.loads((runs["liu_cloth"][1] / "result.json").read_text())
     # the (M + h^2 L) factorisation is built once and reused for every step
     assert liu["linear_solver"]["factorizations"] == 1
-    assert liu["integrator"]["options"] == {"iterations": 10, "tol": None}
+    assert liu["integrator"]["options"] == {"iterations": 10, "tol": None, "chebyshev": False,
+                                            "chebyshev_rho": None, "chebyshev_delay": 2,
+                                            "chebyshev_warmup": 10}

@@ -196,9 +196,9 @@ def test_linear_operator_matrix_free(poisson):
 
 def test_names_and_registry_errors(poisson):
     A, b = poisson
-    assert set(SOLVERS.names()) == {"jacobi", "sd", "cg", "pcg", "direct"}
+    assert set(SOLVERS.names()) == {"jacobi", "sd", "cg", "pcg", "direct", "cholesky"}
     assert set(PRECONDITIONERS.names()) == {"none", "jacobi", "ic0", "amg", "amg_sa", "amg_rs"}
-    with pytest.raises(UnknownNameError, match="valid solvers: cg, direct, jacobi, pcg, sd"):
+    with pytest.raises(UnknownNameError, match="valid solvers: cg, cholesky, direct, jacobi, pcg, sd"):
         solve(A, b, method="gmres")
     with pytest.raises(UnknownNameError, match="amg_rs"):
         solve(A, b, method="pcg", preconditioner="ilu")

@@ -47,6 +47,8 @@ __all__ = [
     "Integrator",
     "solve_linear",
     "factorize_linear",
+    "uses_cholesky",
+    "solve_cholesky",
     "restrict",
     "box_length",
     "check_iteration_options",
@@ -374,13 +376,19 @@ def _solve_direct_reusing_ordering(A, b: np.ndarray, ctx: StepContext,
             ctx.cache[keep] = _ReusedFactor(factor, time.perf_counter() - t_factor)
         else:
             ctx.cache.pop(keep, None)
+    return _checked_solve(factor, A, b, bnorm, ctx, "direct")
+
+
+def _checked_solve(factor, A, b: np.ndarray, bnorm: float, ctx: StepContext, name: str) -> np.ndarray:
+    """``factor.solve(b)`` (timed as ``time_solve``) under the direct solvers' residual rule
+    ``||b - A x|| <= max(rtol ||b||, atol)``; :class:`~femkit.errors.SolverError` otherwise."""
     t0 = time.perf_counter()
     x = factor.solve(b)
     _add_time(ctx, "time_solve", time.perf_counter() - t0)
     res = float(np.linalg.norm(b - A @ x))
     if not (np.isfinite(res) and res <= max(ctx.rtol * bnorm, ctx.atol)):
         raise SolverError(
-            f"linear solve (direct) missed the residual rule: relative residual {res / bnorm:.3e} "
+            f"linear solve ({name}) missed the residual rule: relative residual {res / bnorm:.3e} "
             f"> rtol {ctx.rtol:.1e}; the matrix is numerically singular or very ill-conditioned")
     return x
 
@@ -388,12 +396,61 @@ def _solve_direct_reusing_ordering(A, b: np.ndarray, ctx: StepContext,
 def factorize_linear(A, ctx: StepContext):
     """Factorise a sparse SPD matrix once for repeated solves; returns an object with ``.solve(b)``.
 
-    ``b`` may be ``(n,)`` or ``(n, k)`` (several right-hand sides in one call).
+    ``b`` may be ``(n,)`` or ``(n, k)`` (several right-hand sides in one call). With
+    ``ctx.solver == "cholesky"`` the factor is CHOLMOD's (:func:`femkit.solvers.factorize_spd`;
+    :class:`~femkit.errors.NotSPDError` if ``A`` is not SPD), otherwise SuperLU's.
     """
     from ...solvers import factorize
 
     ctx.count("factorizations")
+    if ctx.solver == "cholesky":
+        from ...solvers import factorize_spd
+
+        return factorize_spd(A)
     return factorize(A)
+
+
+def uses_cholesky(ctx: StepContext, integrator) -> bool:
+    """Whether a step takes the compiled path: ``ctx.solver == "cholesky"`` (assembled, not
+    matrix-free). ``reuse_factorization`` (PCG preconditioned by an older SuperLU factor) is a
+    ``direct``-only option: with ``cholesky`` it raises :class:`~femkit.errors.InputError`."""
+    if ctx.solver != "cholesky" or getattr(integrator, "matrix_free", False):
+        return False
+    if getattr(integrator, "reuse_factorization", False):
+        raise InputError(f"{integrator.name}: reuse_factorization applies to the 'direct' solver; "
+                         "'cholesky' refactorises on the cached symbolic analysis instead")
+    return True
+
+
+def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "cholesky_factor") -> np.ndarray:
+    """Solve ``A x = b`` for an SPD ``A`` assembled into the fixed ``pattern`` (a
+    :class:`~femkit.dynamics.kernels.assembly.FreePattern`, the same object every step): the
+    factor kept in ``ctx.cache[key]`` is refactorised in place on its symbolic analysis while
+    the pattern object is the same (no hashing, no comparison), and
+    factorised afresh (analysis from the pattern cache of :mod:`femkit.solvers.cholesky`)
+    otherwise. Counts ``factorizations`` and ``symbolic_reuses``, times ``time_factorization``
+    and ``time_solve``, and applies the direct solver's residual rule
+    ``||b - A x|| <= max(rtol ||b||, atol)`` (:class:`~femkit.errors.SolverError` otherwise).
+    """
+    from ...solvers import factorize_spd
+
+    ctx.count("linear_solves")
+    b = np.asarray(b, dtype=float)
+    bnorm = float(np.linalg.norm(b))
+    if bnorm == 0.0:
+        return np.zeros_like(b)
+    kept = ctx.cache.get(key)
+    t0 = time.perf_counter()
+    if kept is not None and kept[0] is pattern:
+        factor = kept[1].refactor(A)
+    else:
+        factor = factorize_spd(A, check_symmetry=False)
+        ctx.cache[key] = (pattern, factor)
+    ctx.count("factorizations")
+    if factor.info["symbolic_reused"]:
+        ctx.count("symbolic_reuses")
+    _add_time(ctx, "time_factorization", time.perf_counter() - t0)
+    return _checked_solve(factor, A, b, bnorm, ctx, "cholesky")
 
 
 # ----------------------------------------------------------------------------- matrix-free

@@ -35,6 +35,11 @@ blocks, :meth:`~femkit.dynamics.system.MassSpringSystem.stiffness_diagonal`); ot
 raise :class:`~femkit.errors.InputError` when the run starts. The iterates are those of the
 assembled path to the linear solver's tolerance.
 
+With the ``cholesky`` solver each Newton matrix is written by one compiled pass over the springs
+into the free-dof pattern cached for the run (the clamp applied in the same pass; ``C`` assembled
+once per step on the same pattern) and refactorised by CHOLMOD on the symbolic analysis of the
+first iteration (:func:`.base.solve_cholesky`).
+
 First order; unconditionally stable.
 """
 
@@ -47,7 +52,7 @@ import numpy as np
 from ...errors import InputError
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
                    check_matrix_free_options, free_operator, note_unconverged, restrict,
-                   solve_linear)
+                   solve_cholesky, solve_linear, uses_cholesky)
 from .registry import INTEGRATORS
 
 
@@ -116,9 +121,23 @@ class NewtonImplicitEuler(Integrator):
         xn = state.x.reshape(-1)
         M = system.mass_matrix()
         m = M.diagonal()
+        compiled = uses_cholesky(ctx, self)
         if self.matrix_free:
             C = self.damping_operator(system, state.x)
             c_apply = C[0]
+        elif compiled:  # C on the cached pattern, the springs in one compiled pass
+            from ..kernels.assembly import assemble_with_forces, free_pattern
+
+            pat = free_pattern(system, ctx.cache)
+            zero_v = np.zeros(shape)
+            c_data = assemble_with_forces(pat, system, state.x, zero_v, state.t, diagonal=rm * m,
+                                          kcoef=rk, dcoef=1.0, fix=None)[0]
+            Cf = pat.matrix(c_data)
+
+            def c_apply(e):
+                out = np.zeros_like(e)
+                out[free] = Cf @ e[free]
+                return out
         else:
             C = system.damping_matrix(state.x)
             if rm != 0.0:
@@ -145,6 +164,11 @@ class NewtonImplicitEuler(Integrator):
             if self.matrix_free:
                 op, diag = self.newton_operator(system, x.reshape(shape), h, C)
                 dx[free] = solve_linear(op, -grad[free], ctx, diagonal=diag)
+            elif compiled:
+                data = assemble_with_forces(pat, system, x.reshape(shape), zero_v, state.t,
+                                            diagonal=m, kcoef=h * h, dcoef=0.0, fix=self.fix)[0]
+                data += h * c_data
+                dx[free] = solve_cholesky(pat.matrix(data), -grad[free], ctx, pat)
             else:
                 H = M + (h * h) * system.stiffness_matrix(x.reshape(shape), fix=self.fix) + h * C
                 dx[free] = solve_linear(restrict(H, free), -grad[free], ctx, system=system,
