@@ -5,7 +5,7 @@ CHOLMOD (Chen, Davis, Hager, Rajamanickam 2008, "Algorithm 887: CHOLMOD, superno
 Cholesky factorization and update/downdate", ACM TOMS 35(3)) through scikit-sparse. A
 factorisation has two parts:
 
-* the *symbolic analysis*: a fill-reducing ordering (METIS nested dissection, AMD ...), the
+* the *symbolic analysis*: a fill-reducing ordering (AMD, METIS nested dissection ...), the
   elimination tree, the supernodes and the pattern of ``L``; it depends only on the sparsity
   pattern of ``A``;
 * the *numeric factorisation* ``P A P^T = L L^T`` on that structure, dense BLAS-3 kernels on
@@ -58,9 +58,10 @@ __all__ = ["CholeskyFactor", "cholesky", "factorize_spd", "clear_symbolic_cache"
 #: CHOLMOD orderings accepted by ``ordering=``.
 ORDERINGS = ("default", "best", "amd", "metis", "nesdis", "natural")
 
-#: Default ordering: METIS nested dissection (on the cloth matrices 15% less fill and ~20%
-#: faster factorisations than AMD; the analysis is paid once per pattern anyway).
-DEFAULT_ORDERING = "metis"
+#: Default ordering: approximate minimum degree (AMD). On the cloth matrices of the benchmark
+#: METIS / nested dissection give 5-15% less fill but no faster factorisation (within the
+#: noise of a shared machine), at 3-5x the analysis time.
+DEFAULT_ORDERING = "amd"
 
 #: Number of sparsity patterns whose symbolic analysis is kept (least recently used dropped).
 CACHE_SIZE = 8

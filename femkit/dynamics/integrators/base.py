@@ -426,12 +426,14 @@ def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "chol
     """Solve ``A x = b`` for an SPD ``A`` assembled into the fixed ``pattern`` (a
     :class:`~femkit.dynamics.kernels.assembly.FreePattern`, the same object every step): the
     factor kept in ``ctx.cache[key]`` is refactorised in place on its symbolic analysis while
-    the pattern object is the same (no hashing, no comparison), and
-    factorised afresh (analysis from the pattern cache of :mod:`femkit.solvers.cholesky`)
+    the pattern object and the set of its exact zeros (dropped before factorising) are the same
+    (no hashing), and factorised afresh (analysis from the pattern cache of :mod:`femkit.solvers.cholesky`)
     otherwise. Counts ``factorizations`` and ``symbolic_reuses``, times ``time_factorization``
     and ``time_solve``, and applies the direct solver's residual rule
     ``||b - A x|| <= max(rtol ||b||, atol)`` (:class:`~femkit.errors.SolverError` otherwise).
     """
+    import scipy.sparse as sp
+
     from ...solvers import factorize_spd
 
     ctx.count("linear_solves")
@@ -441,16 +443,22 @@ def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "chol
         return np.zeros_like(b)
     kept = ctx.cache.get(key)
     t0 = time.perf_counter()
-    if kept is not None and kept[0] is pattern:
-        factor = kept[1].refactor(A)
+    # exact zeros of the pattern (e.g. the out-of-plane couplings of a planar cloth) are dropped:
+    # the factor exploits them; the analysis is reused while the set of zeros stays the same
+    nz = A.data != 0.0
+    if kept is not None and kept[0] is pattern and np.array_equal(kept[1], nz):
+        Ac = sp.csr_matrix((A.data[nz], kept[3], kept[2]), shape=A.shape)
+        factor = kept[4].refactor(Ac)
     else:
-        factor = factorize_spd(A, check_symmetry=False)
-        ctx.cache[key] = (pattern, factor)
+        counts = np.concatenate([[0], np.cumsum(nz)])
+        Ac = sp.csr_matrix((A.data[nz], A.indices[nz], counts[A.indptr]), shape=A.shape)
+        factor = factorize_spd(Ac, check_symmetry=False)
+        ctx.cache[key] = (pattern, nz, Ac.indptr, Ac.indices, factor)
     ctx.count("factorizations")
     if factor.info["symbolic_reused"]:
         ctx.count("symbolic_reuses")
     _add_time(ctx, "time_factorization", time.perf_counter() - t0)
-    return _checked_solve(factor, A, b, bnorm, ctx, "cholesky")
+    return _checked_solve(factor, Ac, b, bnorm, ctx, "cholesky")
 
 
 # ----------------------------------------------------------------------------- matrix-free

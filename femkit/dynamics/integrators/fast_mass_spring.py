@@ -48,6 +48,20 @@ holds references, so identities cannot be recycled): assigning a new array inval
 modifying one of those arrays in place does not (clear ``ctx.cache`` then). No array is hashed
 per step. ``ctx.stats["factorizations"]`` counts factorisations.
 
+With the ``cholesky`` solver the matrix is factorised by CHOLMOD
+(:func:`femkit.solvers.factorize_spd`) and the local step and ``J d`` are one compiled pass over
+the springs (:func:`femkit.dynamics.kernels.spring_kernels.local_global_rhs`), writing the
+right-hand side of the free nodes directly (the pinned nodes' positions read in place).
+
+Chebyshev acceleration (``chebyshev=True``; Wang 2015, "A Chebyshev semi-iterative approach for
+accelerating projective and position-based dynamics", ACM TOG 34(6)): after ``chebyshev_delay``
+plain sweeps each iterate is extrapolated, ``x_{k+1} = omega_{k+1} (x^_{k+1} - x_{k-1}) + x_{k-1}``
+with ``omega = 2 / (2 - rho^2)`` at the first accelerated sweep and ``4 / (4 - rho^2 omega)``
+after. The spectral radius ``rho`` of the local/global iteration is estimated once per run
+(``chebyshev_warmup`` plain sweeps of the first step on a scratch copy, the ratio of successive
+iterate differences; ``ctx.stats["chebyshev_rho"]``), or given as ``chebyshev_rho``. A fixed
+point of the accelerated iteration is still the implicit Euler step.
+
 ``iterations`` local/global sweeps per step (Liu et al.: 10); with ``tol`` set, the sweeps stop
 early when ``||x+ - x||_inf <= tol * L_box``. Iterated to convergence this is implicit Euler
 (``newton``); with few iterations it is an approximation that damps high frequencies. Order 1,

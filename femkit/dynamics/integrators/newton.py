@@ -130,14 +130,22 @@ class NewtonImplicitEuler(Integrator):
 
             pat = free_pattern(system, ctx.cache)
             zero_v = np.zeros(shape)
-            c_data = assemble_with_forces(pat, system, state.x, zero_v, state.t, diagonal=rm * m,
-                                          kcoef=rk, dcoef=1.0, fix=None)[0]
-            Cf = pat.matrix(c_data)
+            damped = rm or rk or system._has_dashpots or any(
+                f.damping(state.x) is not None for f in system.forces)
+            if damped:
+                c_data = assemble_with_forces(pat, system, state.x, zero_v, state.t,
+                                              diagonal=rm * m, kcoef=rk, dcoef=1.0, fix=None)[0]
+                Cf = pat.matrix(c_data)
 
-            def c_apply(e):
-                out = np.zeros_like(e)
-                out[free] = Cf @ e[free]
-                return out
+                def c_apply(e):
+                    out = np.zeros_like(e)
+                    out[free] = Cf @ e[free]
+                    return out
+            else:  # nothing damps: C = 0
+                c_data = 0.0
+
+                def c_apply(e):
+                    return np.zeros_like(e)
         else:
             C = system.damping_matrix(state.x)
             if rm != 0.0:
