@@ -80,6 +80,7 @@ class _Symbolic:
         self.ordering = ordering
         self.analysis_time = analysis_time
         self.uses = 0
+        self.owned = False              # a CholeskyFactor refactorises ``factor`` in place
 
 
 def _cholmod():
@@ -254,7 +255,11 @@ def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, check_symmetry: bool =
         raise InputError("A is empty (0 x 0)")
     sym, reused = _symbolic(Ac, ordering)
     t0 = time.perf_counter()
-    f = _numeric(lambda: sym.factor.cholesky(Ac), "cholesky")
+    if not sym.owned:  # the first factor of an analysis takes it over (no copy) ...
+        sym.owned = True
+        f = _numeric(lambda: sym.factor.cholesky_inplace(Ac) or sym.factor, "cholesky")
+    else:              # ... later ones copy it (its owner may refactorise it in place: the
+        f = _numeric(lambda: sym.factor.cholesky(Ac), "cholesky")  # analysis stays valid)
     dt = time.perf_counter() - t0
     sym.uses += 1
     return CholeskyFactor(f, Ac.shape, sym, reused, dt)

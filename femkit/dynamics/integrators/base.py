@@ -426,8 +426,8 @@ def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "chol
     """Solve ``A x = b`` for an SPD ``A`` assembled into the fixed ``pattern`` (a
     :class:`~femkit.dynamics.kernels.assembly.FreePattern`, the same object every step): the
     factor kept in ``ctx.cache[key]`` is refactorised in place on its symbolic analysis while
-    the pattern object and the set of its exact zeros (dropped before factorising) are the same
-    (no hashing), and factorised afresh (analysis from the pattern cache of :mod:`femkit.solvers.cholesky`)
+    the pattern object is the same and no entry is nonzero that has always been zero before
+    (those are left out of the factor: see the comment in the code; no hashing), and factorised afresh (analysis from the pattern cache of :mod:`femkit.solvers.cholesky`)
     otherwise. Counts ``factorizations`` and ``symbolic_reuses``, times ``time_factorization``
     and ``time_solve``, and applies the direct solver's residual rule
     ``||b - A x|| <= max(rtol ||b||, atol)`` (:class:`~femkit.errors.SolverError` otherwise).
@@ -443,17 +443,21 @@ def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "chol
         return np.zeros_like(b)
     kept = ctx.cache.get(key)
     t0 = time.perf_counter()
-    # exact zeros of the pattern (e.g. the out-of-plane couplings of a planar cloth) are dropped:
-    # the factor exploits them; the analysis is reused while the set of zeros stays the same
+    # Entries of the pattern that have always been exactly zero so far (e.g. the out-of-plane
+    # couplings of a planar cloth) are left out: the factor exploits them. The analysed pattern is
+    # the union of the nonzeros seen, so it only grows (a few analyses per run at most) and
+    # every other step refactorises in place.
     nz = A.data != 0.0
-    if kept is not None and kept[0] is pattern and np.array_equal(kept[1], nz):
-        Ac = sp.csr_matrix((A.data[nz], kept[3], kept[2]), shape=A.shape)
+    if kept is not None and kept[0] is pattern and not np.any(nz & ~kept[1]):
+        mask = kept[1]
+        Ac = sp.csr_matrix((A.data[mask], kept[3], kept[2]), shape=A.shape)
         factor = kept[4].refactor(Ac)
     else:
-        counts = np.concatenate([[0], np.cumsum(nz)])
-        Ac = sp.csr_matrix((A.data[nz], A.indices[nz], counts[A.indptr]), shape=A.shape)
+        mask = nz | kept[1] if kept is not None and kept[0] is pattern else nz
+        counts = np.concatenate([[0], np.cumsum(mask)])
+        Ac = sp.csr_matrix((A.data[mask], A.indices[mask], counts[A.indptr]), shape=A.shape)
         factor = factorize_spd(Ac, check_symmetry=False)
-        ctx.cache[key] = (pattern, nz, Ac.indptr, Ac.indices, factor)
+        ctx.cache[key] = (pattern, mask, Ac.indptr, Ac.indices, factor)
     ctx.count("factorizations")
     if factor.info["symbolic_reused"]:
         ctx.count("symbolic_reuses")
