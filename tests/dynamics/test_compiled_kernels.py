@@ -48,8 +48,9 @@ def test_spring_force_kernel_equals_numpy(dim):
     assert np.abs(out - ref).max() <= 1e-12 * _scale(ref)
 
 
-def test_local_global_kernel_equals_sparse_products():
-    system = _random_system(3)
+@pytest.mark.parametrize("dim", [2, 3], ids=["2d", "3d"])
+def test_local_global_kernel_equals_sparse_products(dim):
+    system = _random_system(dim)
     x = system.x0 + 0.1 * RNG.standard_normal(system.x0.shape)
     free = np.flatnonzero(~system.pinned)
     G = system.difference_operators[0]
@@ -58,10 +59,13 @@ def test_local_global_kernel_equals_sparse_products():
     ref = 0.3 * (G[:, free].T @ sp.diags(system.k * system.rest) @ d_unit)   # h^2 J d
     free_of = np.full(system.n, -1, dtype=np.int64)
     free_of[free] = np.arange(len(free))
-    out = np.zeros((len(free), 3))
-    local_global_rhs(x, system._i, system._j, system.k * system.rest, system.length_floor,
-                     free_of, 0.3, out)
-    assert np.abs(out - ref).max() <= 1e-12 * _scale(ref)
+    const = RNG.standard_normal((len(free), dim))
+    out = np.zeros((len(free), dim))
+    xf = x[free] + 0.0                             # the free iterate, read in place of x[free]
+    x[free] = np.nan
+    local_global_rhs(xf, x, system._i, system._j, system.k * system.rest, system.length_floor,
+                     free_of, 0.3, const, out)
+    assert np.abs(out - const - ref).max() <= 1e-12 * _scale(ref)
 
 
 @pytest.mark.parametrize("fix", [None, "clamp", "regularize"], ids=["nofix", "clamp", "regularize"])

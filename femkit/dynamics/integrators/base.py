@@ -403,10 +403,10 @@ def factorize_linear(A, ctx: StepContext):
     from ...solvers import factorize
 
     ctx.count("factorizations")
-    if ctx.solver == "cholesky":
+    if ctx.solver == "cholesky":  # factorised once: the ordering with the least fill pays
         from ...solvers import factorize_spd
 
-        return factorize_spd(A)
+        return factorize_spd(A, ordering="nesdis")
     return factorize(A)
 
 

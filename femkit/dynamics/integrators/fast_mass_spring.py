@@ -237,10 +237,10 @@ class FastMassSpring(Integrator):
 
         def sweep(x_free):
             if compiled:  # local step and J d in one compiled pass
-                x[free] = x_free
-                rhs = const.copy()
-                local_global_rhs(x, i, j, kr, ops.floor, free_of, h * h, rhs)
+                rhs = np.empty_like(const)
+                local_global_rhs(x_free, x, i, j, kr, ops.floor, free_of, h * h, const, rhs)
                 if variable:
+                    x[free] = x_free
                     rhs += (h * h) * system.variable_force(x, (x - xn) / h, t_new)[free]
             else:
                 dx = ops.G_free @ x_free            # (s, d): x_j - x_i
