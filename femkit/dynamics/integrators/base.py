@@ -426,8 +426,9 @@ def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "chol
     """Solve ``A x = b`` for an SPD ``A`` assembled into the fixed ``pattern`` (a
     :class:`~femkit.dynamics.kernels.assembly.FreePattern`, the same object every step): the
     factor kept in ``ctx.cache[key]`` is refactorised in place on its symbolic analysis while
-    the pattern object is the same and no entry is nonzero that has always been zero before
-    (those are left out of the factor: see the comment in the code; no hashing), and factorised afresh (analysis from the pattern cache of :mod:`femkit.solvers.cholesky`)
+    the pattern object is the same and no coordinate pair has become nonzero that was all
+    zero before (those are left out of the factor: see the comment in the code; no hashing),
+    and factorised afresh (analysis from the pattern cache of :mod:`femkit.solvers.cholesky`)
     otherwise. Counts ``factorizations`` and ``symbolic_reuses``, times ``time_factorization``
     and ``time_solve``, and applies the direct solver's residual rule
     ``||b - A x|| <= max(rtol ||b||, atol)`` (:class:`~femkit.errors.SolverError` otherwise).
@@ -443,21 +444,26 @@ def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "chol
         return np.zeros_like(b)
     kept = ctx.cache.get(key)
     t0 = time.perf_counter()
-    # Entries of the pattern that have always been exactly zero so far (e.g. the out-of-plane
-    # couplings of a planar cloth) are left out: the factor exploits them. The analysed pattern is
-    # the union of the nonzeros seen, so it only grows (a few analyses per run at most) and
-    # every other step refactorises in place.
-    nz = A.data != 0.0
-    if kept is not None and kept[0] is pattern and not np.any(nz & ~kept[1]):
-        mask = kept[1]
-        Ac = sp.csr_matrix((A.data[mask], kept[3], kept[2]), shape=A.shape)
-        factor = kept[4].refactor(Ac)
+    # Coordinate pairs (x-y, y-z ...) whose couplings have all been exactly zero so far (the
+    # out-of-plane couplings of a planar cloth) are left out of the factor, which exploits them;
+    # all entries of a pair enter once one of them is nonzero, and the same-coordinate pairs
+    # always (the clamp zeroes and restores them spring by spring). So the analysed pattern
+    # changes only when the geometry leaves its plane, and every other step refactorises in place.
+    d = pattern.dim
+    seen = np.bincount(pattern.coordinate_pair[A.data != 0.0], minlength=d * d) > 0
+    seen[np.arange(d) * (d + 1)] = True
+    if kept is not None and kept[0] is pattern:
+        seen |= kept[1]
+    if kept is not None and kept[0] is pattern and np.array_equal(seen, kept[1]):
+        mask = kept[2]
+        Ac = sp.csr_matrix((A.data[mask], kept[4], kept[3]), shape=A.shape)
+        factor = kept[5].refactor(Ac)
     else:
-        mask = nz | kept[1] if kept is not None and kept[0] is pattern else nz
+        mask = seen[pattern.coordinate_pair]
         counts = np.concatenate([[0], np.cumsum(mask)])
         Ac = sp.csr_matrix((A.data[mask], A.indices[mask], counts[A.indptr]), shape=A.shape)
         factor = factorize_spd(Ac, check_symmetry=False)
-        ctx.cache[key] = (pattern, mask, Ac.indptr, Ac.indices, factor)
+        ctx.cache[key] = (pattern, seen, mask, Ac.indptr, Ac.indices, factor)
     ctx.count("factorizations")
     if factor.info["symbolic_reused"]:
         ctx.count("symbolic_reuses")

@@ -35,6 +35,8 @@ class FreePattern:
     slots : (4, s, d*d) int64, the ``data`` position of each spring block entry (or -1):
         blocks ``(i, i)``, ``(j, j)``, ``(i, j)``, ``(j, i)``, entry ``p*d + q``.
     diag : (n_free_dofs,) int64, the ``data`` position of each diagonal entry.
+    coordinate_pair : (nnz,) int8, ``p*d + q`` for an entry coupling coordinate ``p`` of one node
+        with coordinate ``q`` of another (or the same) node.
     free : the free dofs (``system.free_dofs``).
     """
 
@@ -65,6 +67,11 @@ class FreePattern:
         counts = np.bincount(uniq // nf, minlength=nf) if nf else np.zeros(0, np.int64)
         self.indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
         self.nnz = len(uniq)
+        # the coordinate pair (p, q) -> p*d + q an entry couples (see solve_cholesky)
+        coord = free % d
+        rows = np.repeat(np.arange(nf), np.diff(self.indptr))
+        self.coordinate_pair = (coord[rows] * d + coord[self.indices]).astype(np.int8)
+        self.dim = d
         self.free = free
         self.shape = (nf, nf)
         self.ndof = ndof
