@@ -298,13 +298,18 @@ def compiled_rows(quick: bool = False) -> None:
     rows.append(("Liu 81x81", "  + Chebyshev (Wang 2015)", None, cheb["median"], ""))
     steps = {}
     for label, name, opts in (("Newton iteration (1 solve)", "newton", {"max_iterations": 1}),
+                              ("Newton iteration, reused factor", "newton",
+                               {"max_iterations": 1, "reuse_factorization": True}),
                               ("Baraff-Witkin (clamp)", "implicit_euler", {"fix": "clamp"}),
-                              ("Newton, converged (tol 1e-10)", "newton", {"max_iterations": 50})):
+                              ("Newton, converged (tol 1e-10)", "newton", {"max_iterations": 50}),
+                              ("Newton, converged, reused factor", "newton",
+                               {"max_iterations": 50, "reuse_factorization": True})):
         import warnings
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            r = {solver: _time_steps(liu, name, h, 2 if quick else 5, solver=solver, **opts)
+            reps = (2 if quick else 5) * (3 if opts.get("reuse_factorization") else 1)
+            r = {solver: _time_steps(liu, name, h, reps, solver=solver, **opts)
                  for solver in ("direct", "cholesky")}
         steps[label] = r
         it = r["cholesky"]["newton"]

@@ -186,7 +186,13 @@ def test_bad_chebyshev_options_raise(opts):
         get_integrator("fast_mass_spring", chebyshev=True, **opts)
 
 
-def test_reuse_factorization_is_a_direct_only_option():
-    system = _cloth(4, forces=[Gravity(9.81)])
-    with pytest.raises(InputError, match="reuse_factorization"):
-        _run("implicit_euler", system, "cholesky", steps=1, fix="clamp", reuse_factorization=True)
+@pytest.mark.parametrize("name,opts", [("implicit_euler", {"fix": "clamp"}), ("newton", {"tol": 1e-12})],
+                         ids=["bw", "newton"])
+def test_reused_cholesky_factor_preconditions_later_solves_to_the_same_step(name, opts):
+    system = _cloth(forces=[Gravity(9.81)])
+    exact, ctx_e = _run(name, system, "cholesky", steps=6, **opts)
+    reuse, ctx_r = _run(name, system, "cholesky", steps=6, reuse_factorization=True, **opts)
+    disp = np.abs(exact.x - system.x0).max()
+    np.testing.assert_allclose(reuse.x, exact.x, rtol=0, atol=1e-7 * disp)
+    assert ctx_r.stats["factorizations"] < ctx_e.stats["factorizations"]
+    assert ctx_r.stats["linear_iterations"] > 0          # PCG with the kept factor did the rest

@@ -49,6 +49,7 @@ __all__ = [
     "factorize_linear",
     "uses_cholesky",
     "solve_cholesky",
+    "solve_compiled",
     "restrict",
     "box_length",
     "check_iteration_options",
@@ -329,7 +330,8 @@ class _ReusedFactor:
     solves: int = 1
 
 
-def _solve_reusing_factor(A, b: np.ndarray, ctx: StepContext, key: str, x0=None) -> np.ndarray:
+def _solve_reusing_factor(A, b: np.ndarray, ctx: StepContext, key: str, x0=None,
+                          direct=None) -> np.ndarray:
     """PCG with the kept factor; the renewal rule drops the factor once one PCG solve costs more
     than the average cost per solve since it was made (factorisation included), so the next
     solve refactorises; a PCG solve that misses the tolerance within the cap refactorises now."""
@@ -355,6 +357,8 @@ def _solve_reusing_factor(A, b: np.ndarray, ctx: StepContext, key: str, x0=None)
                 ctx.cache.pop(key, None)  # marginal cost above the average: refactorise next
             return np.asarray(res.x, dtype=float)
         ctx.count("refactorizations")
+    if direct is not None:  # e.g. the Cholesky refactorisation of the compiled path
+        return direct(A, b, ctx, key)
     return _solve_direct_reusing_ordering(A, b, ctx, keep=key)
 
 
@@ -412,17 +416,23 @@ def factorize_linear(A, ctx: StepContext):
 
 def uses_cholesky(ctx: StepContext, integrator) -> bool:
     """Whether a step takes the compiled path: ``ctx.solver == "cholesky"`` (assembled, not
-    matrix-free). ``reuse_factorization`` (PCG preconditioned by an older SuperLU factor) is a
-    ``direct``-only option: with ``cholesky`` it raises :class:`~femkit.errors.InputError`."""
-    if ctx.solver != "cholesky" or getattr(integrator, "matrix_free", False):
-        return False
-    if getattr(integrator, "reuse_factorization", False):
-        raise InputError(f"{integrator.name}: reuse_factorization applies to the 'direct' solver; "
-                         "'cholesky' refactorises on the cached symbolic analysis instead")
-    return True
+    matrix-free)."""
+    return ctx.solver == "cholesky" and not getattr(integrator, "matrix_free", False)
 
 
-def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "cholesky_factor") -> np.ndarray:
+def solve_compiled(A, b: np.ndarray, ctx: StepContext, pattern, reuse_key: str | None = None) -> np.ndarray:
+    """:func:`solve_cholesky`, or with ``reuse_key`` (``reuse_factorization=True``) PCG
+    preconditioned by the kept (older) Cholesky factor under the renewal rule of
+    :func:`solve_linear`, the refactorisation being :func:`solve_cholesky`'s."""
+    if reuse_key is None:
+        return solve_cholesky(A, b, ctx, pattern)
+    return _solve_reusing_factor(
+        A, b, ctx, reuse_key,
+        direct=lambda A, b, ctx, keep: solve_cholesky(A, b, ctx, pattern, keep=keep))
+
+
+def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "cholesky_factor",
+                   keep: str | None = None) -> np.ndarray:
     """Solve ``A x = b`` for an SPD ``A`` assembled into the fixed ``pattern`` (a
     :class:`~femkit.dynamics.kernels.assembly.FreePattern`, the same object every step): the
     factor kept in ``ctx.cache[key]`` is refactorised in place on its symbolic analysis while
@@ -467,7 +477,10 @@ def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "chol
     ctx.count("factorizations")
     if factor.info["symbolic_reused"]:
         ctx.count("symbolic_reuses")
-    _add_time(ctx, "time_factorization", time.perf_counter() - t0)
+    spent = time.perf_counter() - t0
+    _add_time(ctx, "time_factorization", spent)
+    if keep is not None:  # preconditions later solves (reuse_factorization)
+        ctx.cache[keep] = _ReusedFactor(factor, spent)
     return _checked_solve(factor, Ac, b, bnorm, ctx, "cholesky")
 
 

@@ -15,7 +15,7 @@ First order; unconditionally stable on the linear oscillator (amplitude ``1/sqrt
 per step), i.e. artificially damped. Option ``fix`` (``None``, ``"clamp"``, ``"regularize"``)
 makes ``K`` positive semi-definite for CG-type solvers when springs are compressed.
 
-With the ``direct`` solver and ``reuse_factorization=True`` (opt-in; the default
+With the ``direct`` (or ``cholesky``) solver and ``reuse_factorization=True`` (opt-in; the default
 ``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
 earlier step's matrix is kept (when it is SPD) and later steps solve by PCG preconditioned with
 it, to ``ctx.rtol`` on the true residual, renewing the factor when a PCG solve costs more than
@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import (Integrator, StepContext, StepperState, check_matrix_free_options, free_operator,
-                   restrict, solve_cholesky, solve_linear, uses_cholesky)
+                   restrict, solve_compiled, solve_linear, uses_cholesky)
 from .registry import INTEGRATORS
 
 
@@ -124,7 +124,8 @@ class ImplicitEuler(Integrator):
                                            kcoef=a_k, dcoef=h, fix=self.fix)
         vf = v.reshape(-1)
         b = h * (f.reshape(-1) - (h + rk) * kv.reshape(-1) - rm * m * vf)
-        dv = solve_cholesky(pat.matrix(data), b[pat.free], ctx, pat)
+        dv = solve_compiled(pat.matrix(data), b[pat.free], ctx, pat,
+                            "implicit_euler_factor" if self.reuse_factorization else None)
         return self._advance(state, vf, pat.free, dv, h)
 
     @staticmethod

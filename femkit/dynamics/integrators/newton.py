@@ -17,7 +17,7 @@ is a descent direction), then backtracks (Armijo: ``g(x + t dx) <= g(x) + c t gr
 first one. (A line search that finds no decrease leaves ``x`` in place and ends the step: at
 round-off level that is convergence.)
 
-With the ``direct`` solver and ``reuse_factorization=True`` (opt-in; the default
+With the ``direct`` (or ``cholesky``) solver and ``reuse_factorization=True`` (opt-in; the default
 ``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
 earlier Newton matrix (this step's or a previous step's) is kept and later Newton systems are
 solved by PCG preconditioned with it, to the same relative residual ``ctx.rtol`` on the true
@@ -52,7 +52,7 @@ import numpy as np
 from ...errors import InputError
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
                    check_matrix_free_options, free_operator, note_unconverged, restrict,
-                   solve_cholesky, solve_linear, uses_cholesky)
+                   solve_compiled, solve_linear, uses_cholesky)
 from .registry import INTEGRATORS
 
 
@@ -176,7 +176,8 @@ class NewtonImplicitEuler(Integrator):
                 data = assemble_with_forces(pat, system, x.reshape(shape), zero_v, state.t,
                                             diagonal=m, kcoef=h * h, dcoef=0.0, fix=self.fix)[0]
                 data += h * c_data
-                dx[free] = solve_cholesky(pat.matrix(data), -grad[free], ctx, pat)
+                dx[free] = solve_compiled(pat.matrix(data), -grad[free], ctx, pat,
+                                          "newton_factor" if self.reuse_factorization else None)
             else:
                 H = M + (h * h) * system.stiffness_matrix(x.reshape(shape), fix=self.fix) + h * C
                 dx[free] = solve_linear(restrict(H, free), -grad[free], ctx, system=system,
