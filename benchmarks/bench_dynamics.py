@@ -47,6 +47,7 @@ import time  # noqa: E402
 
 from femkit.dynamics.forces import Gravity  # noqa: E402
 from femkit.dynamics.integrators import StepContext, get_integrator  # noqa: E402
+from femkit.solvers import SolverSpec
 from femkit.dynamics.topology import cloth_grid  # noqa: E402
 
 _SPLIT = ("time_permute", "time_factorization", "time_solve", "time_pcg")
@@ -55,7 +56,7 @@ _SPLIT = ("time_permute", "time_factorization", "time_solve", "time_pcg")
 def _time_steps(system, name, dt, repeats, *, solver="direct", preconditioner="none",
                 **opts) -> dict:
     """Median seconds per step after a warm-up, factorisations and the time split per step."""
-    ctx = StepContext(solver=solver, preconditioner=preconditioner)
+    ctx = StepContext(SolverSpec(solver, preconditioner))
     integ = get_integrator(name, **opts)
     s = integ.start(system, system.x0, system.v0, 0.0, dt, ctx)
     s = integ.step(system, s, dt, ctx)  # warm-up: one-time factorisation / ordering
@@ -261,11 +262,12 @@ def compile_times() -> dict:
     code = ("import time; t0 = time.perf_counter(); import numpy as np;"
             "from femkit.dynamics.topology import cloth_grid;"
             "from femkit.dynamics.integrators import StepContext, get_integrator;"
+            "from femkit.solvers import SolverSpec;"
             "s = cloth_grid(8, 8, 1.0, 1.0, k_structural=1e3, k_shear=1e3, k_bending=1e2,"
             " total_mass=1.0, pinned='top_corners');"
             "t1 = time.perf_counter();"
             "[get_integrator(m).step(s, get_integrator(m).start(s, s.x0, s.v0, 0.0, 0.01,"
-            " StepContext(solver='cholesky')), 0.01, StepContext(solver='cholesky'))"
+            " StepContext(SolverSpec('cholesky'))), 0.01, StepContext(SolverSpec('cholesky')))"
             " for m in ('fast_mass_spring', 'implicit_euler', 'newton')];"
             "import femkit.dynamics.kernels.spring_kernels as k;"
             "k.spring_forces(s.x0, s._i, s._j, s.k, s.rest, 1e-12, np.zeros_like(s.x0));"

@@ -4,7 +4,7 @@ Importing femkit is cheap: heavy modules (gmsh, pyamg, matplotlib, numba, scikit
 are imported only by the code path that needs them.
 """
 
-__version__ = "0.1.0"
+from ._version import __version__  # noqa: F401
 
 from .errors import FemkitError  # noqa: F401  (cheap)
 

@@ -109,7 +109,7 @@ def _add_check(sub) -> None:
 
 def _run_check(args) -> int:
     from .case import load_case
-    from .case.check import cross_check, format_table
+    from .case.poisson.cross_check import cross_check, format_table
 
     case = load_case(args.case)
     rows = cross_check(case)
@@ -136,7 +136,7 @@ def build_parser() -> argparse.ArgumentParser:
         description=("femkit: P1 finite elements for Poisson problems (and mass-spring "
                      "dynamics), every result reported with its error and its cost."),
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    from . import __version__
+    from ._version import __version__
 
     parser.add_argument("--version", action="version", version=f"femkit {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)

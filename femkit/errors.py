@@ -129,3 +129,12 @@ class StabilityWarning(UserWarning):
     Issued by :func:`femkit.dynamics.simulate.simulate` before the run (``warnings.warn``);
     the message names ``dt``, the critical step and ``omega_max``.
     """
+
+
+def with_prefix(exc: InputError, where: str) -> InputError:
+    """The same exception (type and attributes kept) with ``where: `` before its one-line message."""
+    cls = type(exc)
+    new = cls.__new__(cls)
+    new.__dict__.update(exc.__dict__)
+    new.args = (f"{where}: {' '.join(str(exc).split())}",)
+    return new

@@ -55,6 +55,12 @@ class Registry(Generic[T]):
         except (KeyError, TypeError):
             raise UnknownNameError(self.kind, str(name), self._items) from None
 
+    def remove(self, name: str) -> T:
+        """Unregister ``name`` and return its object (UnknownNameError if absent)."""
+        obj = self.get(name)
+        del self._items[name]
+        return obj
+
     def names(self) -> list[str]:
         return sorted(self._items)
 

@@ -48,6 +48,8 @@ class Case:
     functions : dict
         Compiled callables keyed by their key path (``"source"``, ``"exact.u"`` ...),
         each with ``.source`` holding its text. Replace an entry to swap a piece.
+    solver : SolverSpec or None
+        The validated ``solver`` (``linear_solver`` in scenes): built once at load time.
     """
 
     data: dict
@@ -57,6 +59,7 @@ class Case:
     path: Path | None = None
     functions: dict = field(default_factory=dict)
     extras: dict = field(default_factory=dict)
+    solver: Any = None
 
     def run(self, output_dir: str | os.PathLike | None = None, quiet: bool = False,
             write: bool = True, echo=None):

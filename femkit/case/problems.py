@@ -1,86 +1,101 @@
-"""Problem types a case file can declare with ``problem: <name>``.
+"""Problem types a case file can declare with ``problem: <name>``: the registry :data:`PROBLEMS`.
 
-:data:`PROBLEMS` maps a problem name to a :class:`ProblemType`: where its JSON schema lives, the
-function that checks and compiles a validated case (names against registries, expressions,
-paths) and the function that runs it. Entries are ``"module:attribute"`` strings resolved on
-first use, so listing a problem type imports nothing heavy.
+Each entry is a :class:`ProblemType`: a function returning its JSON schema, the function that
+checks and compiles a validated case (names against registries, expressions, paths) and the
+function that runs it. The built-in entries import their modules on first use (plain
+functions below, no import strings), so listing problem types imports nothing heavy.
 
-Adding a problem type is one entry (as for the dynamics ``mass_spring`` scenes)::
+Adding a problem type is one registration::
 
-    PROBLEMS["my_problem"] = ProblemType(
-        schema="my.module:SCHEMA",        # JSON schema dict (additionalProperties: false)
-        prepare="my.module:prepare",      # (case: Case) -> None: names, paths, expressions
-        run="my.module:run",              # (case, output_dir=None, quiet=False, write=True,
-    )                                     #  echo=None) -> result with .converged
+    register_problem("my_problem", schema=MY_SCHEMA, prepare=prepare, run=run)
 
-or, from outside this package, :func:`register_problem`. ``femkit solve`` dispatches on the
-``problem`` key through this table; a result whose ``converged`` attribute is false makes the
-command exit with code 1.
+``run(case, output_dir=None, quiet=False, write=True, echo=None)`` returns a result with
+``converged``; ``femkit solve`` dispatches on the ``problem`` key through this registry and
+exits with code 1 when ``converged`` is false.
 """
 
 from __future__ import annotations
 
-import importlib
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
-from ..errors import UnknownNameError
+from ..registry import Registry
 
-
-def resolve(ref: Any) -> Any:
-    """Import ``"package.module:attr"`` and return the attribute (non-strings pass through)."""
-    if not isinstance(ref, str):
-        return ref
-    module, _, attr = ref.partition(":")
-    obj = importlib.import_module(module)
-    for part in attr.split("."):
-        obj = getattr(obj, part)
-    return obj
+__all__ = ["PROBLEMS", "ProblemType", "register_problem", "get_problem"]
 
 
 @dataclass(frozen=True)
 class ProblemType:
-    """How to validate, prepare and run one ``problem:`` kind (references may be lazy strings)."""
+    """How to validate, prepare and run one ``problem:`` kind.
+
+    ``schema`` is the JSON-schema dict or a zero-argument function returning it.
+    """
 
     schema: Any
-    prepare: Any
-    run: Any
+    prepare: Callable
+    run: Callable
 
     def get_schema(self) -> dict:
-        return resolve(self.schema)
+        return self.schema() if callable(self.schema) else self.schema
 
-    def get_prepare(self):
-        return resolve(self.prepare)
+    def get_prepare(self) -> Callable:
+        return self.prepare
 
-    def get_run(self):
-        return resolve(self.run)
+    def get_run(self) -> Callable:
+        return self.run
 
 
 #: problem name -> ProblemType
-PROBLEMS: dict[str, ProblemType] = {
-    "poisson": ProblemType(
-        schema="femkit.case.schema_poisson:POISSON_SCHEMA",
-        prepare="femkit.case.run:prepare_poisson",
-        run="femkit.case.run:run_poisson",
-    ),
-    "mass_spring": ProblemType(
-        schema="femkit.dynamics.scene_schema:SCENE_SCHEMA",
-        prepare="femkit.dynamics.scene:prepare_scene",
-        run="femkit.dynamics.scene:run_scene",
-    ),
-}
+PROBLEMS: Registry = Registry("problem")
 
 
-def register_problem(name: str, schema: Any, prepare: Any, run: Any) -> None:
-    """Register a problem type (objects or lazy ``"module:attr"`` strings)."""
-    if name in PROBLEMS:
-        raise ValueError(f"problem type {name!r} registered twice")
-    PROBLEMS[name] = ProblemType(schema, prepare, run)
+def register_problem(name: str, schema: Any, prepare: Callable, run: Callable) -> ProblemType:
+    """Register a problem type; a name registered twice raises ValueError."""
+    return PROBLEMS.register(name, ProblemType(schema, prepare, run))
 
 
 def get_problem(name: Any) -> ProblemType:
     """The :class:`ProblemType` called ``name``; UnknownNameError lists the valid ones."""
-    try:
-        return PROBLEMS[name]
-    except (KeyError, TypeError):
-        raise UnknownNameError("problem", str(name), PROBLEMS) from None
+    return PROBLEMS.get(name)
+
+
+# ----------------------------------------------------------------------------- built-in types
+
+def _poisson_schema() -> dict:
+    from .poisson.schema import POISSON_SCHEMA
+
+    return POISSON_SCHEMA
+
+
+def _poisson_prepare(case) -> None:
+    from .poisson.run import prepare_poisson
+
+    prepare_poisson(case)
+
+
+def _poisson_run(case, **kwargs):
+    from .poisson.run import run_poisson
+
+    return run_poisson(case, **kwargs)
+
+
+def _scene_schema() -> dict:
+    from .scene.schema import SCENE_SCHEMA
+
+    return SCENE_SCHEMA
+
+
+def _scene_prepare(case) -> None:
+    from .scene.run import prepare_scene
+
+    prepare_scene(case)
+
+
+def _scene_run(case, **kwargs):
+    from .scene.run import run_scene
+
+    return run_scene(case, **kwargs)
+
+
+register_problem("poisson", _poisson_schema, _poisson_prepare, _poisson_run)
+register_problem("mass_spring", _scene_schema, _scene_prepare, _scene_run)

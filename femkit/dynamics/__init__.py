@@ -9,32 +9,29 @@ Names are resolved lazily on first access, so ``import femkit.dynamics`` costs n
 
 from __future__ import annotations
 
-import importlib
-
+#: submodule -> the names it exports here (imported on first access, by plain relative imports)
 _EXPORTS = {
-    "MassSpringSystem": "femkit.dynamics.system",
-    "Gravity": "femkit.dynamics.forces",
-    "ViscousDamping": "femkit.dynamics.forces",
-    "RayleighDamping": "femkit.dynamics.forces",
-    "GroundContact": "femkit.dynamics.forces",
-    "SphereContact": "femkit.dynamics.forces",
-    "rope": "femkit.dynamics.topology",
-    "cloth_grid": "femkit.dynamics.topology",
-    "mesh_springs": "femkit.dynamics.topology",
-    "single_spring": "femkit.dynamics.topology",
-    "estimate_omega_max": "femkit.dynamics.stability",
-    "critical_dt": "femkit.dynamics.stability",
+    "system": ("MassSpringSystem",),
+    "forces": ("Gravity", "ViscousDamping", "RayleighDamping", "GroundContact", "SphereContact"),
+    "topology": ("rope", "cloth_grid", "mesh_springs", "single_spring"),
+    "stability": ("estimate_omega_max", "critical_dt"),
 }
 
-__all__ = sorted(_EXPORTS)
+__all__ = sorted(name for names in _EXPORTS.values() for name in names)
 
 
 def __getattr__(name: str):
-    try:
-        module = _EXPORTS[name]
-    except KeyError:
-        raise AttributeError(f"module 'femkit.dynamics' has no attribute {name!r}") from None
-    value = getattr(importlib.import_module(module), name)
+    if name in _EXPORTS["system"]:
+        from . import system as module
+    elif name in _EXPORTS["forces"]:
+        from . import forces as module
+    elif name in _EXPORTS["topology"]:
+        from . import topology as module
+    elif name in _EXPORTS["stability"]:
+        from . import stability as module
+    else:
+        raise AttributeError(f"module 'femkit.dynamics' has no attribute {name!r}")
+    value = getattr(module, name)
     globals()[name] = value
     return value
 

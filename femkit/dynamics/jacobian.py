@@ -1,7 +1,7 @@
 """Spring geometry, Hooke/dashpot kernels, the spring Jacobian blocks and their sparse assembly.
 
-Conventions (seed 000 section 2, seed 001 "local regularization")
------------------------------------------------------------------
+Conventions (Schlögl, mass-spring forces; Baraff & Witkin 1998, section 5)
+---------------------------------------------------------------------------
 A spring ``s = (i, j)`` with stiffness ``k``, rest length ``L`` and current vector
 ``x_ij = x_j - x_i``, length ``l = |x_ij|``, direction ``u = x_ij / l`` exerts
 
@@ -16,15 +16,15 @@ and enters ``K`` with ``+H_s`` on the ``(i, i)`` and ``(j, j)`` blocks and ``-H_
 ``(i, j)`` and ``(j, i)``. Its eigenvalues are ``k`` (along ``u``) and ``k (1 - L/l)``
 (``d - 1`` times, across ``u``): a compressed spring (``l < L``) makes ``K`` indefinite.
 
-Definiteness fixes (seed 001)
------------------------------
+Definiteness fixes (Hessian modification: Nocedal & Wright, Numerical Optimization, section 3.4)
+-----------------------------------------------------------------------------------------------
 ``fix="clamp"``
     per-spring eigenvalue clamp: ``(1 - L/l)`` is replaced by ``max(0, 1 - L/l)``, which
     is exactly ``Q max(0, Lambda) Q^T`` of the block because ``u`` and its complement are
     the eigenvectors. Every block is then PSD, hence so is ``K`` (sum of ``A_s A_s^T (x) H_s``).
 ``fix="regularize"``
     global shift ``K + mu I`` with the analytic bound :func:`regularization_shift`
-    (instead of the seed's trial-factorisation loop ``reg = 1, 10, 100 ...``, which
+    (instead of a trial-factorisation loop ``reg = 1, 10, 100 ...``, which
     needs a factorisation per trial).
 
 Zero-length springs: the length is floored at ``length_floor`` (``1e-12`` times the

@@ -34,7 +34,7 @@ def scaled_stiffness(system, x=None, *, fix: str | None = None) -> sp.csr_matrix
     return (Dw @ K @ Dw).tocsr()
 
 
-def estimate_omega_max(system, x=None, iters: int = 500, *, tol: float = 1e-10, seed: int = 0,
+def estimate_omega_max(system, x=None, iters: int = 500, *, tol: float = 1e-10, random_state: int = 0,
                        fix: str | None = None) -> float:
     """``omega_max = sqrt(|lambda_max|)`` of ``M^-1 K`` on the free dofs, by power iteration.
 
@@ -44,7 +44,7 @@ def estimate_omega_max(system, x=None, iters: int = 500, *, tol: float = 1e-10, 
     x : (n, d) positions of the linearisation (default ``system.x0``).
     iters : maximum number of power iterations.
     tol : stop when the Rayleigh quotient changes by less than ``tol`` relatively.
-    seed : seed of the random start vector (deterministic by default).
+    random_state : key of the random start vector (deterministic by default).
     fix : definiteness fix passed to ``stiffness_matrix``.
 
     Returns
@@ -58,7 +58,7 @@ def estimate_omega_max(system, x=None, iters: int = 500, *, tol: float = 1e-10, 
     m = S.shape[0]
     if m == 0 or S.nnz == 0:
         return 0.0
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(random_state)
     z = rng.standard_normal(m)
     z /= np.linalg.norm(z)
     lam = 0.0

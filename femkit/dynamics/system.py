@@ -399,7 +399,8 @@ class MassSpringSystem:
         return K.tocsr()
 
     def hessian_product(self, x, d, *, fix: str | None = None) -> np.ndarray:
-        """Matrix-free ``K d`` (seed 001: ``A d = M d + h^2 sum_j H_j d``), equal to
+        """Matrix-free ``K d`` (matrix-free CG on the implicit-Euler matrix, Baraff & Witkin 1998:
+        ``A d = M d + h^2 sum_j H_j d``), equal to
         ``stiffness_matrix(x, fix=fix) @ d`` with ``d`` of shape ``(n, d)`` or flat."""
         self._check_fix(fix)
         x = self._state(x)

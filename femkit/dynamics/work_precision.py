@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..solvers.spec import SolverSpec
 from .integrators import StepContext, get_integrator
 
 __all__ = ["MethodRun", "FAMILIES", "expand_methods", "cloth_work_precision"]
@@ -93,15 +94,14 @@ def expand_methods(spec: list[dict]) -> list[MethodRun]:
             opts = {**extra, knob: int(k)}
             if fam == "newton":
                 opts.setdefault("tol", 1e-14)     # stopped by the iteration count, not the tolerance
-            unit = "it" if fam != "newton" else "Newton it"
-            runs.append(MethodRun(fam, f"{prefix} {k} {unit}", integ, opts, setting=int(k)))
+            runs.append(MethodRun(fam, f"{prefix} {k} it", integ, opts, setting=int(k)))
     return runs
 
 
 def _trajectory(system, name, opts, dt, frames, solver, substeps=1):
     """Positions at every frame (``frames + 1`` of them), seconds per frame (median after a
     warm-up step) and total energies."""
-    ctx = StepContext(solver=solver)
+    ctx = StepContext(SolverSpec(solver))
     integ = get_integrator(name, **opts)
     h = dt / substeps
     s = integ.start(system, system.x0, system.v0, 0.0, h, ctx)

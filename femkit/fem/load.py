@@ -1,6 +1,6 @@
 """P1 load vector ``F_j = int f N_j``.
 
-The default ``barycentric`` rule is the seed's one-point rule ``F_j += |T| f(c) / 3``; named
+The default ``barycentric`` rule is the classical one-point (centroid) rule of P1 lecture notes (e.g. Schlögl, physically based simulation; Braess, *Finite Elements*, 2007) ``F_j += |T| f(c) / 3``; named
 higher-order rules (:mod:`femkit.fem.quadrature`) evaluate ``f`` at their points and weight
 by the P1 basis values there.
 

@@ -32,7 +32,7 @@ def tagged_edges(mesh, tags) -> np.ndarray:
     a flux is never integrated twice over it.
     """
     if tags is None:
-        from ..mesh.refine import boundary_edges_topological
+        from ..mesh.edges import boundary_edges_topological
 
         return boundary_edges_topological(mesh)
     if isinstance(tags, (str, int, np.integer)):

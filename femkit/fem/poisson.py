@@ -45,12 +45,13 @@ pure-Neumann solution with an exact solution modulo the constant: :func:`mean_sh
 
 from __future__ import annotations
 
-import time
 from typing import Callable, NamedTuple, Sequence
 
 import numpy as np
 
 from ..errors import InputError, PureNeumannError, SingularSystemError  # noqa: F401 (re-exported)
+from ..mesh.edges import boundary_nodes
+from ..timing import StageTimer
 from ._elements import triangle_geometry
 from .coefficients import Coefficient, evaluate_callable
 from .dirichlet import DirichletSystem, apply_dirichlet, dirichlet_values
@@ -278,7 +279,7 @@ class PoissonProblem:
         self.dirichlet = [tuple(d) for d in dirichlet]
         self.neumann = [tuple(d) for d in neumann]
         self.load_rule = load_rule
-        self.timings: dict[str, float] = {}
+        self._timer = StageTimer()
         self.system: DirichletSystem | NullspaceSystem | None = None
         if self.dirichlet and nullspace is not None:
             raise InputError("nullspace only applies to pure-Neumann problems (no Dirichlet data)")
@@ -294,95 +295,97 @@ class PoissonProblem:
             if len(entry) != 2:
                 raise InputError(f"boundary conditions are (tags, value) pairs, got {entry!r}")
 
-    def assemble(self, method: str = "direct") -> DirichletSystem | NullspaceSystem:
-        """Assemble K, F (+ Neumann) and eliminate the Dirichlet nodes; stage times in ``timings``.
+    @property
+    def timings(self) -> dict[str, float]:
+        """Seconds per stage of the last assembly and solve."""
+        return self._timer.times
 
-        Pure Neumann: check the compatibility of the data and fix the constant
-        (:func:`pure_neumann_system`; ``method`` says whether a direct solver will be used).
+    def assemble_matrices(self) -> tuple:
+        """Stiffness ``K`` and load ``F`` (source + Neumann fluxes) on the whole mesh.
+
+        The Neumann part alone is kept as :attr:`neumann_load` (the pure-Neumann compatibility
+        check needs it). Stage times go to :attr:`timings`.
         """
-        t = {}
-        t0 = time.perf_counter()
-        pattern = SparsityPattern.for_mesh(self.mesh)
-        t["pattern"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        K = assemble_stiffness(self.mesh, self.kappa, pattern=pattern)
-        t["stiffness"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        F = assemble_load(self.mesh, self.f, rule=self.load_rule)
-        t["load"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        F_flux = np.zeros(self.mesh.n_points)
-        for tags, h in self.neumann:
-            F_flux += assemble_neumann(self.mesh, tags, h)
-        t["neumann"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        if self.nullspace is not None:
-            w = node_weights(self.mesh)
-            F, info = check_compatibility(F, F_flux, weights=w, rtol=self.compatibility_rtol)
-            self.system = pure_neumann_system(K, F, mode=self.nullspace, weights=w, method=method,
-                                              pin_node=self.pin_node, pin_value=self.pin_value,
-                                              compatibility=info)
-            t["dirichlet"] = time.perf_counter() - t0
-            self.timings = t
-            return self.system
-        F = F + F_flux
+        self._timer = StageTimer()
+        t = self._timer
+        with t("pattern"):
+            pattern = SparsityPattern.for_mesh(self.mesh)
+        with t("stiffness"):
+            K = assemble_stiffness(self.mesh, self.kappa, pattern=pattern)
+        with t("load"):
+            F = assemble_load(self.mesh, self.f, rule=self.load_rule)
+        with t("neumann"):
+            F_flux = np.zeros(self.mesh.n_points)
+            for tags, h in self.neumann:
+                F_flux += assemble_neumann(self.mesh, tags, h)
+        self.neumann_load = F_flux
+        return K, F + F_flux
+
+    def dirichlet_data(self) -> tuple[np.ndarray, np.ndarray]:
+        """Dirichlet nodes (sorted) and their values; a later entry wins on shared nodes."""
         g = np.full(self.mesh.n_points, np.nan)
         for tags, value in self.dirichlet:
-            nodes = _boundary_nodes(self.mesh, tags)
+            nodes = boundary_nodes(self.mesh, tags)
             g[nodes] = dirichlet_values(self.mesh, nodes, value)
         fixed = np.flatnonzero(~np.isnan(g))
-        self.system = apply_dirichlet(K, F, fixed, g[fixed])
-        t["dirichlet"] = time.perf_counter() - t0
-        self.timings = t
+        return fixed, g[fixed]
+
+    def reduce(self, K, F, method: str = "direct") -> DirichletSystem | NullspaceSystem:
+        """The system a solver gets: Dirichlet nodes eliminated (SPD), or, pure Neumann, the
+        compatibility checked and the constant fixed (:func:`pure_neumann_system`; ``method``
+        says whether a direct solver will be used)."""
+        with self._timer("dirichlet"):
+            if self.nullspace is not None:
+                w = node_weights(self.mesh)
+                F_flux = getattr(self, "neumann_load", np.zeros_like(F))
+                F, info = check_compatibility(F - F_flux, F_flux, weights=w,
+                                              rtol=self.compatibility_rtol)
+                self.system = pure_neumann_system(K, F, mode=self.nullspace, weights=w, method=method,
+                                                  pin_node=self.pin_node, pin_value=self.pin_value,
+                                                  compatibility=info)
+            else:
+                fixed, values = self.dirichlet_data()
+                self.system = apply_dirichlet(K, F, fixed, values)
         return self.system
 
-    def solve(self, method: str = "direct", preconditioner=None, **solver_opts) -> PoissonSolution:
+    def assemble(self, method: str = "direct") -> DirichletSystem | NullspaceSystem:
+        """:meth:`assemble_matrices` then :meth:`reduce`; stage times in ``timings``."""
+        return self.reduce(*self.assemble_matrices(), method=method)
+
+    def solve(self, method="direct", preconditioner=None, **solver_opts) -> PoissonSolution:
         """Assemble (if not done) and solve; returns ``(u, SolveResult)``.
 
-        ``method``, ``preconditioner`` and ``solver_opts`` (rtol, atol, maxiter, ...) go to
-        :func:`femkit.solvers.solve`.
+        ``method`` is a solver name or a :class:`~femkit.solvers.SolverSpec`; a name goes with
+        ``preconditioner`` and ``solver_opts`` (rtol, atol, maxiter, ...) to
+        :func:`femkit.solvers.solve`, a spec is used as it is (``solver_opts`` override its
+        stopping rule).
         """
+        from ..solvers import SolverSpec, solve
+
+        name = method.method if isinstance(method, SolverSpec) else method
         system = self.system
         if system is None or (isinstance(system, NullspaceSystem)
-                              and system.bordered != (method == "direct" and system.mode == "mean_zero")):
-            system = self.assemble(method)  # bordered only for a direct mean-zero solve
-        t0 = time.perf_counter()
-        result = _solve(system.A, system.b, method=method, preconditioner=preconditioner, **solver_opts)
-        self.timings["solve"] = time.perf_counter() - t0
+                              and system.bordered != (name == "direct" and system.mode == "mean_zero")):
+            system = self.assemble(name)  # bordered only for a direct mean-zero solve
+        with self._timer("solve"):
+            if isinstance(method, SolverSpec):
+                result = method.solve(system.A, system.b, **solver_opts)
+            else:
+                result = solve(system.A, system.b, method=method, preconditioner=preconditioner,
+                               **solver_opts)
         return PoissonSolution(system.expand(result.x), result)
 
+    def errors(self, u: np.ndarray, exact: Callable, grad_exact: Callable | None = None, *,
+               order: int = 5) -> dict:
+        """L2 / H1-seminorm / max-nodal errors of ``u`` (:func:`femkit.fem.error_norms`).
 
-def _boundary_nodes(mesh, tags) -> np.ndarray:
-    try:
-        from ..mesh import boundary_nodes
-    except ImportError:  # pragma: no cover - mesh package without it
-        boundary_nodes = _boundary_nodes_fallback
-    return boundary_nodes(mesh, tags)
+        Pure Neumann: modulo the constant, i.e. of ``u - c`` with ``int (u - c - exact) = 0``
+        (:func:`mean_shift`).
+        """
+        from .norms import error_norms
 
+        if self.nullspace is not None:
+            u = u - mean_shift(self.mesh, u, exact, order=order)
+        errs = error_norms(self.mesh, u, exact, grad_exact, order=order)
+        return {k: (None if v is None else float(v)) for k, v in errs.items()}
 
-def _boundary_nodes_fallback(mesh, tags) -> np.ndarray:
-    if tags is None:
-        tri = mesh.triangles
-        e = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
-        uniq, counts = np.unique(e, axis=0, return_counts=True)
-        return np.unique(uniq[counts == 1])
-    from .neumann import tagged_edges
-
-    return np.unique(tagged_edges(mesh, tags))
-
-
-def _solve(A, b, *, method, preconditioner, **opts):
-    try:
-        from ..solvers import solve
-    except ImportError:  # pragma: no cover - solver layer absent
-        solve = None
-    if solve is not None:
-        return solve(A, b, method=method, preconditioner=preconditioner, **opts)
-    from scipy.sparse.linalg import spsolve  # pragma: no cover
-
-    from ..solvers.result import SolveResult  # pragma: no cover
-
-    x = spsolve(A.tocsc(), b)  # pragma: no cover
-    res = float(np.linalg.norm(b - A @ x))  # pragma: no cover
-    return SolveResult(x=x, converged=True, iterations=0, residuals=np.array([res]), reason="direct",
-                       true_residual=res, rhs_norm=float(np.linalg.norm(b)), method="direct")  # pragma: no cover

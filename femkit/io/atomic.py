@@ -30,6 +30,12 @@ __all__ = ["atomic_write_text", "atomic_write_bytes", "atomic_path", "atomic_dir
            "check_output_dir"]
 
 
+#: Files that mark a directory as an earlier femkit output of each kind (a run of a case or a
+#: scene; a study report): :func:`check_output_dir` lets a new output of the same kind replace it.
+EARLIER_RUN = ("result.json",)
+EARLIER_REPORT = ("results.json", "report.md")
+
+
 def _fsync_dir(path: Path) -> None:
     try:
         fd = os.open(path, os.O_RDONLY)

@@ -20,7 +20,7 @@ Tag conventions (names go to :attr:`Mesh.tag_names`):
   triangle carries exactly one cell tag).
 * Tag numbers are unique across edge and cell groups of a generated mesh.
 
-Generated meshes are deterministic: one gmsh thread, fixed algorithm, no random reseeding
+Generated meshes are deterministic: one gmsh thread, fixed algorithm, no random restarts
 between runs; triangles are counter-clockwise.
 """
 

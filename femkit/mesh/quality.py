@@ -27,7 +27,7 @@ def quality(mesh: Mesh) -> dict:
         equilateral triangle, infinite for a degenerate one;
         ``area`` (total area).
     """
-    from .refine import edges
+    from .edges import edges
 
     p = mesh.points[mesh.triangles]                      # (m, 3, 2)
     e = p[:, [2, 0, 1]] - p[:, [1, 2, 0]]                # edge opposite vertex k

@@ -19,11 +19,13 @@ from .pcg import pcg
 from .preconditioners.base import Preconditioner
 from .registry import (PRECONDITIONERS, SOLVERS, get_preconditioner, get_solver, solve)
 from .result import REASONS, SolveResult
+from .spec import SolverSpec
 from .steepest_descent import steepest_descent
 
 __all__ = [
-    "PRECONDITIONERS", "SOLVERS", "REASONS", "CholeskyFactor", "Factor", "FemkitBackend", "LinearSolverBackend",
-    "Preconditioner", "SolveResult", "cg", "cholesky", "direct", "factorize_spd",
+    "PRECONDITIONERS", "SOLVERS", "REASONS", "CholeskyFactor", "Factor", "FemkitBackend",
+    "LinearSolverBackend", "Preconditioner", "SolveResult", "SolverSpec", "cg", "cholesky",
+    "direct", "factorize_spd",
     "factorize", "get_preconditioner", "get_solver", "jacobi", "pcg", "solve",
     "steepest_descent",
 ]

@@ -14,6 +14,8 @@ still recompute the true residual at exit and set ``converged`` from it.
 
 from __future__ import annotations
 
+from .defaults import DEFAULT_RTOL
+
 from typing import Callable, Protocol, runtime_checkable
 
 import numpy as np
@@ -36,7 +38,7 @@ class LinearSolverBackend(Protocol):
         ...
 
     def solve(self, A, b: np.ndarray, x0: np.ndarray | None = None, *, method: str = "pcg",
-              preconditioner: str | None = None, rtol: float = 1e-8, atol: float = 0.0,
+              preconditioner: str | None = None, rtol: float = DEFAULT_RTOL, atol: float = 0.0,
               maxiter: int | None = None, callback: Callable | None = None,
               **options) -> SolveResult:
         """Same contract as :func:`femkit.solvers.solve`; unknown names raise

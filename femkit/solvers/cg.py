@@ -1,4 +1,4 @@
-"""Conjugate gradients (the seed's CG, section 4), the documented entry for unpreconditioned CG.
+"""Conjugate gradients (Hestenes & Stiefel 1952; Saad 2003, algorithm 6.18), the documented entry for unpreconditioned CG.
 
 It shares the loop of :mod:`femkit.solvers.pcg` with ``z = r`` (no preconditioner copy),
 so both carry the same checks: symmetry once, ``p^T A p > 0`` every iteration, non-finite
@@ -7,11 +7,13 @@ values, stagnation, and the true residual at exit.
 
 from __future__ import annotations
 
+from .defaults import DEFAULT_RTOL
+
 from .pcg import pcg
 from .result import SolveResult
 
 
-def cg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | None = None,
+def cg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
        M=None, callback=None, check_symmetry: bool = True,
        stagnation_window: int | None = None,
        raise_on_breakdown: bool = False) -> SolveResult:

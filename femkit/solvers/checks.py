@@ -16,6 +16,8 @@ silently running to ``maxiter``.
 
 from __future__ import annotations
 
+from .defaults import DEFAULT_RTOL
+
 import time
 from dataclasses import dataclass
 from typing import Any, Callable
@@ -217,7 +219,7 @@ def check_positive_diagonal(d: np.ndarray, *, what: str) -> None:
         )
 
 
-def prepare(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter=None,
+def prepare(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter=None,
             method: str, symmetric: bool = False, check_symmetry: bool = True,
             default_maxiter_factor: int = 10) -> Problem:
     """Validate a system and return a :class:`Problem` (``x`` is a fresh float64 copy)."""

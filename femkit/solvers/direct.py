@@ -19,6 +19,8 @@ Time-stepping code factors once and reuses the factor::
 
 from __future__ import annotations
 
+from .defaults import DEFAULT_RTOL
+
 import time
 
 import numpy as np
@@ -148,7 +150,7 @@ def superlu_factor(A, *, symmetric: bool | None = None, permc_spec: str | None =
     return Factor(lu, Ac.shape, bool(spd), dt, info)
 
 
-def direct(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter=None, M=None,
+def direct(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter=None, M=None,
            callback=None, factorization: Factor | None = None,
            spd: bool | None = None) -> SolveResult:
     """Solve ``A x = b`` with a sparse LU factorisation (see :func:`factorize`).

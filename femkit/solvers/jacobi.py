@@ -1,13 +1,15 @@
-"""Weighted Jacobi iteration (the seed's section 4.1), vectorised.
+"""Weighted Jacobi iteration (Saad 2003, *Iterative Methods for Sparse Linear Systems*, section 4.1), vectorised.
 
 ``x_{k+1} = x_k + omega D^-1 r_k`` with ``r_k = b - A x_k`` and ``D = diag(A)``; ``omega = 1``
-is the seed's classical Jacobi. It converges for strictly diagonally dominant matrices,
+is the classical Jacobi iteration. It converges for strictly diagonally dominant matrices,
 and for SPD ``A`` exactly when ``0 < omega < 2 / lambda_max(D^-1 A)`` (``omega = 2/3`` is the
 classical smoothing weight). A divergent iteration stops with ``reason="non-finite"``
 (returning the last finite iterate) or ``"maxiter"``, never a silent NaN.
 """
 
 from __future__ import annotations
+
+from .defaults import DEFAULT_RTOL
 
 import math
 import numbers
@@ -20,7 +22,7 @@ from .checks import (as_apply, check_positive_diagonal, diagonal_of, finish,
 from .result import SolveResult
 
 
-def jacobi(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | None = None,
+def jacobi(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
            M=None, callback=None, omega: float = 1.0, diagonal=None) -> SolveResult:
     """Weighted Jacobi: ``x += omega D^-1 (b - A x)`` until ``||b - A x|| <= max(rtol ||b||, atol)``.
 

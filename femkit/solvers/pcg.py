@@ -1,4 +1,4 @@
-"""Preconditioned conjugate gradients (the seed's CG with ``M ~ A^-1``), vectorised.
+"""Preconditioned conjugate gradients (Saad 2003, algorithm 9.1, with ``M ~ A^-1``), vectorised.
 
 Iteration (Saad, Alg. 9.1), ``z = M r``::
 
@@ -14,6 +14,8 @@ updates, with no temporaries for the vector updates.
 """
 
 from __future__ import annotations
+
+from .defaults import DEFAULT_RTOL
 
 import math
 from typing import Callable
@@ -143,7 +145,7 @@ def _stop(prob, k, residuals, reason, message, method, raise_on_breakdown, err, 
                   method=method, recursive_met=recursive_met)
 
 
-def pcg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | None = None,
+def pcg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
         M=None, callback=None, check_symmetry: bool = True,
         stagnation_window: int | None = None,
         raise_on_breakdown: bool = False) -> SolveResult:

@@ -9,6 +9,8 @@ this module imports neither pyamg nor numba.
 
 from __future__ import annotations
 
+from .defaults import DEFAULT_RTOL, default_preconditioner
+
 import time
 from typing import Callable
 
@@ -51,8 +53,6 @@ PRECONDITIONERS.register("amg_sa", _amg.build_sa)
 PRECONDITIONERS.register("amg_rs", _amg.build_rs)
 PRECONDITIONERS.register("amg", _amg.build)
 
-#: Preconditioner used by ``solve(method="pcg")`` when none is named.
-DEFAULT_PRECONDITIONER = "amg"
 
 
 def get_solver(name: str) -> Callable[..., SolveResult]:
@@ -66,7 +66,7 @@ def get_preconditioner(name: str) -> Callable:
 
 
 def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = None,
-          rtol: float = 1e-8, atol: float = 0.0, maxiter: int | None = None, callback=None,
+          rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None, callback=None,
           preconditioner_options: dict | None = None, **options) -> SolveResult:
     """Solve ``A x = b`` with a registered method and preconditioner, by name.
 
@@ -81,7 +81,7 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
         A name in :data:`SOLVERS`.
     preconditioner : str, optional
         A name in :data:`PRECONDITIONERS`; only valid with ``method="pcg"``. ``None`` means
-        :data:`DEFAULT_PRECONDITIONER` (``"amg"``) for ``pcg`` and nothing for the others.
+        ``amg`` for ``pcg`` and nothing for the others (:mod:`femkit.solvers.defaults`).
         A preconditioner object/callable may be passed instead of a name (``pcg`` only).
     rtol, atol, maxiter, callback
         As in every method.
@@ -121,7 +121,7 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
         pc_name = getattr(M, "name", type(M).__name__)
     else:
         if preconditioner is None:
-            preconditioner = DEFAULT_PRECONDITIONER if method == "pcg" else "none"
+            preconditioner = default_preconditioner(method)
         factory = PRECONDITIONERS.get(preconditioner)
         if preconditioner != "none" and method != "pcg":
             raise InputError(
@@ -144,7 +144,7 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     elapsed = time.perf_counter() - t0
     res.method = method
     res.preconditioner = pc_name
-    if method in ("direct", "cholesky"):
+    if method in ("direct", "cholesky"):  # the factorisation time is the method's own setup_time
         res.solve_time = elapsed - res.setup_time
     else:
         res.setup_time = setup

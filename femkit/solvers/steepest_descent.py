@@ -1,4 +1,4 @@
-"""Steepest descent (the seed's "steepest gradient method"), vectorised.
+"""Steepest descent (Saad 2003, section 5.3.1), vectorised.
 
 For SPD ``A``: ``r = b - A x``, ``alpha = (r, z) / (z, A z)`` with ``z = M r`` (``z = r``
 without preconditioner), ``x += alpha z``, ``r -= alpha A z``. One product per iteration;
@@ -6,6 +6,8 @@ the residual is recursive, re-checked against the true residual at exit.
 """
 
 from __future__ import annotations
+
+from .defaults import DEFAULT_RTOL
 
 import math
 
@@ -17,7 +19,7 @@ from .checks import (as_apply, finish, nonfinite_initial_residual, prepare, reco
 from .result import SolveResult
 
 
-def steepest_descent(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0,
+def steepest_descent(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0,
                      maxiter: int | None = None, M=None, callback=None,
                      check_symmetry: bool = True) -> SolveResult:
     """Steepest descent for SPD ``A`` until ``||b - A x|| <= max(rtol ||b||, atol)``.

@@ -24,7 +24,7 @@ __all__ = ["fingerprint"]
 
 def fingerprint(paths: Iterable[str | os.PathLike], *, extra: dict | None = None) -> str:
     """SHA-256 over the bytes of ``paths`` (in the given order), ``extra`` (JSON) and femkit's version."""
-    from .. import __version__
+    from .._version import __version__
 
     h = hashlib.sha256()
     h.update(f"femkit {__version__}\n".encode())

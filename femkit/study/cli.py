@@ -38,11 +38,6 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
-def _r2(r2) -> str:
-    """``R^2 0.9998``, or ``2 points, no R^2`` for a two-point fit (None / nan)."""
-    return "2 points, no R^2" if r2 is None or r2 != r2 else f"R^2 {r2:.4f}"
-
-
 def cli_main(args) -> int:
     """Run ``femkit study``; ``args`` is a namespace from :func:`add_parser` or a list of strings."""
     if not isinstance(args, argparse.Namespace):
@@ -61,16 +56,10 @@ def cli_main(args) -> int:
         print(f"femkit study: error: {exc}", file=sys.stderr)
         return 2
     print(f"{study.kind} '{study.name}': {len(result.records)} runs in {result.elapsed:.1f} s")
-    if study.kind == "poisson_convergence":  # one line per group of solvers with the same fit, like the report
-        from .report_poisson import grouped_rate_rows
+    from .kinds import STUDY_KINDS
 
-        for who, rule, norm, slope, _, r2, *_ in grouped_rate_rows(result.fits):
-            print(f"  rate {who} / {rule} / {norm}: {slope:.3f} ({_r2(r2)})")
-    else:
-        for f in result.fits[:12]:
-            what = " / ".join(str(f[k]) for k in ("solver", "integrator", "quadrature", "norm", "error") if k in f)
-            extra = f", dt {max(f['dt_used']):.3g}..{min(f['dt_used']):.3g}" if f.get("dt_used") else ""
-            print(f"  rate {what}: {f['slope']:.3f} ({_r2(f['r2'])}{extra})")
+    for line in STUDY_KINDS.get(study.kind).summary(result):
+        print(f"  {line}")
     for line in result.notes:
         print(f"  note: {line}")
     print(f"report: {result.output_dir / 'report.html'}")

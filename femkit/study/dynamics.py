@@ -27,14 +27,6 @@ from .progress import progress
 from .timing import time_call
 
 
-def integrator_spec(item) -> tuple[str, dict, str]:
-    if isinstance(item, str):
-        return item, {}, item
-    opts = dict(item.get("options") or {})
-    label = item.get("label") or (item["name"] + ("" if not opts else " " + ",".join(f"{k}={v}" for k, v in opts.items())))
-    return item["name"], opts, label
-
-
 def build_scene(scene: dict):
     """(system, x0, v0, exact) with ``exact(times) -> (m, n, d)`` positions or None."""
     from ..dynamics import rope, single_spring
@@ -112,7 +104,7 @@ def run_dynamics_study(study, *, progress_enabled=None) -> dict:
                                 "wall_time": rtraj.wall_time, "error_estimate": ref_error}]
     free = ~system.pinned
     records, energy_series = [], {}
-    integrators = [integrator_spec(i) for i in d["integrators"]]
+    integrators = [(i.method, i.options, i.label) for i in study.integrators]
     if d["warmup"]:
         for name, opts, _ in integrators:
             try:

@@ -18,6 +18,8 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
+from ..io.figures import new_figure, save_figure
+
 __all__ = ["StyleBook", "REFERENCE_STYLE", "loglog_figure", "work_precision_figure", "energy_figure",
            "stability_map_figure"]
 
@@ -80,19 +82,11 @@ class StyleBook:
 
 
 def _figure(width: float = 7.0, height: float = 5.0):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
+    return new_figure(width, height, dpi=DPI, layout="constrained")
 
 
 def _save(fig, path) -> str:
-    path = os.fspath(path)
-    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
-    fig.savefig(path, dpi=DPI)
-    return path
+    return os.fspath(save_figure(fig, path, dpi=DPI))
 
 
 def _positive(x, y):

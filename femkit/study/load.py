@@ -22,9 +22,10 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import CaseFileError
-from .schema import KINDS, schema_for
+from .kinds import STUDY_KINDS
+from .schema import schema_for
 
-__all__ = ["Study", "load_study", "study_from_dict", "KINDS"]
+__all__ = ["Study", "load_study", "study_from_dict", "STUDY_KINDS"]
 
 
 @dataclass
@@ -46,6 +47,10 @@ class Study:
         Whether the ``quick:`` block was applied.
     files : list of Path
         Every input file the study reads (for the fingerprint).
+    solvers : list of SolverSpec
+        ``solvers:`` validated once (names, options, defaults from the one table).
+    integrators : list of IntegratorSpec
+        ``integrators:`` validated once.
     """
 
     kind: str
@@ -55,6 +60,8 @@ class Study:
     path: Path | None = None
     quick: bool = False
     files: list = field(default_factory=list)
+    solvers: list = field(default_factory=list)
+    integrators: list = field(default_factory=list)
 
     @property
     def title(self) -> str:
@@ -88,9 +95,10 @@ def study_from_dict(data: Mapping, base_dir: str | os.PathLike = ".", *, name: s
         raise CaseFileError(f"a study file must be a mapping of keys, got {type(data).__name__}")
     kind = data.get("kind")
     if kind is None:
-        raise CaseFileError(f"(top level): missing required key 'kind'; valid kinds: {', '.join(sorted(KINDS))}")
-    if kind not in KINDS:
-        raise CaseFileError(f"kind: unknown study kind {kind!r}; valid kinds: {', '.join(sorted(KINDS))}")
+        raise CaseFileError("(top level): missing required key 'kind'; valid kinds: "
+                            + ", ".join(STUDY_KINDS.names()))
+    if kind not in STUDY_KINDS:
+        raise CaseFileError(f"kind: unknown study kind {kind!r}; valid kinds: {', '.join(STUDY_KINDS.names())}")
     schema = schema_for(kind)
     validate_against(dict(data), schema)
     merged = dict(data)
@@ -107,46 +115,16 @@ def study_from_dict(data: Mapping, base_dir: str | os.PathLike = ".", *, name: s
     return study
 
 
-def _check_solver_names(solvers) -> None:
-    """Unknown solver or preconditioner names fail here, before any run (not as FAIL rows)."""
-    from ..solvers.registry import PRECONDITIONERS, SOLVERS
-
-    for s in solvers or ():
-        SOLVERS.get(s["method"])
-        if s.get("preconditioner") is not None:
-            PRECONDITIONERS.get(s["preconditioner"])
-
-
 def _check_kind(study: Study) -> None:
+    """Build the solver and integrator specs once (unknown names fail here, before any run),
+    then the kind's own checks."""
+    from ..case.specs import IntegratorSpec, solver_spec
+
     d = study.data
-    if study.kind in ("poisson_convergence", "stability"):
-        _check_solver_names(d.get("solvers"))
-    if study.kind == "poisson_convergence":
-        if ("problem" in d) == ("base_case" in d):
-            raise CaseFileError("poisson_convergence: give exactly one of 'problem' (inline) or 'base_case' (a case file)")
-        lv = d.get("levels") or {}
-        if "h" not in lv and not ("h0" in lv and "count" in lv):
-            raise CaseFileError("levels: give either 'h' (a list of mesh sizes) or 'h0' and 'count' "
-                                "(uniform refinements of one mesh)")
-        if "base_case" in d:
-            p = study.resolve(d["base_case"])
-            if not p.is_file():
-                raise CaseFileError(f"base_case: file not found: {p}")
-            study.files.append(p)
-    elif study.kind == "dynamics_work_precision":
-        for key in ("scene", "integrators", "dt"):
-            if key not in d:
-                raise CaseFileError(f"(top level): missing required key {key!r}")
-        dt = d["dt"]
-        if "values" not in dt and not ("k_min" in dt and "k_max" in dt and dt["k_max"] > dt["k_min"]):
-            raise CaseFileError("dt: give 'values' or 'k_min' < 'k_max' (dt = 2^-k)")
-    elif study.kind == "stability":
-        for i, c in enumerate(d["cases"]):
-            if isinstance(c, str):
-                p = study.resolve(c)
-                if not p.is_file():
-                    raise CaseFileError(f"cases[{i}]: stress case file not found: {p}")
-                study.files.append(p)
+    study.solvers = [solver_spec(s, f"solvers[{i}]") for i, s in enumerate(d.get("solvers") or ())]
+    study.integrators = [IntegratorSpec.from_mapping(s, f"integrators[{i}]")
+                         for i, s in enumerate(d.get("integrators") or ())]
+    STUDY_KINDS.get(study.kind).check(study)
 
 
 def load_study(path: str | os.PathLike, *, quick: bool = False, **overrides: Any) -> Study:

@@ -13,7 +13,6 @@ adds nested-iteration runs (see :func:`_nested_runs`).
 
 from __future__ import annotations
 
-import time
 
 import numpy as np
 
@@ -22,76 +21,44 @@ from .progress import progress
 from .timing import StageTimer, time_call
 
 
-def solver_label(s: dict) -> str:
-    if s.get("label"):
-        return s["label"]
-    pc = s.get("preconditioner")
-    return s["method"] if not pc or pc == "none" else f"{s['method']}+{pc}"
-
-
 def _meshes(study, spec, timer_list):
-    """The mesh levels: uniform refinements of one mesh, or one gmsh mesh per h."""
+    """The mesh levels: uniform refinements of one mesh, or one gmsh mesh per h; the time of
+    each level is appended to ``timer_list``."""
     from ..mesh import refine
 
     lv = study.data["levels"]
     meshes = []
+    timer = StageTimer()
+
+    def timed(level, make):
+        with timer(level):
+            meshes.append(make())
+        timer_list.append(timer.times[level])
+
     if "h" in lv:
         hs = list(lv["h"])
         if "max_level" in lv:
             hs = hs[: lv["max_level"] + 1]
-        for h in hs:
-            t0 = time.perf_counter()
-            meshes.append(spec.base_mesh(h))
-            timer_list.append(time.perf_counter() - t0)
+        for i, h in enumerate(hs):
+            timed(i, lambda h=h: spec.base_mesh(h))
     else:
         count = lv["count"] if "max_level" not in lv else min(lv["count"], lv["max_level"] + 1)
-        t0 = time.perf_counter()
-        m = spec.base_mesh(lv["h0"])
-        timer_list.append(time.perf_counter() - t0)
-        meshes.append(m)
-        for _ in range(count - 1):
-            t0 = time.perf_counter()
-            m = refine(m, 1)
-            timer_list.append(time.perf_counter() - t0)
-            meshes.append(m)
+        timed(0, lambda: spec.base_mesh(lv["h0"]))
+        for i in range(1, count):
+            timed(i, lambda: refine(meshes[-1], 1))
     return meshes
 
 
 def _assemble(spec, mesh, rule):
-    from ..fem import assemble_load, assemble_stiffness
-
-    kappa = spec.kappa_elements(mesh)
-    K = assemble_stiffness(mesh, kappa)
-    F = assemble_load(mesh, spec.source, rule=rule)
-    if spec.neumann is not None:
-        F = F + spec.neumann(mesh)
-    return K, F
-
-
-def _boundary(spec, mesh, K, F):
-    from ..fem import apply_dirichlet
-
-    nodes, vals = spec.dirichlet(mesh)
-    return apply_dirichlet(K, F, nodes, vals)
-
-
-def _errors(spec, mesh, u, order):
-    from ..fem import error_norms
-
-    return error_norms(mesh, u, spec.exact, spec.grad_exact, order=order)
+    """The level's PoissonProblem (the one pipeline) and its K, F."""
+    problem = spec.problem(mesh, rule)
+    K, F = problem.assemble_matrices()
+    return problem, K, F
 
 
 def _solve(sys, s, x0=None, atol=None):
-    from ..solvers import solve
-
-    kw = {"method": s["method"], "rtol": s.get("rtol", 1e-10), "atol": s.get("atol", 0.0) if atol is None else atol}
-    if s["method"] == "pcg":
-        kw["preconditioner"] = s.get("preconditioner") or "amg"
-    elif s.get("preconditioner") not in (None, "none"):
-        kw["preconditioner"] = s["preconditioner"]
-    if s.get("maxiter"):
-        kw["maxiter"] = s["maxiter"]
-    return solve(sys.A, sys.b, x0, **kw)
+    """Solve with a :class:`~femkit.solvers.SolverSpec` (``atol`` overrides the spec's)."""
+    return s.solve(sys.A, sys.b, x0, **({} if atol is None else {"atol": atol}))
 
 
 def interpolate_nested(coarse, fine, u_coarse: np.ndarray) -> np.ndarray:
@@ -117,8 +84,7 @@ def _record(level, mesh, sys, rule, label, s, res, errs, times, *, source="femki
     rec = {
         "source": source, "mode": mode, "level": level, "h": float(h), "nodes": mesh.n_points,
         "elements": mesh.n_triangles, "dofs": int(sys.A.shape[0]), "nnz": int(sys.A.nnz),
-        "quadrature": rule, "solver": label, "method": s.get("method"),
-        "preconditioner": s.get("preconditioner") or ("amg" if s.get("method") == "pcg" else "none"),
+        "quadrature": rule, "solver": label, "method": s["method"], "preconditioner": s["preconditioner"],
         "converged": bool(res.converged), "iterations": int(res.iterations),
         "true_residual": float(res.true_residual), "relative_residual": float(res.relative_residual),
         "L2": errs["L2"], "H1_semi": errs["H1_semi"], "max_nodal": errs["max_nodal"],
@@ -136,8 +102,9 @@ def _skfem_run(spec, mesh, rtol, repeats):
     import skfem
     from skfem.helpers import dot, grad
 
-    kappa = spec.kappa_elements(mesh)
-    f = spec.source
+    problem = spec.problem(mesh)
+    kappa = problem.kappa
+    f = spec.case.functions["source"]
 
     @skfem.BilinearForm
     def a(u, v, w):
@@ -155,7 +122,7 @@ def _skfem_run(spec, mesh, rtol, repeats):
 
     ta = time_call(assemble, repeats=repeats, warmup=0)
     K, F = ta.value
-    nodes, vals = spec.dirichlet(mesh)
+    nodes, vals = problem.dirichlet_data()
     x = np.zeros(mesh.n_points)
     x[nodes] = vals
     tb = time_call(lambda: skfem.condense(K, F, x=x, D=nodes), repeats=repeats, warmup=0)
@@ -188,20 +155,20 @@ class _Res:  # minimal SolveResult stand-in for the reference rows
 
 def run_poisson_study(study, *, progress_enabled=None) -> dict:
     """Run the sweep; return ``{"records", "fits", "nested", "meshes", "notes"}``."""
-    from .problem import case_spec, inline_spec
+    from .problem import study_problem
 
     d = study.data
-    spec = inline_spec(d["problem"]) if "problem" in d else case_spec(study.resolve(d["base_case"]))
+    spec = study_problem(study)
     repeats, warmup, order = d["repeats"], d["warmup"], d["error_order"]
     mesh_times: list[float] = []
     meshes = _meshes(study, spec, mesh_times)
-    rules, solvers = d["quadrature"], d["solvers"]
+    rules, solvers = d["quadrature"], study.solvers
     notes = []
     if warmup:
         # untimed pass on the coarsest mesh: imports, numba compilation, pyamg import
         for rule in rules:
-            K, F = _assemble(spec, meshes[0], rule)
-            sys0 = _boundary(spec, meshes[0], K, F)
+            prob0, K, F = _assemble(spec, meshes[0], rule)
+            sys0 = prob0.reduce(K, F, "pcg")
             for s in solvers:
                 _solve(sys0, s)
     records = []
@@ -209,28 +176,28 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
     for lvl, rule in progress(jobs, total=len(jobs), desc=f"{study.name}", enabled=progress_enabled):
         mesh = meshes[lvl]
         ta = time_call(lambda: _assemble(spec, mesh, rule), repeats=repeats, warmup=0)
-        K, F = ta.value
-        tb = time_call(lambda: _boundary(spec, mesh, K, F), repeats=repeats, warmup=0)
+        prob, K, F = ta.value
+        tb = time_call(lambda: prob.reduce(K, F, "pcg"), repeats=repeats, warmup=0)
         sys = tb.value
         for s in solvers:
             ts = time_call(lambda: _solve(sys, s), repeats=repeats, warmup=0)
             res = ts.value
             timer = StageTimer()
             with timer("errors"):
-                errs = _errors(spec, mesh, sys.expand(res.x), order)
+                errs = spec.errors(prob, sys.expand(res.x), order)
             times = {"mesh": mesh_times[lvl], "assembly": ta.min, "boundary": tb.min,
                      "solve": ts.min, "errors": timer.times["errors"]}
-            records.append(_record(lvl, mesh, sys, rule, solver_label(s), s, res, errs, times))
+            records.append(_record(lvl, mesh, sys, rule, s.label, s.to_dict(), res, errs, times))
     if d["reference"] == "scikit-fem":
-        if spec.neumann is not None:
+        if spec.has_neumann:
             notes.append("scikit-fem reference skipped: the base case has Neumann boundaries.")
         else:
-            rtol = solvers[0].get("rtol", 1e-10)
+            rtol = solvers[0].rtol
             if warmup:  # untimed: skfem's and pyamg's first calls are ~2x slower than the next ones
                 _skfem_run(spec, meshes[0], rtol, 1)
             for lvl, mesh in enumerate(meshes):
                 u, iters, relres, conv, times, A = _skfem_run(spec, mesh, rtol, repeats)
-                errs = _errors(spec, mesh, u, order)
+                errs = spec.errors(spec.problem(mesh), u, order)
                 times["mesh"] = mesh_times[lvl]
                 sys_like = type("S", (), {"A": A})()
                 s = {"method": "cg", "preconditioner": "pyamg_sa"}
@@ -254,10 +221,10 @@ def _energy_norm(A, d) -> float:
     return float(np.sqrt(max(float(d @ (A @ d)), 0.0)))
 
 
-def cg_history(A, b, x0, s: dict) -> dict:
+def cg_history(A, b, x0, s) -> dict:
     """Untimed analysis pass of (P)CG: the coefficients a stopping test on the error needs.
 
-    Runs femkit's solver with a callback (which receives only the iterate ``x_k``) and recovers
+    ``s`` is a :class:`~femkit.solvers.SolverSpec`. Runs femkit's solver with a callback (which receives only the iterate ``x_k``) and recovers
     per iteration, from one matrix-vector product and one preconditioner application,
     ``rz[k] = r_k^T z_k`` (``z = M^-1 r``; ``z = r`` for CG) and
     ``inc[k] = ||x_{k+1} - x_k||_A^2 = alpha_k r_k^T z_k`` (the Hestenes-Stiefel terms;
@@ -266,9 +233,9 @@ def cg_history(A, b, x0, s: dict) -> dict:
     from ..solvers import get_preconditioner, solve
 
     M = None
-    kw = {k: v for k, v in s.items() if k in ("rtol", "atol", "maxiter")}
-    if s["method"] == "pcg":
-        M = get_preconditioner(s.get("preconditioner") or "amg")(A)
+    kw = dict(rtol=s.rtol, atol=s.atol, maxiter=s.maxiter)
+    if s.method == "pcg":
+        M = get_preconditioner(s.preconditioner)(A, **s.preconditioner_options)
         kw["preconditioner"] = M
     x_prev = [np.array(x0, dtype=float, copy=True)]
     r_prev = [b - A @ x_prev[0]]
@@ -284,7 +251,7 @@ def cg_history(A, b, x0, s: dict) -> dict:
         x_prev[0] = np.array(xk, copy=True)
         r_prev[0] = r
 
-    solve(A, b, np.array(x0, dtype=float, copy=True), method=s["method"], callback=cb, **kw)
+    solve(A, b, np.array(x0, dtype=float, copy=True), method=s.method, callback=cb, **kw)
     rz_a, inc_a = np.array(rz), np.array(inc)
     return {"rz": rz_a, "inc": inc_a, "alpha": inc_a / np.maximum(rz_a[:-1], 1e-300)}
 
@@ -298,7 +265,8 @@ def smallest_ritz_value(alpha: np.ndarray, rz: np.ndarray) -> float:
 
     >>> import numpy as np, scipy.sparse as sp
     >>> A = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(30, 30)).tocsr()
-    >>> h = cg_history(A, np.ones(30), np.zeros(30), {"method": "cg", "rtol": 1e-12})
+    >>> from femkit.solvers import SolverSpec
+    >>> h = cg_history(A, np.ones(30), np.zeros(30), SolverSpec.from_mapping({"method": "cg", "rtol": 1e-12}))
     >>> lam = 2 - 2 * np.cos(np.pi / 31)     # exact smallest eigenvalue
     >>> bool(abs(smallest_ritz_value(h["alpha"], h["rz"]) / lam - 1) < 1e-6)
     True
@@ -371,15 +339,16 @@ def _nested_runs(study, spec, meshes, mesh_times, records):
     frac = d["stop_at_discretisation_error"]["fraction"]
     rule = d["quadrature"][0]
     out = []
-    systems, exact = [], []
+    systems, exact, problems = [], [], []
     for mesh in meshes:
-        K, F = _assemble(spec, mesh, rule)
-        systems.append(_boundary(spec, mesh, K, F))
+        prob, K, F = _assemble(spec, mesh, rule)
+        problems.append(prob)
+        systems.append(prob.reduce(K, F, "pcg"))
         exact.append(_solve_raw(systems[-1].A, systems[-1].b, method="direct").x)
-    for s in d["solvers"]:
-        if s["method"] not in ("cg", "pcg"):
+    for s in study.solvers:
+        if s.method not in ("cg", "pcg"):
             continue
-        label = solver_label(s)
+        label = s.label
         prev = None
         lam0 = h0 = None
         for lvl, mesh in enumerate(meshes):
@@ -399,14 +368,14 @@ def _nested_runs(study, spec, meshes, mesh_times, records):
                 stop, U, eta = stop_iteration(hist, mu, frac)
                 if stop is not None:
                     bound, eta_m = float(np.sqrt(U[stop])), float(eta[stop])
-                s_run = s if stop is None else {**s, "maxiter": stop}
+                s_run = s if stop is None else s.replace(maxiter=stop, label=s.label)
                 tc = time_call(lambda: _solve(sys, s_run, x0=x0.copy()), repeats=d["repeats"], warmup=0)
             res, t_solve = tc.value, tc.min  # min over repeats, like the fixed-rtol runs
             u = sys.expand(res.x)
             prev = u
-            errs = _errors(spec, mesh, u, d["error_order"])
+            errs = spec.errors(problems[lvl], u, d["error_order"])
             alg = _energy_norm(sys.A, res.x - exact[lvl])
-            disc = _energy_norm_error(spec, mesh, fixed["H1_semi"])
+            disc = _energy_norm_error(problems[lvl].kappa, fixed["H1_semi"])
             out.append({
                 "solver": label, "level": lvl, "dofs": fixed["dofs"], "h": fixed["h"],
                 "iterations_fixed": fixed["iterations"], "iterations_nested": int(res.iterations),
@@ -422,12 +391,12 @@ def _nested_runs(study, spec, meshes, mesh_times, records):
     return out
 
 
-def _energy_norm_error(spec, mesh, h1_semi: float) -> float:
+def _energy_norm_error(kappa, h1_semi: float) -> float:
     """``||u - u_l||_A`` from the H1 seminorm error: ``sqrt(kappa) |u - u_l|_1`` for a constant ``kappa``.
 
     A piecewise ``kappa`` has no such relation: ``nan`` (the ratio column then stays empty).
     """
-    kap = np.asarray(spec.kappa_elements(mesh), dtype=float)
+    kap = np.asarray(kappa, dtype=float)
     if np.allclose(kap, kap.flat[0]):
         return float(np.sqrt(kap.flat[0]) * h1_semi)
     return float("nan")

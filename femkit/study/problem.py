@@ -1,121 +1,74 @@
-"""The Poisson problem of a study: an inline ``problem:`` block or a ``base_case:`` file.
+"""The Poisson problem of a study: a Poisson case (inline ``problem:`` or a ``base_case:`` file).
 
-Both are turned into one small adapter with the pieces a sweep needs per mesh: the coarse mesh,
-per-element kappa, the source, Dirichlet nodes/values, the exact solution and its gradient.
+Both are one :class:`~femkit.case.Case` in the case-file language (docs/case-files.md), and
+every mesh level is assembled, reduced and solved through the one Poisson pipeline
+(:func:`femkit.case.poisson.run.poisson_problem`, a :class:`femkit.fem.PoissonProblem`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
 
-import numpy as np
+from ..errors import CaseFileError, InputError, with_prefix
 
-from ..errors import CaseFileError, ExpressionError
+__all__ = ["StudyProblem", "study_problem"]
 
 
 @dataclass
-class PoissonSpec:
-    geometry: str | None
-    geometry_params: dict
-    kappa: object                 # float, callable or a function mesh -> (m,) array
-    source: Callable
-    exact: Callable | None
-    grad_exact: Callable | None
-    dirichlet: Callable           # mesh -> (nodes, values)
-    neumann: Callable | None      # mesh -> (n,) extra load, or None
-    case: object = None
-    mesh_file_mesh: Callable | None = None   # () -> Mesh when the base case reads a file
+class StudyProblem:
+    """A validated Poisson case whose mesh size a sweep varies."""
 
-    def kappa_elements(self, mesh) -> np.ndarray:
-        from ..fem.coefficients import element_coefficient
+    case: object
 
-        if callable(self.kappa) and getattr(self.kappa, "_per_mesh", False):
-            return self.kappa(mesh)
-        return element_coefficient(mesh, self.kappa, name="kappa")
+    @property
+    def has_neumann(self) -> bool:
+        return bool(self.case.data["boundary"].get("neumann"))
 
-    def base_mesh(self, h: float):
-        from ..mesh import generate, validate
+    @property
+    def exact(self):
+        return self.case.functions["exact.u"]
 
-        if self.mesh_file_mesh is not None:
-            return self.mesh_file_mesh()
-        return validate(generate(self.geometry, h, **self.geometry_params))
+    def base_mesh(self, h: float | None):
+        """The case's mesh with ``mesh.h = h`` (a mesh file is read as it is)."""
+        from ..case.poisson.run import build_mesh
 
+        return build_mesh(self.case, h=h)
 
-def _expr(key: str, text, *, check_finite: bool = True):
-    from ..case.expressions import compile_expression
+    def problem(self, mesh, load_rule: str | None = None):
+        """The case on ``mesh`` as a :class:`femkit.fem.PoissonProblem` (the one pipeline)."""
+        from ..case.poisson.run import poisson_problem
 
-    try:
-        return compile_expression(text, ("x", "y"), check_finite=check_finite)
-    except ExpressionError as exc:
-        raise ExpressionError(f"{key}: {exc}") from None
+        return poisson_problem(self.case, mesh, load_rule=load_rule)
+
+    def errors(self, problem, u, order: int) -> dict:
+        from ..case.poisson.run import compute_errors
+
+        return compute_errors(self.case, problem, u, order=order)
 
 
-def inline_spec(problem: dict) -> PoissonSpec:
-    """Compile an inline ``problem:`` block (expressions through the safe parser)."""
-    exact = _expr("problem.exact", problem["exact"])
-    grad = None
-    if "grad_exact" in problem:
-        gx = _expr("problem.grad_exact[0]", problem["grad_exact"][0], check_finite=False)
-        gy = _expr("problem.grad_exact[1]", problem["grad_exact"][1], check_finite=False)
-
-        def grad(x, y):
-            return gx(x, y), gy(x, y)
-
-    source = _expr("problem.source", problem["source"])
-    kappa = problem.get("kappa", 1.0)
-    if isinstance(kappa, str):
-        kappa = _expr("problem.kappa", kappa)
-    g = _expr("problem.dirichlet", problem["dirichlet"]) if "dirichlet" in problem else exact
-
-    def dirichlet(mesh):
-        from ..mesh import boundary_nodes
-
-        nodes = boundary_nodes(mesh, None)
-        p = mesh.points[nodes]
-        return nodes, np.broadcast_to(np.asarray(g(p[:, 0], p[:, 1]), float), nodes.shape)
-
-    return PoissonSpec(problem.get("geometry", "unit_square"), dict(problem.get("geometry_params") or {}),
-                       kappa, source, exact, grad, dirichlet, None)
-
-
-def case_spec(path) -> PoissonSpec:
-    """Adapter over a Poisson case file (its mesh geometry, coefficient, source, boundary, exact)."""
+def study_problem(study) -> StudyProblem:
+    """The study's Poisson case: inline ``problem:`` (prefixed errors) or ``base_case:``."""
     from ..case import load_case
-    from ..case import run as crun
+    from ..case.load import case_from_dict
 
-    case = load_case(path)
+    d = study.data
+    if "base_case" in d:
+        case = load_case(study.resolve(d["base_case"]))
+        where = f"base_case: {study.resolve(d['base_case'])}"
+    else:
+        data = {"problem": "poisson", **d["problem"]}
+        mesh = dict(data.get("mesh") or {})
+        if "geometry" in mesh and "h" not in mesh:  # the levels give the sizes
+            lv = d["levels"]
+            mesh["h"] = lv["h"][0] if "h" in lv else lv["h0"]
+        data["mesh"] = mesh
+        try:
+            case = case_from_dict(data, study.base_dir, name=study.name)
+        except InputError as exc:
+            raise with_prefix(exc, "problem") from None
+        where = "problem"
     if case.problem != "poisson":
-        raise CaseFileError(f"base_case: {path} is a {case.problem!r} case; a convergence study needs 'poisson'")
+        raise CaseFileError(f"{where} is a {case.problem!r} case; a convergence study needs 'poisson'")
     if "exact.u" not in case.functions:
-        raise CaseFileError(f"base_case: {path} gives no exact solution; a convergence study needs 'exact'")
-    spec_mesh = case.data["mesh"]
-
-    def kappa(mesh):
-        return crun.element_kappa(case, mesh)
-
-    kappa._per_mesh = True
-    grad = None
-    if "exact.grad[0]" in case.functions:
-        gx, gy = case.functions["exact.grad[0]"], case.functions["exact.grad[1]"]
-
-        def grad(x, y):
-            return gx(x, y), gy(x, y)
-
-    def neumann(mesh):
-        from ..fem import assemble_neumann
-
-        out = np.zeros(mesh.n_points)
-        for i, bc in enumerate(case.data["boundary"].get("neumann", [])):
-            out += assemble_neumann(mesh, bc["tags"], case.functions[f"boundary.neumann[{i}].flux"])
-        return out
-
-    file_mesh = None
-    if "file" in spec_mesh:
-        def file_mesh():
-            return crun.build_mesh(case)
-
-    return PoissonSpec(spec_mesh.get("geometry"), dict(spec_mesh.get("params") or {}), kappa,
-                       case.functions["source"], case.functions["exact.u"], grad,
-                       lambda mesh: crun.dirichlet_data(case, mesh),
-                       neumann if case.data["boundary"].get("neumann") else None, case, file_mesh)
+        raise CaseFileError(f"{where} gives no exact solution; a convergence study needs 'exact'")
+    return StudyProblem(case)

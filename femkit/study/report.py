@@ -18,16 +18,14 @@ study leaves the previous report untouched and no half-written one.
 from __future__ import annotations
 
 import base64
-import csv
 import html
-import json
 import math
 import os
 from typing import Any, Sequence
 
 import numpy as np
 
-from ..io.results import to_jsonable  # noqa: F401  (one JSON conversion for every femkit output)
+from ..io.writers import to_jsonable, write_csv, write_json  # noqa: F401  (the one writer of each format)
 
 __all__ = ["Report", "staged_output", "write_csv", "write_json", "to_jsonable", "fmt"]
 
@@ -48,30 +46,6 @@ def fmt(v: Any) -> str:
             return "inf" if v > 0 else "-inf"
         return f"{v:.4g}"
     return str(v)
-
-
-def write_json(path, obj: Any) -> None:
-    with open(path, "w", encoding="utf-8") as fh:
-        json.dump(to_jsonable(obj), fh, indent=1, allow_nan=False)
-        fh.write("\n")
-
-
-def write_csv(path, records: Sequence[dict]) -> None:
-    """One row per record; columns are the union of keys in first-seen order."""
-    cols: list[str] = []
-    for r in records:
-        for k in r:
-            if k not in cols:
-                cols.append(k)
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(cols)
-        for r in records:
-            row = []
-            for c in cols:
-                v = to_jsonable(r.get(c))
-                row.append("" if v is None else (json.dumps(v) if isinstance(v, (list, dict)) else v))
-            w.writerow(row)
 
 
 class Report:
@@ -165,11 +139,6 @@ def staged_output(output_dir):
     The study-side name of :func:`femkit.io.atomic.atomic_directory`: on an exception the
     temporary directory is removed and ``output_dir`` (an earlier report) is untouched.
     """
-    from ..io.atomic import atomic_directory
+    from ..io.atomic import EARLIER_REPORT, atomic_directory
 
-    return atomic_directory(output_dir, PREVIOUS_REPORT)
-
-
-#: Files that mark a directory as an earlier study report: only such a directory (or an empty or
-#: missing one) is replaced; anything else (``-o .``, a project folder) is refused.
-PREVIOUS_REPORT = ("results.json", "report.md")
+    return atomic_directory(output_dir, EARLIER_REPORT)

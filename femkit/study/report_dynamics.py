@@ -32,13 +32,10 @@ def integrator_family(name: str, **options) -> str:
 
 def integrator_styles(study) -> dict:
     """Label -> line style: one colour + marker per integrator, line style per family."""
-    from .dynamics import integrator_spec
-
     book = F.StyleBook(FAMILY_LINES)
     styles = {}
-    for item in study.data["integrators"]:
-        name, opts, lab = integrator_spec(item)
-        styles[lab] = book(lab, integrator_family(name, **opts))
+    for spec in study.integrators:
+        styles[spec.label] = book(spec.label, integrator_family(spec.method, **spec.options))
     return styles
 
 
@@ -118,16 +115,13 @@ def build_dynamics_report(report, study, result, data, stage) -> None:
     rows = [{"method": r["integrator"], "h_omega": r["h_omega"], "stable": r["stable"],
              "bound": None} for r in recs if r.get("h_omega")]
     if rows:
-        from ..dynamics.integrators import get_integrator
-        from .dynamics import integrator_spec
-
         from .stability import NEVER_STABLE
 
         bounds, never = {}, []
-        for item in study.data["integrators"]:
-            name, opts, lab = integrator_spec(item)
+        for spec in study.integrators:
+            name, lab = spec.method, spec.label
             # the scenes are undamped: methods whose region misses the imaginary axis have no limit
-            bounds[lab] = None if name in NEVER_STABLE else get_integrator(name, **opts).stability_bound
+            bounds[lab] = None if name in NEVER_STABLE else spec.build().stability_bound
             if name in NEVER_STABLE:
                 never.append(lab)
         for r in rows:

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .cache import fingerprint
+from .kinds import STUDY_KINDS
 from .report import Report, staged_output, write_csv, write_json
 
 __all__ = ["StudyResult", "run_study"]
@@ -89,26 +90,12 @@ def run_study(study, output_dir=None, *, progress: bool | None = None, write: bo
     """
     t0 = time.perf_counter()
     if write:  # a bad report location is refused before the sweep runs
-        from ..io.atomic import check_output_dir
-        from .report import PREVIOUS_REPORT
+        from ..io.atomic import EARLIER_REPORT, check_output_dir
 
         check_output_dir(output_dir if output_dir is not None else study.default_output(),
-                         PREVIOUS_REPORT)
-    if study.kind == "poisson_convergence":
-        from .poisson import run_poisson_study
-        from .report_poisson import build_poisson_report as build
-
-        data = run_poisson_study(study, progress_enabled=progress)
-    elif study.kind == "dynamics_work_precision":
-        from .dynamics import run_dynamics_study
-        from .report_dynamics import build_dynamics_report as build
-
-        data = run_dynamics_study(study, progress_enabled=progress)
-    else:
-        from .report_stability import build_stability_report as build
-        from .stability import run_stability_study
-
-        data = run_stability_study(study, progress_enabled=progress)
+                         EARLIER_REPORT)
+    kind = STUDY_KINDS.get(study.kind)
+    data = kind.run(study, progress_enabled=progress)
     result = StudyResult(kind=study.kind, name=study.name, records=data["records"], fits=data.get("fits", []),
                          tables=data.get("tables", {}), notes=data.get("notes", []),
                          fingerprint=fingerprint(study.files, extra={"quick": study.quick, "data": study.data}))
@@ -128,7 +115,7 @@ def run_study(study, output_dir=None, *, progress: bool | None = None, write: bo
                          f"Input fingerprint `{result.fingerprint[:16]}`.")
         if study.data.get("description"):
             report.paragraph(study.data["description"])
-        build(report, study, result, data, stage)
+        kind.report(report, study, result, data, stage)
         if result.notes:
             report.heading("Notes")
             for n in result.notes:

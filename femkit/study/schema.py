@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import copy
 
+from ..case.specs import INTEGRATOR_SCHEMA, solver_schema
+
 POS = {"type": "number", "exclusiveMinimum": 0}
 POSINT = {"type": "integer", "minimum": 1}
 EXPR = {"oneOf": [{"type": "string", "minLength": 1}, {"type": "number"}],
@@ -33,24 +35,12 @@ COMMON = {
     "warmup": {"type": "integer", "minimum": 0, "default": 1, "description": "untimed warm-up runs"},
 }
 
-SOLVER = _obj({
-    "method": {"type": "string"},
-    "preconditioner": {"type": "string"},
-    "rtol": {**POS, "default": 1e-10},
-    "atol": {"type": "number", "minimum": 0, "default": 0.0},
-    "maxiter": POSINT,
-    "label": {"type": "string"},
-}, required=["method"])
+#: One entry of ``solvers:``: femkit's one solver spec (docs/case-files.md#solver) plus a label.
+SOLVER = {**solver_schema(label=True), "required": ["method"]}
 
-PROBLEM = _obj({
-    "geometry": {"type": "string", "default": "unit_square"},
-    "geometry_params": {"type": "object"},
-    "exact": EXPR,
-    "grad_exact": {"type": "array", "items": EXPR, "minItems": 2, "maxItems": 2},
-    "source": EXPR,
-    "kappa": EXPR,
-    "dirichlet": EXPR,
-}, required=["exact", "source"])
+#: An inline Poisson problem: a case mapping in the case-file language (docs/case-files.md),
+#: validated by the Poisson case schema; ``mesh.h`` may be left out (the levels give it).
+PROBLEM = {"type": "object", "x-message": "expected a Poisson case mapping (mesh, source, boundary, exact)"}
 
 POISSON = {
     "problem": PROBLEM,
@@ -80,10 +70,8 @@ SCENE = _obj({
     "t_end": {**POS, "default": 1.0},
 }, required=["type"])
 
-INTEGRATOR = {"oneOf": [{"type": "string"},
-                        _obj({"name": {"type": "string"}, "options": {"type": "object"},
-                              "label": {"type": "string"}}, required=["name"])],
-              "x-message": "must be an integrator name or {name:, options:}"}
+#: One entry of ``integrators:``: the scene files' integrator spec (a name or {method, options, label}).
+INTEGRATOR = INTEGRATOR_SCHEMA
 
 DYNAMICS = {
     "scene": SCENE,
@@ -125,9 +113,6 @@ STABILITY = {
     "case_overrides": {"type": "object", "description": "per case name: keys merged over that case"},
 }
 
-KINDS = {"poisson_convergence": POISSON, "dynamics_work_precision": DYNAMICS, "stability": STABILITY}
-
-
 def _partial(node: dict) -> None:
     """A ``quick:`` value may give part of an object: no defaults, no required keys (lists stay whole)."""
     node.pop("default", None)
@@ -138,7 +123,9 @@ def _partial(node: dict) -> None:
 
 def schema_for(kind: str) -> dict:
     """The full schema of a study of ``kind`` (with its ``quick:`` block)."""
-    props = {**copy.deepcopy(COMMON), **copy.deepcopy(KINDS[kind])}
+    from .kinds import STUDY_KINDS
+
+    props = {**copy.deepcopy(COMMON), **copy.deepcopy(STUDY_KINDS.get(kind).schema)}
     quick = _obj({k: copy.deepcopy(v) for k, v in props.items() if k != "kind"})
     for v in quick["properties"].values():
         _partial(v)

@@ -31,54 +31,38 @@ import warnings
 import numpy as np
 
 from ..errors import FemkitError, InstabilityError, SingularSystemError
-from .poisson import solver_label
+from ..mesh.structured import structured_mesh
 from .progress import progress
 
 
 # ----------------------------------------------------------------------------- meshes
 
-def structured_mesh(nx: int, ny: int, width: float = 1.0, height: float = 1.0):
-    """Right triangles on an nx x ny grid of [0, width] x [0, height] (a Mesh, boundary tagged)."""
-    from ..mesh import Mesh
-
-    xs, ys = np.linspace(0, width, nx + 1), np.linspace(0, height, ny + 1)
-    X, Y = np.meshgrid(xs, ys)
-    pts = np.column_stack([X.ravel(), Y.ravel()])
-    i, j = np.meshgrid(np.arange(nx), np.arange(ny))
-    a = (j * (nx + 1) + i).ravel()
-    b, c, d = a + 1, a + nx + 2, a + nx + 1
-    tri = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
-    return Mesh(points=pts, triangles=tri)
-
-
 def _poisson_system(mesh, kappa, f, g=0.0):
-    from ..fem import apply_dirichlet, assemble_load, assemble_stiffness
-    from ..mesh import boundary_nodes
+    """K, F and the reduced system of ``-div(kappa grad u) = f``, ``u = g`` on the whole boundary,
+    through the one Poisson pipeline (:class:`femkit.fem.PoissonProblem`)."""
+    from ..fem import PoissonProblem
 
-    K = assemble_stiffness(mesh, kappa)
-    F = assemble_load(mesh, f)
-    nodes = boundary_nodes(mesh, None)
-    vals = g(*mesh.points[nodes].T) if callable(g) else np.full(len(nodes), g)
-    return K, F, apply_dirichlet(K, F, nodes, vals)
+    problem = PoissonProblem(mesh, kappa, f, dirichlet=[(None, g)])
+    K, F = problem.assemble_matrices()
+    return K, F, problem.reduce(K, F)
+
+
+def _spec(data: dict):
+    from ..solvers import SolverSpec
+
+    return SolverSpec.from_mapping(data)
 
 
 def _solve_row(A, b, s, *, x_ref=None, maxiter=None):
-    from ..solvers import solve
-
-    kw = {"method": s["method"], "rtol": s.get("rtol", 1e-8), "atol": s.get("atol", 0.0)}
-    if s["method"] == "pcg":
-        kw["preconditioner"] = s.get("preconditioner") or "amg"
-    mi = s.get("maxiter") or maxiter
-    if mi:
-        kw["maxiter"] = mi
+    """One solver (a :class:`~femkit.solvers.SolverSpec`) on one system: the row of the table."""
     t0 = time.perf_counter()
     try:
-        res = solve(A, b, **kw)
+        res = s.solve(A, b, maxiter=s.maxiter or maxiter)
     except FemkitError as exc:
         return {"survived": False, "outcome": type(exc).__name__, "detail": str(exc)[:200],
                 "time": time.perf_counter() - t0}
     row = {"survived": bool(res.converged), "outcome": res.reason, "iterations": int(res.iterations),
-           "relative_residual": float(res.relative_residual), "requested_rtol": kw["rtol"],
+           "relative_residual": float(res.relative_residual), "requested_rtol": s.rtol,
            "recursive_residual": float(res.residuals[-1] / max(res.rhs_norm, 1e-300)) if len(res.residuals) else None,
            "time": time.perf_counter() - t0, "detail": res.message[:200]}
     if x_ref is not None:
@@ -146,19 +130,20 @@ def case_poisson(case, solvers, quick_n):
                 # discretisation error relative to ||u||: identical at every scale if nothing leaks
                 uex = u(*mesh.points.T)
                 r["error"] = float(np.linalg.norm(sys.expand(_direct(sys.A, sys.b)) - uex) / np.linalg.norm(uex))
-            rows.append({**base, "method": solver_label(s), **r})
+            rows.append({**base, "method": s.label, **r})
     return rows
 
 
 def case_neumann(case, quick_n):
-    from ..fem import assemble_load, assemble_stiffness
+    from ..fem import PoissonProblem
     from ..solvers import solve
 
     n = case.get("n", quick_n)
     mesh = structured_mesh(n, n)
-    K = assemble_stiffness(mesh, 1.0)
     uex = lambda x, y: np.cos(np.pi * x) * np.cos(np.pi * y)  # noqa: E731
-    F = assemble_load(mesh, lambda x, y: 2 * np.pi**2 * uex(x, y), rule="gauss3")
+    problem = PoissonProblem(mesh, 1.0, lambda x, y: 2 * np.pi**2 * uex(x, y), dirichlet=[],
+                             load_rule="gauss3", nullspace="pin", pin_value=float(uex(0.0, 0.0)))
+    K, F = problem.assemble_matrices()
     F_cons = F - F.mean()  # exactly consistent: orthogonal to the constant null vector
     F_bad = F_cons + 1.0   # inconsistent
     ue = uex(*mesh.points.T)
@@ -169,9 +154,7 @@ def case_neumann(case, quick_n):
         d = (x - x.mean()) - (ue - ue.mean())
         return float(np.linalg.norm(d) / np.linalg.norm(ue - ue.mean()))
 
-    from ..fem import apply_dirichlet
-
-    sys = apply_dirichlet(K, F_cons, [0], [ue[0]])
+    sys = problem.reduce(K, F_cons)  # node 0 pinned to the exact value: SPD
     pinned_err = err(sys.expand(_direct(sys.A, sys.b)))
     t0 = time.perf_counter()
     try:
@@ -185,17 +168,17 @@ def case_neumann(case, quick_n):
         rows.append({**base, "value": "singular K, direct", "method": "direct", "survived": True,
                      "outcome": "SingularSystemError (detected)", "detail": str(exc)[:200],
                      "time": time.perf_counter() - t0})
-    r = _solve_row(K, F_cons, {"method": "cg", "rtol": 1e-10}, maxiter=case.get("maxiter", 5000))
+    r = _solve_row(K, F_cons, _spec({"method": "cg", "rtol": 1e-10}), maxiter=case.get("maxiter", 5000))
     if "iterations" in r:
         r["error"] = None
     rows.append({**base, "value": "singular K, consistent rhs", "method": "cg", **r})
-    r = _solve_row(K, F_bad, {"method": "cg", "rtol": 1e-10}, maxiter=case.get("maxiter", 2000))
+    r = _solve_row(K, F_bad, _spec({"method": "cg", "rtol": 1e-10}), maxiter=case.get("maxiter", 2000))
     # surviving here means: not claiming convergence on an unsolvable system
     r["survived"] = not r.get("survived", False)
     r["outcome"] = "reported not converged: " + str(r.get("outcome")) if r["survived"] else "claimed convergence!"
     rows.append({**base, "value": "singular K, inconsistent rhs", "method": "cg", **r})
     # the fix: pin one node (value of the exact solution there) -> SPD
-    r = _solve_row(sys.A, sys.b, {"method": "pcg", "preconditioner": "amg", "rtol": 1e-10})
+    r = _solve_row(sys.A, sys.b, _spec({"method": "pcg", "preconditioner": "amg", "rtol": 1e-10}))
     rows.append({**base, "value": "one node pinned (constant fixed)", "method": "pcg+amg", **r,
                  "error": pinned_err})
     return rows
@@ -280,10 +263,8 @@ def _chain(k, ratio):
 
 
 def case_dynamics(case, integrators):
-    from ..dynamics.integrators import get_integrator
     from ..dynamics.simulate import simulate
     from ..dynamics.stability import estimate_omega_max
-    from .dynamics import integrator_spec
 
     factors = case.get("dt_factors", [0.5, 0.9, 0.98, 1.02, 1.1, 2.0])
     steps = int(case.get("t_end", 1000))  # number of steps per run
@@ -294,9 +275,9 @@ def case_dynamics(case, integrators):
             x0 = system.x0.copy()
             x0[2, 0] += 0.01  # small stretch of the outer spring
             w = float(estimate_omega_max(system))
-            for item in integrators:
-                name, opts, label = integrator_spec(item)
-                integ = get_integrator(name, **opts)
+            for spec in integrators:
+                label = spec.label
+                integ = spec.build()
                 if integ.implicit:
                     continue
                 for fac in factors:
@@ -320,7 +301,7 @@ def case_dynamics(case, integrators):
                     rows.append({"case": case["name"], "type": "dynamics_stiffness", "value": f"k={k:g}, m2/m1={ratio:g}",
                                  "k": float(k), "mass_ratio": float(ratio), "method": label, "dt": dt,
                                  "dt_factor": fac, "omega_max": w, "h_omega": dt * w,
-                                 "bound": 0.0 if name in NEVER_STABLE else integ.stability_bound,
+                                 "bound": 0.0 if spec.method in NEVER_STABLE else integ.stability_bound,
                                  "survived": ok, "outcome": outcome, "energy_growth": drift, "time": time.perf_counter() - t0})
     return rows
 
@@ -388,9 +369,7 @@ def warm_up(solvers, integrators) -> list[str]:
     the numba IC(0) kernels, loads the sparse direct solver) and each explicit integrator takes
     a few steps on the two-spring chain. Returns what was warmed (for the report's notes).
     """
-    from ..dynamics.integrators import get_integrator
     from ..dynamics.simulate import simulate
-    from .dynamics import integrator_spec
 
     mesh = structured_mesh(8, 8)
     _, _, sys_ = _poisson_system(mesh, np.ones(mesh.n_triangles), lambda x, y: np.ones_like(x))
@@ -401,9 +380,9 @@ def warm_up(solvers, integrators) -> list[str]:
     x0 = chain.x0.copy()
     x0[2, 0] += 0.01
     names = []
-    for item in integrators:
-        name, opts, label = integrator_spec(item)
-        if not get_integrator(name, **opts).implicit:
+    for spec in integrators:
+        name, opts, label = spec.method, spec.options, spec.label
+        if not spec.build().implicit:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 try:
@@ -411,7 +390,7 @@ def warm_up(solvers, integrators) -> list[str]:
                 except FemkitError:
                     pass
             names.append(label)
-    return [solver_label(s) for s in solvers] + ["direct"] + names
+    return [s.label for s in solvers] + ["direct"] + names
 
 
 def run_stability_study(study, *, progress_enabled=None) -> dict:
@@ -421,7 +400,7 @@ def run_stability_study(study, *, progress_enabled=None) -> dict:
     rows = []
     notes = []
     if d.get("warmup", 1):
-        warmed = warm_up(d["solvers"], d["integrators"])
+        warmed = warm_up(study.solvers, study.integrators)
         notes.append("Warm-up before timing (untimed, on an 8 x 8 Poisson system and a two-spring chain): "
                      + ", ".join(warmed) + "; no timed run includes imports, AMG module loading or compilation.")
     for case in progress(cases, total=len(cases), desc=study.name, enabled=progress_enabled):
@@ -429,13 +408,13 @@ def run_stability_study(study, *, progress_enabled=None) -> dict:
         if t == "poisson_neumann":
             rows += case_neumann(case, quick_n)
         elif t.startswith("poisson_"):
-            rows += case_poisson(case, d["solvers"], quick_n)
+            rows += case_poisson(case, study.solvers, quick_n)
         elif t == "cg_residual_drift":
             rows += case_cg_drift(case)
         elif t == "jacobi_divergence":
             rows += case_jacobi(case)
         else:
-            rows += case_dynamics(case, d["integrators"])
+            rows += case_dynamics(case, study.integrators)
     tables = {}
     b = boundaries(rows)
     if b:

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import femkit
-from femkit.case.check import cross_check
+from femkit.case.poisson.cross_check import cross_check
 
 CASES = Path(__file__).parents[2] / "cases"
 POISSON = sorted(p for p in CASES.glob("poisson_*.yaml"))

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import femkit
-from femkit.case.check import cross_check
+from femkit.case.poisson.cross_check import cross_check
 from femkit.errors import CaseFileError, SingularSystemError
 
 CASE = Path(__file__).parents[2] / "cases" / "poisson_neumann.yaml"

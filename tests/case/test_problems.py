@@ -44,4 +44,4 @@ def test_a_registered_problem_type_is_dispatched(tmp_path):
         with pytest.raises(ValueError, match="twice"):
             register_problem("toy", schema, prepare, run)
     finally:
-        PROBLEMS.pop("toy")
+        PROBLEMS.remove("toy")

@@ -7,7 +7,7 @@ import pytest
 
 from femkit.case import load_case
 from femkit.case.load import case_from_dict
-from femkit.case.schema_poisson import POISSON_SCHEMA
+from femkit.case.poisson.schema import POISSON_SCHEMA
 from femkit.errors import CaseFileError, ExpressionError, InputError, UnknownNameError
 
 

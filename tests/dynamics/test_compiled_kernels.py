@@ -16,6 +16,7 @@ from femkit.dynamics.kernels.spring_kernels import local_global_rhs, spring_forc
 from femkit.dynamics.system import MassSpringSystem
 from femkit.dynamics.topology import cloth_grid
 from femkit.errors import InputError, NotSPDError
+from femkit.solvers import SolverSpec
 
 RNG = np.random.default_rng(7)
 
@@ -97,7 +98,7 @@ def _cloth(n=8, **kw):
 
 
 def _run(name, system, solver, steps=4, dt=1.0 / 60.0, x0=None, v0=None, **opts):
-    ctx = StepContext(solver=solver)
+    ctx = StepContext(SolverSpec(solver))
     integ = get_integrator(name, **opts)
     if v0 is None:
         v0 = np.zeros_like(system.x0)
@@ -173,7 +174,7 @@ def test_compressed_cloth_without_fix_is_not_spd_for_cholesky():
     x0 = system.x0 * 0.8 + 0.1 * RNG.standard_normal(system.x0.shape)   # compressed springs
     x0[system.pinned] = system.x0[system.pinned]
     integ = get_integrator("implicit_euler")
-    ctx = StepContext(solver="cholesky")
+    ctx = StepContext(SolverSpec("cholesky"))
     s = integ.start(system, x0, np.zeros_like(x0), 0.0, 1.0, ctx)
     with pytest.raises(NotSPDError, match="not positive definite"):
         integ.step(system, s, 1.0, ctx)

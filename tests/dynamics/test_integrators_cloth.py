@@ -8,6 +8,7 @@ import pytest
 
 from femkit.dynamics.forces import Gravity
 from femkit.dynamics.integrators import StepContext, get_integrator
+from femkit.solvers import SolverSpec
 from femkit.dynamics.topology import cloth_grid
 
 
@@ -60,9 +61,9 @@ def test_fast_mass_spring_factorises_once_while_dt_is_fixed():
 def test_implicit_euler_step_independent_of_linear_solver(solver, pc):
     system = _cloth()
     dt = 1.0 / 60.0
-    ref, _ = _one_step("implicit_euler", system, dt, StepContext(solver="direct"), fix="clamp")
+    ref, _ = _one_step("implicit_euler", system, dt, StepContext(SolverSpec("direct")), fix="clamp")
     got, ctx = _one_step("implicit_euler", system, dt,
-                         StepContext(solver=solver, preconditioner=pc, rtol=1e-12), fix="clamp")
+                         StepContext(SolverSpec(solver, pc, rtol=1e-12)), fix="clamp")
     assert ctx.stats["linear_iterations"] > 0
     scale = np.abs(ref.v).max()
     np.testing.assert_allclose(got.v, ref.v, rtol=0, atol=1e-9 * scale)
@@ -145,9 +146,9 @@ def test_direct_solves_reusing_the_ordering_match_plain_direct(name):
     system = _cloth(7)
     dt = 1.0 / 60.0
     opts = {"reuse_factorization": False} if name in ("newton", "implicit_euler") else {}
-    ordered, ctx = _one_step(name, system, dt, StepContext(solver="direct"), **opts)
+    ordered, ctx = _one_step(name, system, dt, StepContext(SolverSpec("direct")), **opts)
     # any ctx.options sends the solve through femkit.solvers.solve (SuperLU orders every matrix)
-    plain, ctx_plain = _one_step(name, system, dt, StepContext(solver="direct", options={"spd": None}),
+    plain, ctx_plain = _one_step(name, system, dt, StepContext(SolverSpec("direct", options={"spd": None})),
                                  **opts)
     assert "orderings" not in ctx_plain.stats
     assert ctx.stats["factorizations"] == ctx.stats["linear_solves"] >= 3
@@ -181,8 +182,8 @@ def test_reusing_an_older_factorisation_gives_the_same_steps(name, opts):
     """Opt-in reuse (the default factorises every system: 'direct' means direct)."""
     system = _cloth(8)
     dt = 1.0 / 60.0
-    exact, ctx_exact = _one_step(name, system, dt, StepContext(solver="direct"), **opts)
-    reused, ctx = _one_step(name, system, dt, StepContext(solver="direct"),
+    exact, ctx_exact = _one_step(name, system, dt, StepContext(SolverSpec("direct")), **opts)
+    reused, ctx = _one_step(name, system, dt, StepContext(SolverSpec("direct")),
                             reuse_factorization=True, **opts)
     scale = np.abs(exact.x - system.x0).max()
     np.testing.assert_allclose(reused.x, exact.x, rtol=0, atol=1e-8 * scale)

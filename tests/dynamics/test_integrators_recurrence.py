@@ -3,7 +3,9 @@
 Scene (SOFA): node 0 fixed at y = 2, spring rest length 1 to node 1 starting at y = 1 with
 v = 0, gravity. The free node moves along y only; the scalar force is
 ``F(y) = K (1 - y) - m g`` and Rayleigh damping adds ``-(r_M m + r_K K) v``. The recurrences
-below are written from the formulas of seeds 000/001/002 (SOFA's recursive equations),
+below are written from SOFA's ODE solver documentation (EulerImplicitSolver,
+NewmarkImplicitSolver, VariationalSymplecticSolver, RungeKutta4Solver, CentralDifferenceSolver)
+and Schlögl's lecture notes (explicit and symplectic Euler, Verlet),
 independently of femkit's vector code.
 """
 

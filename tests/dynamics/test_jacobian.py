@@ -9,9 +9,9 @@ from femkit.dynamics.system import MassSpringSystem
 from femkit.errors import UnknownNameError
 
 
-def random_system(dim, seed, *, contacts=True, compress=False, damping=0.0):
+def random_system(dim, draw, *, contacts=True, compress=False, damping=0.0):
     """Random springs among 9 particles; rest lengths random (so many springs are compressed)."""
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(draw)
     n = 9
     x0 = rng.random((n, dim))
     a, b = np.triu_indices(n, 1)
@@ -38,9 +38,9 @@ def fd_jacobian(fun, z, h=1e-6):
 
 
 @pytest.mark.parametrize("dim", [2, 3], ids=["2d", "3d"])
-@pytest.mark.parametrize("seed", [1, 2, 3], ids=lambda s: f"seed{s}")
-def test_stiffness_matches_central_differences(dim, seed):
-    s, rng = random_system(dim, seed)
+@pytest.mark.parametrize("draw", [1, 2, 3], ids=lambda s: f"draw{s}")
+def test_stiffness_matches_central_differences(dim, draw):
+    s, rng = random_system(dim, draw)
     x = s.x0 + 0.02 * rng.standard_normal(s.x0.shape)
     v = rng.standard_normal(s.x0.shape)
     K = s.stiffness_matrix(x).toarray()

@@ -1,4 +1,4 @@
-"""Matrix-free implicit steps (seed 001, matrix-free CG): the operator ``A d`` equals the
+"""Matrix-free implicit steps (matrix-free CG, Baraff & Witkin 1998; Saad 2003): the operator ``A d`` equals the
 assembled matrix times ``d``, one matrix-free step equals the assembled direct step to the
 linear solver's tolerance, solvers that need the matrix are refused, and the scene path runs.
 """
@@ -14,6 +14,7 @@ from femkit.cli import main
 from femkit.dynamics.forces import (Gravity, GroundContact, RayleighDamping, SphereContact,
                                     ViscousDamping)
 from femkit.dynamics.integrators import StepContext, get_integrator
+from femkit.solvers import SolverSpec
 from femkit.dynamics.integrators.base import MATRIX_FREE_MESSAGE, restrict
 from femkit.dynamics.topology import cloth_grid
 from femkit.errors import InputError
@@ -107,7 +108,7 @@ def test_baraff_witkin_matrix_free_step_equals_direct(solver):
     system, x, v = _cloth()
     out = {}
     for key, mf, (name, pc) in (("direct", False, ("direct", "none")), ("mf", True, solver)):
-        ctx = StepContext(solver=name, preconditioner=pc, rtol=RTOL)
+        ctx = StepContext(SolverSpec(name, pc, rtol=RTOL))
         integ = get_integrator("implicit_euler", matrix_free=mf)
         out[key] = integ.step(system, integ.start(system, x, v, 0.0, H, ctx), H, ctx)
         out[key + "_ctx"] = ctx
@@ -130,7 +131,7 @@ def test_newton_matrix_free_step_equals_direct(solver):
     tol = 1e-12
     res = {}
     for key, mf, (name, pc) in (("direct", False, ("direct", "none")), ("mf", True, solver)):
-        ctx = StepContext(solver=name, preconditioner=pc, rtol=RTOL)
+        ctx = StepContext(SolverSpec(name, pc, rtol=RTOL))
         integ = get_integrator("newton", matrix_free=mf, tol=tol)
         res[key] = integ.step(system, integ.start(system, x, v, 0.0, H, ctx), H, ctx)
         assert ctx.stats["newton_iterations"][0] < 50
@@ -147,7 +148,7 @@ def test_newton_matrix_free_step_equals_direct(solver):
 def test_matrix_free_refuses_solvers_that_need_the_matrix(method, solver, pc):
     system, x, v = _cloth(4)
     integ = get_integrator(method, matrix_free=True)
-    ctx = StepContext(solver=solver, preconditioner=pc)
+    ctx = StepContext(SolverSpec(solver, pc))
     with pytest.raises(InputError, match=MATRIX_FREE_MESSAGE.replace("(", r"\(").replace(")", r"\)")):
         integ.start(system, x, v, 0.0, H, ctx)
 

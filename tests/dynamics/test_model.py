@@ -35,8 +35,8 @@ def test_default_rest_is_initial_length_so_no_force():
     assert np.abs(s.force(x0, s.v0)).max() < 1e-13
 
 
-def _random(dim, seed, pinned=None, forces=()):
-    rng = np.random.default_rng(seed)
+def _random(dim, draw, pinned=None, forces=()):
+    rng = np.random.default_rng(draw)
     n = 10
     x0 = rng.random((n, dim))
     a, b = np.triu_indices(n, 1)

@@ -12,8 +12,8 @@ import yaml
 
 from femkit.case import load_case
 from femkit.cli import main
-from femkit.dynamics.scene import build_system, output_every, run_scene, state_checksum
-from femkit.dynamics.scene_schema import SCENE_SCHEMA
+from femkit.case.scene.run import build_system, output_every, run_scene, state_checksum
+from femkit.case.scene.schema import SCENE_SCHEMA
 from femkit.errors import CaseFileError, UnknownNameError
 
 ROOT = Path(__file__).parents[2]
@@ -243,7 +243,15 @@ def test_docs_cover_every_scene_key():
     assert {"k_structural", "energy_growth_limit", "stiffness", "every", "preconditioner"} <= names
     missing = sorted(n for n in names if f"`{n}`" not in doc)
     assert not missing, f"keys missing from docs/scenes.md: {missing}"
-    from femkit.dynamics.output import RESULT_KEYS, energy_columns
+    from femkit.case.scene.output import RESULT_KEYS, energy_columns
 
     missing = [k for k in (*RESULT_KEYS, *energy_columns(3)) if f"`{k}`" not in doc]
     assert not missing, f"output keys missing from docs/scenes.md: {missing}"
+
+
+def test_schema_and_builder_registries_name_the_same_types():
+    from femkit.case.scene.run import FORCES, SYSTEMS
+    from femkit.case.scene.schema import FORCE_TYPES, SYSTEM_TYPES
+
+    assert set(FORCES.names()) | {"dashpot"} == set(FORCE_TYPES)  # dashpot: a spring coefficient
+    assert set(SYSTEMS.names()) == set(SYSTEM_TYPES)

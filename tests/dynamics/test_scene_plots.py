@@ -1,4 +1,4 @@
-"""Pictures of mass-spring runs (femkit.dynamics.plot): valid files, 3-D views, strain colours.
+"""Pictures of mass-spring runs (femkit.case.scene.plot): valid files, 3-D views, strain colours.
 
 Small systems, few steps: every test builds its trajectory with ``simulate`` directly.
 """
@@ -10,8 +10,8 @@ import pytest
 
 from femkit.dynamics.forces import Gravity
 from femkit.dynamics.forces.contact import GroundContact, SphereContact
-from femkit.dynamics.scene import _grid_triangles as grid_triangles
-from femkit.dynamics.plot import (gif_frame_times, gif_frames, plot_frame, scene_view,
+from femkit.mesh import grid_triangles
+from femkit.case.scene.plot import (gif_frame_times, gif_frames, plot_frame, scene_view,
                                   spring_strain, write_final_png, write_gif)
 from femkit.dynamics.simulate import simulate
 from femkit.dynamics.topology import cloth_grid, rope, single_spring
@@ -158,7 +158,7 @@ def test_strain_colours_are_symmetric_about_zero_and_match_the_springs(dim):
 
 
 def test_final_png_colours_resolve_the_final_strains(runs, tmp_path, monkeypatch):
-    import femkit.dynamics.plot as plot
+    import femkit.case.scene.plot as plot
 
     system, tri, traj = runs["rope-2d"]
     seen = {}

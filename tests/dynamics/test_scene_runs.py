@@ -15,7 +15,7 @@ import pytest
 import yaml
 
 from femkit.cli import main
-from femkit.dynamics.output import RESULT_KEYS, energy_columns
+from femkit.case.scene.output import RESULT_KEYS, energy_columns
 
 ROOT = Path(__file__).parents[2]
 SCENES = ROOT / "cases" / "scenes"

@@ -32,7 +32,9 @@ def test_cloth_families_left_out_and_taichi_count():
     c = cloth_grid(5, 5, 1.0, 1.0, k_structural=1.0)
     assert set(np.unique(c.family)) == {0}
     big = cloth_grid(128, 128, 1.0, 1.0, k_structural=1.0, k_shear=1.0, k_bending=1.0)
-    assert big.n_springs == 97026       # the Taichi demo cloth (REFERENCE.md)
+    # the 128 x 128 cloth of Taichi's mass-spring demo: 2*128*127 structural + 2*127*127 shear
+    # + 2*128*126 bending springs
+    assert big.n_springs == 2 * 128 * 127 + 2 * 127 * 127 + 2 * 128 * 126 == 97026
     assert FAMILIES[:3] == ("structural", "shear", "bending")
 
 

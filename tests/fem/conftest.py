@@ -5,37 +5,18 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from femkit.mesh import Mesh
-
-SIDES = {"bottom": 1, "right": 2, "top": 3, "left": 4}
-
+from femkit.mesh import Mesh, structured_mesh
+from femkit.mesh.structured import SIDES
 
 def unit_square(n: int, *, diagonal: str = "alternating") -> Mesh:
     """Structured triangulation of [0, 1]^2 with n x n cells, sides tagged bottom/right/top/left.
 
     Cells with ``x_cell < 0.5`` get cell tag 1, the others 2 (group names ``west``/``east``).
     """
-    x = np.linspace(0.0, 1.0, n + 1)
-    X, Y = np.meshgrid(x, x, indexing="xy")
-    pts = np.column_stack([X.ravel(), Y.ravel()])
-    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="xy")
-    v0 = (j * (n + 1) + i).ravel()
-    v1, v2, v3 = v0 + 1, v0 + n + 2, v0 + n + 1
-    flip = ((i + j) % 2 == 1).ravel() if diagonal == "alternating" else np.zeros(n * n, bool)
-    t_a = np.where(flip[:, None], np.column_stack([v0, v1, v3]), np.column_stack([v0, v1, v2]))
-    t_b = np.where(flip[:, None], np.column_stack([v1, v2, v3]), np.column_stack([v0, v2, v3]))
-    tri = np.concatenate([t_a, t_b])
-    c = pts[tri].mean(axis=1)
-    cell_tags = np.where(c[:, 0] < 0.5, 1, 2)
-    k = np.arange(n)
-    bottom = np.column_stack([k, k + 1])
-    right = np.column_stack([k * (n + 1) + n, (k + 1) * (n + 1) + n])
-    top = np.column_stack([n * (n + 1) + k, n * (n + 1) + k + 1])
-    left = np.column_stack([k * (n + 1), (k + 1) * (n + 1)])
-    edges = np.concatenate([bottom, right, top, left])
-    tags = np.repeat([1, 2, 3, 4], n)
-    names = dict(SIDES, west=1, east=2)
-    return Mesh(pts, tri, cell_tags=cell_tags, boundary_edges=edges, boundary_tags=tags, tag_names=names)
+    m = structured_mesh(n, n, diagonal=diagonal)
+    cell_tags = np.where(m.centroids()[:, 0] < 0.5, 1, 2)
+    return Mesh(m.points, m.triangles, cell_tags=cell_tags, boundary_edges=m.boundary_edges,
+                boundary_tags=m.boundary_tags, tag_names=dict(SIDES, west=1, east=2))
 
 
 def from_skfem(skmesh) -> Mesh:

@@ -10,10 +10,10 @@ from femkit.fem import SparsityPattern, assemble_load, assemble_stiffness
 from femkit.mesh import Mesh
 
 
-def _scrambled(make_square, seed=3):
+def _scrambled(make_square, draw=3):
     """A structured square with randomly permuted node and element numbers (far-apart vertices)."""
     base = make_square(9)
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(draw)
     perm = rng.permutation(base.n_points)
     inv = np.empty_like(perm)
     inv[perm] = np.arange(len(perm))

@@ -7,7 +7,7 @@ import pytest
 
 from femkit.errors import InputError, MeshError, UnknownNameError
 from femkit.mesh import GEOMETRIES, generate, geo_file, validate
-from femkit.mesh.refine import boundary_edges_topological
+from femkit.mesh.edges import boundary_edges_topological
 
 H = 0.1
 

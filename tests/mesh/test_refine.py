@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from femkit.mesh import boundary_nodes, edges, generate, quality, refine, validate
-from femkit.mesh.refine import boundary_edges_topological
+from femkit.mesh.edges import boundary_edges_topological
 
 
 @pytest.fixture(scope="module", params=["l_shape", "annulus", "checkerboard"])

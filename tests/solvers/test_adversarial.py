@@ -191,8 +191,8 @@ def test_stopping_rule_at_its_boundary(method):
     assert below.iterations == 1
 
 
-def _spd(draw_seed: int, n: int, cond_exp: float):
-    rng = np.random.default_rng(draw_seed)
+def _spd(draw: int, n: int, cond_exp: float):
+    rng = np.random.default_rng(draw)
     Q, _ = np.linalg.qr(rng.standard_normal((n, n)))
     lam = np.logspace(0.0, cond_exp, n)
     A = (Q * lam) @ Q.T
@@ -201,13 +201,13 @@ def _spd(draw_seed: int, n: int, cond_exp: float):
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(seed=st.integers(0, 2**31 - 1), n=st.integers(1, 12), cond_exp=st.floats(0.0, 9.0),
+@given(key=st.integers(0, 2**31 - 1), n=st.integers(1, 12), cond_exp=st.floats(0.0, 9.0),
        method=st.sampled_from(METHODS + ["pcg-ic0", "pcg-amg"]),
        rtol=st.sampled_from([1e-2, 1e-8, 1e-14]), maxiter=st.integers(0, 30),
        dense=st.booleans(), use_x0=st.booleans())
-def test_converged_never_contradicts_true_residual(seed, n, cond_exp, method, rtol, maxiter,
+def test_converged_never_contradicts_true_residual(key, n, cond_exp, method, rtol, maxiter,
                                                    dense, use_x0):
-    A, b, x0 = _spd(seed, n, cond_exp)
+    A, b, x0 = _spd(key, n, cond_exp)
     M = A if dense else sp.csr_matrix(A)
     name, _, pc = method.partition("-")
     kw = dict(rtol=rtol, x0=x0 if use_x0 else None)

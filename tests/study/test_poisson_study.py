@@ -18,9 +18,10 @@ PNG = b"\x89PNG\r\n\x1a\n"
 
 SMOOTH = {
     "kind": "poisson_convergence",
-    "problem": {"geometry": "unit_square", "exact": "sin(pi*x)*sin(pi*y)",
-                "grad_exact": ["pi*cos(pi*x)*sin(pi*y)", "pi*sin(pi*x)*cos(pi*y)"],
-                "source": "2*pi**2*sin(pi*x)*sin(pi*y)"},
+    "problem": {"mesh": {"geometry": "unit_square"}, "source": "2*pi**2*sin(pi*x)*sin(pi*y)",
+                "boundary": {"dirichlet": [{"tags": ["boundary"], "value": "sin(pi*x)*sin(pi*y)"}]},
+                "exact": {"u": "sin(pi*x)*sin(pi*y)",
+                          "grad": ["pi*cos(pi*x)*sin(pi*y)", "pi*sin(pi*x)*cos(pi*y)"]}},
     "levels": {"h0": 0.2, "count": 4},
     "solvers": [{"method": "pcg", "preconditioner": "amg", "rtol": 1e-10}, {"method": "cg", "rtol": 1e-10},
                 {"method": "pcg", "preconditioner": "ic0", "rtol": 1e-10}, {"method": "direct"}],
@@ -97,6 +98,7 @@ def test_nested_amg_keeps_l2_accuracy(smooth):
 def test_gauss_radau_bound_is_an_upper_bound():
     import scipy.sparse as sp
 
+    from femkit.solvers import SolverSpec
     from femkit.study.poisson import cg_history, gauss_radau_bounds, smallest_ritz_value
 
     T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(15, 15))
@@ -106,7 +108,7 @@ def test_gauss_radau_bound_is_an_upper_bound():
     b = rng.standard_normal(n)
     x_star = np.linalg.solve(A.toarray(), b)
     for s in ({"method": "cg", "rtol": 1e-12}, {"method": "pcg", "preconditioner": "ic0", "rtol": 1e-12}):
-        h = cg_history(A, b, np.zeros(n), s)
+        h = cg_history(A, b, np.zeros(n), SolverSpec.from_mapping(s))
         lam = smallest_ritz_value(h["alpha"], h["rz"])
         U = gauss_radau_bounds(h["inc"], h["rz"], 0.5 * lam)
         xs = [np.zeros(n)]
@@ -152,7 +154,7 @@ def test_report_files(smooth):
     ({"levels": {"h0": 0.2, "cont": 3}}, CaseFileError, "levels.cont: unknown key"),
     ({"solvers": [{"method": "cg", "rtl": 1}]}, CaseFileError, "solvers[0].rtl"),
     ({"reference": "fenics"}, CaseFileError, "reference"),
-    ({"problem": {**SMOOTH["problem"], "exact": "__import__('os')"}}, ExpressionError, "problem.exact"),
+    ({"problem": {**SMOOTH["problem"], "exact": {"u": "__import__('os')"}}}, ExpressionError, "problem: exact.u"),
 ], ids=["levels-typo", "solver-typo", "bad-reference", "unsafe-expression"])
 def test_bad_study_files(patch, exc, text, tmp_path):
     with pytest.raises(exc, match=re.escape(text)):

@@ -8,8 +8,10 @@ import pytest
 from femkit.study import run_study, study_from_dict
 from femkit.study.fit import fit_asymptotic, fit_rate
 
-SMOOTH = {"exact": "sin(pi*x)*sin(pi*y)", "source": "2*pi**2*sin(pi*x)*sin(pi*y)",
-          "grad_exact": ["pi*cos(pi*x)*sin(pi*y)", "pi*sin(pi*x)*cos(pi*y)"]}
+SMOOTH = {"mesh": {"geometry": "unit_square"}, "source": "2*pi**2*sin(pi*x)*sin(pi*y)",
+          "boundary": {"dirichlet": [{"tags": ["boundary"], "value": "sin(pi*x)*sin(pi*y)"}]},
+          "exact": {"u": "sin(pi*x)*sin(pi*y)",
+                    "grad": ["pi*cos(pi*x)*sin(pi*y)", "pi*sin(pi*x)*cos(pi*y)"]}}
 
 
 def test_two_point_fit_has_no_r2():

@@ -1,4 +1,5 @@
-"""Penalty contact with a ground plane and a sphere (seed 000 section 2.7).
+"""Penalty contact with a ground plane and a sphere (penalty collisions: Schlögl's
+lecture notes on physically based simulation).
 
 Any penetration creates a spring force pushing the particle out: ``f = k_c p n`` with
 penetration depth ``p > 0`` and outward normal ``n``; energy ``1/2 k_c p^2``. Nothing acts

@@ -1,4 +1,4 @@
-"""Uniform gravity ``f_i = m_i g`` (seed 000 section 2.1)."""
+"""Uniform gravity ``f_i = m_i g`` (Schlögl's lecture notes on physically based simulation)."""
 
 from __future__ import annotations
 

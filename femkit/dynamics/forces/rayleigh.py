@@ -2,7 +2,7 @@
 
 Explicit integrators get it inside ``system.force`` (``K`` applied matrix-free, unfixed);
 implicit ones read ``system.rayleigh == (alpha, beta)``, call ``force(..., rayleigh=False)``
-and build the term into their matrix (SOFA's EulerImplicit form in REFERENCE.md).
+and build the term into their matrix (the form of SOFA's EulerImplicitSolver documentation).
 It is not part of ``damping_matrix`` (so it is never counted twice).
 """
 

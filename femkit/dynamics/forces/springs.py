@@ -1,7 +1,8 @@
-"""Hooke springs and spring dashpots, vectorised over springs (seed 000 section 2.2).
+"""Hooke springs and spring dashpots, vectorised over springs (Schlögl's lecture notes on physically based
+simulation, mass-spring forces).
 
 Spring ``s = (i, j)``: ``x_ij = x_j - x_i``, ``l = |x_ij|``, ``u = x_ij / l``.
-Hooke: ``f_i = k (l - L) u = -f_j`` (seed eq. 2 with ``x_i - x_j`` written as ``-x_ij``; a
+Hooke: ``f_i = k (l - L) u = -f_j`` (the textbook ``f_i = -k (l - L) (x_i - x_j) / l`` with ``x_i - x_j = -x_ij``; a
 stretched spring pulls ``i`` toward ``j``), energy ``1/2 k (l - L)^2``.
 Dashpot: ``f_i = c ((v_j - v_i) . u) u = -f_j`` (damps only the rate of change of length).
 The system scatters the per-spring forces with one ``np.bincount`` over precomputed

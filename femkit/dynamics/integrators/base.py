@@ -15,8 +15,10 @@ Per-run caches (a factorised matrix, counters) live in :class:`StepContext`, nev
 integrator object, so one integrator instance can drive several runs.
 
 Linear solves of the implicit methods go through :func:`solve_linear` / :func:`factorize_linear`,
-which call :mod:`femkit.solvers` with the solver named in the context and restrict every system
-to ``system.free_dofs`` (pinned dofs are eliminated).
+which solve with the context's :class:`~femkit.solvers.SolverSpec` (``ctx.linear_solver``, the
+one solver description of femkit; :meth:`SolverSpec.solve` is the one translator to
+:func:`femkit.solvers.solve`) and restrict every system to ``system.free_dofs`` (pinned dofs are
+eliminated).
 
 Direct solves of a new matrix every step (Baraff-Witkin, Newton) reuse the ordering: the
 first factorisation lets SuperLU order the matrix (symmetric mode, minimum degree on the actual
@@ -34,12 +36,13 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from ...errors import InputError, SolverError, StabilityWarning
+from ...solvers.spec import SolverSpec
 
 __all__ = [
     "StepContext",
@@ -68,14 +71,10 @@ class StepContext:
 
     Parameters
     ----------
-    solver : str
-        Name of a :mod:`femkit.solvers` method (``"direct"``, ``"cg"``, ``"pcg"``, ``"jacobi"``).
-    preconditioner : str
-        Preconditioner name for ``pcg`` (``"none"``, ``"jacobi"``, ``"ic0"``, ``"amg"``).
-    rtol, atol, maxiter : float, float, int or None
-        Stopping rule of iterative solvers.
-    options : dict
-        Extra keyword options passed to ``femkit.solvers.solve``.
+    linear_solver : SolverSpec
+        The linear solver of the implicit steps: method (``"direct"``, ``"cg"``, ``"pcg"``,
+        ``"jacobi"``), preconditioner, stopping rule ``rtol``/``atol``/``maxiter`` and extra
+        options (default: ``direct`` with ``rtol`` 1e-10).
     cache : dict
         Per-run caches (e.g. the fast mass-spring factorisation); filled by integrators.
     stats : dict
@@ -83,12 +82,7 @@ class StepContext:
         ``newton_iterations`` list, ``linear_iterations``).
     """
 
-    solver: str = "direct"
-    preconditioner: str = "none"
-    rtol: float = 1e-10
-    atol: float = 0.0
-    maxiter: int | None = None
-    options: dict = field(default_factory=dict)
+    linear_solver: SolverSpec = field(default_factory=lambda: SolverSpec("direct"))
     cache: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)
 
@@ -247,7 +241,7 @@ def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = Non
     (:func:`check_matrix_free`) and ``diagonal`` (the operator's diagonal) builds the Jacobi
     preconditioner.
 
-    With ``ctx.solver == "direct"`` and the ``system`` (which marks a matrix refactorised every
+    With a ``direct`` solver and the ``system`` (which marks a matrix refactorised every
     step), the SuperLU ordering is reused while the pattern of ``A`` stays the same (module
     docstring); the result must meet the direct solver's rule
     ``||b - A x|| <= max(rtol ||b||, atol)``.
@@ -266,27 +260,25 @@ def solve_linear(A, b: np.ndarray, ctx: StepContext, x0: np.ndarray | None = Non
     """
     from scipy.sparse.linalg import LinearOperator
 
-    pc_options = None
+    spec = ctx.linear_solver
     if isinstance(A, LinearOperator):
         check_matrix_free("matrix-free solve", ctx)
-        if ctx.solver == "pcg" and ctx.preconditioner == "jacobi":
+        if spec.method == "pcg" and spec.preconditioner == "jacobi":
             if diagonal is None:
                 raise InputError("matrix-free pcg with jacobi needs the operator's diagonal")
-            pc_options = {"diagonal": diagonal}
-    elif system is not None and ctx.solver == "direct" and not ctx.options:
+            spec = replace(spec, preconditioner_options={**spec.preconditioner_options,
+                                                         "diagonal": diagonal})
+    elif system is not None and spec.method == "direct" and not spec.options:
         if reuse_key is not None:
             return _solve_reusing_factor(A, b, ctx, reuse_key, x0)
         return _solve_direct_reusing_ordering(A, b, ctx)
-    from ...solvers import solve as _solve  # lazy: keeps ``import femkit.dynamics`` light
 
     ctx.count("linear_solves")
-    res = _solve(A, b, x0, method=ctx.solver, preconditioner=ctx.preconditioner,
-                 rtol=ctx.rtol, atol=ctx.atol, maxiter=ctx.maxiter,
-                 preconditioner_options=pc_options, **ctx.options)
+    res = spec.solve(A, b, x0)
     ctx.count("linear_iterations", int(res.iterations))
     if not res.converged:
         raise SolverError(
-            f"linear solve ({ctx.solver}/{ctx.preconditioner}) did not converge: {res.reason}; "
+            f"linear solve ({spec.method}/{spec.preconditioner}) did not converge: {res.reason}; "
             f"relative residual {res.relative_residual:.3e} after {res.iterations} iterations"
         )
     return np.asarray(res.x, dtype=float)
@@ -337,15 +329,13 @@ def _solve_reusing_factor(A, b: np.ndarray, ctx: StepContext, key: str, x0=None,
     solve refactorises; a PCG solve that misses the tolerance within the cap refactorises now."""
     import scipy.sparse as sp
 
-    from ...solvers import solve as _solve
-
     kept = ctx.cache.get(key)
     b = np.asarray(b, dtype=float)
     if kept is not None and tuple(kept.factor.shape) == A.shape and float(np.linalg.norm(b)) > 0.0:
         t0 = time.perf_counter()
-        res = _solve(sp.csr_matrix(A), b, x0, method="pcg", preconditioner=kept.factor,
-                     rtol=ctx.rtol, atol=ctx.atol, maxiter=REUSE_MAX_ITERATIONS,
-                     check_symmetry=False)
+        spec = replace(ctx.linear_solver, method="pcg", preconditioner=kept.factor,
+                       maxiter=REUSE_MAX_ITERATIONS, options={"check_symmetry": False})
+        res = spec.solve(sp.csr_matrix(A), b, x0)
         spent = time.perf_counter() - t0
         _add_time(ctx, "time_pcg", spent)
         ctx.count("linear_solves")
@@ -390,10 +380,11 @@ def _checked_solve(factor, A, b: np.ndarray, bnorm: float, ctx: StepContext, nam
     x = factor.solve(b)
     _add_time(ctx, "time_solve", time.perf_counter() - t0)
     res = float(np.linalg.norm(b - A @ x))
-    if not (np.isfinite(res) and res <= max(ctx.rtol * bnorm, ctx.atol)):
+    rtol, atol = ctx.linear_solver.rtol, ctx.linear_solver.atol
+    if not (np.isfinite(res) and res <= max(rtol * bnorm, atol)):
         raise SolverError(
             f"linear solve ({name}) missed the residual rule: relative residual {res / bnorm:.3e} "
-            f"> rtol {ctx.rtol:.1e}; the matrix is numerically singular or very ill-conditioned")
+            f"> rtol {rtol:.1e}; the matrix is numerically singular or very ill-conditioned")
     return x
 
 
@@ -401,13 +392,13 @@ def factorize_linear(A, ctx: StepContext):
     """Factorise a sparse SPD matrix once for repeated solves; returns an object with ``.solve(b)``.
 
     ``b`` may be ``(n,)`` or ``(n, k)`` (several right-hand sides in one call). With
-    ``ctx.solver == "cholesky"`` the factor is CHOLMOD's (:func:`femkit.solvers.factorize_spd`;
+    ``ctx.linear_solver.method == "cholesky"`` the factor is CHOLMOD's (:func:`femkit.solvers.factorize_spd`;
     :class:`~femkit.errors.NotSPDError` if ``A`` is not SPD), otherwise SuperLU's.
     """
     from ...solvers import factorize
 
     ctx.count("factorizations")
-    if ctx.solver == "cholesky":  # factorised once: the ordering with the least fill pays
+    if ctx.linear_solver.method == "cholesky":  # factorised once: the ordering with the least fill pays
         from ...solvers import factorize_spd
 
         return factorize_spd(A, ordering="nesdis")
@@ -415,9 +406,9 @@ def factorize_linear(A, ctx: StepContext):
 
 
 def uses_cholesky(ctx: StepContext, integrator) -> bool:
-    """Whether a step takes the compiled path: ``ctx.solver == "cholesky"`` (assembled, not
+    """Whether a step takes the compiled path: ``ctx.linear_solver.method == "cholesky"`` (assembled, not
     matrix-free)."""
-    return ctx.solver == "cholesky" and not getattr(integrator, "matrix_free", False)
+    return ctx.linear_solver.method == "cholesky" and not getattr(integrator, "matrix_free", False)
 
 
 def solve_compiled(A, b: np.ndarray, ctx: StepContext, pattern, reuse_key: str | None = None) -> np.ndarray:
@@ -497,16 +488,17 @@ def check_matrix_free(name: str, ctx: StepContext) -> None:
     products alone: ``cg``, or ``pcg`` with preconditioner ``none``/``jacobi`` (``direct``,
     ``jacobi`` iteration, ``ic0`` and ``amg`` need the assembled matrix).
 
-    >>> check_matrix_free("implicit_euler", StepContext(solver="pcg", preconditioner="jacobi"))
-    >>> check_matrix_free("implicit_euler", StepContext(solver="direct"))
+    >>> check_matrix_free("implicit_euler", StepContext(SolverSpec("pcg", "jacobi")))
+    >>> check_matrix_free("implicit_euler", StepContext(SolverSpec("direct")))
     Traceback (most recent call last):
     ...
     femkit.errors.InputError: implicit_euler: matrix-free needs an iterative solver: cg or pcg (jacobi); got linear solver 'direct'
     """
-    allowed = MATRIX_FREE_SOLVERS.get(ctx.solver)
+    spec = ctx.linear_solver
+    allowed = MATRIX_FREE_SOLVERS.get(spec.method)
     if allowed is None:
-        raise InputError(f"{name}: {MATRIX_FREE_MESSAGE}; got linear solver {ctx.solver!r}")
-    pc = ctx.preconditioner if ctx.solver == "pcg" else "none"
+        raise InputError(f"{name}: {MATRIX_FREE_MESSAGE}; got linear solver {spec.method!r}")
+    pc = spec.preconditioner if spec.method == "pcg" else "none"
     if pc not in allowed:
         raise InputError(f"{name}: {MATRIX_FREE_MESSAGE}; preconditioner {pc!r} needs the "
                          f"assembled matrix")

@@ -23,13 +23,12 @@ from dataclasses import dataclass
 
 from .base import StepContext, StepperState
 from .kick_drift_kick import KickDriftKick
-from .registry import INTEGRATORS
+from .registry import register
 
 
-@INTEGRATORS.register("central_difference")
+@register("central_difference")
 @dataclass(frozen=True)
 class CentralDifference(KickDriftKick):
-    name = "central_difference"
 
     def accel(self, system, x, v, t):
         """Every force but Rayleigh's mass part, divided by the masses (zero rows on pinned nodes)."""

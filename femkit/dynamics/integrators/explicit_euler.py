@@ -9,14 +9,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .registry import INTEGRATORS
-from .tableau import ButcherTableau, ExplicitRungeKutta
+from .registry import register
+from .runge_kutta import ButcherTableau, ExplicitRungeKutta
 
 
-@INTEGRATORS.register("explicit_euler")
+@register("explicit_euler")
 @dataclass(frozen=True)
 class ExplicitEuler(ExplicitRungeKutta):
-    name = "explicit_euler"
     order = 1
     stability_bound = 2.0
     tableau = ButcherTableau(((0.0,),), (1.0,), (0.0,))

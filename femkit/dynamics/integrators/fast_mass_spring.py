@@ -77,7 +77,7 @@ import numpy as np
 from ...errors import InputError
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
                    factorize_linear, restrict)
-from .registry import INTEGRATORS
+from .registry import register
 
 _KEY_ATTRS = ("mass", "k", "rest", "damping", "springs", "pinned", "forces")
 
@@ -139,7 +139,7 @@ class _Operators:
     B_free: object = None       # nf x n rows of the damping split h B (None: no damping)
 
 
-@INTEGRATORS.register("fast_mass_spring")
+@register("fast_mass_spring")
 @dataclass(frozen=True)
 class FastMassSpring(Integrator):
     iterations: int = 10
@@ -149,7 +149,6 @@ class FastMassSpring(Integrator):
     chebyshev_delay: int = 2
     chebyshev_warmup: int = 10
 
-    name = "fast_mass_spring"
     order = 1
     implicit = True
     symplectic = False
@@ -226,7 +225,7 @@ class FastMassSpring(Integrator):
         ``(n, d)`` work array whose pinned rows hold the fixed positions)."""
         free = ops.free
         variable = system.has_variable_forces
-        compiled = ctx.solver == "cholesky"
+        compiled = ctx.linear_solver.method == "cholesky"
         if compiled:
             from ..kernels.spring_kernels import local_global_rhs
 

@@ -8,14 +8,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .registry import INTEGRATORS
-from .tableau import ButcherTableau, ExplicitRungeKutta
+from .registry import register
+from .runge_kutta import ButcherTableau, ExplicitRungeKutta
 
 
-@INTEGRATORS.register("heun")
+@register("heun")
 @dataclass(frozen=True)
 class Heun(ExplicitRungeKutta):
-    name = "heun"
     order = 2
     stability_bound = 2.0
     tableau = ButcherTableau(((0.0, 0.0), (1.0, 0.0)), (0.5, 0.5), (0.0, 1.0))

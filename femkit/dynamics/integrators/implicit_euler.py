@@ -18,11 +18,11 @@ makes ``K`` positive semi-definite for CG-type solvers when springs are compress
 With the ``direct`` (or ``cholesky``) solver and ``reuse_factorization=True`` (opt-in; the default
 ``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
 earlier step's matrix is kept (when it is SPD) and later steps solve by PCG preconditioned with
-it, to ``ctx.rtol`` on the true residual, renewing the factor when a PCG solve costs more than
+it, to ``ctx.linear_solver.rtol`` on the true residual, renewing the factor when a PCG solve costs more than
 the average per solve since the factorisation (:func:`.base.solve_linear`): the same step to
 that tolerance at a fraction of the cost while the matrix changes slowly. ``reuse_factorization=False``: one factorisation per step.
 
-``matrix_free=True`` (seed 001, matrix-free CG) solves the same system without assembling
+``matrix_free=True`` (matrix-free CG: Baraff & Witkin 1998; Saad 2003, section 6.7) solves the same system without assembling
 it: a ``LinearOperator`` on the free dofs applies
 ``A d = (1 + h r_M) M d + h (h + r_K) K d + h D d`` through ``system.stiffness_operator`` /
 ``system.damping_operator`` (spring geometry computed once per step, two sparse passes over
@@ -47,17 +47,16 @@ import numpy as np
 
 from .base import (Integrator, StepContext, StepperState, check_matrix_free_options, free_operator,
                    restrict, solve_compiled, solve_linear, uses_cholesky)
-from .registry import INTEGRATORS
+from .registry import register
 
 
-@INTEGRATORS.register("implicit_euler")
+@register("implicit_euler")
 @dataclass(frozen=True)
 class ImplicitEuler(Integrator):
     fix: str | None = None
     reuse_factorization: bool = False
     matrix_free: bool = False
 
-    name = "implicit_euler"
     order = 1
     implicit = True
     symplectic = False

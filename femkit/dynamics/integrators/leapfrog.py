@@ -13,13 +13,12 @@ from dataclasses import dataclass
 
 from .base import StepContext, StepperState
 from .kick_drift_kick import KickDriftKick
-from .registry import INTEGRATORS
+from .registry import register
 
 
-@INTEGRATORS.register("leapfrog")
+@register("leapfrog")
 @dataclass(frozen=True)
 class Leapfrog(KickDriftKick):
-    name = "leapfrog"
 
     def start(self, system, x, v, t, dt, ctx):
         state = super().start(system, x, v, t, dt, ctx)

@@ -28,7 +28,7 @@ import numpy as np
 
 from ...errors import InputError
 from .base import Integrator, StepContext, StepperState, note_unconverged, restrict, solve_linear
-from .registry import INTEGRATORS
+from .registry import register
 
 
 def _roundoff_floor(system) -> float:
@@ -40,7 +40,7 @@ def _roundoff_floor(system) -> float:
     return 100.0 * np.finfo(float).eps * float(np.max(system.k * system.rest))
 
 
-@INTEGRATORS.register("newmark")
+@register("newmark")
 @dataclass(frozen=True)
 class Newmark(Integrator):
     beta: float = 0.25
@@ -49,7 +49,6 @@ class Newmark(Integrator):
     max_iterations: int = 20
     fix: str | None = None
 
-    name = "newmark"
     implicit = True
     symplectic = False
 

@@ -2,14 +2,14 @@
 
 ``x+ = argmin g(x)``, ``g(x) = 1/2 ||x - y||_M^2 + h^2 E(x) + h/2 ||x - x_n||_C^2``, with
 ``y = x_n + h v_n``, ``E`` the potential energy of every conservative force (springs, gravity,
-contact: ``system.potential_energy``; gravity inside ``E`` is the same as the seed's
+contact: ``system.potential_energy``; gravity inside ``E`` is the same as Liu et al. 2013's
 ``y = x_n + h v_n + h^2 M^-1 f_ext``) and ``C = D(x_n) + r_M M + r_K K(x_n)`` the damping
 (dashpots, viscous, Rayleigh) frozen at the start of the step (implicit in velocity, exact for
 constant damping). Then ``v+ = (x+ - x_n) / h``.
 
 Each iteration solves ``(M + h^2 K_fix(x) + h C) dx = -grad g(x)`` on the free dofs (``K_fix``
 with the per-spring eigenvalue clamp ``fix="clamp"`` by default, or ``"regularize"``, so ``dx``
-is a descent direction), then backtracks (Armijo: ``g(x + t dx) <= g(x) + c t grad.dx``,
+is a descent direction), then backtracks (Armijo, Nocedal & Wright, Numerical Optimization, section 3.1: ``g(x + t dx) <= g(x) + c t grad.dx``,
 ``t *= shrink``). It stops when ``||dx||_inf <= tol * L`` (``L`` = bounding-box diagonal of
 ``x_n``) or after ``max_iterations``; the iteration count of every step is appended to
 ``ctx.stats["newton_iterations"]``, and a step stopped by ``max_iterations`` is counted in
@@ -20,7 +20,7 @@ round-off level that is convergence.)
 With the ``direct`` (or ``cholesky``) solver and ``reuse_factorization=True`` (opt-in; the default
 ``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
 earlier Newton matrix (this step's or a previous step's) is kept and later Newton systems are
-solved by PCG preconditioned with it, to the same relative residual ``ctx.rtol`` on the true
+solved by PCG preconditioned with it, to the same relative residual ``ctx.linear_solver.rtol`` on the true
 residual; the factor is renewed when a PCG solve costs more than the average cost per solve
 since the factorisation (see :func:`.base.solve_linear`; ``ctx.stats``: ``factorizations``,
 ``refactorizations``, ``linear_iterations``, ``time_pcg``).
@@ -53,10 +53,10 @@ from ...errors import InputError
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
                    check_matrix_free_options, free_operator, note_unconverged, restrict,
                    solve_compiled, solve_linear, uses_cholesky)
-from .registry import INTEGRATORS
+from .registry import register
 
 
-@INTEGRATORS.register("newton")
+@register("newton")
 @dataclass(frozen=True)
 class NewtonImplicitEuler(Integrator):
     tol: float = 1e-10
@@ -68,7 +68,6 @@ class NewtonImplicitEuler(Integrator):
     reuse_factorization: bool = False
     matrix_free: bool = False
 
-    name = "newton"
     order = 1
     implicit = True
     symplectic = False

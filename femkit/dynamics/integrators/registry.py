@@ -3,8 +3,8 @@
 >>> from femkit.dynamics.integrators import INTEGRATORS, get_integrator
 >>> get_integrator("newmark", beta=0.25).order
 2
->>> "rk4" in INTEGRATORS
-True
+>>> "rk4" in INTEGRATORS, INTEGRATORS.get("rk4").name
+(True, 'rk4')
 """
 
 from __future__ import annotations
@@ -13,6 +13,17 @@ from ...errors import InputError
 from ...registry import Registry
 
 INTEGRATORS: Registry = Registry("integrator")
+
+
+def register(name: str):
+    """Class decorator: register an integrator class as ``name`` and set its ``name`` attribute
+    (the name is written once, here)."""
+
+    def decorator(cls):
+        cls.name = name
+        return INTEGRATORS.register(name, cls)
+
+    return decorator
 
 
 def get_integrator(name: str, **options):

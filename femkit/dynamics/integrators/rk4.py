@@ -9,14 +9,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .registry import INTEGRATORS
-from .tableau import ButcherTableau, ExplicitRungeKutta
+from .registry import register
+from .runge_kutta import ButcherTableau, ExplicitRungeKutta
 
 
-@INTEGRATORS.register("rk4")
+@register("rk4")
 @dataclass(frozen=True)
 class RK4(ExplicitRungeKutta):
-    name = "rk4"
     order = 4
     stability_bound = 2.0 * math.sqrt(2.0)
     tableau = ButcherTableau(

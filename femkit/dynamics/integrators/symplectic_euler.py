@@ -16,15 +16,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .base import Integrator, StepContext, StepperState
-from .registry import INTEGRATORS
+from .registry import register
 
 
-@INTEGRATORS.register("symplectic_euler")
+@register("symplectic_euler")
 @dataclass(frozen=True)
 class SymplecticEuler(Integrator):
     """Velocity first: kick with the force at the old state, then drift with the new velocity."""
 
-    name = "symplectic_euler"
     order = 1
     implicit = False
     symplectic = True
@@ -35,12 +34,11 @@ class SymplecticEuler(Integrator):
         return StepperState(state.x + dt * v_new, v_new, state.t + dt)
 
 
-@INTEGRATORS.register("symplectic_euler_position_first")
+@register("symplectic_euler_position_first")
 @dataclass(frozen=True)
 class SymplecticEulerPositionFirst(Integrator):
     """Position first: drift with the old velocity, then kick with the force at the new positions."""
 
-    name = "symplectic_euler_position_first"
     order = 1
     implicit = False
     symplectic = True

@@ -25,17 +25,16 @@ import numpy as np
 
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
                    note_unconverged, restrict, solve_linear)
-from .registry import INTEGRATORS
+from .registry import register
 
 
-@INTEGRATORS.register("variational_symplectic")
+@register("variational_symplectic")
 @dataclass(frozen=True)
 class VariationalSymplectic(Integrator):
     tol: float = 1e-12
     max_iterations: int = 20
     fix: str | None = None
 
-    name = "variational_symplectic"
     order = 2
     implicit = True
     symplectic = True

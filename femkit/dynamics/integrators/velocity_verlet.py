@@ -12,13 +12,12 @@ from dataclasses import dataclass
 
 from .base import StepContext, StepperState
 from .kick_drift_kick import KickDriftKick
-from .registry import INTEGRATORS
+from .registry import register
 
 
-@INTEGRATORS.register("velocity_verlet")
+@register("velocity_verlet")
 @dataclass(frozen=True)
 class VelocityVerlet(KickDriftKick):
-    name = "velocity_verlet"
 
     def step(self, system, state: StepperState, dt: float, ctx: StepContext) -> StepperState:
         a = state.aux["a"]

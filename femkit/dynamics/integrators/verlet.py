@@ -15,13 +15,12 @@ from dataclasses import dataclass
 
 from .base import StepContext, StepperState
 from .kick_drift_kick import KickDriftKick
-from .registry import INTEGRATORS
+from .registry import register
 
 
-@INTEGRATORS.register("verlet")
+@register("verlet")
 @dataclass(frozen=True)
 class Verlet(KickDriftKick):
-    name = "verlet"
 
     def start(self, system, x, v, t, dt, ctx):
         state = super().start(system, x, v, t, dt, ctx)

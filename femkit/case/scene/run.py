@@ -6,7 +6,7 @@ preconditioner names against their registries, integrator options, mesh geometry
 expressions, output cadence), so bad input fails before anything is computed or written;
 :func:`run_scene` builds the system with *only the declared forces*, runs
 :func:`femkit.dynamics.simulate.simulate` and writes the outputs atomically
-(:mod:`femkit.dynamics.output`).
+(:mod:`femkit.case.scene.output`).
 
 Stability: an :class:`~femkit.errors.InstabilityError` does not escape :func:`run_scene`. The
 trajectory up to the last good step is written, ``result.json`` says ``"verdict":
@@ -35,29 +35,35 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..case.load import Case
-from ..errors import CaseFileError, ExpressionError, InputError, InstabilityError, UnknownNameError
+from ..._version import __version__
+from ...dynamics import topology
+from ...dynamics.forces import GroundContact, Gravity, RayleighDamping, SphereContact, ViscousDamping
+from ...dynamics.integrators import StepContext, get_integrator
+from ...dynamics.integrators.base import check_matrix_free
+from ...dynamics.simulate import StabilityWarning, simulate
+from ...dynamics.stability import estimate_omega_max
+from ...errors import (CaseFileError, ExpressionError, InputError, InstabilityError,
+                       UnknownNameError, with_prefix)
+from ...io.atomic import check_output_dir
+from ...mesh import generate, grid_triangles, read_mesh, validate
+from ...registry import Registry
+from ...solvers.spec import SolverSpec
+from ...timing import StageTimer
+from ..expressions import compile_expression
+from ..load import Case
+from ..names import check_geometry_spec, resolve_file
+from ..specs import IntegratorSpec, solver_spec
+from ...io.atomic import EARLIER_RUN
+from .output import write_scene_outputs
 
 __all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "build_context",
-           "output_every", "n_steps", "SceneResult", "state_checksum"]
+           "output_every", "n_steps", "SceneResult", "state_checksum", "FORCES", "SYSTEMS"]
 
 
 # ----------------------------------------------------------------------------- prepare
 
-def _prefixed(exc: InputError, where: str) -> InputError:
-    """The same exception (type and attributes kept) with ``where: `` before its message."""
-    new = type(exc).__new__(type(exc))
-    new.__dict__.update(exc.__dict__)
-    new.args = (f"{where}: {' '.join(str(exc).split())}",)
-    return new
-
-
-
-
 def _time_value(case: Case, key: str) -> float:
     """``dt``/``t_end``: a number, or a constant expression such as ``"1/60"``."""
-    from ..case.expressions import compile_expression
-
     value = case.data[key]
     if isinstance(value, str):
         try:
@@ -106,36 +112,20 @@ def prepare_scene(case: Case) -> None:
         case.name = d["name"]
 
     # integrator: name and options checked by building it once
-    integ = d["integrator"]
-    if isinstance(integ, str):
-        integ = {"method": integ}
-    integ = {"method": integ["method"], "options": dict(integ.get("options") or {})}
-    d["integrator"] = integ
-    from .integrators import INTEGRATORS, get_integrator
-
     try:
-        INTEGRATORS.get(integ["method"])
-    except UnknownNameError as exc:
-        raise _prefixed(exc, "integrator.method") from None
-    try:
-        get_integrator(integ["method"], **integ["options"])
+        integ = IntegratorSpec.from_mapping(d["integrator"], "integrator")
     except UnknownNameError:
         raise
     except InputError as exc:
-        raise CaseFileError(f"integrator.options: {' '.join(str(exc).split())}") from None
+        raise CaseFileError(str(exc)) from None
+    d["integrator"] = {"method": integ.method, "options": dict(integ.options)}
 
     # linear solver
-    from ..case.checks import check_solver_spec
-
-    check_solver_spec(d["linear_solver"], "linear_solver", default_preconditioner="jacobi")
-    if integ["options"].get("matrix_free"):  # caught at load time, before anything runs
-        from .integrators import StepContext
-        from .integrators.base import check_matrix_free
-
-        ls = d["linear_solver"]
+    ls_spec = solver_spec(d["linear_solver"], "linear_solver", default_method="direct")
+    d["linear_solver"] = ls_spec.to_dict()
+    if integ.options.get("matrix_free"):  # caught at load time, before anything runs
         try:
-            check_matrix_free(integ["method"], StepContext(solver=ls["method"],
-                                                           preconditioner=ls.get("preconditioner") or "none"))
+            check_matrix_free(integ.method, StepContext(ls_spec))
         except InputError as exc:
             raise CaseFileError(f"linear_solver: {exc}") from None
 
@@ -158,8 +148,6 @@ def prepare_scene(case: Case) -> None:
         if kinds.count(kind) > 1:
             raise CaseFileError(f"forces: {kind!r} is declared {kinds.count(kind)} times "
                                 "(only 'sphere' may repeat)")
-    from ..case.expressions import compile_expression
-
     for i, comp in enumerate(system.get("velocity") or []):
         key = f"system.velocity[{i}]"
         try:
@@ -175,8 +163,6 @@ def prepare_scene(case: Case) -> None:
 
 
 def _prepare_mesh(system: dict, base: Path) -> None:
-    from ..case.checks import check_geometry_spec, resolve_file
-
     if "file" in system:
         resolve_file(system, "system", base)
     else:
@@ -185,37 +171,80 @@ def _prepare_mesh(system: dict, base: Path) -> None:
 
 # ----------------------------------------------------------------------------- build
 
+#: force type -> builder ``(params) -> force object`` (``dashpot`` is a spring coefficient,
+#: handled by :func:`_forces`)
+FORCES: Registry = Registry("force")
+
+
+@FORCES.register("gravity")
+def _gravity(f: dict):
+    g = f.get("g", 9.81)
+    return Gravity(g, axis=int(f.get("axis", -1))) if np.ndim(g) == 0 else Gravity(list(g))
+
+
+@FORCES.register("viscous")
+def _viscous(f: dict):
+    return ViscousDamping(f["gamma"], per_mass=bool(f.get("per_mass", False)))
+
+
+@FORCES.register("rayleigh")
+def _rayleigh(f: dict):
+    return RayleighDamping(f.get("alpha", 0.0), f.get("beta", 0.0))
+
+
+@FORCES.register("ground")
+def _ground(f: dict):
+    return GroundContact(f["stiffness"], f.get("height", 0.0), f.get("normal"))
+
+
+@FORCES.register("sphere")
+def _sphere(f: dict):
+    return SphereContact(f["centre"], f["radius"], f["stiffness"])
+
+
 def _forces(case: Case) -> tuple[list, float | None]:
     """Force objects for the declared forces, and the dashpot coefficient (None: no dashpot)."""
-    from .forces import GroundContact, Gravity, RayleighDamping, SphereContact, ViscousDamping
-
     objs, dashpot = [], None
     for f in case.data["forces"]:
-        kind = f["type"]
-        if kind == "gravity":
-            g = f.get("g", 9.81)
-            objs.append(Gravity(g, axis=int(f.get("axis", -1))) if np.ndim(g) == 0
-                        else Gravity(list(g)))
-        elif kind == "dashpot":
+        if f["type"] == "dashpot":
             dashpot = float(f["c"])
-        elif kind == "viscous":
-            objs.append(ViscousDamping(f["gamma"], per_mass=bool(f.get("per_mass", False))))
-        elif kind == "rayleigh":
-            objs.append(RayleighDamping(f.get("alpha", 0.0), f.get("beta", 0.0)))
-        elif kind == "ground":
-            objs.append(GroundContact(f["stiffness"], f.get("height", 0.0), f.get("normal")))
-        elif kind == "sphere":
-            objs.append(SphereContact(f["centre"], f["radius"], f["stiffness"]))
-        else:  # the schema admits nothing else
-            raise CaseFileError(f"forces: unknown force type {kind!r}")
+        else:  # the schema admits only registered types
+            objs.append(FORCES.get(f["type"])(f))
     return objs, dashpot
 
 
-def _grid_triangles(nx: int, ny: int) -> np.ndarray:
-    idx = np.arange(nx * ny).reshape(ny, nx)
-    a, b, c, d = idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]
-    return np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3),
-                           np.stack([a, c, d], -1).reshape(-1, 3)]).astype(np.int64)
+#: system type -> builder ``(params, origin, forces/damping keywords) -> (system, triangles)``;
+#: ``params`` is the ``system`` mapping without ``type``, ``velocity``, ``damping``, ``origin``.
+SYSTEMS: Registry = Registry("system type")
+
+
+@SYSTEMS.register("rope")
+def _rope(s: dict, origin, kw: dict):
+    return topology.rope(s.pop("n"), s.pop("length"), origin=origin, **s, **kw), None
+
+
+@SYSTEMS.register("cloth")
+def _cloth(s: dict, origin, kw: dict):
+    nx, ny = s.pop("nx"), s.pop("ny")
+    system = topology.cloth_grid(nx, ny, s.pop("width"), s.pop("height"), origin=origin, **s, **kw)
+    return system, grid_triangles(nx, ny)
+
+
+@SYSTEMS.register("mesh")
+def _mesh(s: dict, origin, kw: dict):
+    mesh = _scene_mesh(s)
+    for key in ("geometry", "h", "params", "file"):
+        s.pop(key, None)
+    system = topology.mesh_springs(mesh, **s, **kw)
+    if origin is not None:
+        system.x0 = system.x0 + np.asarray(origin, float).reshape(1, system.dim)
+    return system, np.asarray(mesh.triangles, dtype=np.int64)
+
+
+@SYSTEMS.register("single_spring")
+def _single_spring(s: dict, origin, kw: dict):
+    return topology.single_spring(s.pop("k"), s.pop("m"), s.pop("rest", 1.0), gravity=None,
+                                  **s, **kw), None
 
 
 def build_system(case: Case):
@@ -224,41 +253,19 @@ def build_system(case: Case):
     Only the declared forces are attached; the dashpot is present only when declared
     (``system.damping`` or a ``dashpot`` force).
     """
-    from . import topology
-
     s = dict(case.data["system"])
     kind = s.pop("type")
     s.pop("velocity", None)
     forces, dashpot = _forces(case)
     damping = s.pop("damping", dashpot if dashpot is not None else 0.0)
     origin = s.pop("origin", None)
-    kw = dict(forces=forces, damping=damping)
-    triangles = None
+    builder = SYSTEMS.get(kind)  # the schema admits only registered types
     try:
-        if kind == "rope":
-            system = topology.rope(s.pop("n"), s.pop("length"), origin=origin, **s, **kw)
-        elif kind == "cloth":
-            nx, ny = s["nx"], s["ny"]
-            system = topology.cloth_grid(s.pop("nx"), s.pop("ny"), s.pop("width"), s.pop("height"),
-                                         origin=origin, **s, **kw)
-            triangles = _grid_triangles(nx, ny)
-        elif kind == "mesh":
-            mesh = _scene_mesh(s)
-            for key in ("geometry", "h", "params", "file"):
-                s.pop(key, None)
-            system = topology.mesh_springs(mesh, **s, **kw)
-            if origin is not None:
-                system.x0 = system.x0 + np.asarray(origin, float).reshape(1, system.dim)
-            triangles = np.asarray(mesh.triangles, dtype=np.int64)
-        elif kind == "single_spring":
-            system = topology.single_spring(s.pop("k"), s.pop("m"), s.pop("rest", 1.0),
-                                            gravity=None, **s, **kw)
-        else:  # pragma: no cover - the schema admits nothing else
-            raise CaseFileError(f"system.type: unknown system type {kind!r}")
+        system, triangles = builder(s, origin, dict(forces=forces, damping=damping))
     except CaseFileError:
         raise
     except InputError as exc:
-        raise _prefixed(exc, "system") from None
+        raise with_prefix(exc, "system") from None
     vel = [case.functions[f"system.velocity[{i}]"]
            for i in range(len(case.data["system"].get("velocity") or []))]
     if vel:
@@ -274,7 +281,6 @@ def build_system(case: Case):
 
 
 def _scene_mesh(spec: dict):
-    from ..mesh import generate, read_mesh, validate
 
     where = f"system.file {spec['file']}" if "file" in spec else f"system.geometry {spec['geometry']}"
     try:
@@ -282,24 +288,18 @@ def _scene_mesh(spec: dict):
             return validate(read_mesh(spec["file"]))
         return validate(generate(spec["geometry"], spec["h"], **(spec.get("params") or {})))
     except InputError as exc:
-        raise _prefixed(exc, where) from None
+        raise with_prefix(exc, where) from None
 
 
 def build_integrator(case: Case):
     """The integrator object named by ``integrator.method`` with its ``options``."""
-    from .integrators import get_integrator
-
     spec = case.data["integrator"]
     return get_integrator(spec["method"], **spec["options"])
 
 
 def build_context(case: Case):
-    """A :class:`~femkit.dynamics.integrators.StepContext` from ``linear_solver``."""
-    from .integrators import StepContext
-
-    ls = case.data["linear_solver"]
-    return StepContext(solver=ls["method"], preconditioner=ls["preconditioner"], rtol=ls["rtol"],
-                       atol=ls["atol"], maxiter=ls.get("maxiter"))
+    """A :class:`~femkit.dynamics.integrators.StepContext` holding the ``linear_solver`` spec."""
+    return StepContext(SolverSpec(**case.data["linear_solver"]))
 
 
 def n_steps(case: Case) -> int:
@@ -390,8 +390,6 @@ class SceneResult:
 
     def to_dict(self) -> dict:
         """The content of ``result.json`` (keys documented in docs/scenes.md)."""
-        from .. import __version__
-
         tr = self.trajectory
         s = self.system
         x_final = tr.x[-1]
@@ -498,28 +496,22 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
         ``converged`` is false when the run became unstable; the results up to the last good
         step are still written, marked ``"verdict": "unstable"``.
     """
-    from .simulate import StabilityWarning, simulate
-
     if write:  # refuse a bad output location before any work (never replaces user files)
-        from ..io.atomic import check_output_dir
-        from .output import PREVIOUS_RUN
-
-        check_output_dir(output_dir or case.data["output"]["dir"], PREVIOUS_RUN)
+        check_output_dir(output_dir or case.data["output"]["dir"], EARLIER_RUN)
     out = echo or print
-    timings: dict[str, float] = {}
+    timer = StageTimer()
     t0 = time.perf_counter()
-    system, triangles = build_system(case)
-    integrator = build_integrator(case)
-    ctx = build_context(case)
-    every = output_every(case)
-    timings["build"] = time.perf_counter() - t0
+    with timer("build"):
+        system, triangles = build_system(case)
+        integrator = build_integrator(case)
+        ctx = build_context(case)
+        every = output_every(case)
     st = case.data["stability"]
     progress = (not quiet) and sys.stderr.isatty()
 
-    t1 = time.perf_counter()
     caught: list[str] = []
     instability = None
-    with warnings.catch_warnings(record=True) as wlist:
+    with timer("simulate"), warnings.catch_warnings(record=True) as wlist:
         warnings.simplefilter("always", StabilityWarning)
         try:
             traj = simulate(system, integrator, case.data["dt"], case.data["t_end"], ctx=ctx,
@@ -534,26 +526,20 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
                 caught.append(" ".join(str(w.message).split()))
             else:
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    timings["simulate"] = time.perf_counter() - t1
 
     omega = None
     if st["check"] and traj.omega_max is None and system.n_springs:
-        from .stability import estimate_omega_max
-
         omega = float(estimate_omega_max(system, iters=200))
     result = SceneResult(case=case, system=system, integrator=integrator, trajectory=traj,
                          triangles=triangles, instability=instability, every=every,
-                         wall_time=time.perf_counter() - t0, timings=timings, omega_max=omega,
+                         wall_time=time.perf_counter() - t0, timings=timer.times, omega_max=omega,
                          warnings=caught)
     if not quiet:
         for w in caught:
             print(f"femkit: warning: {w}", file=sys.stderr)
     if write:
-        from .output import write_scene_outputs
-
-        t2 = time.perf_counter()
-        write_scene_outputs(result, output_dir or case.data["output"]["dir"])
-        timings["output"] = time.perf_counter() - t2
+        with timer("output"):
+            write_scene_outputs(result, output_dir or case.data["output"]["dir"])
         result.wall_time = time.perf_counter() - t0
     if instability is not None:
         print(f"femkit: unstable: {result.failure}", file=sys.stderr)

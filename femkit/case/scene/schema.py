@@ -5,12 +5,14 @@ with the valid keys listed. The ``system`` mapping is checked per ``type`` (``ro
 ``cloth``, ``mesh``, ``single_spring``) with ``if``/``then`` branches, so the error for a
 wrong key names the keys of *that* builder. Names of integrators, linear solvers,
 preconditioners and mesh geometries are not enumerated here: they are checked against the
-live registries at load time (:func:`femkit.dynamics.scene.prepare_scene`).
+live registries at load time (:func:`femkit.case.scene.run.prepare_scene`).
 
 Every property named here appears in docs/scenes.md (a test checks it).
 """
 
 from __future__ import annotations
+
+from ..specs import INTEGRATOR_SCHEMA, SOLVER_SCHEMA
 
 _POS = {"type": "number", "exclusiveMinimum": 0}
 _NONNEG = {"type": "number", "minimum": 0}
@@ -140,26 +142,8 @@ SCENE_SCHEMA: dict = {
                       "additionalProperties": {"type": "number"}, "default": {}},
         "system": _SYSTEM,
         "forces": _FORCES,
-        "integrator": {
-            "anyOf": [
-                {"type": "string", "minLength": 1},
-                {"type": "object", "additionalProperties": False, "required": ["method"],
-                 "properties": {"method": {"type": "string", "minLength": 1},
-                                "options": {"type": "object", "default": {}}}},
-            ],
-            "x-message": "expected an integrator name or {method: name, options: {...}}",
-        },
-        "linear_solver": {
-            "type": "object", "additionalProperties": False, "default": {},
-            "properties": {
-                "method": {"type": "string", "default": "direct"},
-                "preconditioner": {"type": "string"},
-                "rtol": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1,
-                         "default": 1e-10},
-                "atol": {"type": "number", "minimum": 0, "default": 0.0},
-                "maxiter": {"type": "integer", "minimum": 1},
-            },
-        },
+        "integrator": INTEGRATOR_SCHEMA,
+        "linear_solver": {**SOLVER_SCHEMA, "default": {}},
         "dt": _TIME,
         "t_end": _TIME,
         "stability": {

@@ -9,13 +9,12 @@ springs as ``line`` cells, plus the ``triangle`` cells of cloth and mesh systems
 triangles) and ``scene.pvd`` listing them with their times (ParaView opens the ``.pvd`` as a
 time series). ``xdmf: true`` writes ``scene.xdmf`` + ``scene.h5`` (meshio's time-series writer).
 
-Matplotlib and Pillow (pictures: :mod:`femkit.dynamics.plot`) are imported only when a PNG or GIF is asked for; meshio only when
-frames are written.
+Matplotlib and Pillow (pictures: :mod:`femkit.case.scene.plot`) are imported only when a PNG
+or GIF is asked for; meshio only when frames are written.
 """
 
 from __future__ import annotations
 
-import contextlib
 import os
 from pathlib import Path
 from typing import Sequence
@@ -23,10 +22,12 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from ..io.atomic import atomic_directory, atomic_write_text
+from ...io.atomic import EARLIER_RUN, atomic_directory, atomic_write_text
+from ...io.writers import write_csv, write_json
+from .plot import write_final_png, write_gif
 
 __all__ = ["write_scene_outputs", "write_frames_vtu", "write_frames_xdmf", "write_pvd",
-           "write_energy_csv", "energy_columns", "write_final_png", "write_gif", "RESULT_KEYS"]
+           "write_energy_csv", "energy_columns", "RESULT_KEYS"]
 
 #: Top-level keys of a scene's result.json.
 RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "system", "integrator",
@@ -35,10 +36,6 @@ RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "system", "inte
                "momentum_final", "stability", "converged", "warnings", "timings", "files")
 
 
-
-#: Files that mark a directory as an earlier scene run: only such a directory (or an empty or
-#: missing one) is replaced; anything else (``--output .``, a project folder) is refused.
-PREVIOUS_RUN = ("result.json",)
 
 def _pad3(a: np.ndarray) -> np.ndarray:
     a = np.asarray(a, dtype=np.float64)
@@ -98,13 +95,19 @@ def write_frames_xdmf(path: str | os.PathLike, system, traj, triangles=None) -> 
     x0 = _pad3(traj.x[0])
     path = Path(path).resolve()
     # meshio 5 opens the .h5 by its bare name, i.e. in the current directory: write from there
-    with contextlib.chdir(path.parent), meshio.xdmf.TimeSeriesWriter(str(path)) as w:
-        w.write_points_cells(m0.points, m0.cells)
-        for k, t in enumerate(traj.times):
-            x = _pad3(traj.x[k])
-            w.write_data(float(t), point_data={"position": x, "displacement": x - x0,
-                                               "velocity": _pad3(traj.v[k])})
-    return Path(path)
+    # (os.chdir and back: contextlib.chdir needs Python 3.11)
+    cwd = os.getcwd()
+    os.chdir(path.parent)
+    try:
+        with meshio.xdmf.TimeSeriesWriter(str(path)) as w:
+            w.write_points_cells(m0.points, m0.cells)
+            for k, t in enumerate(traj.times):
+                x = _pad3(traj.x[k])
+                w.write_data(float(t), point_data={"position": x, "displacement": x - x0,
+                                                   "velocity": _pad3(traj.v[k])})
+    finally:
+        os.chdir(cwd)
+    return path
 
 
 def energy_columns(dim: int) -> list[str]:
@@ -120,46 +123,21 @@ def write_energy_csv(path: str | os.PathLike, traj) -> Path:
     table = np.column_stack([traj.times] + [e[k] for k in ("kinetic", "spring", "gravity",
                                                            "contact", "total")]
                             + [traj.momentum[:, c] for c in range(dim)])
-    lines = [",".join(energy_columns(dim))]
-    lines += [",".join(f"{v:.17g}" for v in row) for row in table]
-    return atomic_write_text(path, "\n".join(lines) + "\n")
-
-
-# ----------------------------------------------------------------------------- pictures
-
-def write_final_png(path: str | os.PathLike, system, traj, name: str, triangles=None) -> Path:
-    """The last frame (3-D view for 3-D systems) and the energy of the run as a PNG.
-
-    Thin wrapper of :func:`femkit.dynamics.plot.write_final_png` (matplotlib imported only here).
-    """
-    from .plot import write_final_png as _png
-
-    return _png(path, system, traj, name, triangles=triangles)
-
-
-def write_gif(path: str | os.PathLike, system, traj, name: str, max_frames: int = 60,
-              triangles=None) -> Path:
-    """An animated GIF of at most ``max_frames`` evenly spaced recorded frames.
-
-    Thin wrapper of :func:`femkit.dynamics.plot.write_gif`.
-    """
-    from .plot import write_gif as _gif
-
-    return _gif(path, system, traj, name, triangles=triangles, max_frames=max_frames)
+    columns = energy_columns(dim)
+    return write_csv(path, [dict(zip(columns, map(float, row))) for row in table],
+                     columns=columns, float_format=".17g")
 
 
 # ----------------------------------------------------------------------------- all
 
 def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
     """Write every requested output of ``result`` (a SceneResult) into ``directory`` atomically."""
-    from ..io.results import write_json
-
     opts = result.case.data["output"]
     traj, system, tri = result.trajectory, result.system, result.triangles
     final = Path(directory).resolve()
     result.output_dir = final
     files: list[str] = []
-    with atomic_directory(final, PREVIOUS_RUN) as tmp:
+    with atomic_directory(final, EARLIER_RUN) as tmp:
         if opts["vtu"]:
             frames = write_frames_vtu(tmp, system, traj, tri)
             write_pvd(tmp / "scene.pvd", traj.times, frames)
@@ -171,7 +149,7 @@ def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
             write_energy_csv(tmp / "energy.csv", traj)
             files.append("energy.csv")
         if opts["png"]:
-            write_final_png(tmp / "final.png", system, traj, result.case.name, tri)
+            write_final_png(tmp / "final.png", system, traj, result.case.name, triangles=tri)
             files.append("final.png")
         if opts["gif"]:
             write_gif(tmp / "animation.gif", system, traj, result.case.name, triangles=tri)

@@ -8,6 +8,8 @@ registered solver is accepted without touching the schema.
 
 from __future__ import annotations
 
+from ..specs import SOLVER_SCHEMA
+
 _NUMBER_OR_EXPR = {
     "anyOf": [{"type": "number"}, {"type": "string", "minLength": 1}],
     "x-message": "expected a number or an expression string of x and y",
@@ -102,19 +104,7 @@ POISSON_SCHEMA: dict = {
             "type": "object", "additionalProperties": False, "default": {},
             "properties": {"load": {"type": "string", "default": "barycentric"}},
         },
-        "solver": {
-            "type": "object", "additionalProperties": False, "default": {},
-            "properties": {
-                "method": {"type": "string", "default": "pcg"},
-                "preconditioner": {"type": "string"},
-                "rtol": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1,
-                         "default": 1e-10},
-                "atol": {"type": "number", "minimum": 0, "default": 0.0},
-                "maxiter": {"type": "integer", "minimum": 1, "default": 10000},
-                "options": {"type": "object", "default": {}},
-                "preconditioner_options": {"type": "object", "default": {}},
-            },
-        },
+        "solver": {**SOLVER_SCHEMA, "default": {}},
         "output": {
             "type": "object", "additionalProperties": False, "default": {},
             "properties": {

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .load import Case
+from ..load import Case
 
 __all__ = ["CheckRow", "cross_check", "format_table", "MATRIX_TOL", "SOLUTION_FACTOR"]
 
@@ -56,27 +56,42 @@ def _rel(a, b) -> float:
     return num / den if den > 0 else num
 
 
+def _require(module: str, package: str):
+    """Import ``module``; a missing package is one line naming how to install it (exit code 2)."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        from ...errors import InputError
+
+        raise InputError(f"femkit check needs {package}, which is not installed; install it with "
+                         f"`python -m pip install {package}` (it is a dependency of femkit: "
+                         "reinstall femkit to get it)") from None
+
+
 def cross_check(case: Case) -> list[CheckRow]:
     """Run the comparisons of the module docstring; returns the rows (nothing written)."""
     if case.problem != "poisson":
-        from ..errors import CaseFileError
+        from ...errors import CaseFileError
 
         raise CaseFileError(f"femkit check handles 'poisson' cases, not {case.problem!r}")
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
-    import skfem
+    skfem = _require("skfem", "scikit-fem")
+    _require("pyamg", "pyamg")
     from skfem import Basis, BilinearForm, ElementTriP1, LinearForm, MeshTri, condense
     from skfem.helpers import dot, grad
 
-    from ..fem import assemble_load
-    from .run import (assemble_system, build_mesh, dirichlet_data, dirichlet_system,
-                      is_pure_neumann, solve_system)
+    from .run import build_mesh, is_pure_neumann, poisson_problem
 
     mesh = build_mesh(case)
-    K, F, kappa = assemble_system(case, mesh)
-    F_source = assemble_load(mesh, case.functions["source"], rule="barycentric")
-    neumann = F - assemble_load(mesh, case.functions["source"],
-                                rule=case.data["quadrature"]["load"])
+    problem = poisson_problem(case, mesh)
+    K, F = problem.assemble_matrices()
+    kappa = problem.kappa
+    neumann = problem.neumann_load
+    one_point = poisson_problem(case, mesh, load_rule="barycentric")  # skfem gets the same rule
+    F_source = one_point.assemble_matrices()[1] - one_point.neumann_load
 
     m = MeshTri(mesh.points.T.copy(), mesh.triangles.T.copy(), sort_t=False)
     # skfem's intorder=1 picks a 3-point rule on triangles; pass the centroid rule itself
@@ -104,17 +119,17 @@ def cross_check(case: Case) -> list[CheckRow]:
     ]
 
     # Our solution with the case's solver.
-    system = dirichlet_system(case, mesh, K, F)
-    res = solve_system(case, system.A, system.b)
+    system = problem.reduce(K, F, case.solver.method)
+    res = case.solver.solve(system.A, system.b)
     u = system.expand(res.x)
-    s = case.data["solver"]
-    sol_tol = max(SOLUTION_FACTOR * s["rtol"], SOLUTION_FLOOR)
+    spec = case.solver
+    sol_tol = max(SOLUTION_FACTOR * spec.rtol, SOLUTION_FLOOR)
 
     F_sk = F_sk + neumann
     pure = is_pure_neumann(case)
     if pure:
         # u is defined up to a constant: skfem pins node 0, both compared at mean zero
-        from ..fem.poisson import check_compatibility, node_weights, pure_neumann_system
+        from ...fem.poisson import check_compatibility, node_weights, pure_neumann_system
 
         w = node_weights(mesh)
         F_sk = check_compatibility(F_sk, weights=w, rtol=case.data["boundary"]["compatibility_rtol"])[0]
@@ -125,7 +140,7 @@ def cross_check(case: Case) -> list[CheckRow]:
 
         u = at_mean_zero(u)
     else:
-        nodes, values = dirichlet_data(case, mesh)
+        nodes, values = problem.dirichlet_data()
     x_d = np.zeros(mesh.n_points)
     x_d[nodes] = values
     u_sk = skfem.solve(*condense(sp.csr_matrix(K_sk), F_sk, x=x_d, D=nodes))
@@ -143,7 +158,7 @@ def cross_check(case: Case) -> list[CheckRow]:
         spd = pure_neumann_system(K, system.b[:-1], mode="mean_zero", weights=w, method="pcg")
     ml = pyamg.smoothed_aggregation_solver(spd.A.tocsr())
     pyres: list[float] = []
-    x_amg = ml.solve(spd.b, tol=s["rtol"], accel="cg", maxiter=s["maxiter"], residuals=pyres)
+    x_amg = ml.solve(spd.b, tol=spec.rtol, accel="cg", maxiter=spec.maxiter, residuals=pyres)
     x_amg = spd.expand(np.asarray(x_amg).ravel())
     u_ours = u if pure else res.x
     if not pure:

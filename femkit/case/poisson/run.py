@@ -1,14 +1,16 @@
-"""Run a ``problem: poisson`` case end to end: mesh, assembly, boundary, solve, errors, output.
+"""Run a ``problem: poisson`` case end to end: the one Poisson pipeline.
 
-Each stage is a small public function, so a Python user can reuse or replace any one of
-them (their own mesh, coefficient, solver) and still get the same outputs::
+The case is translated once into the library's :class:`femkit.fem.PoissonProblem`
+(:func:`poisson_problem`); ``femkit solve``, ``femkit check`` and every study kind assemble,
+reduce and solve through it. Each stage is a small public function, so a Python user can
+reuse or replace any one of them (their own mesh, coefficient, solver)::
 
     case = femkit.load_case("cases/poisson_unit_square.yaml", mesh={"h": 0.1})
     result = case.run(write=False)          # or step by step:
     mesh = build_mesh(case)
-    K, F, kappa = assemble_system(case, mesh)
-    system = dirichlet_system(case, mesh, K, F)
-    res = solve_system(case, system.A, system.b)
+    problem = poisson_problem(case, mesh)   # a femkit.fem.PoissonProblem
+    system = problem.assemble(case.solver.method)
+    res = case.solver.solve(system.A, system.b)
 
 Nothing is written before the mesh is built and checked against every tag the case names,
 so bad input leaves no output directory behind; the output directory itself appears
@@ -18,20 +20,19 @@ atomically (see :func:`femkit.io.atomic.atomic_directory`).
 from __future__ import annotations
 
 import os
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import CaseFileError, ExpressionError, InputError
-from .checks import check_geometry_spec, check_solver_spec, lookup, resolve_file, with_prefix
-from .expressions import compile_expression
-from .load import Case
+from ...errors import CaseFileError, ExpressionError, InputError
+from ..expressions import compile_expression
+from ..load import Case
+from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
 
-__all__ = ["prepare_poisson", "run_poisson", "build_mesh", "element_kappa", "assemble_system",
-           "dirichlet_data", "dirichlet_system", "solve_system", "compute_errors", "CaseResult"]
+__all__ = ["prepare_poisson", "run_poisson", "build_mesh", "element_kappa", "poisson_problem",
+           "compute_errors", "CaseResult"]
 
 
 # ----------------------------------------------------------------------------- prepare
@@ -65,9 +66,12 @@ def prepare_poisson(case: Case) -> None:
             raise CaseFileError(f"mesh.{bad}: only used with mesh.geometry, not with mesh.file")
     else:
         check_geometry_spec(mesh, "mesh")
-    check_solver_spec(d["solver"], "solver", default_preconditioner="amg")
+    from ..specs import solver_spec
 
-    from ..fem.quadrature import QUADRATURE
+    case.solver = solver_spec(d["solver"], "solver", default_method="pcg")
+    d["solver"] = case.solver.to_dict()
+
+    from ...fem.quadrature import QUADRATURE
 
     lookup(QUADRATURE, d["quadrature"]["load"], "quadrature.load")
 
@@ -93,7 +97,7 @@ def prepare_poisson(case: Case) -> None:
 
 def _prepare_nullspace(bnd: dict) -> None:
     """Pure Neumann (no ``dirichlet``): fill ``nullspace`` (mean_zero) and ``compatibility_rtol``."""
-    from ..fem.poisson import COMPATIBILITY_RTOL
+    from ...fem.poisson import COMPATIBILITY_RTOL
 
     if bnd.get("dirichlet"):
         for key in ("nullspace", "compatibility_rtol"):
@@ -105,16 +109,14 @@ def _prepare_nullspace(bnd: dict) -> None:
     bnd.setdefault("compatibility_rtol", COMPATIBILITY_RTOL)
 
 
-def is_pure_neumann(case: Case) -> bool:
-    """True when the case has no Dirichlet condition (``u`` fixed only up to a constant)."""
-    return not case.data["boundary"].get("dirichlet")
-
-
 # ----------------------------------------------------------------------------- stages
 
-def build_mesh(case: Case):
-    """Generate or read the mesh, refine, validate, and check every tag the case names."""
-    from ..mesh import check_tags, generate, read_mesh, refine, validate
+def build_mesh(case: Case, *, h: float | None = None):
+    """Generate or read the mesh, refine, validate, and check every tag the case names.
+
+    ``h`` replaces ``mesh.h`` of a generated mesh (studies sweep it); a mesh file ignores it.
+    """
+    from ...mesh import check_tags, generate, read_mesh, refine, validate
 
     spec = case.data["mesh"]
     where = f"mesh.file {spec['file']}" if "file" in spec else f"mesh.geometry {spec['geometry']}"
@@ -122,7 +124,7 @@ def build_mesh(case: Case):
         if "file" in spec:
             mesh = read_mesh(spec["file"])
         else:
-            mesh = generate(spec["geometry"], spec["h"], **(spec.get("params") or {}))
+            mesh = generate(spec["geometry"], spec["h"] if h is None else h, **(spec.get("params") or {}))
         mesh = validate(mesh)
     except InputError as exc:
         raise with_prefix(exc, where) from None
@@ -153,11 +155,11 @@ def _is_whole_boundary(mesh, tag) -> bool:
 
 def element_kappa(case: Case, mesh) -> np.ndarray:
     """Per-triangle coefficient values (constant, expression at barycentres, or region table)."""
-    from ..fem.coefficients import element_coefficient
+    from ...fem.coefficients import element_coefficient
 
     coef = case.data["coefficient"]
     if isinstance(coef, dict):
-        from ..mesh import check_tags
+        from ...mesh import check_tags
 
         values = np.full(mesh.n_triangles, float(coef.get("default", np.nan)))
         for name, value in coef["regions"].items():
@@ -179,127 +181,70 @@ def element_kappa(case: Case, mesh) -> np.ndarray:
         raise with_prefix(exc, "coefficient") from None
 
 
-def assemble_system(case: Case, mesh):
-    """Stiffness matrix, load vector (with Neumann fluxes) and per-element kappa."""
-    from ..fem import assemble_load, assemble_stiffness
-
-    kappa = element_kappa(case, mesh)
-    K = assemble_stiffness(mesh, kappa)
-    F = assemble_load(mesh, case.functions["source"], rule=case.data["quadrature"]["load"])
-    return K, F + neumann_load(case, mesh), kappa
+def _tags(mesh, tags: list):
+    """Boundary-condition tags for the library: ``None`` (the whole boundary, found
+    topologically) when the list names the whole boundary of a mesh without such a group."""
+    named = [t for t in tags if not _is_whole_boundary(mesh, t)]
+    return named if len(named) == len(tags) else None
 
 
-def neumann_load(case: Case, mesh) -> np.ndarray:
-    """The load of every ``boundary.neumann`` flux, ``int h N_i ds`` (zeros without any)."""
-    from ..fem import assemble_neumann
+def poisson_problem(case: Case, mesh, *, load_rule: str | None = None):
+    """The case on ``mesh`` as a :class:`femkit.fem.PoissonProblem` (the one translation).
 
-    F = np.zeros(mesh.n_points)
-    for i, bc in enumerate(case.data["boundary"].get("neumann", [])):
-        named = [t for t in bc["tags"] if not _is_whole_boundary(mesh, t)]
-        # the whole boundary (tags=None) covers every named edge: take each edge once
-        tags = named if len(named) == len(bc["tags"]) else None
-        F += assemble_neumann(mesh, tags, case.functions[f"boundary.neumann[{i}].flux"])
-    return F
-
-
-def dirichlet_data(case: Case, mesh) -> tuple[np.ndarray, np.ndarray]:
-    """Dirichlet nodes and values; a later entry wins on shared nodes (e.g. corners).
-
-    Empty arrays for a pure-Neumann case (see :func:`nullspace_system`).
+    Dirichlet entries naming the whole boundary together with other tags cover both (a later
+    entry wins on shared nodes); a Neumann entry naming the whole boundary takes each boundary
+    edge once. Pure Neumann with ``nullspace: pin`` pins node 0 to the exact solution's value
+    there when ``exact`` is given, else to 0.
     """
-    from ..mesh import boundary_nodes
+    from ...fem import PoissonProblem
 
-    all_nodes, all_vals = [np.zeros(0, dtype=np.int64)], [np.zeros(0)]  # none: pure Neumann
-    for i, bc in enumerate(case.data["boundary"].get("dirichlet", [])):
+    d = case.data
+    bnd = d["boundary"]
+    dirichlet = []
+    for i, bc in enumerate(bnd.get("dirichlet", [])):
         g = case.functions[f"boundary.dirichlet[{i}].value"]
-        parts = []
         named = [t for t in bc["tags"] if not _is_whole_boundary(mesh, t)]
-        if named:
-            parts.append(boundary_nodes(mesh, named))
         if len(named) < len(bc["tags"]):
-            parts.append(boundary_nodes(mesh, None))
-        nodes = np.unique(np.concatenate(parts))
-        p = mesh.points[nodes]
-        all_nodes.append(nodes)
-        all_vals.append(g(p[:, 0], p[:, 1]))
-    nodes = np.concatenate(all_nodes)
-    vals = np.concatenate(all_vals)
-    # keep the last occurrence of each node
-    rev_unique, rev_idx = np.unique(nodes[::-1], return_index=True)
-    return rev_unique, vals[::-1][rev_idx]
+            dirichlet.append((None, g))
+        if named:
+            dirichlet.append((named, g))
+    neumann = [(_tags(mesh, bc["tags"]), case.functions[f"boundary.neumann[{i}].flux"])
+               for i, bc in enumerate(bnd.get("neumann", []))]
+    extra = {}
+    if not dirichlet:
+        extra = dict(nullspace=bnd["nullspace"], compatibility_rtol=bnd["compatibility_rtol"])
+        if bnd["nullspace"] == "pin" and "exact.u" in case.functions:
+            x0, y0 = mesh.points[0]
+            u0 = case.functions["exact.u"](np.array([x0]), np.array([y0]))
+            extra["pin_value"] = float(np.asarray(u0).ravel()[0])
+    return PoissonProblem(mesh, element_kappa(case, mesh), case.functions["source"],
+                          dirichlet=dirichlet, neumann=neumann,
+                          load_rule=load_rule or d["quadrature"]["load"], **extra)
 
 
-def dirichlet_system(case: Case, mesh, K, F):
-    """Eliminate the Dirichlet nodes: an SPD reduced system (``.A``, ``.b``, ``.expand``).
-
-    Pure Neumann (no ``boundary.dirichlet``): check the compatibility of the data and fix
-    the constant as ``boundary.nullspace`` says (a
-    :class:`~femkit.fem.poisson.NullspaceSystem` with the same interface).
-    """
-    if is_pure_neumann(case):
-        return nullspace_system(case, mesh, K, F)
-    from ..fem import apply_dirichlet
-
-    nodes, values = dirichlet_data(case, mesh)
-    return apply_dirichlet(K, F, nodes, values)
+def is_pure_neumann(case: Case) -> bool:
+    """True when the case has no Dirichlet condition (``u`` fixed only up to a constant)."""
+    return not case.data["boundary"].get("dirichlet")
 
 
-def nullspace_system(case: Case, mesh, K, F):
-    """The pure-Neumann system: compatibility checked, constant fixed (``boundary.nullspace``).
+def exact_gradient(case: Case):
+    """``grad u`` of ``exact`` as one callable ``(x, y) -> (gx, gy)``, or None."""
+    if "exact.grad[0]" not in case.functions:
+        return None
+    gx, gy = case.functions["exact.grad[0]"], case.functions["exact.grad[1]"]
 
-    ``pin`` pins node 0 to the exact solution's value there when ``exact`` is given, else to 0.
-    """
-    from ..fem.poisson import check_compatibility, node_weights, pure_neumann_system
+    def grad(x, y):
+        return gx(x, y), gy(x, y)
 
-    bnd = case.data["boundary"]
-    w = node_weights(mesh)
-    F_flux = neumann_load(case, mesh)
-    F, info = check_compatibility(F - F_flux, F_flux, weights=w, rtol=bnd["compatibility_rtol"])
-    pin_value = 0.0
-    if bnd["nullspace"] == "pin" and "exact.u" in case.functions:
-        x0, y0 = mesh.points[0]
-        pin_value = float(np.asarray(case.functions["exact.u"](np.array([x0]), np.array([y0])))[0])
-    return pure_neumann_system(K, F, mode=bnd["nullspace"], weights=w,
-                               method=case.data["solver"]["method"], pin_node=0,
-                               pin_value=pin_value, compatibility=info)
+    return grad
 
 
-def solve_system(case: Case, A, b, x0=None, callback=None):
-    """Solve with the case's solver settings through :func:`femkit.solvers.solve`."""
-    from ..solvers import solve
-
-    s = case.data["solver"]
-    pc = s["preconditioner"]
-    return solve(A, b, x0, method=s["method"], preconditioner=pc if s["method"] == "pcg" else None,
-                 rtol=s["rtol"], atol=s["atol"], maxiter=s["maxiter"], callback=callback,
-                 preconditioner_options=s.get("preconditioner_options") or None,
-                 **(s.get("options") or {}))
-
-
-def compute_errors(case: Case, mesh, u: np.ndarray) -> dict | None:
-    """Error norms against ``exact`` (None when the case gives no exact solution).
-
-    Pure Neumann: modulo the constant, i.e. of ``u - c`` with ``c`` the mean difference
-    ``int (u_h - u) dx / |Omega|`` (:func:`femkit.fem.poisson.mean_shift`).
-    """
+def compute_errors(case: Case, problem, u: np.ndarray, *, order: int = 5) -> dict | None:
+    """Error norms against ``exact`` (None when the case gives no exact solution); pure
+    Neumann: modulo the constant (:meth:`femkit.fem.PoissonProblem.errors`)."""
     if "exact.u" not in case.functions:
         return None
-    from ..fem import error_norms
-
-    grad = None
-    if "exact.grad[0]" in case.functions:
-        gx, gy = case.functions["exact.grad[0]"], case.functions["exact.grad[1]"]
-
-        def grad(x, y):
-            return gx(x, y), gy(x, y)
-
-    exact = case.functions["exact.u"]
-    if is_pure_neumann(case):  # u is defined up to a constant: compare u - c with int(u - c - exact) = 0
-        from ..fem.poisson import mean_shift
-
-        u = u - mean_shift(mesh, u, exact)
-    errs = error_norms(mesh, u, exact, grad)
-    return {k: (None if v is None else float(v)) for k, v in errs.items()}
+    return problem.errors(u, case.functions["exact.u"], exact_gradient(case), order=order)
 
 
 # ----------------------------------------------------------------------------- result
@@ -329,7 +274,7 @@ class CaseResult:
 
     def to_dict(self) -> dict:
         """The content of ``result.json`` (keys documented in docs/case-files.md)."""
-        from .. import __version__
+        from ..._version import __version__
 
         spec = self.case.data["mesh"]
         mesh_info = {k: self.quality.get(k) for k in (
@@ -408,33 +353,37 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     CaseResult
         ``converged`` false is not an exception: the results are still written.
     """
-    from ..mesh import quality
-
-    from ..timing import StageTimer
+    from ...mesh import quality
+    from ...timing import StageTimer
 
     stage = StageTimer()
     target = None
     if write:  # a bad output location is bad input: refuse it before any work is done
+        from .output import output_location
+
         target = output_location(output_dir or case.data["output"]["dir"])
     with stage("mesh"):
         mesh = build_mesh(case)
         q = quality(mesh)
+    problem = poisson_problem(case, mesh)
     with stage("assembly"):
-        K, F, kappa = assemble_system(case, mesh)
+        K, F = problem.assemble_matrices()
     with stage("boundary"):
-        system = dirichlet_system(case, mesh, K, F)
+        system = problem.reduce(K, F, case.solver.method)
     with stage("solve"):
-        res = solve_system(case, system.A, system.b)
+        res = case.solver.solve(system.A, system.b)
         u = system.expand(res.x)
     errors = None
     if "exact.u" in case.functions:
         with stage("errors"):
-            errors = compute_errors(case, mesh, u)
-    result = CaseResult(case=case, mesh=mesh, u=u, kappa=kappa, solve=res, errors=errors,
+            errors = compute_errors(case, problem, u)
+    result = CaseResult(case=case, mesh=mesh, u=u, kappa=problem.kappa, solve=res, errors=errors,
                         timings=stage.times, quality=q, dofs=int(system.A.shape[0]),
                         n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
                         nnz=int(system.A.nnz), nullspace=_nullspace_facts(system))
     if write:
+        from .output import write_outputs
+
         write_outputs(result, target)
     if not quiet:
         out = echo or print
@@ -453,54 +402,3 @@ def _nullspace_facts(system) -> dict | None:
     else:
         how = f"node {int(system.fixed[0])} pinned" + (", shifted to mean zero" if mode == "mean_zero" else "")
     return {"mode": mode, "how": how, **system.compatibility}
-
-
-#: A directory holding one of these is an earlier run that a new run may replace.
-PREVIOUS_RUN = ("result.json",)
-
-
-def output_location(directory: str | os.PathLike) -> Path:
-    """The resolved output directory, checked before the run (:func:`check_output_dir`).
-
-    Raises
-    ------
-    InputError
-        (prefixed ``output.dir``) ``directory`` is a file, lies below a file, or is a
-        non-empty directory that is not an earlier run (no ``result.json``): replacing it
-        would delete the user's files.
-    """
-    from ..io.atomic import check_output_dir
-
-    try:
-        return check_output_dir(directory, PREVIOUS_RUN)
-    except InputError as exc:
-        raise with_prefix(exc, "output.dir") from None
-
-
-def write_outputs(result: CaseResult, directory: str | os.PathLike) -> Path:
-    """Write result.json and the requested solution files into ``directory`` (atomically).
-
-    ``directory`` is replaced as a whole, so it must be new, empty or an earlier run
-    (:func:`output_location`).
-    """
-    from ..io.atomic import atomic_directory
-    from ..io.results import write_json, write_plot, write_solution
-
-    opts = result.case.data["output"]
-    final = output_location(directory)
-    result.output_dir = final
-    t0 = time.perf_counter()
-    with atomic_directory(final, PREVIOUS_RUN) as tmp:
-        if opts["vtu"]:
-            write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa)
-        if opts["xdmf"]:
-            write_solution(tmp / "solution.xdmf", result.mesh, result.u, result.kappa)
-        if opts["plot"]:
-            title = (f"{result.case.name}: {result.mesh.n_triangles} triangles, "
-                     f"h_max = {result.quality.get('h_max', float('nan')):.3g}")
-            write_plot(tmp / "solution.png", result.mesh, result.u, title)
-        result.files = sorted({p.name for p in tmp.iterdir()} | {"result.json"})
-        result.timings["output"] = time.perf_counter() - t0  # up to result.json itself
-        write_json(tmp / "result.json", result.to_dict())
-    result.timings["output"] = time.perf_counter() - t0
-    return final

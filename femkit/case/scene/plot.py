@@ -31,6 +31,8 @@ from typing import Sequence
 
 import numpy as np
 
+from ...io.figures import new_figure
+
 __all__ = ["spring_strain", "tracked_nodes", "SceneView", "scene_view", "plot_frame",
            "write_final_png", "write_gif", "gif_frames", "gif_frame_times"]
 
@@ -78,7 +80,7 @@ def tracked_nodes(system, x0: np.ndarray | None = None, count: int = 2) -> np.nd
 
 def _contacts(system):
     """(ground list, sphere list) among the declared forces."""
-    from .forces.contact import GroundContact, SphereContact
+    from ...dynamics.forces.contact import GroundContact, SphereContact
 
     grounds = [f for f in system.forces if isinstance(f, GroundContact)]
     spheres = [f for f in system.forces if isinstance(f, SphereContact)]
@@ -177,15 +179,6 @@ def _title(name: str, traj, k: int) -> tuple[str, str]:
     if stop is not None:
         return text + f"\nUNSTABLE at step {stop[0]} (t = {stop[1]:.4g} s)", _PIN
     return text, "black"
-
-
-def _figure(width: float, height: float, dpi: float):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(width, height), dpi=dpi)
-    FigureCanvasAgg(fig)
-    return fig
 
 
 def _strain_mappable(view: SceneView):
@@ -380,7 +373,7 @@ def plot_frame(system, traj, frame: int = -1, *, triangles=None, name: str = "",
     k = int(frame) % len(traj.times)
     view = view or scene_view(system, traj)
     x = np.asarray(traj.x[k], dtype=float)
-    fig = _figure(size[0], size[1], dpi)
+    fig = new_figure(size[0], size[1], dpi=dpi)
     if system.dim == 3:
         main = [-0.03, 0.0, 0.68, 0.9] if energy else [0.0, 0.0, 0.9, 0.9]
         ax, mappable = _draw_3d(fig, main, system, x, triangles, view, name, traj, k)
@@ -407,7 +400,7 @@ def write_final_png(path: str | os.PathLike, system, traj, name: str, *, triangl
 
     3-D systems are framed on the final shape; 2-D ones on the whole run (the tracked paths).
     """
-    from ..io.atomic import atomic_path
+    from ...io.atomic import atomic_path
 
     frames = [len(traj.times) - 1] if system.dim == 3 else None
     view = scene_view(system, traj, frames)
@@ -467,7 +460,7 @@ def gif_frames(n: int, max_frames: int = 60) -> np.ndarray:
     (51, [0, 1, 2, 3, 4, 5])
     """
     if n < 1 or max_frames < 1:
-        from ..errors import InputError
+        from ...errors import InputError
 
         raise InputError(f"a GIF needs at least one frame (n = {n}, max_frames = {max_frames})")
     stride = -(-n // max_frames)
@@ -506,7 +499,7 @@ def write_gif(path: str | os.PathLike, system, traj, name: str, *, triangles=Non
     Same two panels as the PNG, with fixed axes over the whole animation and the current time
     marked on the energy panel; one shared palette; frame times from :func:`gif_frame_times`.
     """
-    from ..io.atomic import atomic_path
+    from ...io.atomic import atomic_path
 
     picks = gif_frames(len(traj.times), max_frames)
     view = scene_view(system, traj, picks)

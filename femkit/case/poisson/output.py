@@ -1,0 +1,110 @@
+"""Outputs of a Poisson run: ``result.json``, the solution as ``.vtu`` / ``.xdmf``, a PNG plot.
+
+Every file is written atomically (see :mod:`femkit.io.atomic`). The keys of ``result.json``
+are documented in docs/case-files.md ("Outputs").
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import InputError, with_prefix
+from ...io.figures import new_figure, save_figure
+
+__all__ = ["write_solution", "write_plot", "write_outputs", "output_location",
+           "RESULT_KEYS"]
+
+#: Top-level keys of result.json.
+RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs", "nnz",
+               "solver", "converged", "errors", "timings", "expressions", "files")
+
+
+def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarray | None = None,
+                   extra_point_data: dict | None = None) -> Path:
+    """Write the mesh with point data ``u`` and cell data ``kappa`` and ``tag`` (vtu/xdmf by extension).
+
+    Not atomic by itself (meshio may write sibling files); use it inside
+    :func:`femkit.io.atomic.atomic_directory`.
+    """
+    from ...mesh import write_mesh
+
+    point_data = {"u": np.asarray(u, dtype=np.float64)}
+    point_data.update(extra_point_data or {})
+    cell_data = {"tag": np.asarray(mesh.cell_tags, dtype=np.int32)}
+    if kappa is not None:
+        cell_data["kappa"] = np.asarray(kappa, dtype=np.float64)
+    # Written in place: sibling files (XDMF's .h5, a tag-name sidecar) are named after the
+    # file, so a temporary name would orphan them. Callers write into an atomic directory.
+    target = Path(path)
+    write_mesh(target, mesh, point_data=point_data, cell_data=cell_data)
+    return target
+
+
+def write_plot(path: str | os.PathLike, mesh, u: np.ndarray, title: str = "") -> Path:
+    """Save a filled-contour PNG of ``u`` with a colour bar (matplotlib, Agg backend)."""
+    from matplotlib.tri import Triangulation
+
+    tri = Triangulation(mesh.points[:, 0], mesh.points[:, 1], mesh.triangles)
+    fig = new_figure(6, 5, dpi=120)
+    ax = fig.add_subplot()
+    art = ax.tripcolor(tri, np.asarray(u, dtype=np.float64), shading="gouraud", cmap="viridis")
+    fig.colorbar(art, ax=ax, label="u")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+
+
+def output_location(directory: str | os.PathLike) -> Path:
+    """The resolved output directory, checked before the run (:func:`check_output_dir`).
+
+    Raises
+    ------
+    InputError
+        (prefixed ``output.dir``) ``directory`` is a file, lies below a file, or is a
+        non-empty directory that is not an earlier run (no ``result.json``): replacing it
+        would delete the user's files.
+    """
+    from ...io.atomic import EARLIER_RUN, check_output_dir
+
+    try:
+        return check_output_dir(directory, EARLIER_RUN)
+    except InputError as exc:
+        raise with_prefix(exc, "output.dir") from None
+
+
+def write_outputs(result, directory: str | os.PathLike) -> Path:
+    """Write result.json and the requested solution files into ``directory`` (atomically).
+
+    ``directory`` is replaced as a whole, so it must be new, empty or an earlier run
+    (:func:`output_location`).
+    """
+    from ...io.atomic import EARLIER_RUN, atomic_directory
+    from ...io.writers import write_json
+
+    opts = result.case.data["output"]
+    final = output_location(directory)
+    result.output_dir = final
+    t0 = time.perf_counter()
+    with atomic_directory(final, EARLIER_RUN) as tmp:
+        if opts["vtu"]:
+            write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa)
+        if opts["xdmf"]:
+            write_solution(tmp / "solution.xdmf", result.mesh, result.u, result.kappa)
+        if opts["plot"]:
+            title = (f"{result.case.name}: {result.mesh.n_triangles} triangles, "
+                     f"h_max = {result.quality.get('h_max', float('nan')):.3g}")
+            write_plot(tmp / "solution.png", result.mesh, result.u, title)
+        result.files = sorted({p.name for p in tmp.iterdir()} | {"result.json"})
+        result.timings["output"] = time.perf_counter() - t0  # up to result.json itself
+        write_json(tmp / "result.json", result.to_dict())
+    result.timings["output"] = time.perf_counter() - t0
+    return final
