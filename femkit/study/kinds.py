@@ -147,6 +147,9 @@ def _register() -> None:
         DYNAMICS, _dynamics_check, _dynamics_run, _dynamics_report, _fit_lines))
     STUDY_KINDS.register("stability", StudyKind(
         STABILITY, _stability_check, _stability_run, _stability_report, _fit_lines))
+    from .cloth import CLOTH_KIND
+
+    STUDY_KINDS.register("cloth_work_precision", CLOTH_KIND)
 
 
 _register()
