@@ -26,10 +26,11 @@ def test_quick_study_measures_every_method(quick):
         assert r["scene"] == "hanging_cloth" and r["nodes"] == 49 and not r["failed"]
         assert r["time_per_frame"] > 0 and r["solve_error"] > 0 and r["trajectory_error"] > 0
     by = {r["label"]: r for r in quick.records}
-    # more work, smaller solve error; Newton 3 it is the implicit Euler step to round-off level
+    # more work, smaller solve error; Newton 3 it is the implicit Euler step to the reference's
+    # own tolerance (converged local/global, tol 1e-10)
     assert by["fast mass-spring 5 it"]["solve_error"] < by["fast mass-spring 1 it"]["solve_error"]
     assert by["Chebyshev fast mass-spring 5 it"]["solve_error"] < by["fast mass-spring 5 it"]["solve_error"]
-    assert by["Newton 3 it"]["solve_error"] < 1e-8
+    assert by["Newton 3 it"]["solve_error"] < 1e-6 < 1e-3 * by["fast mass-spring 1 it"]["solve_error"]
 
 
 def test_pareto_fronts_and_outputs(quick):
