@@ -9,7 +9,7 @@ with the key path in front of its message, e.g.
 >>> lookup(SOLVERS, "bicgstab", "solver.method")
 Traceback (most recent call last):
 ...
-femkit.errors.UnknownNameError: solver.method: unknown solver 'bicgstab'; valid solvers: cg, direct, jacobi, pcg, sd
+femkit.errors.UnknownNameError: solver.method: unknown solver 'bicgstab'; valid solvers: cg, cholesky, direct, jacobi, pcg, sd
 """
 
 from __future__ import annotations
