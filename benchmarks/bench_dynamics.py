@@ -67,14 +67,16 @@ def _time_steps(system, name, dt, repeats, *, solver="direct", preconditioner="n
         s = integ.step(system, s, dt, ctx)
         times.append(time.perf_counter() - t0)
     per = {key: (ctx.stats.get(key, 0) - before.get(key, 0)) / repeats
-           for key in ("factorizations", "linear_iterations") + _SPLIT}
+           for key in ("factorizations", "linear_iterations", "symbolic_reuses") + _SPLIT}
     total = sum(times) / repeats
     split = {k: per[k] for k in _SPLIT}
     split["assembly"] = total - sum(split.values())
     iters = ctx.stats.get("newton_iterations", [])[1:]
-    return {"median": statistics.median(times), "factorizations": per["factorizations"],
+    return {"median": statistics.median(times), "min": min(times),
+            "factorizations": per["factorizations"],
             "pcg": per["linear_iterations"],
-            "split": split, "total": total, "newton": iters, "x": s.x}
+            "split": split, "total": total, "newton": iters, "x": s.x,
+            "rho": ctx.stats.get("chebyshev_rho"), "symbolic_reuses": per["symbolic_reuses"]}
 
 
 def _ref(ours: float, lo: float, hi: float) -> str:
@@ -83,6 +85,13 @@ def _ref(ours: float, lo: float, hi: float) -> str:
 
 def _fmt_time(sec: float) -> str:
     return f"{1e3 * sec:8.1f} ms" if sec < 10 else f"{sec:8.2f} s "
+
+
+def _table_head(preamble: str, head: str) -> None:
+    print(f"OPENBLAS_NUM_THREADS={os.environ['OPENBLAS_NUM_THREADS']}; medians after a warm-up "
+          f"step; {preamble}")
+    print(head)
+    print("-" * len(head))
 
 
 def _big_mass(dt_explicit: float = 3.125e-4) -> float:
@@ -125,13 +134,10 @@ def main(quick: bool = False) -> None:
         rows.append(("cloth 128x128", label,
                      "1/60", r, "-", "-"))
 
-    print(f"OPENBLAS_NUM_THREADS={os.environ['OPENBLAS_NUM_THREADS']}; medians after a warm-up step; "
-          f"128x128 cloth: {big.n_springs} springs, {big.ndof} dofs, node mass {mass:.3g} "
-          f"(dt omega_max = 1.6 at dt = {dt_explicit})")
-    head = (f"{'scene':14s} {'method':24s} {'dt':>8s} {'time/step':>11s} {'fact/step':>9s}  "
-            f"{'split ms: assembly/permute/factor/solve/pcg':44s} {'reference':38s} ours/ref")
-    print(head)
-    print("-" * len(head))
+    _table_head(f"128x128 cloth: {big.n_springs} springs, {big.ndof} dofs, node mass {mass:.3g} "
+                f"(dt omega_max = 1.6 at dt = {dt_explicit})",
+                f"{'scene':14s} {'method':24s} {'dt':>8s} {'time/step':>11s} {'fact/step':>9s}  "
+                f"{'split ms: assembly/permute/factor/solve/pcg':44s} {'reference':38s} ours/ref")
     for scene, method, dt, r, ref, ratio in rows:
         sp = r["split"]
         split = "-"
@@ -177,8 +183,190 @@ def matrix_free_rows(system, quick: bool = False) -> None:
         print(f"{label:34s} {_fmt_time(r['median']):>11s} {it:>11s} {memory:>14s}")
 
 
+# ----------------------------------------------------------------------------- issue 11
+TAICHI_N = 128
+
+
+def taichi_substep_time(repeats: int) -> float | None:
+    """Median seconds of one substep of Taichi's own cloth demo (``mass_spring_3d_ggui``:
+    128 x 128 nodes, 12 neighbours per node, ``spring_Y = 3e4``, dashpot ``1e4``, drag, ball
+    collision, symplectic Euler, ``dt = 4e-2 / n``) on Taichi's CPU backend with one thread and
+    float64; ``None`` when taichi is not installed (it is not a femkit dependency)."""
+    try:
+        import taichi as ti
+    except ImportError:
+        return None
+    ti.init(arch=ti.cpu, cpu_max_num_threads=1, default_fp=ti.f64, log_level=ti.WARN)
+    n = TAICHI_N
+    quad_size = 1.0 / n
+    dt = 4e-2 / n
+    gravity = ti.Vector([0, -9.8, 0])
+    spring_Y, dashpot_damping, drag_damping = 3e4, 1e4, 1.0
+    ball_radius = 0.3
+    ball_center = ti.Vector.field(3, dtype=float, shape=(1,))
+    ball_center[0] = [0, 0, 0]
+    x = ti.Vector.field(3, dtype=float, shape=(n, n))
+    v = ti.Vector.field(3, dtype=float, shape=(n, n))
+    spring_offsets = [ti.Vector([i, j]) for i in range(-2, 3) for j in range(-2, 3)
+                      if (i, j) != (0, 0) and abs(i) + abs(j) <= 2]
+
+    @ti.kernel
+    def initialize():
+        for i, j in x:
+            x[i, j] = [i * quad_size - 0.5, 0.6, j * quad_size - 0.5]
+            v[i, j] = [0, 0, 0]
+
+    @ti.kernel
+    def substep():
+        for i in ti.grouped(x):
+            v[i] += gravity * dt
+        for i in ti.grouped(x):
+            force = ti.Vector([0.0, 0.0, 0.0])
+            for spring_offset in ti.static(spring_offsets):
+                j = i + spring_offset
+                if 0 <= j[0] < n and 0 <= j[1] < n:
+                    x_ij = x[i] - x[j]
+                    v_ij = v[i] - v[j]
+                    d = x_ij.normalized()
+                    current_dist = x_ij.norm()
+                    original_dist = quad_size * float(i - j).norm()
+                    force += -spring_Y * d * (current_dist / original_dist - 1)
+                    force += -v_ij.dot(d) * d * dashpot_damping * quad_size
+            v[i] += force * dt
+        for i in ti.grouped(x):
+            v[i] *= ti.exp(-drag_damping * dt)
+            offset_to_center = x[i] - ball_center[0]
+            if offset_to_center.norm() <= ball_radius:
+                normal = offset_to_center.normalized()
+                v[i] -= min(v[i].dot(normal), 0) * normal
+            x[i] += dt * v[i]
+
+    initialize()
+    substep()
+    ti.sync()
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        substep()
+        ti.sync()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def compile_times() -> dict:
+    """First-call compile time of the spring kernels (empty numba cache, a fresh process) and
+    the load time from the on-disk cache (a second fresh process), in seconds."""
+    import subprocess
+    import tempfile
+
+    code = ("import time; t0 = time.perf_counter(); import numpy as np;"
+            "from femkit.dynamics.topology import cloth_grid;"
+            "from femkit.dynamics.integrators import StepContext, get_integrator;"
+            "from femkit.solvers import SolverSpec;"
+            "s = cloth_grid(8, 8, 1.0, 1.0, k_structural=1e3, k_shear=1e3, k_bending=1e2,"
+            " total_mass=1.0, pinned='top_corners');"
+            "t1 = time.perf_counter();"
+            "[get_integrator(m).step(s, get_integrator(m).start(s, s.x0, s.v0, 0.0, 0.01,"
+            " StepContext(SolverSpec('cholesky'))), 0.01, StepContext(SolverSpec('cholesky')))"
+            " for m in ('fast_mass_spring', 'implicit_euler', 'newton')];"
+            "import femkit.dynamics.kernels.spring_kernels as k;"
+            "k.spring_forces(s.x0, s._i, s._j, s.k, s.rest, 1e-12, np.zeros_like(s.x0));"
+            "print(time.perf_counter() - t1)")
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        env = dict(os.environ, NUMBA_CACHE_DIR=tmp)
+        for label in ("cold", "cached"):
+            r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                               text=True, check=True)
+            out[label] = float(r.stdout.strip().splitlines()[-1])
+    return out
+
+
+def compiled_rows(quick: bool = False) -> None:
+    """Issue 11: the compiled/Cholesky path against the SuperLU/NumPy path of the same step,
+    measured in this run, and symplectic Euler against Taichi's demo."""
+    rows = []
+    liu = cloth_grid(81, 81, 1.0, 1.0, k_structural=1e3, k_shear=1e3, k_bending=1e2,
+                     total_mass=1.0, pinned="top_corners", forces=[Gravity(9.81)])
+    h = 1.0 / 30.0
+    reps = 5 if quick else 20
+    fms = {}
+    for solver in ("direct", "cholesky"):
+        fms[solver] = _time_steps(liu, "fast_mass_spring", h, reps, solver=solver, iterations=10)
+    cheb = _time_steps(liu, "fast_mass_spring", h, reps, solver="cholesky", iterations=10,
+                       chebyshev=True)
+    rows.append(("Liu 81x81", "fast mass-spring, 10 it", fms["direct"]["median"],
+                 fms["cholesky"]["median"], "<= 10 ms/frame"))
+    rows.append(("Liu 81x81", "  + Chebyshev (Wang 2015)", None, cheb["median"], ""))
+    steps = {}
+    for label, name, opts in (("Newton iteration (1 solve)", "newton", {"max_iterations": 1}),
+                              ("Newton iteration, reused factor", "newton",
+                               {"max_iterations": 1, "reuse_factorization": True}),
+                              ("Baraff-Witkin (clamp)", "implicit_euler", {"fix": "clamp"}),
+                              ("Newton, converged (tol 1e-10)", "newton", {"max_iterations": 50}),
+                              ("Newton, converged, reused factor", "newton",
+                               {"max_iterations": 50, "reuse_factorization": True})):
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            reps = (2 if quick else 5) * (3 if opts.get("reuse_factorization") else 1)
+            r = {solver: _time_steps(liu, name, h, reps, solver=solver, **opts)
+                 for solver in ("direct", "cholesky")}
+        steps[label] = r
+        it = r["cholesky"]["newton"]
+        extra = f" ({statistics.mean(it):.1f} it)" if it and opts.get("max_iterations", 1) > 1 else ""
+        rows.append(("Liu 81x81", label + extra, r["direct"]["median"], r["cholesky"]["median"],
+                     f"{r['cholesky']['median'] / fms['cholesky']['median']:.1f} FMS frames"))
+    dt_explicit = 3.125e-4
+    mass = _big_mass(dt_explicit)
+    big = cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4, k_bending=3e4,
+                     mass=mass, pinned="top_corners", forces=[Gravity(9.81)])
+    bw = {solver: _time_steps(big, "implicit_euler", 1.0 / 60.0, 2 if quick else 5, solver=solver,
+                              fix="clamp") for solver in ("direct", "cholesky")}
+    rows.append(("cloth 128x128", "Baraff-Witkin (clamp), 1/60", bw["direct"]["median"],
+                 bw["cholesky"]["median"], ">= 3x faster"))
+    import femkit.dynamics.system as system_module
+
+    limit = system_module.COMPILED_SPRINGS
+    system_module.COMPILED_SPRINGS = 10 ** 12          # the NumPy sparse-product forces
+    se_numpy = _time_steps(big, "symplectic_euler", dt_explicit, 50 if quick else 300)
+    system_module.COMPILED_SPRINGS = limit
+    se = _time_steps(big, "symplectic_euler", dt_explicit, 50 if quick else 300)
+    taichi = taichi_substep_time(50 if quick else 300)
+    ref = "taichi not installed" if taichi is None else f"Taichi 1.7.4 CPU: {1e3 * taichi:.2f} ms"
+    rows.append(("cloth 128x128", "symplectic Euler", se_numpy["median"], se["median"],
+                 ref + ("" if taichi is None else f", ours {taichi / se['median']:.2f}x faster")))
+
+    _table_head(f"baseline = SuperLU (direct) and the NumPy sparse-product spring passes, "
+                f"measured in this run; 128x128 cloth: {big.n_springs} springs, node mass {mass:.3g}",
+                f"{'scene':14s} {'method':38s} {'SuperLU/NumPy':>14s} {'Cholesky/compiled':>18s} "
+                f"{'speed-up':>9s}  note")
+    for scene, label, base, ours, note in rows:
+        b = _fmt_time(base) if base is not None else "-"
+        ratio = f"{base / ours:.2f}x" if base is not None else "-"
+        print(f"{scene:14s} {label:38s} {b:>14s} {_fmt_time(ours):>18s} {ratio:>9s}  {note}")
+    print(f"best (minimum) times: fast mass-spring {1e3 * fms['direct']['min']:.1f} / "
+          f"{1e3 * fms['cholesky']['min']:.1f} ms, Chebyshev {1e3 * cheb['min']:.1f} ms, "
+          f"BW 128x128 {1e3 * bw['direct']['min']:.0f} / {1e3 * bw['cholesky']['min']:.0f} ms, "
+          f"symplectic Euler {1e3 * se['min']:.2f} ms")
+    for solver in ("direct", "cholesky"):
+        print(f"BW 128x128 {solver}: factorisations/step {bw[solver]['factorizations']:.1f}, "
+              f"symbolic analyses reused/step {bw[solver].get('symbolic_reuses', 0):.1f}")
+    print(f"\nChebyshev spectral radius estimated from the first step: {cheb['rho']:.4f}")
+    print(f"BW 128x128 split (ms, cholesky): "
+          + ", ".join(f"{k} {1e3 * v:.0f}" for k, v in bw["cholesky"]["split"].items()))
+    print(f"BW 128x128 split (ms, direct):   "
+          + ", ".join(f"{k} {1e3 * v:.0f}" for k, v in bw["direct"]["split"].items()))
+    ct = compile_times()
+    print(f"numba kernels, first call in a fresh process: {ct['cold']:.2f} s with an empty cache "
+          f"(compilation), {ct['cached']:.2f} s from the on-disk cache")
+
+
 if __name__ == "__main__":
-    if "--matrix-free" in sys.argv:  # only the matrix-free comparison
+    if "--compiled" in sys.argv:
+        compiled_rows(quick="--quick" in sys.argv)
+    elif "--matrix-free" in sys.argv:  # only the matrix-free comparison
         matrix_free_rows(cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4,
                                     k_bending=3e4, mass=_big_mass(), pinned="top_corners",
                                     forces=[Gravity(9.81)]), quick="--quick" in sys.argv)

@@ -44,7 +44,12 @@ from .jacobian import (
     spring_blocks,
 )
 
-__all__ = ["MassSpringSystem"]
+__all__ = ["MassSpringSystem", "COMPILED_SPRINGS"]
+
+#: From this many springs on, :meth:`MassSpringSystem.spring_forces` (Hooke only) runs the
+#: compiled one-pass kernel (:func:`femkit.dynamics.kernels.spring_kernels.spring_forces`)
+#: instead of the two sparse products; below it the NumPy path avoids importing numba.
+COMPILED_SPRINGS = 10_000
 
 
 def _per_item(value, count: int, name: str, *, positive: bool = False) -> np.ndarray:
@@ -245,6 +250,14 @@ class MassSpringSystem:
     def spring_forces(self, x, v=None) -> np.ndarray:
         """Hooke (+ dashpot when ``v`` is given and damping is non-zero) forces, ``(n, d)``, pins not zeroed."""
         x = self._state(x)
+        if (v is None or not self._has_dashpots) and self.n_springs >= COMPILED_SPRINGS:
+            # Hooke only, one compiled pass over the springs (femkit.dynamics.kernels)
+            from .kernels.spring_kernels import spring_forces
+
+            out = np.zeros((self.n, self.dim))
+            spring_forces(np.ascontiguousarray(x), self._i, self._j, self.k, self.rest,
+                          self.length_floor, out)
+            return out
         if (v is None or not self._has_dashpots) and self.n_springs:
             # Hooke only: f_i = k (l - L) / l (x_j - x_i), two sparse passes and no unit vectors
             dx = self.difference_operators[0] @ x

@@ -1,5 +1,5 @@
 """Linear solvers: femkit's own Jacobi, steepest descent, CG and PCG, a SuperLU direct
-solver, and Jacobi / IC(0) / AMG preconditioners, selectable by name.
+solver, a sparse Cholesky (CHOLMOD) for SPD systems, and Jacobi / IC(0) / AMG preconditioners, selectable by name.
 
 >>> import numpy as np, scipy.sparse as sp
 >>> from femkit.solvers import solve
@@ -12,6 +12,7 @@ Importing this package imports numpy and scipy only (pyamg and numba load on fir
 
 from .backend import FemkitBackend, LinearSolverBackend
 from .cg import cg
+from .cholesky import CholeskyFactor, cholesky, factorize_spd
 from .direct import Factor, direct, factorize
 from .jacobi import jacobi
 from .pcg import pcg
@@ -22,8 +23,9 @@ from .spec import SolverSpec
 from .steepest_descent import steepest_descent
 
 __all__ = [
-    "PRECONDITIONERS", "SOLVERS", "REASONS", "Factor", "FemkitBackend", "LinearSolverBackend",
-    "Preconditioner", "SolveResult", "SolverSpec", "cg", "direct",
+    "PRECONDITIONERS", "SOLVERS", "REASONS", "CholeskyFactor", "Factor", "FemkitBackend",
+    "LinearSolverBackend", "Preconditioner", "SolveResult", "SolverSpec", "cg", "cholesky",
+    "direct", "factorize_spd",
     "factorize", "get_preconditioner", "get_solver", "jacobi", "pcg", "solve",
     "steepest_descent",
 ]

@@ -81,9 +81,12 @@ def factorize(A, *, spd: bool | None = None, permc_spec: str | None = None) -> F
     ----------
     A : sparse matrix or ndarray, shape (n, n)
     spd : bool, optional
-        Use the symmetric ordering and diagonal pivoting (threshold
-        :data:`DIAG_PIVOT_THRESH`). ``None`` (default) decides automatically: symmetric to
-        1e-10 and a positive diagonal.
+        ``True``: the caller states that ``A`` is symmetric positive definite, and gets its
+        sparse Cholesky factor (:func:`femkit.solvers.cholesky.factorize_spd`, CHOLMOD, the
+        symbolic analysis cached per pattern), or :class:`~femkit.errors.NotSPDError` if it is
+        not (never a silent switch to LU). ``None`` (default): SuperLU, with the symmetric
+        ordering and diagonal pivoting (threshold :data:`DIAG_PIVOT_THRESH`) when ``A`` is
+        symmetric to 1e-10 with a positive diagonal. ``False``: SuperLU's general LU.
     permc_spec : str, optional
         SuperLU column ordering overriding the default (``"MMD_AT_PLUS_A"`` for SPD,
         ``"COLAMD"`` otherwise); ``"NATURAL"`` for a matrix the caller has already permuted
@@ -93,6 +96,8 @@ def factorize(A, *, spd: bool | None = None, permc_spec: str | None = None) -> F
     ------
     SingularSystemError
         SuperLU finds an exactly zero pivot.
+    NotSPDError
+        ``spd=True`` and ``A`` is not symmetric positive definite.
 
     Examples
     --------
@@ -103,6 +108,22 @@ def factorize(A, *, spd: bool | None = None, permc_spec: str | None = None) -> F
     """
     from scipy.sparse.linalg import splu
 
+    if spd is True:
+        if permc_spec is not None:
+            raise InputError("permc_spec is a SuperLU option; spd=True factorises by Cholesky")
+        from .cholesky import factorize_spd
+
+        return factorize_spd(A)
+    return superlu_factor(A, symmetric=spd, permc_spec=permc_spec)
+
+
+def superlu_factor(A, *, symmetric: bool | None = None, permc_spec: str | None = None) -> Factor:
+    """SuperLU factor of ``A``: symmetric mode (``MMD_AT_PLUS_A``, diagonal pivoting with
+    threshold :data:`DIAG_PIVOT_THRESH`) when ``symmetric`` is true (``None``: symmetric to
+    1e-10 with a positive diagonal), general LU (``COLAMD``, partial pivoting) otherwise."""
+    from scipy.sparse.linalg import splu
+
+    spd = symmetric
     if isinstance(A, LinearOperator):
         raise InputError("the direct solver needs an explicit matrix, not a LinearOperator")
     Ac = sp.csc_matrix(as_operator(A))
@@ -146,7 +167,8 @@ def direct(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxi
         A factor of this ``A`` from :func:`factorize`, reused instead of factorising again.
         ``info["factorization"]`` of the result holds the factor used, for reuse.
     spd : bool, optional
-        Passed to :func:`factorize`.
+        SuperLU's symmetric mode (``True``), general LU (``False``) or automatic (``None``),
+        see :func:`superlu_factor`; the SPD Cholesky path is the ``cholesky`` method.
 
     Raises
     ------
@@ -161,7 +183,7 @@ def direct(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxi
         res.reason = "direct"
         return res
     if factorization is None:
-        factorization = factorize(prob.A, spd=spd)
+        factorization = superlu_factor(prob.A, symmetric=spd)
         setup = factorization.setup_time
     else:
         if tuple(factorization.shape) != prob.A.shape:

@@ -1,8 +1,8 @@
 """Solver and preconditioner registries, and :func:`solve`, the high-level entry.
 
-``SOLVERS``: ``jacobi``, ``sd``, ``cg``, ``pcg``, ``direct``, ``fmg``. ``PRECONDITIONERS``:
-``none``, ``jacobi``, ``ic0``, ``amg_sa``, ``amg_rs``, ``amg`` (= ``amg_sa``) and ``gmg``
-(geometric multigrid; needs ``hierarchy=``). Preconditioner
+``SOLVERS``: ``jacobi``, ``sd``, ``cg``, ``pcg``, ``direct`` (SuperLU), ``cholesky`` (CHOLMOD,
+SPD only), ``fmg``. ``PRECONDITIONERS``: ``none``, ``jacobi``, ``ic0``, ``amg_sa``, ``amg_rs``,
+``amg`` (= ``amg_sa``) and ``gmg`` (geometric multigrid; needs ``hierarchy=``). Preconditioner
 factories are ``build(A, **opts) -> Preconditioner`` (or ``None`` for ``none``); importing
 this module imports neither pyamg nor numba.
 """
@@ -18,6 +18,7 @@ from ..errors import InputError
 from ..registry import Registry
 from .cg import cg
 from .checks import check_options
+from .cholesky import cholesky
 from .direct import direct
 from .fmg import fmg
 from .jacobi import jacobi
@@ -38,6 +39,7 @@ SOLVERS.register("cg", cg)
 SOLVERS.register("pcg", pcg)
 SOLVERS.register("direct", direct)
 SOLVERS.register("fmg", fmg)
+SOLVERS.register("cholesky", cholesky)
 
 
 def _no_preconditioner(A, **opts):
@@ -161,7 +163,7 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     elapsed = time.perf_counter() - t0
     res.method = method
     res.preconditioner = pc_name
-    if method in ("direct", "fmg"):  # their own setup_time: the factorisation, the multigrid
+    if method in ("direct", "cholesky", "fmg"):  # their own setup_time: factorisation, multigrid
         res.solve_time = elapsed - res.setup_time
     else:
         res.setup_time = setup

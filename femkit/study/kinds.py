@@ -193,6 +193,9 @@ def _register() -> None:
         STABILITY, _stability_check, _stability_run, _stability_report, _fit_lines))
     STUDY_KINDS.register("adaptive", StudyKind(
         ADAPTIVE, _adaptive_check, _adaptive_run, _adaptive_report, _adaptive_summary))
+    from .cloth import CLOTH_KIND
+
+    STUDY_KINDS.register("cloth_work_precision", CLOTH_KIND)
 
 
 _register()

@@ -196,10 +196,11 @@ def test_linear_operator_matrix_free(poisson):
 
 def test_names_and_registry_errors(poisson):
     A, b = poisson
-    assert set(SOLVERS.names()) == {"jacobi", "sd", "cg", "pcg", "direct", "fmg"}
+    assert set(SOLVERS.names()) == {"jacobi", "sd", "cg", "pcg", "direct", "cholesky", "fmg"}
     assert set(PRECONDITIONERS.names()) == {"none", "jacobi", "ic0", "amg", "amg_sa", "amg_rs",
                                             "gmg"}
-    with pytest.raises(UnknownNameError, match="valid solvers: cg, direct, fmg, jacobi, pcg, sd"):
+    with pytest.raises(UnknownNameError,
+                       match="valid solvers: cg, cholesky, direct, fmg, jacobi, pcg, sd"):
         solve(A, b, method="gmres")
     with pytest.raises(UnknownNameError, match="amg_rs"):
         solve(A, b, method="pcg", preconditioner="ilu")

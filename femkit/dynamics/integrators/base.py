@@ -50,6 +50,9 @@ __all__ = [
     "Integrator",
     "solve_linear",
     "factorize_linear",
+    "uses_cholesky",
+    "solve_cholesky",
+    "solve_compiled",
     "restrict",
     "box_length",
     "check_iteration_options",
@@ -323,7 +326,8 @@ class _ReusedFactor:
     solves: int = 1
 
 
-def _solve_reusing_factor(A, b: np.ndarray, ctx: StepContext, key: str, x0=None) -> np.ndarray:
+def _solve_reusing_factor(A, b: np.ndarray, ctx: StepContext, key: str, x0=None,
+                          direct=None) -> np.ndarray:
     """PCG with the kept factor; the renewal rule drops the factor once one PCG solve costs more
     than the average cost per solve since it was made (factorisation included), so the next
     solve refactorises; a PCG solve that misses the tolerance within the cap refactorises now."""
@@ -347,6 +351,8 @@ def _solve_reusing_factor(A, b: np.ndarray, ctx: StepContext, key: str, x0=None)
                 ctx.cache.pop(key, None)  # marginal cost above the average: refactorise next
             return np.asarray(res.x, dtype=float)
         ctx.count("refactorizations")
+    if direct is not None:  # e.g. the Cholesky refactorisation of the compiled path
+        return direct(A, b, ctx, key)
     return _solve_direct_reusing_ordering(A, b, ctx, keep=key)
 
 
@@ -368,6 +374,12 @@ def _solve_direct_reusing_ordering(A, b: np.ndarray, ctx: StepContext,
             ctx.cache[keep] = _ReusedFactor(factor, time.perf_counter() - t_factor)
         else:
             ctx.cache.pop(keep, None)
+    return _checked_solve(factor, A, b, bnorm, ctx, "direct")
+
+
+def _checked_solve(factor, A, b: np.ndarray, bnorm: float, ctx: StepContext, name: str) -> np.ndarray:
+    """``factor.solve(b)`` (timed as ``time_solve``) under the direct solvers' residual rule
+    ``||b - A x|| <= max(rtol ||b||, atol)``; :class:`~femkit.errors.SolverError` otherwise."""
     t0 = time.perf_counter()
     x = factor.solve(b)
     _add_time(ctx, "time_solve", time.perf_counter() - t0)
@@ -375,7 +387,7 @@ def _solve_direct_reusing_ordering(A, b: np.ndarray, ctx: StepContext,
     rtol, atol = ctx.linear_solver.rtol, ctx.linear_solver.atol
     if not (np.isfinite(res) and res <= max(rtol * bnorm, atol)):
         raise SolverError(
-            f"linear solve (direct) missed the residual rule: relative residual {res / bnorm:.3e} "
+            f"linear solve ({name}) missed the residual rule: relative residual {res / bnorm:.3e} "
             f"> rtol {rtol:.1e}; the matrix is numerically singular or very ill-conditioned")
     return x
 
@@ -383,7 +395,9 @@ def _solve_direct_reusing_ordering(A, b: np.ndarray, ctx: StepContext,
 def factorize_linear(A, ctx: StepContext):
     """Factorise a sparse SPD matrix once for repeated solves; returns an object with ``.solve(b)``.
 
-    ``b`` may be ``(n,)`` or ``(n, k)`` (several right-hand sides in one call).
+    ``b`` may be ``(n,)`` or ``(n, k)`` (several right-hand sides in one call). With
+    ``ctx.linear_solver.method == "cholesky"`` the factor is CHOLMOD's (:func:`femkit.solvers.factorize_spd`;
+    :class:`~femkit.errors.NotSPDError` if ``A`` is not SPD), otherwise SuperLU's.
     """
     from ...solvers import factorize
 
@@ -392,7 +406,81 @@ def factorize_linear(A, ctx: StepContext):
                          f"linear_solver.backend {ctx.linear_solver.backend!r} is not supported "
                          f"here (use backend: femkit)")
     ctx.count("factorizations")
+    if ctx.linear_solver.method == "cholesky":  # factorised once: the ordering with the least fill pays
+        from ...solvers import factorize_spd
+
+        return factorize_spd(A, ordering="nesdis")
     return factorize(A)
+
+
+def uses_cholesky(ctx: StepContext, integrator) -> bool:
+    """Whether a step takes the compiled path: ``ctx.linear_solver.method == "cholesky"`` (assembled, not
+    matrix-free)."""
+    return ctx.linear_solver.method == "cholesky" and not getattr(integrator, "matrix_free", False)
+
+
+def solve_compiled(A, b: np.ndarray, ctx: StepContext, pattern, reuse_key: str | None = None) -> np.ndarray:
+    """:func:`solve_cholesky`, or with ``reuse_key`` (``reuse_factorization=True``) PCG
+    preconditioned by the kept (older) Cholesky factor under the renewal rule of
+    :func:`solve_linear`, the refactorisation being :func:`solve_cholesky`'s."""
+    if reuse_key is None:
+        return solve_cholesky(A, b, ctx, pattern)
+    return _solve_reusing_factor(
+        A, b, ctx, reuse_key,
+        direct=lambda A, b, ctx, keep: solve_cholesky(A, b, ctx, pattern, keep=keep))
+
+
+def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "cholesky_factor",
+                   keep: str | None = None) -> np.ndarray:
+    """Solve ``A x = b`` for an SPD ``A`` assembled into the fixed ``pattern`` (a
+    :class:`~femkit.dynamics.kernels.assembly.FreePattern`, the same object every step): the
+    factor kept in ``ctx.cache[key]`` is refactorised in place on its symbolic analysis while
+    the pattern object is the same and no coordinate pair has become nonzero that was all
+    zero before (those are left out of the factor: see the comment in the code; no hashing),
+    and factorised afresh (analysis from the pattern cache of :mod:`femkit.solvers.cholesky`)
+    otherwise. Counts ``factorizations`` and ``symbolic_reuses``, times ``time_factorization``
+    and ``time_solve``, and applies the direct solver's residual rule
+    ``||b - A x|| <= max(rtol ||b||, atol)`` (:class:`~femkit.errors.SolverError` otherwise).
+    """
+    import scipy.sparse as sp
+
+    from ...solvers import factorize_spd
+
+    ctx.count("linear_solves")
+    b = np.asarray(b, dtype=float)
+    bnorm = float(np.linalg.norm(b))
+    if bnorm == 0.0:
+        return np.zeros_like(b)
+    kept = ctx.cache.get(key)
+    t0 = time.perf_counter()
+    # Coordinate pairs (x-y, y-z ...) whose couplings have all been exactly zero so far (the
+    # out-of-plane couplings of a planar cloth) are left out of the factor, which exploits them;
+    # all entries of a pair enter once one of them is nonzero, and the same-coordinate pairs
+    # always (the clamp zeroes and restores them spring by spring). So the analysed pattern
+    # changes only when the geometry leaves its plane, and every other step refactorises in place.
+    d = pattern.dim
+    seen = np.bincount(pattern.coordinate_pair[A.data != 0.0], minlength=d * d) > 0
+    seen[np.arange(d) * (d + 1)] = True
+    if kept is not None and kept[0] is pattern:
+        seen |= kept[1]
+    if kept is not None and kept[0] is pattern and np.array_equal(seen, kept[1]):
+        mask = kept[2]
+        Ac = sp.csr_matrix((A.data[mask], kept[4], kept[3]), shape=A.shape)
+        factor = kept[5].refactor(Ac)
+    else:
+        mask = seen[pattern.coordinate_pair]
+        counts = np.concatenate([[0], np.cumsum(mask)])
+        Ac = sp.csr_matrix((A.data[mask], A.indices[mask], counts[A.indptr]), shape=A.shape)
+        factor = factorize_spd(Ac, check_symmetry=False)
+        ctx.cache[key] = (pattern, seen, mask, Ac.indptr, Ac.indices, factor)
+    ctx.count("factorizations")
+    if factor.info["symbolic_reused"]:
+        ctx.count("symbolic_reuses")
+    spent = time.perf_counter() - t0
+    _add_time(ctx, "time_factorization", spent)
+    if keep is not None:  # preconditions later solves (reuse_factorization)
+        ctx.cache[keep] = _ReusedFactor(factor, spent)
+    return _checked_solve(factor, Ac, b, bnorm, ctx, "cholesky")
 
 
 # ----------------------------------------------------------------------------- matrix-free

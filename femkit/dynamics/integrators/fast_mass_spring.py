@@ -48,6 +48,20 @@ holds references, so identities cannot be recycled): assigning a new array inval
 modifying one of those arrays in place does not (clear ``ctx.cache`` then). No array is hashed
 per step. ``ctx.stats["factorizations"]`` counts factorisations.
 
+With the ``cholesky`` solver the matrix is factorised by CHOLMOD
+(:func:`femkit.solvers.factorize_spd`) and the local step and ``J d`` are one compiled pass over
+the springs (:func:`femkit.dynamics.kernels.spring_kernels.local_global_rhs`), writing the
+right-hand side of the free nodes directly (the pinned nodes' positions read in place).
+
+Chebyshev acceleration (``chebyshev=True``; Wang 2015, "A Chebyshev semi-iterative approach for
+accelerating projective and position-based dynamics", ACM TOG 34(6)): after ``chebyshev_delay``
+plain sweeps each iterate is extrapolated, ``x_{k+1} = omega_{k+1} (x^_{k+1} - x_{k-1}) + x_{k-1}``
+with ``omega = 2 / (2 - rho^2)`` at the first accelerated sweep and ``4 / (4 - rho^2 omega)``
+after. The spectral radius ``rho`` of the local/global iteration is estimated once per run
+(``chebyshev_warmup`` plain sweeps of the first step on a scratch copy, the ratio of successive
+iterate differences; ``ctx.stats["chebyshev_rho"]``), or given as ``chebyshev_rho``. A fixed
+point of the accelerated iteration is still the implicit Euler step.
+
 ``iterations`` local/global sweeps per step (Liu et al.: 10); with ``tol`` set, the sweeps stop
 early when ``||x+ - x||_inf <= tol * L_box``. Iterated to convergence this is implicit Euler
 (``newton``); with few iterations it is an approximation that damps high frequencies. Order 1,
@@ -60,6 +74,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...errors import InputError
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
                    factorize_linear, restrict)
 from .registry import register
@@ -129,6 +144,10 @@ class _Operators:
 class FastMassSpring(Integrator):
     iterations: int = 10
     tol: float | None = None
+    chebyshev: bool = False
+    chebyshev_rho: float | None = None
+    chebyshev_delay: int = 2
+    chebyshev_warmup: int = 10
 
     order = 1
     implicit = True
@@ -136,6 +155,12 @@ class FastMassSpring(Integrator):
 
     def __post_init__(self):
         check_iteration_options(self.name, self.iterations, self.tol, option="iterations")
+        rho = self.chebyshev_rho
+        if rho is not None and not (0.0 <= rho < 1.0):
+            raise InputError(f"{self.name}: chebyshev_rho must lie in [0, 1), got {rho!r}")
+        if int(self.chebyshev_delay) < 1 or int(self.chebyshev_warmup) < 3:
+            raise InputError(f"{self.name}: need chebyshev_delay >= 1 and chebyshev_warmup >= 3, got "
+                             f"{self.chebyshev_delay!r}, {self.chebyshev_warmup!r}")
 
     def start(self, system, x, v, t: float, dt: float, ctx: StepContext) -> StepperState:
         """The usual start, plus a :class:`~femkit.errors.StabilityWarning` when a declared
@@ -194,6 +219,48 @@ class FastMassSpring(Integrator):
         ctx.cache["fast_mass_spring"] = (key, ops)
         return ops
 
+    def _sweep(self, system, ops: _Operators, x, xn, h: float, t_new: float, const, dx_pin,
+               ctx: StepContext):
+        """One local/global iteration as a function ``x_free -> x_free'`` (``x``: a full
+        ``(n, d)`` work array whose pinned rows hold the fixed positions)."""
+        free = ops.free
+        variable = system.has_variable_forces
+        compiled = ctx.linear_solver.method == "cholesky"
+        if compiled:
+            from ..kernels.spring_kernels import local_global_rhs
+
+            i, j = system._i, system._j
+            kr = system.k * system.rest
+            free_of = np.full(system.n, -1, dtype=np.int64)
+            free_of[free] = np.arange(len(free))
+
+        def sweep(x_free):
+            if compiled:  # local step and J d in one compiled pass
+                rhs = np.empty_like(const)
+                local_global_rhs(x_free, x, i, j, kr, ops.floor, free_of, h * h, const, rhs)
+                if variable:
+                    x[free] = x_free
+                    rhs += (h * h) * system.variable_force(x, (x - xn) / h, t_new)[free]
+            else:
+                dx = ops.G_free @ x_free            # (s, d): x_j - x_i
+                if dx_pin is not None:
+                    dx += dx_pin
+                ln = np.sqrt(np.einsum("sd,sd->s", dx, dx))
+                np.maximum(ln, ops.floor, out=ln)
+                dx /= ln[:, None]
+                rhs = ops.Jkr @ dx                  # J d, (nf, d)
+                if variable:
+                    x[free] = x_free
+                    rhs += system.variable_force(x, (x - xn) / h, t_new)[free]
+                rhs *= h * h
+                rhs += const
+            if ops.B_free is not None:
+                x[free] = x_free
+                rhs += ops.B_free @ x                # h B x_k (the damping split)
+            return ops.factor.solve(rhs if compiled else np.asfortranarray(rhs))
+
+        return sweep
+
     def step(self, system, state: StepperState, dt: float, ctx: StepContext) -> StepperState:
         h = dt
         ops = self._operators(system, h, ctx)
@@ -209,26 +276,19 @@ class FastMassSpring(Integrator):
             x_pin = xn[pinned]
             const -= ops.A_fp @ x_pin
             dx_pin = ops.G_pin @ x_pin
-        variable = system.has_variable_forces
+        sweep = self._sweep(system, ops, x, xn, h, t_new, const, dx_pin, ctx)
         length = box_length(xn) if self.tol is not None else 1.0
-        x_free = y_free
-        for _ in range(int(self.iterations)):
-            dx = ops.G_free @ x_free            # (s, d): x_j - x_i
-            if dx_pin is not None:
-                dx += dx_pin
-            ln = np.sqrt(np.einsum("sd,sd->s", dx, dx))
-            np.maximum(ln, ops.floor, out=ln)
-            dx /= ln[:, None]
-            rhs = ops.Jkr @ dx                  # J d, (nf, d)
-            if variable:
-                x[free] = x_free
-                rhs += system.variable_force(x, (x - xn) / h, t_new)[free]
-            rhs *= h * h
-            if ops.B_free is not None:
-                x[free] = x_free
-                rhs += ops.B_free @ x            # h B x_k (the damping split)
-            rhs += const
-            x_new = ops.factor.solve(np.asfortranarray(rhs))
+        rho = self._rho(sweep, y_free, ctx) if self.chebyshev else 0.0
+        x_prev = x_free = y_free
+        omega = 1.0
+        for k in range(int(self.iterations)):
+            x_hat = sweep(x_free)
+            if self.chebyshev and k >= self.chebyshev_delay:
+                # Wang (2015), eq. (12): omega_{S+1} = 2 / (2 - rho^2), then 4 / (4 - rho^2 omega)
+                omega = 2.0 / (2.0 - rho * rho) if k == self.chebyshev_delay \
+                    else 4.0 / (4.0 - rho * rho * omega)
+                x_hat = omega * (x_hat - x_prev) + x_prev
+            x_prev, x_new = x_free, x_hat
             if self.tol is not None:
                 change = np.abs(x_new - x_free).max(initial=0.0)
                 x_free = x_new
@@ -238,3 +298,28 @@ class FastMassSpring(Integrator):
                 x_free = x_new
         x[free] = x_free
         return StepperState(x, (x - xn) / h, t_new)
+
+    def _rho(self, sweep, y_free, ctx: StepContext) -> float:
+        """The Chebyshev spectral radius: ``chebyshev_rho`` when given, else estimated once per
+        run (kept in ``ctx.cache``) from ``chebyshev_warmup`` plain iterations of the first step
+        on a scratch copy: the ratio ``||x_{k+1} - x_k|| / ||x_k - x_{k-1}||`` of successive
+        differences tends to the spectral radius of the local/global iteration (its
+        dominant eigenvalue); the median of the last three ratios, capped at 0.999."""
+        if self.chebyshev_rho is not None:
+            return float(self.chebyshev_rho)
+        kept = ctx.cache.get("chebyshev_rho")
+        if kept is not None:
+            return kept
+        diffs = []
+        xk = y_free
+        for _ in range(int(self.chebyshev_warmup)):
+            xk1 = sweep(xk)
+            diffs.append(float(np.linalg.norm(xk1 - xk)))
+            xk = xk1
+        d = np.asarray(diffs)
+        ok = d[:-1] > 1e-300
+        ratios = d[1:][ok] / d[:-1][ok]
+        rho = float(min(np.median(ratios[-3:]), 0.999)) if ratios.size else 0.0
+        ctx.cache["chebyshev_rho"] = rho
+        ctx.stats["chebyshev_rho"] = rho
+        return rho

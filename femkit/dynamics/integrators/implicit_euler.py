@@ -15,7 +15,7 @@ First order; unconditionally stable on the linear oscillator (amplitude ``1/sqrt
 per step), i.e. artificially damped. Option ``fix`` (``None``, ``"clamp"``, ``"regularize"``)
 makes ``K`` positive semi-definite for CG-type solvers when springs are compressed.
 
-With the ``direct`` solver and ``reuse_factorization=True`` (opt-in; the default
+With the ``direct`` (or ``cholesky``) solver and ``reuse_factorization=True`` (opt-in; the default
 ``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
 earlier step's matrix is kept (when it is SPD) and later steps solve by PCG preconditioned with
 it, to ``ctx.linear_solver.rtol`` on the true residual, renewing the factor when a PCG solve costs more than
@@ -31,6 +31,12 @@ the springs per product), and the right-hand side uses the product ``K v``. It n
 diagonals, :meth:`~femkit.dynamics.system.MassSpringSystem.stiffness_diagonal`); any other
 solver raises :class:`~femkit.errors.InputError` when the run starts
 (:meth:`.base.Integrator.start`).
+
+With the ``cholesky`` solver the step is compiled: one pass over the springs writes the matrix
+values into the free-dof pattern cached for the run and, in the same pass, the spring forces and
+``K v`` (:mod:`femkit.dynamics.kernels`); CHOLMOD refactorises on the symbolic analysis of the
+first step. Without a definiteness fix a compressed cloth makes the matrix indefinite: that
+raises :class:`~femkit.errors.NotSPDError` (use ``fix="clamp"``, or ``direct``).
 """
 
 from __future__ import annotations
@@ -40,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import (Integrator, StepContext, StepperState, check_matrix_free_options, free_operator,
-                   restrict, solve_linear)
+                   restrict, solve_compiled, solve_linear, uses_cholesky)
 from .registry import register
 
 
@@ -89,6 +95,8 @@ class ImplicitEuler(Integrator):
             b = h * (f - (h + rk) * Kop(vf).reshape(-1) - rm * m * vf)
             dv = solve_linear(op, b[free], ctx, diagonal=diag)
             return self._advance(state, vf, free, dv, h)
+        if uses_cholesky(ctx, self):
+            return self._step_compiled(system, state, h, ctx)
         K = system.stiffness_matrix(x, fix=self.fix)
         M = system.mass_matrix()
         A = (1.0 + h * rm) * M + (h * (h + rk)) * K
@@ -99,6 +107,25 @@ class ImplicitEuler(Integrator):
         dv = solve_linear(restrict(A, free), b[free], ctx, system=system,
                           reuse_key="implicit_euler_factor" if self.reuse_factorization else None)
         return self._advance(state, vf, free, dv, h)
+
+    def _step_compiled(self, system, state: StepperState, h: float, ctx: StepContext) -> StepperState:
+        """The same step with ``cholesky``: matrix values, spring forces and ``K v`` from one
+        compiled pass into the cached free-dof pattern, then a Cholesky refactorisation on the
+        cached symbolic analysis (:func:`.base.solve_cholesky`)."""
+        from ..kernels.assembly import assemble_with_forces, free_pattern
+
+        rm, rk = system.rayleigh
+        x, v = state.x, state.v
+        m = np.repeat(system.mass, system.dim)
+        a_k = h * (h + rk)
+        pat = free_pattern(system, ctx.cache)
+        data, f, kv = assemble_with_forces(pat, system, x, v, state.t, diagonal=(1.0 + h * rm) * m,
+                                           kcoef=a_k, dcoef=h, fix=self.fix)
+        vf = v.reshape(-1)
+        b = h * (f.reshape(-1) - (h + rk) * kv.reshape(-1) - rm * m * vf)
+        dv = solve_compiled(pat.matrix(data), b[pat.free], ctx, pat,
+                            "implicit_euler_factor" if self.reuse_factorization else None)
+        return self._advance(state, vf, pat.free, dv, h)
 
     @staticmethod
     def _advance(state: StepperState, vf, free, dv, h: float) -> StepperState:

@@ -17,7 +17,7 @@ is a descent direction), then backtracks (Armijo, Nocedal & Wright, Numerical Op
 first one. (A line search that finds no decrease leaves ``x`` in place and ends the step: at
 round-off level that is convergence.)
 
-With the ``direct`` solver and ``reuse_factorization=True`` (opt-in; the default
+With the ``direct`` (or ``cholesky``) solver and ``reuse_factorization=True`` (opt-in; the default
 ``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
 earlier Newton matrix (this step's or a previous step's) is kept and later Newton systems are
 solved by PCG preconditioned with it, to the same relative residual ``ctx.linear_solver.rtol`` on the true
@@ -35,6 +35,11 @@ blocks, :meth:`~femkit.dynamics.system.MassSpringSystem.stiffness_diagonal`); ot
 raise :class:`~femkit.errors.InputError` when the run starts. The iterates are those of the
 assembled path to the linear solver's tolerance.
 
+With the ``cholesky`` solver each Newton matrix is written by one compiled pass over the springs
+into the free-dof pattern cached for the run (the clamp applied in the same pass; ``C`` assembled
+once per step on the same pattern) and refactorised by CHOLMOD on the symbolic analysis of the
+first iteration (:func:`.base.solve_cholesky`).
+
 First order; unconditionally stable.
 """
 
@@ -47,7 +52,7 @@ import numpy as np
 from ...errors import InputError
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
                    check_matrix_free_options, free_operator, note_unconverged, restrict,
-                   solve_linear)
+                   solve_compiled, solve_linear, uses_cholesky)
 from .registry import register
 
 
@@ -115,9 +120,31 @@ class NewtonImplicitEuler(Integrator):
         xn = state.x.reshape(-1)
         M = system.mass_matrix()
         m = M.diagonal()
+        compiled = uses_cholesky(ctx, self)
         if self.matrix_free:
             C = self.damping_operator(system, state.x)
             c_apply = C[0]
+        elif compiled:  # C on the cached pattern, the springs in one compiled pass
+            from ..kernels.assembly import assemble_with_forces, free_pattern
+
+            pat = free_pattern(system, ctx.cache)
+            zero_v = np.zeros(shape)
+            damped = rm or rk or system._has_dashpots or any(
+                f.damping(state.x) is not None for f in system.forces)
+            if damped:
+                c_data = assemble_with_forces(pat, system, state.x, zero_v, state.t,
+                                              diagonal=rm * m, kcoef=rk, dcoef=1.0, fix=None)[0]
+                Cf = pat.matrix(c_data)
+
+                def c_apply(e):
+                    out = np.zeros_like(e)
+                    out[free] = Cf @ e[free]
+                    return out
+            else:  # nothing damps: C = 0
+                c_data = 0.0
+
+                def c_apply(e):
+                    return np.zeros_like(e)
         else:
             C = system.damping_matrix(state.x)
             if rm != 0.0:
@@ -144,6 +171,12 @@ class NewtonImplicitEuler(Integrator):
             if self.matrix_free:
                 op, diag = self.newton_operator(system, x.reshape(shape), h, C)
                 dx[free] = solve_linear(op, -grad[free], ctx, diagonal=diag)
+            elif compiled:
+                data = assemble_with_forces(pat, system, x.reshape(shape), zero_v, state.t,
+                                            diagonal=m, kcoef=h * h, dcoef=0.0, fix=self.fix)[0]
+                data += h * c_data
+                dx[free] = solve_compiled(pat.matrix(data), -grad[free], ctx, pat,
+                                          "newton_factor" if self.reuse_factorization else None)
             else:
                 H = M + (h * h) * system.stiffness_matrix(x.reshape(shape), fix=self.fix) + h * C
                 dx[free] = solve_linear(restrict(H, free), -grad[free], ctx, system=system,

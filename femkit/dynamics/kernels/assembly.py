@@ -1,0 +1,171 @@
+"""The implicit methods' matrices assembled by one compiled pass into a cached pattern.
+
+:class:`FreePattern` is built once per system (topology and pinned set): the CSR pattern of the
+spring matrices (every spring's four ``d x d`` blocks plus the full diagonal, as
+:class:`~femkit.dynamics.jacobian.SpringPattern`) restricted to the free dofs, and for every
+spring block entry its slot in that CSR ``data`` array (``-1`` where the row or column is
+pinned). A step then only writes values: :meth:`FreePattern.assemble` fills ``data`` with the
+diagonal, adds every spring's Hessian (with the definiteness fix) and dashpot blocks in one
+pass (:func:`~femkit.dynamics.kernels.spring_kernels.hessian_values`), and adds the declared
+forces' own matrices (contact stiffness, viscous damping: nodal blocks, inside the pattern) by a
+sorted merge. The pattern never changes, so the Cholesky factorisation reuses one symbolic
+analysis for the whole run (:meth:`femkit.solvers.cholesky.CholeskyFactor.refactor`); a force
+matrix with an entry outside the pattern is reported (``None``), and the caller falls back to the
+general path.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = ["FreePattern", "free_pattern"]
+
+
+class FreePattern:
+    """CSR pattern of the implicit methods' matrices on the free dofs, with the scatter slots.
+
+    The pattern holds every spring's four ``d x d`` blocks and every node's full ``d x d``
+    diagonal block (so nodal force matrices, e.g. contact stiffness or viscous damping, always
+    fit), restricted to the free dofs.
+
+    Attributes
+    ----------
+    indptr, indices : int32 arrays of the restricted CSR pattern (sorted columns).
+    slots : (4, s, d*d) int64, the ``data`` position of each spring block entry (or -1):
+        blocks ``(i, i)``, ``(j, j)``, ``(i, j)``, ``(j, i)``, entry ``p*d + q``.
+    diag : (n_free_dofs,) int64, the ``data`` position of each diagonal entry.
+    coordinate_pair : (nnz,) int8, ``p*d + q`` for an entry coupling coordinate ``p`` of one node
+        with coordinate ``q`` of another (or the same) node.
+    free : the free dofs (``system.free_dofs``).
+    """
+
+    def __init__(self, system):
+        d = system.dim
+        s = system.n_springs
+        ndof = system.ndof
+        free = system.free_dofs
+        nf = len(free)
+        a = np.arange(d)
+        rp, cq = np.repeat(a, d), np.tile(a, d)       # entry p*d + q of a block
+        i, j = system.springs[:, 0], system.springs[:, 1]
+        ri, rj = (i[:, None] * d + rp).ravel(), (j[:, None] * d + rp).ravel()
+        ci, cj = (i[:, None] * d + cq).ravel(), (j[:, None] * d + cq).ravel()
+        nodes = np.arange(system.n)
+        nr, nc = (nodes[:, None] * d + rp).ravel(), (nodes[:, None] * d + cq).ravel()
+        fmap = np.full(ndof, -1, dtype=np.int64)
+        fmap[free] = np.arange(nf)
+        fr = fmap[np.concatenate([ri, rj, ri, rj, nr])]
+        fc = fmap[np.concatenate([ci, cj, cj, ci, nc])]
+        ok = (fr >= 0) & (fc >= 0)
+        uniq, inv = np.unique(fr[ok] * nf + fc[ok], return_inverse=True)
+        slot = np.full(fr.size, -1, dtype=np.int64)
+        slot[ok] = inv
+        self.slots = np.ascontiguousarray(slot[:4 * s * d * d].reshape(4, s, d * d))
+        self.diag = np.searchsorted(uniq, np.arange(nf, dtype=np.int64) * (nf + 1))
+        self.indices = (uniq % nf).astype(np.int32) if nf else np.zeros(0, np.int32)
+        counts = np.bincount(uniq // nf, minlength=nf) if nf else np.zeros(0, np.int64)
+        self.indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
+        self.nnz = len(uniq)
+        # the coordinate pair (p, q) -> p*d + q an entry couples (see solve_cholesky)
+        coord = free % d
+        rows = np.repeat(np.arange(nf), np.diff(self.indptr))
+        self.coordinate_pair = (coord[rows] * d + coord[self.indices]).astype(np.int8)
+        self.dim = d
+        self.free = free
+        self.shape = (nf, nf)
+        self.ndof = ndof
+
+    def matrix(self, data: np.ndarray) -> sp.csr_matrix:
+        """The CSR matrix with these values (the pattern arrays are shared, not copied)."""
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape)
+
+    def add(self, data: np.ndarray, B, scale: float = 1.0) -> bool:
+        """``data += scale * B[free][:, free]`` for a full ``ndof x ndof`` sparse ``B`` inside the
+        pattern; False when ``B`` has an entry outside it (``data`` is then unusable)."""
+        from .spring_kernels import add_csr_into
+
+        Bf = sp.csr_matrix(B)[self.free][:, self.free].tocsr()
+        Bf.sort_indices()
+        return bool(add_csr_into(self.indptr, self.indices, data, Bf.indptr.astype(np.int32),
+                                 Bf.indices.astype(np.int32), Bf.data, float(scale)))
+
+    def assemble(self, system, x, *, diagonal, kcoef: float, ccoef: float = 0.0,
+                 clamp: bool = False, v=None, want_force: bool = False,
+                 want_kv: bool = False):
+        """Values ``diag(diagonal) + kcoef K_springs(x) + ccoef D_dashpots(x)`` on the free dofs,
+        and in the same pass (optional) the spring forces (Hooke + dashpots with ``v``) and the
+        product ``K_springs(x) v``, both ``(n, d)`` over all nodes.
+
+        ``diagonal``: flat ``(ndof,)`` values added on the diagonal (e.g. ``a_m m``).
+        Returns ``(data, force or None, kv or None)``.
+        """
+        from .spring_kernels import hessian_values
+
+        data = np.zeros(self.nnz)
+        data[self.diag] = np.asarray(diagonal, dtype=float)[self.free]
+        n, d = system.n, system.dim
+        vv = np.zeros((0, d)) if v is None else np.ascontiguousarray(v, dtype=float)
+        force = np.zeros((n, d)) if want_force else np.zeros((0, d))
+        kv = np.zeros((n, d)) if want_kv else np.zeros((0, d))
+        if system.n_springs:
+            if (want_force or want_kv) and v is None:
+                vv = np.zeros((n, d))
+            hessian_values(np.ascontiguousarray(x, dtype=float), vv, system._i, system._j,
+                           system.k, system.rest, system.damping, float(system.length_floor),
+                           bool(clamp), float(kcoef), float(ccoef), self.slots, data, force, kv)
+        return data, (force if want_force else None), (kv if want_kv else None)
+
+
+def free_pattern(system, cache: dict) -> FreePattern:
+    """The :class:`FreePattern` of ``system`` kept in ``cache`` (a run's ``ctx.cache``), rebuilt
+    when the system, its springs or its pinned set are other objects."""
+    key = (system, system.springs, system.pinned)
+    kept = cache.get("free_pattern")
+    if kept is not None and all(a is b for a, b in zip(kept[0], key)):
+        return kept[1]
+    pat = FreePattern(system)
+    cache["free_pattern"] = (key, pat)
+    return pat
+
+
+def assemble_with_forces(pat: FreePattern, system, x, v, t: float, *, diagonal, kcoef: float,
+                         dcoef: float, fix: str | None):
+    """One implicit step's matrix and vectors, the springs in one compiled pass.
+
+    Returns ``(data, f, kv)``: the values (on ``pat``) of
+    ``diag(diagonal) + kcoef K_fix(x) + dcoef D(x)`` (``K``: springs with the definiteness fix
+    and the declared forces' stiffness, e.g. contact; ``D``: dashpots and the declared forces'
+    damping, e.g. viscous, not Rayleigh), the force ``system.force(x, v, t, rayleigh=False)``
+    ``(n, d)`` and the product ``K_fix(x) v`` ``(n, d)`` -- the same three objects as
+    ``stiffness_matrix`` / ``damping_matrix`` / ``force`` of the system
+    (:class:`~femkit.dynamics.system.MassSpringSystem`), tested equal to them.
+    """
+    from ...errors import SolverError
+    from ..forces.rayleigh import RayleighDamping
+
+    system._check_fix(fix)
+    x = system._state(x)
+    v = system._state(v, "v")
+    clamp = fix == "clamp"
+    data, f, kv = pat.assemble(system, x, diagonal=diagonal, kcoef=kcoef, ccoef=dcoef,
+                               clamp=clamp, v=v, want_force=True, want_kv=True)
+    force_fix = "clamp" if clamp else None
+    for force in system.forces:
+        if not isinstance(force, RayleighDamping):
+            force.add_force(x, v, t, f)
+        Kf = force.stiffness(x, force_fix)
+        Df = force.damping(x)
+        for B, coef in ((Kf, kcoef), (Df, dcoef)):
+            if B is not None and not pat.add(data, B, coef):
+                raise SolverError(f"{force!r}: its matrix has entries outside the nodal blocks "
+                                  "of the compiled pattern")
+        if Kf is not None:
+            kv += (Kf @ v.reshape(-1)).reshape(v.shape)
+    if fix == "regularize":
+        mu = system.regularization_shift(x)
+        system.last_shift = mu
+        data[pat.diag] += kcoef * mu
+        kv += mu * v
+    f[system.pinned] = 0.0
+    return data, f, kv
