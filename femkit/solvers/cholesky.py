@@ -48,7 +48,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
-from ..errors import InputError, NotSPDError, SolverError
+from ..errors import InputError, NotSPDError
 from .checks import SYMMETRY_TOL, as_operator, asymmetry, finish, prepare, zero_rhs_result
 from .result import SolveResult
 
@@ -83,14 +83,26 @@ class _Symbolic:
         self.owned = False              # a CholeskyFactor refactorises ``factor`` in place
 
 
+def available() -> bool:
+    """Whether scikit-sparse (CHOLMOD), the optional dependency of ``cholesky``, can be imported."""
+    try:
+        from sksparse import cholmod  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 def _cholmod():
     try:
         from sksparse import cholmod
-    except ImportError as e:  # pragma: no cover - the dependency is declared
-        raise SolverError(
-            "the cholesky solver needs scikit-sparse (CHOLMOD): install the system library "
-            "(Debian: apt-get install libsuitesparse-dev libopenblas0-pthread) and then "
-            f"'pip install \"scikit-sparse<0.5\"' ({e})") from None
+    except ImportError:
+        from ..errors import BackendUnavailableError
+
+        raise BackendUnavailableError(
+            "the cholesky solver needs scikit-sparse (CHOLMOD), an optional dependency that builds "
+            "against the system's SuiteSparse: run `bash scripts/install-cholesky.sh` (Debian: "
+            "apt-get install libsuitesparse-dev libopenblas0-pthread, then pip install -e "
+            "'.[cholesky]'), or use method 'direct'") from None
     return cholmod
 
 

@@ -110,6 +110,7 @@ def _run(name, system, solver, steps=4, dt=1.0 / 60.0, x0=None, v0=None, **opts)
     return s, ctx
 
 
+@pytest.mark.cholmod
 @pytest.mark.parametrize("name,opts", [
     ("implicit_euler", {"fix": "clamp"}),
     ("implicit_euler", {"fix": "regularize"}),
@@ -130,6 +131,7 @@ def test_cholesky_path_equals_superlu_path(name, opts):
     assert ctx.stats["factorizations"] >= 1
 
 
+@pytest.mark.cholmod
 def test_symbolic_analysis_reused_every_step_of_a_3d_cloth():
     # a crumpled cloth (no spring along an axis, so no exact zero in any block): one pattern
     # for the whole run, analysed once
@@ -142,6 +144,7 @@ def test_symbolic_analysis_reused_every_step_of_a_3d_cloth():
     assert ctx.stats["symbolic_reuses"] >= 4      # every step after the first (or all five)
 
 
+@pytest.mark.cholmod
 def test_fast_mass_spring_compiled_converges_to_newton_implicit_euler():
     system = _cloth(forces=[Gravity(9.81)])
     ref, _ = _run("newton", system, "cholesky", steps=3, tol=1e-13)
@@ -150,6 +153,7 @@ def test_fast_mass_spring_compiled_converges_to_newton_implicit_euler():
     np.testing.assert_allclose(fms.x, ref.x, rtol=0, atol=1e-6 * disp)
 
 
+@pytest.mark.cholmod
 def test_chebyshev_accelerates_local_global_towards_the_implicit_euler_step():
     system = _cloth(10, forces=[Gravity(9.81)])
     start, _ = _run("newton", system, "cholesky", steps=5)     # a swinging state
@@ -169,6 +173,7 @@ def test_chebyshev_accelerates_local_global_towards_the_implicit_euler_step():
     np.testing.assert_allclose(conv.x, ref.x, rtol=0, atol=1e-6 * disp)
 
 
+@pytest.mark.cholmod
 def test_compressed_cloth_without_fix_is_not_spd_for_cholesky():
     system = _cloth(forces=[Gravity(9.81)])
     x0 = system.x0 * 0.8 + 0.1 * RNG.standard_normal(system.x0.shape)   # compressed springs
@@ -187,6 +192,7 @@ def test_bad_chebyshev_options_raise(opts):
         get_integrator("fast_mass_spring", chebyshev=True, **opts)
 
 
+@pytest.mark.cholmod
 @pytest.mark.parametrize("name,opts", [("implicit_euler", {"fix": "clamp"}), ("newton", {"tol": 1e-12})],
                          ids=["bw", "newton"])
 def test_reused_cholesky_factor_preconditions_later_solves_to_the_same_step(name, opts):

@@ -173,9 +173,9 @@ def test_cloths_keep_pins_and_fall(runs):
         assert frames[-1].points[~pinned, 2].mean() < -0.01   # gravity along -z
     liu = json.loads((runs["liu_cloth"][1] / "result.json").read_text())
     # the (M + h^2 L) factorisation is built once and reused for every step; the scene selects
-    # the sparse Cholesky through its linear_solver spec
+    # SuperLU through its linear_solver spec (the cholesky fast path is the optional extra)
     assert liu["linear_solver"]["factorizations"] == 1
-    assert liu["linear_solver"]["method"] == "cholesky"
+    assert liu["linear_solver"]["method"] == "direct"
     assert liu["integrator"]["options"] == {"iterations": 10, "tol": None, "chebyshev": False,
                                             "chebyshev_rho": None, "chebyshev_delay": 2,
                                             "chebyshev_warmup": 10}

@@ -10,6 +10,8 @@ from femkit.dynamics.topology import cloth_grid
 from femkit.dynamics.work_precision import cloth_work_precision, expand_methods
 from femkit.errors import InputError, UnknownNameError
 
+pytestmark = pytest.mark.cholmod  # the cholesky solver: optional scikit-sparse
+
 
 @pytest.fixture(scope="module")
 def study():

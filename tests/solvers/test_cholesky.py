@@ -19,6 +19,8 @@ from femkit.solvers.cholesky import CholeskyFactor, cholesky, clear_symbolic_cac
 
 from .conftest import poisson_2d
 
+pytestmark = pytest.mark.cholmod  # the cholesky solver: optional scikit-sparse
+
 SCENES = sorted((Path(__file__).resolve().parents[2] / "cases" / "scenes").glob("*.yaml"))
 
 

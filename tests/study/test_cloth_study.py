@@ -9,6 +9,8 @@ import pytest
 from femkit.errors import CaseFileError
 from femkit.study import load_study, run_study, study_from_dict
 
+pytestmark = pytest.mark.cholmod  # the cholesky solver: optional scikit-sparse
+
 ROOT = Path(__file__).resolve().parents[2]
 STUDY = ROOT / "studies" / "cloth_work_precision.yaml"
 

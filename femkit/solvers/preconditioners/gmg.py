@@ -174,7 +174,7 @@ class Multigrid:
         self.omega = float(omega)
         self.levels = [_Level(op, self.omega) for op in ops]
         coarsest = ops[0]
-        self.coarse_factor = factorize(coarsest, spd=True) if coarsest.shape[0] else None
+        self.coarse_factor = factorize(coarsest) if coarsest.shape[0] else None  # SuperLU, symmetric mode
         nnz = [op.nnz for op in ops]
         sizes = [op.shape[0] for op in ops]
         self.info = {
