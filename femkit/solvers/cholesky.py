@@ -53,15 +53,25 @@ from .checks import SYMMETRY_TOL, as_operator, asymmetry, finish, prepare, zero_
 from .result import SolveResult
 
 __all__ = ["CholeskyFactor", "cholesky", "factorize_spd", "clear_symbolic_cache",
-           "symbolic_cache_info", "ORDERINGS", "DEFAULT_ORDERING"]
+           "symbolic_cache_info", "ORDERINGS", "DEFAULT_ORDERING", "MODES"]
 
 #: CHOLMOD orderings accepted by ``ordering=``.
 ORDERINGS = ("default", "best", "amd", "metis", "nesdis", "natural")
 
-#: Default ordering: approximate minimum degree (AMD). On the cloth matrices of the benchmark
-#: METIS / nested dissection give 5-15% less fill but no faster factorisation (within the
-#: noise of a shared machine), at 3-5x the analysis time.
-DEFAULT_ORDERING = "amd"
+#: Default ordering: CHOLMOD's nested dissection (``nesdis``: METIS partitions, constrained
+#: minimum degree on the parts). Measured on the benchmark cloths' Baraff-Witkin matrices on an
+#: unloaded machine (one thread, numeric refactorisation on the cached analysis): Liu's 81 x 81
+#: cloth 110 ms against 155 ms for AMD (flops 328M against 485M), the 128 x 128 cloth 356 ms
+#: against 438 ms (1.30G against 1.79G flops). Its analysis costs 3-5x AMD's (47 ms against
+#: 13 ms at n = 19,677) but is paid once per pattern and is still won back on one factorisation.
+DEFAULT_ORDERING = "nesdis"
+
+#: CHOLMOD factorisation kinds accepted by ``mode=``: ``supernodal`` (dense BLAS-3 kernels on
+#: the supernodes: the fastest numeric factorisation) and ``simplicial`` (column by column: a
+#: slower factorisation but a faster triangular solve on small 2-D patterns, 0.58 ms against
+#: 0.75 ms for three right-hand sides on the fast mass-spring matrix of Liu's cloth, n = 6,557,
+#: so the mode for a matrix factorised once and solved many times).
+MODES = ("supernodal", "simplicial")
 
 #: Number of sparsity patterns whose symbolic analysis is kept (least recently used dropped).
 CACHE_SIZE = 8
@@ -73,11 +83,12 @@ class _Symbolic:
     """One cached symbolic analysis: the pattern it belongs to and how often it served."""
 
     def __init__(self, factor, indptr: np.ndarray, indices: np.ndarray, ordering: str,
-                 analysis_time: float):
+                 analysis_time: float, mode: str = "supernodal"):
         self.factor = factor            # an analysed (not factorised) sksparse Factor
         self.indptr = indptr
         self.indices = indices
         self.ordering = ordering
+        self.mode = mode
         self.analysis_time = analysis_time
         self.uses = 0
         self.owned = False              # a CholeskyFactor refactorises ``factor`` in place
@@ -106,11 +117,13 @@ def _cholmod():
     return cholmod
 
 
-def _check_ordering(ordering: str) -> None:
-    if ordering not in ORDERINGS:
-        from ..errors import UnknownNameError
+def _check_ordering(ordering: str, mode: str = "supernodal") -> None:
+    from ..errors import UnknownNameError
 
+    if ordering not in ORDERINGS:
         raise UnknownNameError("cholesky ordering", ordering, ORDERINGS)
+    if mode not in MODES:
+        raise UnknownNameError("cholesky mode", mode, MODES)
 
 
 def _as_symmetric_csc(A, check_symmetry: bool) -> sp.csc_matrix:
@@ -137,16 +150,16 @@ def _as_symmetric_csc(A, check_symmetry: bool) -> sp.csc_matrix:
     return sp.csc_matrix((A.data, A.indices, A.indptr), shape=A.shape)
 
 
-def _pattern_key(A: sp.csc_matrix, ordering: str) -> tuple:
+def _pattern_key(A: sp.csc_matrix, ordering: str, mode: str) -> tuple:
     h = hashlib.blake2b(digest_size=16)
     h.update(np.ascontiguousarray(A.indptr, dtype=np.int64).view(np.uint8))
     h.update(np.ascontiguousarray(A.indices, dtype=np.int64).view(np.uint8))
-    return (A.shape[0], A.nnz, ordering, h.hexdigest())
+    return (A.shape[0], A.nnz, ordering, mode, h.hexdigest())
 
 
-def _symbolic(A: sp.csc_matrix, ordering: str) -> tuple[_Symbolic, bool]:
+def _symbolic(A: sp.csc_matrix, ordering: str, mode: str = "supernodal") -> tuple[_Symbolic, bool]:
     """The cached analysis of ``A``'s pattern (computed now if absent) and whether it was reused."""
-    key = _pattern_key(A, ordering)
+    key = _pattern_key(A, ordering, mode)
     sym = _CACHE.get(key)
     if sym is not None and np.array_equal(sym.indptr, A.indptr) \
             and np.array_equal(sym.indices, A.indices):
@@ -154,8 +167,8 @@ def _symbolic(A: sp.csc_matrix, ordering: str) -> tuple[_Symbolic, bool]:
         return sym, True
     cholmod = _cholmod()
     t0 = time.perf_counter()
-    f = cholmod.analyze(A, mode="supernodal", ordering_method=ordering)
-    sym = _Symbolic(f, A.indptr.copy(), A.indices.copy(), ordering, time.perf_counter() - t0)
+    f = cholmod.analyze(A, mode=mode, ordering_method=ordering)
+    sym = _Symbolic(f, A.indptr.copy(), A.indices.copy(), ordering, time.perf_counter() - t0, mode)
     _CACHE[key] = sym
     while len(_CACHE) > CACHE_SIZE:
         _CACHE.popitem(last=False)
@@ -169,7 +182,7 @@ def clear_symbolic_cache() -> None:
 
 def symbolic_cache_info() -> list[dict]:
     """One dict per cached pattern: ``n``, ``nnz``, ``ordering``, ``uses``, ``analysis_time``."""
-    return [{"n": k[0], "nnz": k[1], "ordering": s.ordering, "uses": s.uses,
+    return [{"n": k[0], "nnz": k[1], "ordering": s.ordering, "mode": s.mode, "uses": s.uses,
              "analysis_time": s.analysis_time} for k, s in _CACHE.items()]
 
 
@@ -206,7 +219,8 @@ class CholeskyFactor:
         self.shape = tuple(shape)
         self._sym = sym
         self.setup_time = numeric_time + (0.0 if reused else sym.analysis_time)
-        self.info = {"backend": "cholmod-supernodal (scikit-sparse)", "ordering": sym.ordering,
+        self.info = {"backend": f"cholmod-{sym.mode} (scikit-sparse)", "ordering": sym.ordering,
+                     "mode": sym.mode,
                      "symbolic_reused": bool(reused), "symbolic_uses": sym.uses,
                      "analysis_time": sym.analysis_time, "numeric_time": numeric_time,
                      "symmetric": True}
@@ -241,7 +255,8 @@ class CholeskyFactor:
     matvec = solve
 
 
-def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, check_symmetry: bool = True) -> CholeskyFactor:
+def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, mode: str = "supernodal",
+                  check_symmetry: bool = True) -> CholeskyFactor:
     """Cholesky factorisation of a sparse SPD matrix, reusing the cached symbolic analysis of
     its pattern (module docstring).
 
@@ -252,6 +267,10 @@ def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, check_symmetry: bool =
     ordering : str
         CHOLMOD fill-reducing ordering, one of :data:`ORDERINGS` (default
         :data:`DEFAULT_ORDERING`). Part of the cache key.
+    mode : str
+        ``"supernodal"`` (default: the fastest factorisation) or ``"simplicial"`` (the faster
+        triangular solves on small 2-D patterns: for a matrix factorised once and solved many
+        times), see :data:`MODES`. Part of the cache key.
     check_symmetry : bool
         Check ``||A - A^T||_inf <= 1e-10 ||A||_inf`` (one transpose); CHOLMOD itself reads only
         one triangle.
@@ -261,11 +280,11 @@ def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, check_symmetry: bool =
     NotSPDError
         ``A`` is not symmetric, or not positive definite.
     """
-    _check_ordering(ordering)
+    _check_ordering(ordering, mode)
     Ac = _as_symmetric_csc(A, check_symmetry)
     if Ac.shape[0] == 0:
         raise InputError("A is empty (0 x 0)")
-    sym, reused = _symbolic(Ac, ordering)
+    sym, reused = _symbolic(Ac, ordering, mode)
     t0 = time.perf_counter()
     if not sym.owned:  # the first factor of an analysis takes it over (no copy) ...
         sym.owned = True

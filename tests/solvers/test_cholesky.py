@@ -142,10 +142,31 @@ def test_symbolic_analysis_is_reused_per_pattern():
         F.refactor(poisson_2d(16))
 
 
+@pytest.mark.parametrize("ordering", ["amd", "nesdis", "metis"])
+@pytest.mark.parametrize("mode", ["supernodal", "simplicial"])
+def test_every_ordering_and_mode_solves_the_cloth_systems_alike(ordering, mode):
+    """Orderings and factorisation kinds change the cost, never the answer: each equals SuperLU
+    to 1e-10 on both system kinds of the hanging-cloth scene, and the analysis is cached per
+    (pattern, ordering, mode)."""
+    clear_symbolic_cache()
+    for label, A in _scene_matrices(SCENES[0]).items():
+        b = np.random.default_rng(3).standard_normal((A.shape[0], 3))
+        F = factorize_spd(A, ordering=ordering, mode=mode)
+        assert F.info["mode"] == mode and F.info["ordering"] == ordering
+        X = F.solve(b)
+        ref = factorize(A).solve(b)
+        assert np.linalg.norm(X - ref) <= 1e-10 * np.linalg.norm(ref), label
+    other = "simplicial" if mode == "supernodal" else "supernodal"
+    assert factorize_spd(A, ordering=ordering, mode=other).info["symbolic_reused"] is False
+    assert factorize_spd(A, ordering=ordering, mode=mode).info["symbolic_reused"] is True
+
+
 def test_bad_options_raise_named_errors():
     A = poisson_2d(5)
     with pytest.raises(UnknownNameError, match="cholesky ordering"):
         cholesky(A, np.ones(25), ordering="random")
+    with pytest.raises(UnknownNameError, match="cholesky mode.*supernodal"):
+        factorize_spd(A, mode="multifrontal")
     with pytest.raises(InputError, match="LinearOperator"):
         cholesky(aslinearoperator(A), np.ones(25))
     with pytest.raises(InputError, match="permc_spec"):

@@ -406,10 +406,12 @@ def factorize_linear(A, ctx: StepContext):
                          f"linear_solver.backend {ctx.linear_solver.backend!r} is not supported "
                          f"here (use backend: femkit)")
     ctx.count("factorizations")
-    if ctx.linear_solver.method == "cholesky":  # factorised once: the ordering with the least fill pays
+    if ctx.linear_solver.method == "cholesky":
+        # factorised once, solved many times: the least fill (nested dissection) and the
+        # simplicial solve, the faster one on these patterns (femkit.solvers.cholesky.MODES)
         from ...solvers import factorize_spd
 
-        return factorize_spd(A, ordering="nesdis")
+        return factorize_spd(A, ordering="nesdis", mode="simplicial")
     return factorize(A)
 
 
