@@ -69,6 +69,23 @@ def _poisson_check(study) -> None:
     from .problem import study_problem
 
     study_problem(study)  # the problem's keys, names and expressions are checked now
+    _check_nested(study, "h" in lv, "levels: {h: [...]} gives independent gmsh meshes, not "
+                  "nested ones; use levels: {h0, count} (uniform refinements)")
+
+
+def _check_nested(study, not_nested: bool, why: str) -> None:
+    """Geometric multigrid (``fmg``, ``gmg``) in ``solvers:`` needs nested meshes: a one-line
+    :class:`~femkit.errors.HierarchyError` at load time when the study's levels are not."""
+    if not not_nested:
+        return
+    from ..errors import HierarchyError
+    from ..solvers.preconditioners.gmg import ALTERNATIVE
+
+    for i, s in enumerate(study.solvers):
+        if s.needs_hierarchy:
+            what = "method 'fmg'" if s.method == "fmg" else "preconditioner 'gmg'"
+            raise HierarchyError(f"solvers[{i}]: {what} needs nested meshes, but {why}; or "
+                                 f"{ALTERNATIVE.split(' or ')[0]}")
 
 
 def _poisson_run(study, progress_enabled=None) -> dict:
@@ -162,6 +179,8 @@ def _adaptive_check(study) -> None:
     from .problem import study_problem
 
     study_problem(study, need_exact=False)
+    _check_nested(study, True, "adaptive refinement makes graded meshes, not uniformly refined "
+                  "nested ones")
 
 
 def _adaptive_run(study, progress_enabled=None) -> dict:

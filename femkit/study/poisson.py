@@ -22,8 +22,11 @@ from .timing import StageTimer, time_call
 
 def _meshes(study, spec, timer_list):
     """The mesh levels: uniform refinements of one mesh, or one gmsh mesh per h; the time of
-    each level is appended to ``timer_list``."""
-    from ..mesh import refine
+    each level is appended to ``timer_list``. Returns the meshes and ``hierarchy(level)``: the
+    :class:`~femkit.mesh.MeshHierarchy` of levels ``0 .. level`` (refinements only; ``None``
+    for gmsh meshes per h, which are not nested), for geometric multigrid."""
+    from ..mesh import MeshHierarchy, edges, refine
+    from ..mesh.hierarchy import prolongation
 
     lv = study.data["levels"]
     meshes = []
@@ -40,12 +43,19 @@ def _meshes(study, spec, timer_list):
             hs = hs[: lv["max_level"] + 1]
         for i, h in enumerate(hs):
             timed(i, lambda h=h: spec.base_mesh(h))
-    else:
-        count = lv["count"] if "max_level" not in lv else min(lv["count"], lv["max_level"] + 1)
-        timed(0, lambda: spec.base_mesh(lv["h0"]))
-        for i in range(1, count):
-            timed(i, lambda: refine(meshes[-1], 1))
-    return meshes
+        return meshes, lambda level: None
+    count = lv["count"] if "max_level" not in lv else min(lv["count"], lv["max_level"] + 1)
+    timed(0, lambda: spec.base_mesh(lv["h0"]))
+    for i in range(1, count):
+        timed(i, lambda: refine(meshes[-1], 1))
+
+    def hierarchy(level: int):
+        # refine() numbers the coarse nodes first, then one midpoint per edges() edge
+        prols = tuple(prolongation(m.n_points, edges(m)[0]) for m in meshes[:level])
+        injs = tuple(np.arange(m.n_points, dtype=np.int64) for m in meshes[:level])
+        return MeshHierarchy(tuple(meshes[: level + 1]), prols, injs, "none")
+
+    return meshes, hierarchy
 
 
 def _assemble(spec, mesh, rule):
@@ -55,9 +65,20 @@ def _assemble(spec, mesh, rule):
     return problem, K, F
 
 
-def _solve(sys, s, x0=None, atol=None):
-    """Solve with a :class:`~femkit.solvers.SolverSpec` (``atol`` overrides the spec's)."""
-    return s.solve(sys.A, sys.b, x0, **({} if atol is None else {"atol": atol}))
+def _solve(sys, s, x0=None, atol=None, mg=None):
+    """Solve with a :class:`~femkit.solvers.SolverSpec` (``atol`` overrides the spec's; ``mg``:
+    the geometric multigrid overrides of the level, :func:`_multigrid`)."""
+    return s.solve(sys.A, sys.b, x0, **({} if atol is None else {"atol": atol}), **(mg or {}))
+
+
+def _multigrid(s, hierarchy, sys, lower=None) -> dict:
+    """Geometric multigrid arguments of solver ``s`` on a level (``{}`` for other solvers):
+    its hierarchy, free nodes and, for ``fmg``, the lower levels' systems ``lower``."""
+    if not s.needs_hierarchy:
+        return {}
+    from ..case.poisson.run import multigrid_overrides
+
+    return multigrid_overrides(s, hierarchy, sys.free, lower)
 
 
 def interpolate_nested(coarse, fine, u_coarse: np.ndarray) -> np.ndarray:
@@ -160,8 +181,9 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
     spec = study_problem(study)
     repeats, warmup, order = d["repeats"], d["warmup"], d["error_order"]
     mesh_times: list[float] = []
-    meshes = _meshes(study, spec, mesh_times)
+    meshes, hierarchy = _meshes(study, spec, mesh_times)
     rules, solvers = d["quadrature"], study.solvers
+    multigrid = any(s.needs_hierarchy for s in solvers)
     notes = []
     if warmup:
         # untimed pass on the coarsest mesh: imports, numba compilation, pyamg import
@@ -169,8 +191,9 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
             prob0, K, F = _assemble(spec, meshes[0], rule)
             sys0 = prob0.reduce(K, F, "pcg")
             for s in solvers:
-                _solve(sys0, s)
+                _solve(sys0, s, mg=_multigrid(s, hierarchy(0), sys0, []))
     records = []
+    systems = {}  # (level, rule) -> system: fmg's lower levels (its coarse right-hand sides)
     jobs = [(lvl, rule) for lvl in range(len(meshes)) for rule in rules]
     for lvl, rule in progress(jobs, total=len(jobs), desc=f"{study.name}", enabled=progress_enabled):
         mesh = meshes[lvl]
@@ -178,8 +201,14 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
         prob, K, F = ta.value
         tb = time_call(lambda: prob.reduce(K, F, "pcg"), repeats=repeats, warmup=0)
         sys = tb.value
+        H = hierarchy(lvl) if multigrid else None
+        if multigrid:
+            systems[lvl, rule] = sys
+        lower = None if spec.pure_neumann or not multigrid else \
+            [systems[i, rule] for i in range(lvl)]
         for s in solvers:
-            ts = time_call(lambda: _solve(sys, s), repeats=repeats, warmup=0)
+            mg = _multigrid(s, H, sys, lower)
+            ts = time_call(lambda: _solve(sys, s, mg=mg), repeats=repeats, warmup=0)
             res = ts.value
             timer = StageTimer()
             with timer("errors"):
@@ -206,7 +235,7 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
                          f"quadrature), condense, pyamg smoothed aggregation + SciPy CG to rtol {rtol:g}.")
     nested = []
     if d.get("stop_at_discretisation_error") is not None and "h" not in d["levels"]:
-        nested = _nested_runs(study, spec, meshes, mesh_times, records)
+        nested = _nested_runs(study, spec, meshes, mesh_times, records, hierarchy)
     elif d.get("stop_at_discretisation_error") is not None:
         notes.append("stop_at_discretisation_error needs nested levels (levels: {h0, count}); skipped.")
     failed = [r for r in records if not r["converged"]]
@@ -220,21 +249,23 @@ def _energy_norm(A, d) -> float:
     return float(np.sqrt(max(float(d @ (A @ d)), 0.0)))
 
 
-def cg_history(A, b, x0, s) -> dict:
+def cg_history(A, b, x0, s, mg=None) -> dict:
     """Untimed analysis pass of (P)CG: the coefficients a stopping test on the error needs.
 
     ``s`` is a :class:`~femkit.solvers.SolverSpec`. Runs femkit's solver with a callback (which receives only the iterate ``x_k``) and recovers
     per iteration, from one matrix-vector product and one preconditioner application,
     ``rz[k] = r_k^T z_k`` (``z = M^-1 r``; ``z = r`` for CG) and
     ``inc[k] = ||x_{k+1} - x_k||_A^2 = alpha_k r_k^T z_k`` (the Hestenes-Stiefel terms;
-    ``A (x_{k+1} - x_k) = r_k - r_{k+1}``), hence ``alpha[k] = inc[k] / rz[k]``.
+    ``A (x_{k+1} - x_k) = r_k - r_{k+1}``), hence ``alpha[k] = inc[k] / rz[k]``. ``mg``: the
+    level's geometric multigrid overrides (:func:`_multigrid`) for ``preconditioner: gmg``.
     """
     from ..solvers import get_preconditioner, solve
 
     M = None
     kw = dict(rtol=s.rtol, atol=s.atol, maxiter=s.maxiter)
     if s.method == "pcg":
-        M = get_preconditioner(s.preconditioner)(A, **s.preconditioner_options)
+        pc_options = {**s.preconditioner_options, **(mg or {}).get("preconditioner_options", {})}
+        M = get_preconditioner(s.preconditioner)(A, **pc_options)
         kw["preconditioner"] = M
     x_prev = [np.array(x0, dtype=float, copy=True)]
     r_prev = [b - A @ x_prev[0]]
@@ -317,7 +348,7 @@ def stop_iteration(hist: dict, mu: float, fraction: float) -> tuple[int | None, 
     return (int(ok[0]) + 1 if ok.size else None), U, eta
 
 
-def _nested_runs(study, spec, meshes, mesh_times, records):
+def _nested_runs(study, spec, meshes, mesh_times, records, hierarchy=lambda level: None):
     """Nested iteration stopped at a fraction of the estimated discretisation error ((P)CG only).
 
     Level 0 is solved from zero with the solver's fixed ``rtol``; its converged Lanczos coefficients
@@ -330,7 +361,8 @@ def _nested_runs(study, spec, meshes, mesh_times, records):
     discretisation error; the timed run then stops there (``maxiter``), from the same start.
     The record checks the test afterwards: the attained algebraic error
     ``||u_nested - u_l||_A`` (``u_l`` the exact discrete solution, by a direct solve) over the
-    energy-norm discretisation error ``||u - u_l||_A`` of the level.
+    energy-norm discretisation error ``||u - u_l||_A`` of the level. ``hierarchy(level)``: the
+    nested meshes up to a level, for ``preconditioner: gmg``.
     """
     from ..solvers import solve as _solve_raw
 
@@ -352,23 +384,24 @@ def _nested_runs(study, spec, meshes, mesh_times, records):
         lam0 = h0 = None
         for lvl, mesh in enumerate(meshes):
             sys = systems[lvl]
+            mg = _multigrid(s, hierarchy(lvl), sys)
             fixed = next(r for r in records if r["source"] == "femkit" and r["level"] == lvl
                          and r["solver"] == label and r["quadrature"] == rule)
             stop, bound, eta_m, mu = None, None, None, None
             if prev is None:
                 x0 = np.zeros(sys.A.shape[0])
-                hist = cg_history(sys.A, sys.b, x0, s)
+                hist = cg_history(sys.A, sys.b, x0, s, mg)
                 lam0, h0 = smallest_ritz_value(hist["alpha"], hist["rz"]), fixed["h"]
-                tc = time_call(lambda: _solve(sys, s), repeats=d["repeats"], warmup=0)
+                tc = time_call(lambda: _solve(sys, s, mg=mg), repeats=d["repeats"], warmup=0)
             else:
                 x0 = interpolate_nested(meshes[lvl - 1], mesh, prev)[sys.free]
-                hist = cg_history(sys.A, sys.b, x0, s)
+                hist = cg_history(sys.A, sys.b, x0, s, mg)
                 mu = lam0 * (fixed["h"] / h0) ** 2 / 2.0
                 stop, U, eta = stop_iteration(hist, mu, frac)
                 if stop is not None:
                     bound, eta_m = float(np.sqrt(U[stop])), float(eta[stop])
                 s_run = s if stop is None else s.replace(maxiter=stop, label=s.label)
-                tc = time_call(lambda: _solve(sys, s_run, x0=x0.copy()), repeats=d["repeats"], warmup=0)
+                tc = time_call(lambda: _solve(sys, s_run, x0=x0.copy(), mg=mg), repeats=d["repeats"], warmup=0)
             res, t_solve = tc.value, tc.min  # min over repeats, like the fixed-rtol runs
             u = sys.expand(res.x)
             prev = u

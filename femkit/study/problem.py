@@ -25,6 +25,13 @@ class StudyProblem:
         return bool(self.case.data["boundary"].get("neumann"))
 
     @property
+    def pure_neumann(self) -> bool:
+        """No Dirichlet condition: ``u`` fixed only up to a constant."""
+        from ..case.poisson.run import is_pure_neumann
+
+        return is_pure_neumann(self.case)
+
+    @property
     def exact(self):
         return self.case.functions["exact.u"]
 

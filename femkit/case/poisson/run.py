@@ -34,7 +34,7 @@ from ..load import Case
 from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
 
 __all__ = ["prepare_poisson", "run_poisson", "build_mesh", "build_mesh_levels",
-           "multigrid_inputs", "element_kappa", "poisson_problem", "compute_errors", "CaseResult"]
+           "multigrid_inputs", "multigrid_overrides", "element_kappa", "poisson_problem", "compute_errors", "CaseResult"]
 
 
 # ----------------------------------------------------------------------------- prepare
@@ -210,12 +210,24 @@ def multigrid_inputs(case: Case, hierarchy, system) -> dict:
     spec = case.solver
     if not spec.needs_hierarchy:
         return {}
-    mg = {"hierarchy": hierarchy, "free": system.free}
+    levels = None
+    if spec.method == "fmg" and not is_pure_neumann(case):
+        levels = [poisson_problem(case, m).assemble(spec.method) for m in hierarchy.meshes[:-1]]
+    return multigrid_overrides(spec, hierarchy, system.free, levels)
+
+
+def multigrid_overrides(spec, hierarchy, free, levels=None) -> dict:
+    """The :meth:`SolverSpec.solve` overrides of geometric multigrid: ``{"options": ...}`` for
+    ``method: fmg`` (with the coarser levels' own systems ``levels`` when given),
+    ``{"preconditioner_options": ...}`` for ``preconditioner: gmg``, ``{}`` otherwise. The one
+    place the case pipeline and the studies turn a hierarchy into solver arguments."""
+    if not spec.needs_hierarchy:
+        return {}
+    mg = {"hierarchy": hierarchy, "free": free}
     if spec.method != "fmg":
         return {"preconditioner_options": mg}
-    if not is_pure_neumann(case):
-        mg["levels"] = [poisson_problem(case, m).assemble(spec.method)
-                        for m in hierarchy.meshes[:-1]]
+    if levels is not None:
+        mg["levels"] = list(levels)
     return {"options": mg}
 
 
