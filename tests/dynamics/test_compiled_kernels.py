@@ -64,8 +64,8 @@ def test_local_global_kernel_equals_sparse_products(dim):
     out = np.zeros((len(free), dim))
     xf = x[free] + 0.0                             # the free iterate, read in place of x[free]
     x[free] = np.nan
-    local_global_rhs(xf, x, system._i, system._j, system.k * system.rest, system.length_floor,
-                     free_of, 0.3, const, out)
+    local_global_rhs(xf, x, system._i, system._j, free_of[system._i], free_of[system._j],
+                     system.k * system.rest, system.length_floor, 0.3, const, out)
     assert np.abs(out - const - ref).max() <= 1e-12 * _scale(ref)
 
 

@@ -122,6 +122,13 @@ def damping_split(system, L=None):
     return B.tocsr()
 
 
+def _spring_rows(system, free: np.ndarray) -> tuple:
+    """The free-row numbers of every spring's two ends (``-1`` for a pinned end)."""
+    free_of = np.full(system.n, -1, dtype=np.int64)
+    free_of[free] = np.arange(len(free))
+    return free_of[system._i], free_of[system._j]
+
+
 @dataclass
 class _Operators:
     """Everything a fast mass-spring step reuses while the cache key holds."""
@@ -137,6 +144,7 @@ class _Operators:
     f_const: np.ndarray         # (nf, d) constant forces on the free nodes
     floor: float
     B_free: object = None       # nf x n rows of the damping split h B (None: no damping)
+    spring_rows: tuple = ()     # (fi, fj): free rows of every spring's ends, -1 if pinned
 
 
 @register("fast_mass_spring")
@@ -215,6 +223,7 @@ class FastMassSpring(Integrator):
             f_const=system.constant_force()[free],
             floor=float(system.length_floor),
             B_free=None if B is None else (dt * B.tocsr()[free]).tocsr(),
+            spring_rows=_spring_rows(system, free),
         )
         ctx.cache["fast_mass_spring"] = (key, ops)
         return ops
@@ -231,13 +240,12 @@ class FastMassSpring(Integrator):
 
             i, j = system._i, system._j
             kr = system.k * system.rest
-            free_of = np.full(system.n, -1, dtype=np.int64)
-            free_of[free] = np.arange(len(free))
+            fi, fj = ops.spring_rows
 
         def sweep(x_free):
             if compiled:  # local step and J d in one compiled pass
                 rhs = np.empty_like(const)
-                local_global_rhs(x_free, x, i, j, kr, ops.floor, free_of, h * h, const, rhs)
+                local_global_rhs(x_free, x, i, j, fi, fj, kr, ops.floor, h * h, const, rhs)
                 if variable:
                     x[free] = x_free
                     rhs += (h * h) * system.variable_force(x, (x - xn) / h, t_new)[free]

@@ -80,65 +80,65 @@ def spring_forces(x, si, sj, k, rest, floor, out):  # pragma: no cover - compile
 
 
 @numba.njit(cache=True)
-def local_global_rhs(xf, x, si, sj, kr, floor, free_of, scale, const, out):  # pragma: no cover - compiled
+def local_global_rhs(xf, x, si, sj, fi, fj, kr, floor, scale, const, out):  # pragma: no cover - compiled
     """Fast mass-spring local step and its right-hand side in one pass: ``out = const + scale J d``
     with, for every spring, the projection ``d_s = L_s (x_i - x_j) / |x_i - x_j|`` (``kr = k L``);
     ``J d`` puts ``+k L u`` on ``j`` and ``-k L u`` on ``i``. ``out`` and ``const`` are
-    ``(n_free, d)`` (rows ``free_of[node]``); a node's position is read from ``xf`` (the free
-    nodes' current iterate) when ``free_of[node] >= 0`` and from ``x`` (the pinned positions)
-    otherwise, so the iterate is never scattered into a full array."""
+    ``(n_free, d)``; ``fi[s]`` / ``fj[s]`` are the free-row numbers of spring ``s``'s ends (``-1``
+    for a pinned end, computed once per run): an end's position is read from ``xf`` (the free
+    nodes' current iterate) when free and from ``x`` (the pinned positions, rows ``si`` / ``sj``)
+    otherwise, so the iterate is never scattered into a full array and no node-to-row lookup
+    is repeated per sweep."""
     d = xf.shape[1]
     for r in range(out.shape[0]):
         for c in range(d):
             out[r, c] = const[r, c]
     if d == 3:  # written out: 3x faster than the generic loop below
         for s in range(si.shape[0]):
-            i = si[s]
-            j = sj[s]
-            fi = free_of[i]
-            fj = free_of[j]
-            if fi >= 0:
-                a0, a1, a2 = xf[fi, 0], xf[fi, 1], xf[fi, 2]
+            a = fi[s]
+            b = fj[s]
+            if a >= 0:
+                a0, a1, a2 = xf[a, 0], xf[a, 1], xf[a, 2]
             else:
+                i = si[s]
                 a0, a1, a2 = x[i, 0], x[i, 1], x[i, 2]
-            if fj >= 0:
-                w0, w1, w2 = xf[fj, 0] - a0, xf[fj, 1] - a1, xf[fj, 2] - a2
+            if b >= 0:
+                w0, w1, w2 = xf[b, 0] - a0, xf[b, 1] - a1, xf[b, 2] - a2
             else:
+                j = sj[s]
                 w0, w1, w2 = x[j, 0] - a0, x[j, 1] - a1, x[j, 2] - a2
             ln = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
             if ln < floor:
                 continue
             f = scale * kr[s] / ln
-            if fi >= 0:
-                out[fi, 0] -= f * w0
-                out[fi, 1] -= f * w1
-                out[fi, 2] -= f * w2
-            if fj >= 0:
-                out[fj, 0] += f * w0
-                out[fj, 1] += f * w1
-                out[fj, 2] += f * w2
+            if a >= 0:
+                out[a, 0] -= f * w0
+                out[a, 1] -= f * w1
+                out[a, 2] -= f * w2
+            if b >= 0:
+                out[b, 0] += f * w0
+                out[b, 1] += f * w1
+                out[b, 2] += f * w2
         return
     w = np.empty(d)
     for s in range(si.shape[0]):
-        i = si[s]
-        j = sj[s]
-        fi = free_of[i]
-        fj = free_of[j]
+        a = fi[s]
+        b = fj[s]
         s2 = 0.0
         for c in range(d):
-            a = xf[fi, c] if fi >= 0 else x[i, c]
-            b = xf[fj, c] if fj >= 0 else x[j, c]
-            w[c] = b - a
+            pa = xf[a, c] if a >= 0 else x[si[s], c]
+            pb = xf[b, c] if b >= 0 else x[sj[s], c]
+            w[c] = pb - pa
             s2 += w[c] * w[c]
         ln = math.sqrt(s2)
         if ln < floor:
             continue
         f = scale * kr[s] / ln
         for c in range(d):
-            if fi >= 0:
-                out[fi, c] -= f * w[c]
-            if fj >= 0:
-                out[fj, c] += f * w[c]
+            if a >= 0:
+                out[a, c] -= f * w[c]
+            if b >= 0:
+                out[b, c] += f * w[c]
 
 
 @numba.njit(cache=True)
