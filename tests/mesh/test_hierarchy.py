@@ -82,6 +82,26 @@ def test_free_prolongation_interpolates_functions_vanishing_on_the_boundary(lsha
         np.testing.assert_allclose(full[fixed], 0.0, atol=1e-14)
 
 
+@pytest.mark.parametrize("renum", ["none", "rcm"])
+@pytest.mark.parametrize("which", ["boundary", "random-half", "none-free", "all-free"])
+def test_free_prolongations_equal_scipy_fancy_indexing(which, renum, lshape):
+    # array for array (indptr, indices in their order, data): the restriction is SciPy's
+    # P[free_{l+1}][:, free_l], whatever the free set (not only a boundary)
+    H = MeshHierarchy.from_refinement(lshape, 3, renumber=renum)
+    n = H.finest.n_points
+    free = {"boundary": np.setdiff1d(np.arange(n), boundary_nodes(H.finest)),
+            "random-half": np.flatnonzero(np.random.default_rng(2).random(n) < 0.5),
+            "none-free": np.zeros(0, dtype=int),
+            "all-free": np.arange(n)}[which]
+    frees = H.level_free(free)
+    for lvl, (P, Pf) in enumerate(zip(H.prolongations, H.free_prolongations(free))):
+        ref = P[frees[lvl + 1]][:, frees[lvl]].tocsr()
+        assert Pf.shape == ref.shape and Pf.format == "csr"
+        for a, b in ((Pf.indptr, ref.indptr), (Pf.indices, ref.indices), (Pf.data, ref.data)):
+            np.testing.assert_array_equal(a, b)
+            assert a.dtype == b.dtype
+
+
 def test_galerkin_product_equals_rediscretisation_for_piecewise_constant_kappa(lshape):
     # nested P1 spaces + kappa constant on the coarse cells: P^T K_fine P = K_coarse exactly
     H = MeshHierarchy.from_refinement(lshape, 2)

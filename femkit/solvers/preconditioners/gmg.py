@@ -7,6 +7,13 @@ Oosterlee and Schüller, *Multigrid*, 2001, sec. 2.3 and 7.7), or given by the c
 (``coarse_operators=``, e.g. rediscretised). For a ``kappa`` constant on the coarse cells both are
 the same matrix (the P1 spaces are nested and the element integrals exact).
 
+The Galerkin product is one compiled pass per level (:func:`galerkin_product`): Gustavson's
+row-wise sparse product (Gustavson, "Two fast algorithms for sparse matrices: multiplication and
+permuted transposition", ACM TOMS 4(3), 1978) over the rows of ``P^T``, which is built once by a
+counting-sort transposition (:func:`transpose_csr`) and then also serves as the restriction. The
+pass returns canonical CSR and the diagonal the smoother needs; it equals SciPy's
+``P.T @ A @ P`` to round-off.
+
 One application is a V(nu, nu)-cycle from a zero initial guess: ``nu`` forward SOR sweeps
 (Gauss-Seidel over-relaxed by ``omega``, default 1.25) before the coarse correction, ``nu`` backward
 sweeps after it (compiled numba kernels), a cached direct factorisation
@@ -55,25 +62,146 @@ def _unsigned(index: np.ndarray) -> np.ndarray:
     return index.view(np.uint32 if index.dtype == np.int32 else np.uint64)
 
 
+def _kernel_index(index: np.ndarray) -> np.ndarray:
+    """An index array for the setup kernels, which do arithmetic on indices: int32 viewed as
+    uint32 (:func:`_unsigned`), anything else as int64 (numba types ``uint64 + int`` as a float)."""
+    if index.dtype == np.int32:
+        return index.view(np.uint32)
+    return index.astype(np.int64, copy=False)
+
+
+def _csr(indptr, indices, data, shape) -> sp.csr_matrix:
+    """A ``csr_matrix`` from kernel output: uint32 indices back to int32, ``indptr`` (int64 from
+    the kernels) in the indices' dtype as SciPy keeps them (int64 both if ``nnz`` needs it)."""
+    if indices.dtype == np.uint32:
+        indices = indices.view(np.int32)
+    if indptr[-1] > np.iinfo(indices.dtype).max:
+        indices = indices.astype(np.int64)
+    return sp.csr_matrix((data, indices, indptr.astype(indices.dtype, copy=False)), shape=shape)
+
+
+def _float_csr(M) -> sp.csr_matrix:
+    """``M`` as CSR with float64 data (no copy when it already is)."""
+    M = M.tocsr()
+    return M if M.dtype == np.float64 else M.astype(np.float64)
+
+
+def transpose_csr(P) -> sp.csr_matrix:
+    """``P^T`` as CSR by one counting sort (Gustavson's permuted transposition), compiled.
+
+    Parameters
+    ----------
+    P : sparse matrix
+        ``(m, n)``, converted to CSR with float64 data if it is not already.
+
+    Returns
+    -------
+    csr_matrix
+        ``(n, m)``, every row's column indices increasing; the same matrix as ``P.T.tocsr()``.
+    """
+    from ._gmg_kernels import transpose
+
+    P = _float_csr(P)
+    indptr, indices, data = transpose(_kernel_index(P.indptr), _kernel_index(P.indices), P.data,
+                                      P.shape[1])
+    return _csr(indptr, indices, data, (P.shape[1], P.shape[0]))
+
+
+def galerkin_product(A, P, PT=None) -> tuple[sp.csr_matrix, np.ndarray]:
+    """The Galerkin coarse operator ``C = P^T A P`` and its diagonal, in one compiled pass.
+
+    Gustavson's row-wise product (Gustavson, "Two fast algorithms for sparse matrices:
+    multiplication and permuted transposition", ACM TOMS 4(3), 1978) run over the rows of
+    ``P^T``: row ``i`` of ``C`` accumulates ``P_ki a_kj P_j:`` in a dense array of the coarse size
+    (with a marker of the row that last touched each column, so nothing is cleared between rows),
+    then its columns are sorted (insertion sort: the rows are short). No
+    intermediate ``P^T A`` is formed. Nothing is assumed of the numbering or of the number of
+    entries per row of ``P``; the work is ``sum_k nnz(P_k:) sum_(j in A_k:) nnz(P_j:)``, small
+    when ``P`` has a few entries per row as a P1 prolongation has (1 at a coarse node, 2 at a
+    midpoint, fewer after Dirichlet elimination).
+
+    Parameters
+    ----------
+    A : sparse matrix
+        ``(m, m)``; converted to float64 CSR if needed; duplicates and unsorted rows are fine.
+    P : sparse matrix
+        ``(m, n)`` prolongation; converted to float64 CSR if needed.
+    PT : csr_matrix, optional
+        ``P^T`` as CSR (e.g. from :func:`transpose_csr`, kept as the restriction); computed if
+        not given.
+
+    Returns
+    -------
+    C : csr_matrix
+        ``(n, n)``, canonical (sorted indices, no duplicates; entries that are exactly zero are
+        dropped, as SciPy's product drops them). Equal to SciPy's ``P.T @ A @ P`` to round-off
+        (the sums run in another order).
+    diag : ndarray
+        ``C``'s diagonal (0 where ``C`` has no diagonal entry).
+
+    Raises
+    ------
+    InputError
+        The shapes do not match.
+
+    Examples
+    --------
+    >>> import numpy as np, scipy.sparse as sp
+    >>> A = sp.csr_matrix(np.array([[2.0, -1, 0], [-1, 2, -1], [0, -1, 2]]))
+    >>> P = sp.csr_matrix(np.array([[1.0, 0], [0.5, 0.5], [0, 1]]))
+    >>> C, d = galerkin_product(A, P)
+    >>> C.toarray(), d
+    (array([[ 1.5, -0.5],
+           [-0.5,  1.5]]), array([1.5, 1.5]))
+    """
+    from ._gmg_kernels import galerkin
+
+    A = _float_csr(A)
+    P = _float_csr(P)
+    m, n = P.shape
+    if A.shape != (m, m):
+        raise InputError(f"galerkin_product: A is {A.shape[0]} x {A.shape[1]} but P has {m} rows")
+    if PT is None:
+        PT = transpose_csr(P)
+    elif PT.shape != (n, m):
+        raise InputError(f"galerkin_product: P^T must be {n} x {m}, got {PT.shape[0]} x "
+                         f"{PT.shape[1]}")
+    else:
+        PT = _float_csr(PT)
+    # the output grows by doubling; start at the fine level's entries per row (P1: the same)
+    capacity = A.nnz * n // max(m, 1) + n
+    indptr, indices, data, diag = galerkin(
+        _kernel_index(PT.indptr), _kernel_index(PT.indices), PT.data,
+        _kernel_index(A.indptr), _kernel_index(A.indices), A.data,
+        _kernel_index(P.indptr), _kernel_index(P.indices), P.data, capacity)
+    C = _csr(indptr, indices, data, (n, n))
+    C.has_canonical_format = True  # sorted and summed by construction: no O(nnz) re-check
+    return C, diag
+
+
 class _Level:
-    """One level: CSR arrays of ``A_l``, its inverse diagonal and work vectors."""
+    """One level: CSR arrays of ``A_l``, its inverse diagonal and work vectors.
+
+    ``diag``: ``A``'s diagonal when already known (the Galerkin pass returns it, with ``A`` in
+    canonical form, so neither is recomputed here).
+    """
 
     __slots__ = ("A", "indptr", "indices", "data", "inv_diag", "x", "r")
 
-    def __init__(self, A: sp.csr_matrix, omega: float):
+    def __init__(self, A: sp.csr_matrix, omega: float, diag: np.ndarray | None = None):
         A = A.tocsr()
-        A.sum_duplicates()
+        A.sum_duplicates()      # no-ops on canonical CSR (flags set by galerkin_product)
         A.sort_indices()
         self.A = A
         self.indptr = _unsigned(A.indptr)
         self.indices = _unsigned(A.indices)
         self.data = A.data
-        d = A.diagonal()
+        d = A.diagonal() if diag is None else diag
         check_positive_diagonal(d, what="the gmg preconditioner (a level operator)")
         self.inv_diag = omega / d
         n = A.shape[0]
-        self.x = np.zeros(n)
-        self.r = np.zeros(n)
+        self.x = np.empty(n)    # both overwritten before they are read (gs_forward_zero, residual)
+        self.r = np.empty(n)
 
 
 class Multigrid:
@@ -94,7 +222,7 @@ class Multigrid:
         Over-relaxation of the sweeps (SOR), in (0, 2).
     coarse_operators : list of sparse matrices, optional
         The operators of levels ``0 .. L-1`` on their free nodes (coarsest first), e.g.
-        rediscretised; default Galerkin ``P^T A P``.
+        rediscretised; default Galerkin ``P^T A P`` (:func:`galerkin_product`).
     check_symmetry : bool
         Check ``A`` for symmetry (:class:`~femkit.errors.NotSPDError`); the ``gmg`` factory and
         ``fmg`` skip it when PCG / ``fmg`` already checked (it costs ~ten sparse products).
@@ -104,7 +232,9 @@ class Multigrid:
     levels : list
         Per level (coarsest first) the operator and smoother data.
     prolongations : list of csr_matrix
-        Free-dof prolongations ``P_l`` (level ``l`` -> ``l + 1``); ``restrictions`` their transposes.
+        Free-dof prolongations ``P_l`` (level ``l`` -> ``l + 1``).
+    restrictions : list of csr_matrix
+        Their transposes ``P_l^T`` (:func:`transpose_csr`), which the Galerkin products also use.
     frees : list of ndarray
         Free node ids of every level.
     hierarchy : MeshHierarchy
@@ -150,14 +280,16 @@ class Multigrid:
         self.frees = frees
         self.hierarchy = hierarchy
         self.sweeps = int(sweeps)
-        P = hierarchy.free_prolongations(frees[-1])
+        P = [_float_csr(p) for p in hierarchy.free_prolongations(frees[-1])]
         self.prolongations = P
-        self.restrictions = [p.T.tocsr() for p in P]
+        self.restrictions = [transpose_csr(p) for p in P]
         self._p_arrays = [(_unsigned(p.indptr), _unsigned(p.indices), p.data) for p in P]
         ops = [A]
+        diags = [None] * (len(P) + 1)   # known diagonals (the Galerkin pass returns them)
         if coarse_operators is None:
             for lvl in range(len(P) - 1, -1, -1):
-                ops.append((self.restrictions[lvl] @ ops[-1] @ P[lvl]).tocsr())
+                op, diags[lvl] = galerkin_product(ops[-1], P[lvl], self.restrictions[lvl])
+                ops.append(op)
             ops = ops[::-1]
             kind = "galerkin"
         else:
@@ -172,7 +304,7 @@ class Multigrid:
                                      f"{lvl} has {len(frees[lvl])} free nodes")
             kind = "given"
         self.omega = float(omega)
-        self.levels = [_Level(op, self.omega) for op in ops]
+        self.levels = [_Level(op, self.omega, d) for op, d in zip(ops, diags)]
         coarsest = ops[0]
         self.coarse_factor = factorize(coarsest) if coarsest.shape[0] else None  # SuperLU, symmetric mode
         nnz = [op.nnz for op in ops]
