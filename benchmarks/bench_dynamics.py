@@ -54,9 +54,9 @@ _SPLIT = ("time_permute", "time_factorization", "time_solve", "time_pcg")
 
 
 def _time_steps(system, name, dt, repeats, *, solver="direct", preconditioner="none",
-                **opts) -> dict:
+                solver_options=None, **opts) -> dict:
     """Median seconds per step after a warm-up, factorisations and the time split per step."""
-    ctx = StepContext(SolverSpec(solver, preconditioner))
+    ctx = StepContext(SolverSpec(solver, preconditioner, options=dict(solver_options or {})))
     integ = get_integrator(name, **opts)
     s = integ.start(system, system.x0, system.v0, 0.0, dt, ctx)
     s = integ.step(system, s, dt, ctx)  # warm-up: one-time factorisation / ordering
@@ -282,22 +282,38 @@ def compile_times() -> dict:
     return out
 
 
+#: The linear solvers compared: the baseline (SuperLU + NumPy passes) and the compiled path with
+#: either Cholesky engine (CHOLMOD; MKL PARDISO when installed).
+VARIANTS = {"direct": ("direct", {}), "cholesky": ("cholesky", {}),
+            "pardiso": ("cholesky", {"engine": "pardiso"})}
+
+
+def _variants():
+    from femkit.solvers.pardiso import available
+
+    return [v for v in VARIANTS if v != "pardiso" or available()]
+
+
+def _timed_variants(system, name, dt, reps, **opts) -> dict:
+    return {v: _time_steps(system, name, dt, reps, solver=VARIANTS[v][0],
+                           solver_options=VARIANTS[v][1], **opts) for v in _variants()}
+
+
 def compiled_rows(quick: bool = False) -> None:
-    """Issue 11: the compiled/Cholesky path against the SuperLU/NumPy path of the same step,
-    measured in this run, and symplectic Euler against Taichi's demo."""
+    """Issue 11: the compiled/Cholesky path (CHOLMOD, and MKL PARDISO when installed) against
+    the SuperLU/NumPy path of the same step, measured in this run, and symplectic Euler against
+    Taichi's demo."""
     rows = []
     liu = cloth_grid(81, 81, 1.0, 1.0, k_structural=1e3, k_shear=1e3, k_bending=1e2,
                      total_mass=1.0, pinned="top_corners", forces=[Gravity(9.81)])
     h = 1.0 / 30.0
     reps = 5 if quick else 20
-    fms = {}
-    for solver in ("direct", "cholesky"):
-        fms[solver] = _time_steps(liu, "fast_mass_spring", h, reps, solver=solver, iterations=10)
+    fms = _timed_variants(liu, "fast_mass_spring", h, reps, iterations=10)
     cheb = _time_steps(liu, "fast_mass_spring", h, reps, solver="cholesky", iterations=10,
                        chebyshev=True)
-    rows.append(("Liu 81x81", "fast mass-spring, 10 it", fms["direct"]["median"],
-                 fms["cholesky"]["median"], "<= 10 ms/frame"))
-    rows.append(("Liu 81x81", "  + Chebyshev (Wang 2015)", None, cheb["median"], ""))
+    rows.append(("Liu 81x81", "fast mass-spring, 10 it", fms, "<= 10 ms/frame"))
+    rows.append(("Liu 81x81", "  + Chebyshev (Wang 2015)", {"cholesky": cheb}, ""))
+    frame = min(fms[v]["median"] for v in fms if v != "direct")
     steps = {}
     for label, name, opts in (("Newton iteration (1 solve)", "newton", {"max_iterations": 1}),
                               ("Newton iteration, reused factor", "newton",
@@ -311,21 +327,18 @@ def compiled_rows(quick: bool = False) -> None:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             reps = (2 if quick else 5) * (3 if opts.get("reuse_factorization") else 1)
-            r = {solver: _time_steps(liu, name, h, reps, solver=solver, **opts)
-                 for solver in ("direct", "cholesky")}
+            r = _timed_variants(liu, name, h, reps, **opts)
         steps[label] = r
         it = r["cholesky"]["newton"]
         extra = f" ({statistics.mean(it):.1f} it)" if it and opts.get("max_iterations", 1) > 1 else ""
-        rows.append(("Liu 81x81", label + extra, r["direct"]["median"], r["cholesky"]["median"],
-                     f"{r['cholesky']['median'] / fms['cholesky']['median']:.1f} FMS frames"))
+        best = min(r[v]["median"] for v in r if v != "direct")
+        rows.append(("Liu 81x81", label + extra, r, f"{best / frame:.1f} FMS frames (best engine)"))
     dt_explicit = 3.125e-4
     mass = _big_mass(dt_explicit)
     big = cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4, k_bending=3e4,
                      mass=mass, pinned="top_corners", forces=[Gravity(9.81)])
-    bw = {solver: _time_steps(big, "implicit_euler", 1.0 / 60.0, 2 if quick else 5, solver=solver,
-                              fix="clamp") for solver in ("direct", "cholesky")}
-    rows.append(("cloth 128x128", "Baraff-Witkin (clamp), 1/60", bw["direct"]["median"],
-                 bw["cholesky"]["median"], ">= 3x faster"))
+    bw = _timed_variants(big, "implicit_euler", 1.0 / 60.0, 2 if quick else 5, fix="clamp")
+    rows.append(("cloth 128x128", "Baraff-Witkin (clamp), 1/60", bw, ">= 3x faster"))
     import femkit.dynamics.system as system_module
 
     limit = system_module.COMPILED_SPRINGS
@@ -335,29 +348,28 @@ def compiled_rows(quick: bool = False) -> None:
     se = _time_steps(big, "symplectic_euler", dt_explicit, 50 if quick else 300)
     taichi = taichi_substep_time(50 if quick else 300)
     ref = "taichi not installed" if taichi is None else f"Taichi 1.7.4 CPU: {1e3 * taichi:.2f} ms"
-    rows.append(("cloth 128x128", "symplectic Euler", se_numpy["median"], se["median"],
+    rows.append(("cloth 128x128", "symplectic Euler", {"direct": se_numpy, "cholesky": se},
                  ref + ("" if taichi is None else f", ours {taichi / se['median']:.2f}x faster")))
 
     _table_head(f"baseline = SuperLU (direct) and the NumPy sparse-product spring passes, "
                 f"measured in this run; 128x128 cloth: {big.n_springs} springs, node mass {mass:.3g}",
-                f"{'scene':14s} {'method':38s} {'SuperLU/NumPy':>14s} {'Cholesky/compiled':>18s} "
-                f"{'speed-up':>9s}  note")
-    for scene, label, base, ours, note in rows:
-        b = _fmt_time(base) if base is not None else "-"
-        ratio = f"{base / ours:.2f}x" if base is not None else "-"
-        print(f"{scene:14s} {label:38s} {b:>14s} {_fmt_time(ours):>18s} {ratio:>9s}  {note}")
-    print(f"best (minimum) times: fast mass-spring {1e3 * fms['direct']['min']:.1f} / "
-          f"{1e3 * fms['cholesky']['min']:.1f} ms, Chebyshev {1e3 * cheb['min']:.1f} ms, "
-          f"BW 128x128 {1e3 * bw['direct']['min']:.0f} / {1e3 * bw['cholesky']['min']:.0f} ms, "
-          f"symplectic Euler {1e3 * se['min']:.2f} ms")
-    for solver in ("direct", "cholesky"):
-        print(f"BW 128x128 {solver}: factorisations/step {bw[solver]['factorizations']:.1f}, "
-              f"symbolic analyses reused/step {bw[solver].get('symbolic_reuses', 0):.1f}")
+                f"{'scene':14s} {'method':38s} {'SuperLU/NumPy':>14s} {'CHOLMOD/compiled':>17s} "
+                f"{'PARDISO/compiled':>17s} {'speed-up':>9s}  note")
+    for scene, label, r, note in rows:
+        cells = [_fmt_time(r[v]["median"]) if v in r else "-" for v in VARIANTS]
+        ours = [r[v]["median"] for v in ("cholesky", "pardiso") if v in r]
+        ratio = f"{r['direct']['median'] / min(ours):.2f}x" if "direct" in r else "-"
+        print(f"{scene:14s} {label:38s} {cells[0]:>14s} {cells[1]:>17s} {cells[2]:>17s} "
+              f"{ratio:>9s}  {note}")
+    print("best (minimum) times, ms: " + "; ".join(
+        f"{name} " + " / ".join(f"{1e3 * r[v]['min']:.1f}" for v in VARIANTS if v in r)
+        for name, r in (("fast mass-spring", fms), ("Chebyshev", {"cholesky": cheb}),
+                        ("BW 128x128", bw), ("symplectic Euler", {"cholesky": se}))))
+    for v in bw:
+        print(f"BW 128x128 {v}: factorisations/step {bw[v]['factorizations']:.1f}, "
+              f"symbolic analyses reused/step {bw[v].get('symbolic_reuses', 0):.1f}; split ms: "
+              + ", ".join(f"{k} {1e3 * t:.0f}" for k, t in bw[v]["split"].items()))
     print(f"\nChebyshev spectral radius estimated from the first step: {cheb['rho']:.4f}")
-    print(f"BW 128x128 split (ms, cholesky): "
-          + ", ".join(f"{k} {1e3 * v:.0f}" for k, v in bw["cholesky"]["split"].items()))
-    print(f"BW 128x128 split (ms, direct):   "
-          + ", ".join(f"{k} {1e3 * v:.0f}" for k, v in bw["direct"]["split"].items()))
     ct = compile_times()
     print(f"numba kernels, first call in a fresh process: {ct['cold']:.2f} s with an empty cache "
           f"(compilation), {ct['cached']:.2f} s from the on-disk cache")

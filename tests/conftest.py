@@ -9,16 +9,22 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 
 
 def pytest_collection_modifyitems(config, items):
-    """``@pytest.mark.cholmod`` tests need the optional scikit-sparse (CHOLMOD): they run where it is
-    installed (CI installs it) and skip, saying how to install it, where it is not."""
+    """``@pytest.mark.cholmod`` tests need the optional scikit-sparse (CHOLMOD) and
+    ``@pytest.mark.pardiso`` tests the optional MKL (PARDISO): they run where it is installed (CI
+    installs both) and skip, saying how to install it, where it is not."""
     import pytest
 
-    from femkit.solvers.cholesky import available
+    from femkit.solvers.cholesky import available as cholmod_available
+    from femkit.solvers.pardiso import available as pardiso_available
 
-    if available():
-        return
-    skip = pytest.mark.skip(reason="scikit-sparse (CHOLMOD) is not installed: "
-                                   "bash scripts/install-cholesky.sh")
+    skips = {}
+    if not cholmod_available():
+        skips["cholmod"] = pytest.mark.skip(reason="scikit-sparse (CHOLMOD) is not installed: "
+                                                   "bash scripts/install-cholesky.sh")
+    if not pardiso_available():
+        skips["pardiso"] = pytest.mark.skip(reason="MKL (PARDISO) is not installed: "
+                                                   "pip install -e '.[pardiso]'")
     for item in items:
-        if "cholmod" in item.keywords or item.name == "femkit.solvers.cholesky":  # its doctest
-            item.add_marker(skip)
+        for marker, skip in skips.items():
+            if marker in item.keywords or (marker == "cholmod" and item.name == "femkit.solvers.cholesky"):
+                item.add_marker(skip)

@@ -411,8 +411,16 @@ def factorize_linear(A, ctx: StepContext):
         # simplicial solve, the faster one on these patterns (femkit.solvers.cholesky.MODES)
         from ...solvers import factorize_spd
 
-        return factorize_spd(A, ordering="nesdis", mode="simplicial")
+        engine = cholesky_engine(ctx)
+        return factorize_spd(A, ordering="nesdis", engine=engine,
+                             mode="simplicial" if engine == "cholmod" else "supernodal")
     return factorize(A)
+
+
+def cholesky_engine(ctx: StepContext) -> str:
+    """The factorisation library of ``linear_solver: {method: cholesky, options: {engine}}``:
+    ``cholmod`` (default) or ``pardiso`` (:data:`femkit.solvers.cholesky.ENGINES`)."""
+    return ctx.linear_solver.options.get("engine", "cholmod")
 
 
 def uses_cholesky(ctx: StepContext, integrator) -> bool:
@@ -473,7 +481,7 @@ def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "chol
         mask = seen[pattern.coordinate_pair]
         counts = np.concatenate([[0], np.cumsum(mask)])
         Ac = sp.csr_matrix((A.data[mask], A.indices[mask], counts[A.indptr]), shape=A.shape)
-        factor = factorize_spd(Ac, check_symmetry=False)
+        factor = factorize_spd(Ac, engine=cholesky_engine(ctx), check_symmetry=False)
         ctx.cache[key] = (pattern, seen, mask, Ac.indptr, Ac.indices, factor)
     ctx.count("factorizations")
     if factor.info["symbolic_reused"]:
