@@ -27,11 +27,16 @@ Baraff-Witkin (BW) and Newton run twice: ``exact`` (a factorisation per linear s
 ``reuse`` (an older factorisation preconditions PCG to the same tolerance ``rtol = 1e-10``,
 refactorised when PCG is slow).
 
-Matrix-free (issue 3, seed 001): Baraff-Witkin (clamp) on the 128 x 128 cloth at ``dt = 1/60``
-three ways, all to ``rtol = 1e-10``: assembled + direct, assembled + PCG (Jacobi), and
-``matrix_free=True`` + PCG (Jacobi, diagonal from the spring blocks): time per step, PCG
+Matrix-free (Baraff and Witkin 1998 solve their step by CG, which needs only products):
+Baraff-Witkin (clamp) on the 128 x 128 cloth at ``dt = 1/60`` three ways, all to
+``rtol = 1e-10``: assembled + direct, assembled + PCG (Jacobi), and ``matrix_free=True`` + PCG (Jacobi, diagonal from the spring blocks): time per step, PCG
 iterations per step and the memory of the assembled free-dof matrix (``nnz * 12`` bytes of
 values and column indices + ``indptr``; the matrix-free path stores none).
+
+Compiled (``--compiled``, issue 11): each implicit step three ways in the same run, SuperLU with
+the NumPy spring passes (the baseline), ``cholesky`` (CHOLMOD) and ``cholesky`` with
+``options: {engine: pardiso}`` (MKL PARDISO, when the extra ``femkit[pardiso]`` is installed),
+plus symplectic Euler against Taichi's own demo.
 """
 
 from __future__ import annotations
