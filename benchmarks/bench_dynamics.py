@@ -36,7 +36,8 @@ values and column indices + ``indptr``; the matrix-free path stores none).
 Compiled (``--compiled``, issue 11): each implicit step three ways in the same run, SuperLU with
 the NumPy spring passes (the baseline), ``cholesky`` (CHOLMOD) and ``cholesky`` with
 ``options: {engine: pardiso}`` (MKL PARDISO, when the extra ``femkit[pardiso]`` is installed),
-plus symplectic Euler against Taichi's own demo.
+plus symplectic Euler against Taichi's own demo. ``--engines``: the numeric refactorisation
+alone per engine and ordering on the Baraff-Witkin matrices (:func:`engine_rows`).
 """
 
 from __future__ import annotations
@@ -380,8 +381,61 @@ def compiled_rows(quick: bool = False) -> None:
           f"(compilation), {ct['cached']:.2f} s from the on-disk cache")
 
 
+def engine_rows() -> None:
+    """``--engines``: the numeric refactorisation alone, per Cholesky engine and ordering, on the
+    Baraff-Witkin (clamp) matrices the benchmark's steps factorise (Liu's cloth after three steps
+    at dt = 1/30, the 128 x 128 cloth after three steps at dt = 1/60): median of 5 refactorisations
+    of the same matrix on its kept analysis, nnz(L) and flops (CHOLMOD's sum of squared column
+    counts; PARDISO's row divides the CHOLMOD nested-dissection count by its time, a rate estimate:
+    its own fill differs by ~10%)."""
+    import numpy as np
+
+    from femkit.dynamics.integrators.base import restrict
+    from femkit.solvers import factorize_spd
+    from femkit.solvers.pardiso import available
+
+    scenes = {
+        "Liu 81x81": (cloth_grid(81, 81, 1.0, 1.0, k_structural=1e3, k_shear=1e3, k_bending=1e2,
+                                 total_mass=1.0, pinned="top_corners", forces=[Gravity(9.81)]), 1 / 30),
+        "cloth 128x128": (cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4,
+                                     k_bending=3e4, mass=_big_mass(), pinned="top_corners",
+                                     forces=[Gravity(9.81)]), 1 / 60)}
+    print(f"{'scene':14s} {'engine':8s} {'ordering':8s} {'numeric ms':>10s} {'nnz(L)':>10s} "
+          f"{'Mflop':>7s} {'GFlop/s':>7s}")
+    for label, (system, h) in scenes.items():
+        ctx = StepContext(SolverSpec("cholesky"))
+        integ = get_integrator("implicit_euler", fix="clamp")
+        state = integ.start(system, system.x0, system.v0, 0.0, h, ctx)
+        for _ in range(3):
+            state = integ.step(system, state, h, ctx)
+        A = restrict(system.mass_matrix() + h * h * system.stiffness_matrix(state.x, fix="clamp"),
+                     system.free_dofs).tocsr()
+        A.eliminate_zeros()  # the planar cloth's out-of-plane couplings, as the step leaves them out
+        flops = {}
+        for engine, ordering in (("cholmod", "amd"), ("cholmod", "nesdis"), ("pardiso", "nesdis")):
+            if engine == "pardiso" and not available():
+                continue
+            F = factorize_spd(A, ordering=ordering, engine=engine)
+            times = []
+            for _ in range(5):
+                t0 = time.perf_counter()
+                F.refactor(A)
+                times.append(time.perf_counter() - t0)
+            t = statistics.median(times)
+            if engine == "cholmod":
+                cc = np.diff(F._f.copy().L().tocsc().indptr).astype(float)
+                nnz_l, flops[ordering] = int(cc.sum()), float((cc * cc).sum())
+            else:
+                nnz_l = F.info["nnz_L"]
+            fl = flops.get(ordering)
+            print(f"{label:14s} {engine:8s} {ordering:8s} {1e3 * t:10.1f} {nnz_l:10d} "
+                  f"{fl / 1e6 if fl else float('nan'):7.0f} {fl / t / 1e9 if fl else float('nan'):7.2f}")
+
+
 if __name__ == "__main__":
-    if "--compiled" in sys.argv:
+    if "--engines" in sys.argv:
+        engine_rows()
+    elif "--compiled" in sys.argv:
         compiled_rows(quick="--quick" in sys.argv)
     elif "--matrix-free" in sys.argv:  # only the matrix-free comparison
         matrix_free_rows(cloth_grid(128, 128, 1.0, 1.0, k_structural=3e4, k_shear=3e4,
