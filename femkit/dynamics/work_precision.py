@@ -56,12 +56,15 @@ class MethodRun:
     trajectory_error: float = float("nan")
     energy: list = field(default_factory=list)
     failed: str = ""
+    solver: SolverSpec | None = None    # this method's linear solver (None: the study's)
 
     def summary(self) -> dict:
         return {"family": self.family, "label": self.label, "integrator": self.integrator,
                 "options": self.options, "setting": self.setting,
                 "time_per_frame": self.time_per_frame, "solve_error": self.solve_error,
-                "trajectory_error": self.trajectory_error, "failed": self.failed}
+                "trajectory_error": self.trajectory_error, "failed": self.failed,
+                "linear_solver": "" if self.solver is None else " ".join(
+                    [self.solver.method] + [f"{k}={v}" for k, v in self.solver.options.items()])}
 
 
 def expand_methods(spec: list[dict]) -> list[MethodRun]:
@@ -70,7 +73,9 @@ def expand_methods(spec: list[dict]) -> list[MethodRun]:
     {"family": "newton", "iterations": [1, 2, 3]}]``.
 
     ``iterations`` is the local/global sweeps (fast mass-spring, Chebyshev) or the Newton
-    iterations per step; ``options`` (optional) are extra integrator options.
+    iterations per step; ``options`` (optional) are extra integrator options;
+    ``linear_solver`` (optional, a :class:`~femkit.solvers.SolverSpec`) replaces the study's
+    linear solver for this family (e.g. the ``pardiso`` Cholesky engine for Newton only).
     """
     runs = []
     for item in spec:
@@ -81,11 +86,15 @@ def expand_methods(spec: list[dict]) -> list[MethodRun]:
             raise UnknownNameError("work-precision method family", str(fam), FAMILIES)
         prefix, integ, knob = FAMILIES[fam]
         extra = dict(item.get("options") or {})
+        own = item.get("linear_solver")
+        if own is not None and not isinstance(own, SolverSpec):
+            raise InputError(f"method family {fam!r}: linear_solver must be a SolverSpec, got "
+                             f"{type(own).__name__}")
         if fam == "chebyshev":
             extra["chebyshev"] = True
         if fam == "baraff_witkin":
             extra.setdefault("fix", "clamp")
-            runs.append(MethodRun(fam, prefix, integ, extra))
+            runs.append(MethodRun(fam, prefix, integ, extra, solver=own))
             continue
         its = item.get("iterations")
         if not its or any(int(k) < 1 for k in its):
@@ -94,14 +103,14 @@ def expand_methods(spec: list[dict]) -> list[MethodRun]:
             opts = {**extra, knob: int(k)}
             if fam == "newton":
                 opts.setdefault("tol", 1e-14)     # stopped by the iteration count, not the tolerance
-            runs.append(MethodRun(fam, f"{prefix} {k} it", integ, opts, setting=int(k)))
+            runs.append(MethodRun(fam, f"{prefix} {k} it", integ, opts, setting=int(k), solver=own))
     return runs
 
 
 def _trajectory(system, name, opts, dt, frames, solver, substeps=1):
     """Positions at every frame (``frames + 1`` of them), seconds per frame (median after a
-    warm-up step) and total energies."""
-    ctx = StepContext(SolverSpec(solver))
+    warm-up step) and total energies; ``solver`` a method name or a whole SolverSpec."""
+    ctx = StepContext(solver if isinstance(solver, SolverSpec) else SolverSpec(solver))
     integ = get_integrator(name, **opts)
     h = dt / substeps
     s = integ.start(system, system.x0, system.v0, 0.0, h, ctx)
@@ -125,7 +134,7 @@ def _frame_error(xs, ref, length) -> float:
 
 
 def cloth_work_precision(system, dt: float, frames: int, methods: list[dict], *,
-                         solver: str = "cholesky", reference_tol: float = 1e-10,
+                         solver: str | SolverSpec = "cholesky", reference_tol: float = 1e-10,
                          trajectory_reference: str = "newmark", substeps: int = 16,
                          reference_solve: str = "newton", progress=None) -> dict:
     """Run the study on one system (see the module docstring).
@@ -139,8 +148,10 @@ def cloth_work_precision(system, dt: float, frames: int, methods: list[dict], *,
         Frames simulated (one step each).
     methods : list of dict
         See :func:`expand_methods`.
-    solver : str
-        Linear solver of the implicit methods (``"cholesky"``: the compiled path).
+    solver : str or SolverSpec
+        Linear solver of the implicit methods and of the solve reference (``"cholesky"``: the
+        compiled path; a SolverSpec keeps its options, e.g. the Cholesky engine); a method
+        family's own ``linear_solver`` replaces it for that family.
     reference_tol : float
         Tolerance of the implicit Euler reference (``||dx||_inf <= tol L``).
     reference_solve : {"newton", "local_global"}
@@ -183,7 +194,7 @@ def cloth_work_precision(system, dt: float, frames: int, methods: list[dict], *,
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")   # Newton stopped at k iterations is the point
                 xs, run.time_per_frame, run.energy = _trajectory(system, run.integrator, run.options,
-                                                                 dt, frames, solver)
+                                                                 dt, frames, run.solver or solver)
             run.solve_error = _frame_error(xs, ie, length)
             run.trajectory_error = _frame_error(xs, tr, length)
         except (FloatingPointError, ArithmeticError) as exc:

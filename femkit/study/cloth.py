@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..case.specs import SOLVER_SCHEMA
 from ..errors import CaseFileError, InputError
 from .kinds import StudyKind
 
@@ -32,11 +33,13 @@ CLOTH_SCHEMA = {
     "system_overrides": {"type": "object", "description": "merged into every scene's system block"},
     "frames": {"type": "integer", "minimum": 1, "default": 30},
     "dt": {**_POS, "description": "frame length (default: each scene's dt)"},
-    "linear_solver": {"type": "object", "default": {"method": "cholesky"}},
+    "linear_solver": {**SOLVER_SCHEMA, "default": {"method": "cholesky"}},
     "methods": {"type": "array", "minItems": 1, "items": {
         "type": "object", "additionalProperties": False, "required": ["family"],
         "properties": {"family": {"enum": ["fast_mass_spring", "chebyshev", "baraff_witkin", "newton"]},
-                       "iterations": _ITS, "options": {"type": "object"}}},
+                       "iterations": _ITS, "options": {"type": "object"},
+                       "linear_solver": {**SOLVER_SCHEMA, "description":
+                                         "this family's linear solver (default: the study's)"}}},
         "default": [{"family": "fast_mass_spring", "iterations": [1, 2, 3, 5, 10, 20]},
                     {"family": "chebyshev", "iterations": [3, 5, 10, 20]},
                     {"family": "baraff_witkin"},
@@ -71,12 +74,22 @@ def _check(study) -> None:
         if case.data.get("problem") != "mass_spring" or case.data["system"].get("type") != "cloth":
             raise CaseFileError(f"scenes[{i}]: {path.name} is not a cloth scene (system.type: cloth)")
     try:
-        expand_methods(study.data["methods"])
+        expand_methods(_methods(study.data["methods"]))
     except InputError as exc:
         raise CaseFileError(f"methods: {exc}") from None
     from ..case.specs import solver_spec
 
     solver_spec(study.data["linear_solver"], "linear_solver", default_method="cholesky")
+
+
+def _methods(methods: list) -> list:
+    """The method list with each family's own ``linear_solver`` mapping as a SolverSpec
+    (validated like every solver spec: a typo names the key and the valid ones)."""
+    from ..case.specs import solver_spec
+
+    return [{**m, "linear_solver": solver_spec(m["linear_solver"], f"methods[{i}].linear_solver",
+                                               default_method="cholesky")}
+            if "linear_solver" in m else m for i, m in enumerate(methods)]
 
 
 def run_cloth_study(study, progress_enabled=None) -> dict:
@@ -97,7 +110,7 @@ def run_cloth_study(study, progress_enabled=None) -> dict:
         system, _ = build_system(case)
         dt = float(d.get("dt") or _time_value(case, "dt"))
         name = case.name
-        out = cloth_work_precision(system, dt, int(d["frames"]), d["methods"], solver=spec.method,
+        out = cloth_work_precision(system, dt, int(d["frames"]), _methods(d["methods"]), solver=spec,
                                    reference_tol=ref["tol"], trajectory_reference=ref["trajectory"],
                                    substeps=ref["substeps"], reference_solve=ref["solve"])
         runs = out["runs"]
