@@ -133,9 +133,18 @@ def explicit_csr(A, *, what: str) -> sp.csr_matrix:
 def check_options(fn: Callable, options: dict, *, what: str, exclude=()) -> None:
     """Raise :class:`InputError` naming every key of ``options`` that ``fn`` does not take as a
     keyword (so a misspelt option is an error, not a Python ``TypeError`` or silently ignored).
-    Functions with ``**kwargs`` are not checked here (they validate their own)."""
+    Functions with ``**kwargs`` are not checked here (they validate their own).
+
+    A function may also declare ``fn.option_choices = {name: (kind, valid_values)}``: a value
+    outside ``valid_values`` is then an :class:`~femkit.errors.UnknownNameError` at load time
+    (e.g. ``options: {engine: mumps}`` of the ``cholesky`` solver), before any mesh is built."""
     import inspect
 
+    from ..errors import UnknownNameError
+
+    for name, (kind, valid_values) in getattr(fn, "option_choices", {}).items():
+        if name in options and options[name] not in valid_values:
+            raise UnknownNameError(kind, str(options[name]), list(valid_values))
     params = inspect.signature(fn).parameters
     if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
         return

@@ -370,3 +370,8 @@ def cholesky(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter=No
     res.reason = "direct" if np.all(np.isfinite(prob.x)) else "non-finite"
     res.setup_time, res.solve_time = setup, dt
     return res
+
+
+#: Option values checked when a case, scene or study is loaded (:func:`femkit.solvers.checks.check_options`).
+cholesky.option_choices = {"engine": ("cholesky engine", ENGINES),
+                           "ordering": ("cholesky ordering", ORDERINGS)}

@@ -93,6 +93,24 @@ def test_unknown_preconditioner_option_names_the_option(pc):
               preconditioner_options={"bogus": 1})
 
 
+@pytest.mark.parametrize("where, data, text", [
+    ("solver", {"method": "cholesky", "options": {"engine": "mumps"}},
+     "solver.options: unknown cholesky engine 'mumps'; valid cholesky engines: cholmod, pardiso"),
+    ("linear_solver", {"method": "cholesky", "options": {"ordering": "rcm"}},
+     "linear_solver.options: unknown cholesky ordering 'rcm'"),
+], ids=["engine", "ordering"])
+def test_a_bad_option_value_is_named_when_the_spec_is_built(where, data, text):
+    """Declared option values (``fn.option_choices``) are checked when a file is loaded, with the
+    key path and the valid values, not at the first solve after the mesh is built; no solver
+    library is needed to say so."""
+    from femkit.errors import UnknownNameError
+    from femkit.solvers import SolverSpec
+
+    with pytest.raises(UnknownNameError) as info:
+        SolverSpec.from_mapping(data, where)
+    assert str(info.value).startswith(text)
+
+
 def test_known_options_still_pass_through():
     A, b = lap1d(20), np.ones(20)
     assert solve(A, b, method="jacobi", omega=0.8, maxiter=5000).info["omega"] == 0.8
