@@ -320,7 +320,6 @@ def compiled_rows(quick: bool = False) -> None:
     rows.append(("Liu 81x81", "fast mass-spring, 10 it", fms, "<= 10 ms/frame"))
     rows.append(("Liu 81x81", "  + Chebyshev (Wang 2015)", {"cholesky": cheb}, ""))
     frame = min(fms[v]["median"] for v in fms if v != "direct")
-    steps = {}
     for label, name, opts in (("Newton iteration (1 solve)", "newton", {"max_iterations": 1}),
                               ("Newton iteration, reused factor", "newton",
                                {"max_iterations": 1, "reuse_factorization": True}),
@@ -334,7 +333,6 @@ def compiled_rows(quick: bool = False) -> None:
             warnings.simplefilter("ignore")
             reps = (2 if quick else 5) * (3 if opts.get("reuse_factorization") else 1)
             r = _timed_variants(liu, name, h, reps, **opts)
-        steps[label] = r
         it = r["cholesky"]["newton"]
         extra = f" ({statistics.mean(it):.1f} it)" if it and opts.get("max_iterations", 1) > 1 else ""
         best = min(r[v]["median"] for v in r if v != "direct")

@@ -192,6 +192,11 @@ def symbolic_cache_info() -> list[dict]:
              "analysis_time": s.analysis_time} for k, s in _CACHE.items()]
 
 
+#: The advice every NotSPDError of both Cholesky engines ends with.
+NOT_SPD_ADVICE = ("use method 'direct' (SuperLU) for indefinite systems, or a definiteness fix "
+                  "(fix='clamp') for spring Jacobians")
+
+
 def _numeric(run, what: str):
     """Run a CHOLMOD numeric factorisation, mapping a non-positive pivot to NotSPDError."""
     cholmod = _cholmod()
@@ -200,8 +205,7 @@ def _numeric(run, what: str):
     except cholmod.CholmodNotPositiveDefiniteError as e:
         raise NotSPDError(
             f"{what}: the matrix is not positive definite (CHOLMOD met a non-positive pivot: "
-            f"{e}); use method 'direct' (SuperLU) for indefinite systems, or a definiteness "
-            "fix (fix='clamp') for spring Jacobians") from None
+            f"{e}); {NOT_SPD_ADVICE}") from None
 
 
 class CholeskyFactor:

@@ -34,6 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError, NotSPDError
+from .cholesky import NOT_SPD_ADVICE
 
 __all__ = ["PardisoFactor", "available", "factorize_pardiso"]
 
@@ -125,7 +126,7 @@ class PardisoFactor:
         U.sort_indices()
         # the upper-triangle entries of A's pattern, kept so that refactor() extracts values only
         self._upper = np.flatnonzero(A.indices >= np.repeat(np.arange(n), np.diff(A.indptr)))
-        self._pattern = (A.indptr.copy(), A.indices.copy())
+        self._nnz = A.nnz
         self._ia = np.ascontiguousarray(U.indptr, dtype=np.int32)
         self._ja = np.ascontiguousarray(U.indices, dtype=np.int32)
         self._a = np.ascontiguousarray(U.data, dtype=np.float64)
@@ -165,8 +166,7 @@ class PardisoFactor:
         if err.value == -4:
             raise NotSPDError(
                 f"cholesky (pardiso): the matrix is not positive definite (zero or negative pivot "
-                f"at equation {int(self._iparm[29])}); use method 'direct' (SuperLU) for indefinite "
-                "systems, or a definiteness fix (fix='clamp') for spring Jacobians")
+                f"at equation {int(self._iparm[29])}); {NOT_SPD_ADVICE}")
         if err.value != 0:
             raise InputError(f"cholesky (pardiso), phase {phase}: error {err.value} "
                              f"({_ERRORS.get(err.value, 'unknown')})")
@@ -186,9 +186,9 @@ class PardisoFactor:
         (the caller guarantees it: only the sizes are compared). Returns ``self``.
 
         Raises :class:`~femkit.errors.NotSPDError` on a zero or negative pivot."""
-        if A.shape != self.shape or A.nnz != self._pattern[1].size:
+        if A.shape != self.shape or A.nnz != self._nnz:
             raise InputError(f"refactor: A is {A.shape} with {A.nnz} entries, the factor's pattern "
-                             f"is {self.shape} with {self._pattern[1].size}")
+                             f"is {self.shape} with {self._nnz}")
         self._numeric(np.ascontiguousarray(A.data[self._upper], dtype=np.float64))
         return self
 

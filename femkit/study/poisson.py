@@ -49,11 +49,14 @@ def _meshes(study, spec, timer_list):
     for i in range(1, count):
         timed(i, lambda: refine(meshes[-1], 1))
 
+    prols: list = []  # built once, on the first request that reaches them
+
     def hierarchy(level: int):
         # refine() numbers the coarse nodes first, then one midpoint per edges() edge
-        prols = tuple(prolongation(m.n_points, edges(m)[0]) for m in meshes[:level])
+        for m in meshes[len(prols):level]:
+            prols.append(prolongation(m.n_points, edges(m)[0]))
         injs = tuple(np.arange(m.n_points, dtype=np.int64) for m in meshes[:level])
-        return MeshHierarchy(tuple(meshes[: level + 1]), prols, injs, "none")
+        return MeshHierarchy(tuple(meshes[: level + 1]), tuple(prols[:level]), injs, "none")
 
     return meshes, hierarchy
 
@@ -74,8 +77,6 @@ def _solve(sys, s, x0=None, atol=None, mg=None):
 def _multigrid(s, hierarchy, sys, lower=None) -> dict:
     """Geometric multigrid arguments of solver ``s`` on a level (``{}`` for other solvers):
     its hierarchy, free nodes and, for ``fmg``, the lower levels' systems ``lower``."""
-    if not s.needs_hierarchy:
-        return {}
     from ..case.poisson.run import multigrid_overrides
 
     return multigrid_overrides(s, hierarchy, sys.free, lower)
