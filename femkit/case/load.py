@@ -87,7 +87,22 @@ def _loader():
     import yaml
 
     class Loader(yaml.SafeLoader):
-        pass
+        def construct_mapping(self, node, deep=False):
+            # PyYAML keeps the last of two equal keys; a case file that says `source` twice
+            # is a mistake the user must hear about, naming the key and both lines.
+            if isinstance(node, yaml.MappingNode):
+                seen: dict = {}
+                for key_node, _ in node.value:
+                    if not isinstance(key_node, yaml.ScalarNode):
+                        continue
+                    key = key_node.value
+                    if key in seen and key != "<<":
+                        raise yaml.constructor.ConstructorError(
+                            None, None,
+                            f"key {key!r} given twice (lines {seen[key] + 1} and "
+                            f"{key_node.start_mark.line + 1})", key_node.start_mark)
+                    seen[key] = key_node.start_mark.line
+            return super().construct_mapping(node, deep=deep)
 
     Loader.add_implicit_resolver(
         "tag:yaml.org,2002:float",

@@ -61,6 +61,9 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None) -> Iterator[
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or target.suffix,
                                dir=target.parent)
     os.close(fd)
+    # mkstemp creates the file -rw------- whatever the umask; a file written any other way would
+    # get 0o666 & ~umask. Give the result the same mode (result.json next to solution.vtu).
+    os.chmod(tmp, 0o666 & ~_umask())
     tmp_path = Path(tmp)
     try:
         yield tmp_path

@@ -1,0 +1,91 @@
+"""A newcomer's rough edges: ``python -m femkit``, duplicate YAML keys, output file modes."""
+
+import os
+import stat
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from femkit.cli import main
+from femkit.io.atomic import atomic_path, atomic_write_text
+
+SMALL = {
+    "problem": "poisson",
+    "mesh": {"geometry": "unit_square", "h": 0.25},
+    "source": "1",
+    "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
+    "solver": {"method": "cg", "rtol": 1e-10},
+    "output": {"dir": "out", "vtu": True},
+}
+
+
+def test_python_m_femkit_runs_the_command_line():
+    proc = subprocess.run([sys.executable, "-m", "femkit", "--help"], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "solve" in proc.stdout and "study" in proc.stdout
+
+
+def test_python_m_femkit_passes_the_exit_code(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "femkit", "solve", str(tmp_path / "missing.yaml")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "not found" in proc.stderr
+
+
+@pytest.mark.parametrize("text, key, lines", [
+    ("problem: poisson\nsource: 1\nsource: 2\n", "source", (2, 3)),
+    ("problem: poisson\nmesh:\n  h: 0.1\n  geometry: unit_square\n  h: 0.2\n", "h", (3, 5)),
+], ids=["top-level", "nested"])
+def test_duplicate_yaml_key_is_refused_naming_key_and_both_lines(tmp_path, capsys, text, key, lines):
+    case = tmp_path / "case.yaml"
+    case.write_text(text)
+    before = set(tmp_path.iterdir())
+    assert main(["solve", str(case)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert f"key {key!r} given twice" in err[0]
+    assert f"lines {lines[0]} and {lines[1]}" in err[0]
+    assert set(tmp_path.iterdir()) == before
+
+
+def test_yaml_anchor_merge_keys_are_not_duplicates(tmp_path):
+    from femkit.case.load import read_yaml
+
+    p = tmp_path / "a.yaml"
+    p.write_text("base: &b {h: 0.1}\nmesh:\n  <<: *b\n  geometry: unit_square\n")
+    assert read_yaml(p)["mesh"] == {"h": 0.1, "geometry": "unit_square"}
+
+
+def _mode(path: Path) -> int:
+    return stat.S_IMODE(path.stat().st_mode)
+
+
+@pytest.fixture(params=[0o022, 0o077, 0o002], ids=["umask022", "umask077", "umask002"])
+def umask(request):
+    old = os.umask(request.param)
+    try:
+        yield request.param
+    finally:
+        os.umask(old)
+
+
+def test_atomic_files_get_the_umask_mode(tmp_path, umask):
+    text = atomic_write_text(tmp_path / "a.json", "{}")
+    with atomic_path(tmp_path / "b.png") as tmp:
+        tmp.write_bytes(b"x")
+    plain = tmp_path / "plain.txt"
+    plain.write_text("x")  # what open() gives under this umask
+    assert _mode(text) == _mode(tmp_path / "b.png") == _mode(plain) == 0o666 & ~umask
+
+
+def test_every_output_file_of_a_run_has_the_umask_mode(tmp_path, umask, capsys):
+    case = tmp_path / "case.yaml"
+    case.write_text(yaml.safe_dump(SMALL))
+    assert main(["solve", str(case)]) == 0
+    files = [p for p in (tmp_path / "out").rglob("*") if p.is_file()]
+    assert {p.name for p in files} >= {"result.json", "solution.vtu"}
+    assert {p.name: _mode(p) for p in files} == {p.name: 0o666 & ~umask for p in files}
