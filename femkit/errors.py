@@ -66,10 +66,24 @@ class UnknownNameError(InputError, KeyError):
         self.kind = kind
         self.name = name
         self.valid = sorted(valid)
-        super().__init__(f"unknown {kind} {name!r}; valid {kind}s: {', '.join(self.valid)}")
+        super().__init__(f"unknown {kind} {name!r}; valid {_plural(kind)}: {', '.join(self.valid)}")
 
     def __str__(self) -> str:  # KeyError would otherwise repr() the message
         return self.args[0]
+
+
+def _plural(noun: str) -> str:
+    """English plural of the last word of ``noun`` (``geometry`` -> ``geometries``,
+    ``study kind`` -> ``study kinds``, ``mesh`` -> ``meshes``).
+
+    >>> [_plural(w) for w in ("geometry", "solver", "mesh", "key", "study kind", "status")]
+    ['geometries', 'solvers', 'meshes', 'keys', 'study kinds', 'statuses']
+    """
+    if noun.endswith("y") and noun[-2:-1] not in tuple("aeiou"):
+        return noun[:-1] + "ies"
+    if noun.endswith(("s", "x", "z", "ch", "sh")):
+        return noun + "es"
+    return noun + "s"
 
 
 class MeshError(InputError):
