@@ -89,3 +89,37 @@ def test_every_output_file_of_a_run_has_the_umask_mode(tmp_path, umask, capsys):
     files = [p for p in (tmp_path / "out").rglob("*") if p.is_file()]
     assert {p.name for p in files} >= {"result.json", "solution.vtu"}
     assert {p.name: _mode(p) for p in files} == {p.name: 0o666 & ~umask for p in files}
+
+
+ROPE = {
+    "problem": "mass_spring",
+    "system": {"type": "rope", "n": 6, "length": 1.0, "k": 500.0, "total_mass": 0.6},
+    "forces": {"gravity": 9.81},
+    "integrator": {"method": "velocity_verlet"},
+    "dt": 1e-3,
+    "t_end": 0.05,
+    "output": {"dir": "out"},
+}
+
+
+@pytest.mark.parametrize("integrator, pieces", [
+    ({"method": "fast_mass_spring", "options": {"iters": 10}},
+     ["integrator.options", "unknown option 'iters'", "did you mean 'iterations'", "valid options: ",
+      "chebyshev"]),
+    ({"method": "newmark", "options": {"beta": "fast"}},
+     ["integrator.options", "option 'beta' must be a number", "'fast'"]),
+    ({"method": "fast_mass_spring", "options": {"iterations": 2.5}},
+     ["option 'iterations' must be an integer", "2.5"]),
+    ({"method": "newton", "options": {"matrix_free": "yes"}},
+     ["option 'matrix_free' must be true or false"]),
+], ids=["unknown-option", "string-for-number", "float-for-int", "string-for-bool"])
+def test_bad_integrator_option_names_the_option_and_the_valid_ones(tmp_path, capsys, integrator, pieces):
+    data = dict(ROPE, integrator=integrator)
+    case = tmp_path / "scene.yaml"
+    case.write_text(yaml.safe_dump(data))
+    assert main(["solve", str(case)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err and "__init__" not in err, err
+    for piece in pieces:
+        assert piece in err, (piece, err)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.yaml"]
