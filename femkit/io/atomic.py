@@ -106,7 +106,8 @@ def check_output_dir(path: str | os.PathLike, previous: tuple[str, ...] | None =
     Raises
     ------
     InputError
-        ``path`` or one of its parents exists but is not a directory, or (with ``previous``)
+        ``path`` or one of its parents exists but is not a directory, its parent does not accept
+        new files (permissions, a read-only file system), or (with ``previous``)
         ``path`` is a non-empty directory that is not an earlier femkit output.
 
     >>> import tempfile, pathlib
@@ -123,6 +124,7 @@ def check_output_dir(path: str | os.PathLike, previous: tuple[str, ...] | None =
             where = "" if p == final else f" (its parent {p} is a file)"
             raise InputError(f"output directory {final} is not a directory{where}; "
                              "choose another output directory")
+    _check_writable(final)
     if previous is not None and final.is_dir():
         entries = {e.name for e in final.iterdir()}
         if entries and not entries & set(previous):
@@ -131,6 +133,27 @@ def check_output_dir(path: str | os.PathLike, previous: tuple[str, ...] | None =
                 f"{len(entries)} entries but no {' or '.join(previous)}); a run replaces its "
                 "output directory as a whole, so choose a new or empty directory")
     return final
+
+
+def _check_writable(final: Path) -> None:
+    """Refuse, before any work, an output directory whose temporary sibling cannot be created.
+
+    The output is built next to ``final`` (in its parent, made if missing), so the nearest
+    existing ancestor of that parent must accept a new entry. A real probe (create and remove a
+    temporary file) rather than ``os.access``: it also catches read-only file systems, and
+    root, whom ``os.access`` never refuses.
+    """
+    parent = final.parent
+    existing = next(p for p in (parent, *parent.parents) if p.exists())
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".femkit-write-probe-", dir=existing)
+    except OSError as exc:
+        raise InputError(f"output directory {final} cannot be written: {existing} does not accept "
+                         f"new files ({exc.strerror or exc}); choose another output directory "
+                         "(--output DIR)") from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(probe)
 
 
 @contextlib.contextmanager

@@ -123,3 +123,26 @@ def test_bad_integrator_option_names_the_option_and_the_valid_ones(tmp_path, cap
     for piece in pieces:
         assert piece in err, (piece, err)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.yaml"]
+
+
+ROOT = Path(__file__).parents[2]
+
+
+@pytest.mark.parametrize("argv", [
+    ["solve", str(ROOT / "cases" / "poisson_unit_square.yaml")],
+    ["solve", str(ROOT / "cases" / "scenes" / "rope_pendulum.yaml")],
+    ["study", str(ROOT / "studies" / "poisson_convergence.yaml"), "--quick"],
+], ids=["poisson", "scene", "study"])
+def test_unwritable_output_is_refused_before_any_work(argv, capsys):
+    """/proc accepts no new entries, even for root (for whom chmod changes nothing)."""
+    import time
+
+    out = "/proc/femkit-no-such-dir/out"
+    t0 = time.perf_counter()
+    code = main([*argv, "--output", out])
+    elapsed = time.perf_counter() - t0
+    err = capsys.readouterr().err
+    assert code == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "cannot be written" in lines[0] and out in lines[0], err
+    assert elapsed < 5.0  # refused at once, not after the solve / simulation / study
