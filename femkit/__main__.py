@@ -6,9 +6,7 @@ Windows user install): ``python -m femkit solve cases/poisson_unit_square.yaml``
 
 from __future__ import annotations
 
-import sys
+from .cli import entry
 
-from .cli import main
-
-if __name__ == "__main__":  # pragma: no cover - exercised by tests/cli/test_python_m.py
-    sys.exit(main())
+if __name__ == "__main__":  # pragma: no cover - exercised by tests/cli/test_newcomer_edges.py
+    entry()

@@ -232,5 +232,24 @@ def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split())
 
 
+def entry() -> None:
+    """The ``femkit`` console script and ``python -m femkit``: :func:`main`, then the exit.
+
+    After a stop request that abandoned compiled work in a thread (gmsh's mesher:
+    :func:`femkit.interrupt.run_interruptible`), the process ends at once with ``os._exit``,
+    its output flushed, instead of a normal exit that would tear the library down under it.
+    """
+    code = main()
+    from .interrupt import abandoned_work
+
+    if abandoned_work():
+        import os
+
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
+
+
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    entry()

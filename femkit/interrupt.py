@@ -29,7 +29,7 @@ import threading
 from typing import Iterator
 
 __all__ = ["StopFlag", "stop_on_signals", "exit_code", "Interrupted", "stopping_callback",
-           "active_flag"]
+           "active_flag", "run_interruptible", "abandoned_work"]
 
 
 class StopFlag:
@@ -65,6 +65,7 @@ def exit_code(flag: StopFlag) -> int:
 
 
 _ACTIVE: list[StopFlag] = []
+_WORKERS: list[threading.Thread] = []  # threads of run_interruptible, alive or done
 
 
 def active_flag() -> StopFlag | None:
@@ -136,3 +137,54 @@ def stopping_callback(flag: StopFlag, callback=None):
             raise Interrupted(flag, xk.copy(), count[0])
 
     return cb
+
+
+def run_interruptible(fn, *args, what: str, on_abandon=None, poll: float = 0.05, **kwargs):
+    """``fn(*args, **kwargs)``, answering a stop request within ``poll`` seconds even while ``fn``
+    runs compiled code that never returns to Python (gmsh's mesher, a long factorisation).
+
+    Outside a :func:`stop_on_signals` block, or off the main thread, ``fn`` is simply called.
+    Inside one, ``fn`` runs in a daemon thread (the C library must release the GIL, as ctypes
+    calls do) while the main thread waits in short slices, so the signal handler runs at once.
+    When the flag is set, :class:`Interrupted` is raised ``during <what>`` and the worker is
+    abandoned to end with the process; ``on_abandon()`` is called first, so the caller can skip
+    clean-up that would race the worker (e.g. not finalise gmsh under its running mesher).
+
+    >>> run_interruptible(sum, [1, 2, 3], what="adding")
+    6
+    """
+    flag = active_flag()
+    if flag is None or threading.current_thread() is not threading.main_thread():
+        return fn(*args, **kwargs)
+    if flag:
+        raise Interrupted(flag, where=f"before {what}")
+    box: dict = {}
+
+    def work():
+        try:
+            box["value"] = fn(*args, **kwargs)
+        except BaseException as exc:  # relayed to the waiting thread
+            box["error"] = exc
+
+    worker = threading.Thread(target=work, name=f"femkit {what}", daemon=True)
+    _WORKERS.append(worker)
+    worker.start()
+    try:
+        while worker.is_alive():
+            worker.join(poll)
+            if flag and worker.is_alive():
+                raise Interrupted(flag, where=f"during {what}")
+    except BaseException:  # Interrupted, or KeyboardInterrupt from a second Ctrl-C
+        if worker.is_alive() and on_abandon is not None:
+            on_abandon()
+        raise
+    if "error" in box:
+        raise box["error"]
+    return box.get("value")
+
+
+def abandoned_work() -> bool:
+    """Whether a stop request left a :func:`run_interruptible` worker running. The command line
+    then ends the process with ``os._exit`` after flushing its output: a normal interpreter exit
+    would run the C library's global destructors under its still-running thread (a crash)."""
+    return any(w.is_alive() for w in _WORKERS)

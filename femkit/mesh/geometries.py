@@ -51,6 +51,20 @@ def _positive(name: str, value) -> float:
     return v
 
 
+#: set when a stop request abandoned gmsh's mesher in its thread (see :func:`_generate`)
+_ABANDONED: list = []
+
+
+def _generate(gmsh, dim: int) -> None:
+    """``gmsh.model.mesh.generate(dim)``, answering SIGINT/SIGTERM within a fraction of a second
+    under :func:`femkit.interrupt.stop_on_signals` (gmsh's C++ mesher never returns to Python
+    until done: a large mesh used to hold a Ctrl-C for many seconds)."""
+    from ..interrupt import run_interruptible
+
+    run_interruptible(gmsh.model.mesh.generate, dim, what="meshing",
+                      on_abandon=lambda: _ABANDONED.append(True))
+
+
 @contextlib.contextmanager
 def _gmsh_session(name: str) -> Iterator[object]:
     """Initialise gmsh quietly (or reuse a live session), yield the module, clean up.
@@ -75,7 +89,9 @@ def _gmsh_session(name: str) -> Iterator[object]:
         gmsh.model.add(name)
         yield gmsh
     finally:
-        if owner:
+        if _ABANDONED:  # a stop request left the mesher running in its thread: the process is
+            pass        # about to exit, and finalising gmsh under it would crash
+        elif owner:
             gmsh.finalize()
         else:
             with contextlib.suppress(Exception):
@@ -210,7 +226,7 @@ def _side_groups(gmsh, left: list[int], right: list[int], bottom: list[int], top
 def _finish(gmsh, h: float) -> Mesh:
     gmsh.model.geo.synchronize()
     _set_size(gmsh, h)
-    gmsh.model.mesh.generate(2)
+    _generate(gmsh, 2)
     return _mesh_from_gmsh(gmsh)
 
 
@@ -424,7 +440,7 @@ def geo_file(path: str | os.PathLike, h: float | None = None) -> Mesh:
             if hv is not None:
                 gmsh.option.setNumber("Mesh.MeshSizeMax", hv)
             gmsh.option.setNumber("Mesh.ElementOrder", 1)
-            gmsh.model.mesh.generate(2)
+            _generate(gmsh, 2)
         except Exception as exc:  # gmsh raises bare Exception with its last error
             raise MeshError(f"gmsh could not mesh {p}: {exc}") from None
         return _mesh_from_gmsh(gmsh)

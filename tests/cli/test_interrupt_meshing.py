@@ -1,0 +1,86 @@
+"""A stop request during gmsh's meshing answers within a second (issue: 16 s before), through the
+console-script entry point, with the shell's exit code and nothing written."""
+
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+import yaml
+
+# The command line as the console script runs it, with a spy announcing (on stderr) each piece
+# of compiled work started under run_interruptible, so the test signals during meshing itself.
+DRIVER = r"""
+import sys
+import femkit.interrupt as fi
+
+real = fi.run_interruptible
+
+def spy(fn, *args, what, **kwargs):
+    print("STARTED", what, file=sys.stderr, flush=True)
+    return real(fn, *args, what=what, **kwargs)
+
+fi.run_interruptible = spy
+from femkit.cli import entry
+sys.argv = ["femkit", "solve", sys.argv[1], "--quiet"]
+entry()
+"""
+
+CASE = {
+    "problem": "poisson",
+    "mesh": {"geometry": "unit_square", "h": 0.001},   # ~2.3M triangles: gmsh needs many seconds
+    "source": "1",
+    "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
+    "solver": {"method": "cg", "rtol": 1e-8},
+    "output": {"dir": "out"},
+}
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
+                         ids=["SIGINT", "SIGTERM"])
+def test_signal_during_meshing_exits_within_a_second(tmp_path, sig, code):
+    case = tmp_path / "case.yaml"
+    case.write_text(yaml.safe_dump(CASE))
+    proc = subprocess.Popen([sys.executable, "-c", DRIVER, str(case)], stderr=subprocess.PIPE,
+                            stdout=subprocess.DEVNULL, text=True)
+    try:
+        line = proc.stderr.readline()
+        assert line.strip() == "STARTED meshing", line
+        time.sleep(0.3)  # well inside gmsh's C++ mesher
+        assert proc.poll() is None, "meshing finished before the signal: make the mesh larger"
+        t0 = time.perf_counter()
+        proc.send_signal(sig)
+        proc.wait(timeout=30)
+        elapsed = time.perf_counter() - t0
+        err = proc.stderr.read()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == code, err
+    assert elapsed < 1.0, elapsed
+    assert f"interrupted by {sig.name} during meshing; nothing written" in err
+    assert "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.yaml"]
+
+
+def test_run_interruptible_outside_a_signal_block_is_a_plain_call():
+    from femkit.interrupt import run_interruptible
+
+    assert run_interruptible(max, 3, 7, what="test") == 7
+    with pytest.raises(ZeroDivisionError):
+        run_interruptible(lambda: 1 / 0, what="test")
+
+
+def test_run_interruptible_relays_the_worker_result_and_error_under_a_flag():
+    from femkit.interrupt import run_interruptible, stop_on_signals
+
+    with stop_on_signals():
+        assert run_interruptible(sorted, [3, 1, 2], what="sorting") == [1, 2, 3]
+        with pytest.raises(ValueError, match="boom"):
+            run_interruptible(_raise_value_error, what="failing")
+
+
+def _raise_value_error():
+    raise ValueError("boom")
