@@ -68,6 +68,10 @@ def run_adaptive_study(study, progress_enabled=None) -> dict:
             "meshes": meshes, "measured": measured}
 
 
+#: above this many triangles the full-mesh panel shows the local mesh size, not the edges
+_DRAWN_EDGES_MAX = 20_000
+
+
 def _mesh_figure(path, mesh, indicators, title: str) -> str:
     from matplotlib.colors import LogNorm
     from matplotlib.tri import Triangulation
@@ -77,11 +81,17 @@ def _mesh_figure(path, mesh, indicators, title: str) -> str:
     fig = new_figure(16, 5, layout="constrained")
     tri = Triangulation(mesh.points[:, 0], mesh.points[:, 1], mesh.triangles)
     ax1, ax3, ax2 = fig.add_subplot(1, 3, 1), fig.add_subplot(1, 3, 2), fig.add_subplot(1, 3, 3)
-    lw = 0.3 if mesh.n_triangles < 5000 else 0.05
-    ax1.triplot(tri, color="k", linewidth=lw)
-    ax1.set_title(f"{title}: {mesh.n_triangles} triangles", fontsize=9)
-    # zoom on the finest triangle: the grading of the refinement
     areas = mesh.areas()
+    if mesh.n_triangles <= _DRAWN_EDGES_MAX:
+        ax1.triplot(tri, color="k", linewidth=0.3 if mesh.n_triangles < 5000 else 0.1)
+        ax1.set_title(f"{title}: {mesh.n_triangles} triangles", fontsize=9)
+    else:  # edges would merge into a grey moire: show the local mesh size instead
+        h = np.sqrt(2.0 * areas)
+        art1 = ax1.tripcolor(tri, facecolors=h, cmap="viridis_r", norm=LogNorm(h.min(), h.max()))
+        fig.colorbar(art1, ax=ax1, label="local mesh size h_T (log scale)")
+        ax1.set_title(f"{title}: {mesh.n_triangles} triangles (too many to draw: size shown)",
+                      fontsize=9)
+    # zoom on the finest triangle: the grading of the refinement
     k = int(np.argmin(areas))
     c, r = mesh.centroids()[k], 40.0 * np.sqrt(areas[k])
     ax3.triplot(tri, color="k", linewidth=0.4)
@@ -96,6 +106,8 @@ def _mesh_figure(path, mesh, indicators, title: str) -> str:
     ax2.set_title("element error indicators: equidistributed when adapted", fontsize=9)
     for ax in (ax1, ax2, ax3):
         ax.set_aspect("equal")
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
     save_figure(fig, path)
     return str(path)
 

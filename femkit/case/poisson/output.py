@@ -71,10 +71,14 @@ def write_plot(path: str | os.PathLike, mesh, u: np.ndarray, title: str = "",
         fig.colorbar(art2, ax=ax2, label="error indicator eta_T (log scale)")
         ax2.set_title(f"{estimator} indicators: estimate {np.sqrt(np.sum(eta ** 2)):.3e}", fontsize=9)
         axes.append(ax2)
+    from matplotlib.ticker import MaxNLocator
+
     for a in axes:
         a.set_aspect("equal")
         a.set_xlabel("x")
         a.set_ylabel("y")
+        a.xaxis.set_major_locator(MaxNLocator(5))  # two panels side by side: labels must not touch
+        a.yaxis.set_major_locator(MaxNLocator(6))
     fig.tight_layout()
     return save_figure(fig, path)
 

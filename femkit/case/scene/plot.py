@@ -264,7 +264,7 @@ def _draw_3d(fig, rect, system, x, triangles, view: SceneView, name, traj, k):
     ax.set_xlabel("x", labelpad=-6)
     ax.set_ylabel("y", labelpad=-6)
     ax.set_zlabel("z", labelpad=-6)
-    ax.tick_params(labelsize=6, pad=-2)
+    ax.tick_params(labelsize=8, pad=-2)
     for pane in (ax.xaxis, ax.yaxis, ax.zaxis):
         pane.set_pane_color((0.96, 0.96, 0.96, 1.0))
     return ax, mappable
@@ -310,7 +310,7 @@ def _draw_2d(fig, rect, system, x, triangles, view: SceneView, name, traj, k):
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("x", fontsize=8)
     ax.set_ylabel("y", fontsize=8)
-    ax.tick_params(labelsize=7)
+    ax.tick_params(labelsize=8)
     return ax, mappable
 
 
@@ -337,7 +337,7 @@ def _draw_energy(fig, rect, traj, k: int, view: SceneView, marker: bool):
     ax.set_xlabel("t [s]", fontsize=8)
     ax.set_ylabel("energy", fontsize=8)
     ax.set_title("energy", fontsize=9)
-    ax.tick_params(labelsize=7)
+    ax.tick_params(labelsize=8)
     ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
     ax.yaxis.get_offset_text().set_fontsize(7)
     ax.grid(alpha=0.3)
@@ -385,7 +385,7 @@ def plot_frame(system, traj, frame: int = -1, *, triangles=None, name: str = "",
     if mappable is not None:
         cb = fig.colorbar(mappable, cax=cax)
         cb.set_label("spring strain (l - L)/L", fontsize=7)
-        cb.ax.tick_params(labelsize=6)
+        cb.ax.tick_params(labelsize=8)
     text, colour = _title(name, traj, k)
     fig.text(0.02, 0.975, text, fontsize=10, color=colour, va="top", ha="left")
     left = 0.75 if (mappable is not None and system.dim == 3) else 0.72
@@ -493,7 +493,7 @@ def gif_frame_times(times: Sequence[float], picks: Sequence[int],
 
 
 def write_gif(path: str | os.PathLike, system, traj, name: str, *, triangles=None,
-              max_frames: int = 60, dpi: float = 70) -> Path:
+              max_frames: int = 60, dpi: float = 100) -> Path:
     """An animated GIF of at most ``max_frames`` evenly spaced recorded frames.
 
     Same two panels as the PNG, with fixed axes over the whole animation and the current time
