@@ -146,3 +146,15 @@ def test_unwritable_output_is_refused_before_any_work(argv, capsys):
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "cannot be written" in lines[0] and out in lines[0], err
     assert elapsed < 5.0  # refused at once, not after the solve / simulation / study
+
+
+def test_fmg_summary_states_its_criterion_not_a_residual_tolerance(tmp_path, capsys):
+    data = yaml.safe_load((ROOT / "cases" / "poisson_fmg_unit_square.yaml").read_text())
+    data["mesh"]["refine"] = 3
+    data["output"] = {"dir": "out", "vtu": False, "plot": False}
+    case = tmp_path / "fmg.yaml"
+    case.write_text(yaml.safe_dump(data))
+    assert main(["solve", str(case)]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("solver"))
+    assert "converged to the discretisation error" in line and "V-cycles" in line
+    assert "tolerance" not in line and "not the criterion" in line

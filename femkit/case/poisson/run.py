@@ -417,9 +417,21 @@ class CaseResult:
                          f"{ns['relative_imbalance']:.2e} (<= {ns['rtol']:g}) removed")
         pc = f" + {s.preconditioner}" if s.preconditioner not in ("none", "", None) else ""
         status = "converged" if s.converged else f"NOT converged ({s.reason})"
-        lines.append(f"solver    {s.method}{pc}: {status}, {s.iterations} iterations, "
-                     f"true residual {s.true_residual:.3e} (relative {s.relative_residual:.3e}, "
-                     f"tolerance {s.tolerance:.3e})")
+        mg = getattr(s, "info", None) or {}
+        if mg.get("stopped_by") == "discretisation-error estimate":
+            # fmg stops on the error, not on the residual: a residual tolerance beside a
+            # relative residual of 1e-3 would read as a contradiction
+            lines.append(f"solver    {s.method}{pc}: {status} to the discretisation error "
+                         f"(algebraic error {mg['algebraic_error_estimate']:.2e} <= "
+                         f"{mg['fraction']:g} x estimated discretisation error "
+                         f"{mg['discretisation_error_estimate']:.2e}, energy norm), "
+                         f"{s.iterations} V-cycles on the finest level; true residual "
+                         f"{s.true_residual:.3e} (relative {s.relative_residual:.3e}: not the "
+                         f"criterion)")
+        else:
+            lines.append(f"solver    {s.method}{pc}: {status}, {s.iterations} iterations, "
+                         f"true residual {s.true_residual:.3e} (relative {s.relative_residual:.3e}, "
+                         f"tolerance {s.tolerance:.3e})")
         if self.errors is not None:
             lines.append("errors    " + ", ".join(f"{k} {v:.4e}" for k, v in self.errors.items()
                                                   if v is not None))
