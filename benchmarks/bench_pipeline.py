@@ -1,0 +1,287 @@
+"""The whole command: ``femkit solve`` as a user runs it, against the same job in scikit-fem + pyamg.
+
+Run by hand (not in CI), on a quiet machine::
+
+    python benchmarks/bench_pipeline.py                 # ~0.48M and ~1.9M unknowns, fmg and pcg + amg
+    python benchmarks/bench_pipeline.py --levels 5      # ~0.48M only
+    python benchmarks/bench_pipeline.py --cold 4        # first run after install: empty compile cache
+
+Problem: ``-Laplace u = 2 pi^2 sin(pi x) sin(pi y)`` on the unit square, ``u = sin(pi x) sin(pi y)``,
+``u = 0`` on the boundary, P1 on a gmsh mesh (h = 0.05) refined uniformly ``k`` times (k = 5: 0.48M
+unknowns, k = 6: 1.9M). Every row is a fresh process (``python -m femkit.cli solve case.yaml``
+or ``python -c PEER``); wall time is process start to exit, peak memory the child's ``ru_maxrss``.
+
+The peer job, written as a scikit-fem user would, on the identical mesh (saved to ``.npz``
+beforehand, untimed; femkit's rows include generating it, and also print the wall time without
+their mesh stage): ``Basis(MeshTri, ElementTriP1)``, assembly of the Laplacian and the load,
+``condense``, pyamg Ruge-Stueben with CG to rtol 1e-10, L2 and H1-seminorm errors against the
+exact solution (``Functional`` with the default quadrature), the residual estimator of
+scikit-fem's adaptive example (ex22: ``h^2 f^2`` on the elements, ``h [grad u . n]^2`` on the
+interior facets), and ``MeshTri.save(... .vtu)``. femkit's case files ask for the same outputs:
+errors, the residual estimate and ``solution.vtu``.
+
+Goals (issue "the product at the kernels' speed"), printed as ratios measured in this run:
+at ~0.5M, femkit's wall time <= 0.15x the peer's, errors + estimate stages <= 1.5x the fmg solve
+stage, peak RSS <= 0.35x the peer's; at ~2M, the whole command <= 4x its solve stage; fmg's solve
+stage <= 0.2x pyamg RS's time to the same max-nodal error on the same matrix (the peer's CG
+callback records the time at which each iterate reaches it). ``--cold`` runs the fmg case twice
+with an empty numba cache directory: the first run against the second (goal: within 2x).
+BLAS threads are pinned to 1.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_v] = "1"
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+H0 = 0.05
+
+CASE = """problem: poisson
+name: pipeline_{name}
+mesh: {{geometry: unit_square, h: {h}, refine: {k}}}
+coefficient: 1.0
+source: "2 * pi**2 * sin(pi * x) * sin(pi * y)"
+boundary:
+  dirichlet:
+    - {{tags: [boundary], value: 0}}
+exact:
+  u: "sin(pi * x) * sin(pi * y)"
+  grad: ["pi * cos(pi * x) * sin(pi * y)", "pi * sin(pi * x) * cos(pi * y)"]
+quadrature: {{load: barycentric}}
+estimator: residual
+solver: {solver}
+output: {{dir: out_{name}, vtu: true, plot: false}}
+"""
+
+SOLVERS = {
+    "fmg": "{method: fmg}",
+    "pcg_amg": "{method: pcg, preconditioner: amg, rtol: 1.0e-10}",
+}
+
+SAVE_MESH = """
+import numpy as np
+from femkit.mesh import generate, refine
+m = refine(generate("unit_square", {h}), {k})
+np.savez({path!r}, points=m.points, triangles=m.triangles)
+"""
+
+PEER = r"""
+import time
+t_start = time.perf_counter()
+import json, sys
+import numpy as np
+import pyamg
+from skfem import (Basis, BilinearForm, ElementTriP1, Functional, InteriorFacetBasis, LinearForm,
+                   MeshTri, condense)
+from skfem.helpers import dot, grad
+
+pi = np.pi
+stages = {}
+t = time.perf_counter()
+d = np.load(sys.argv[1])
+m = MeshTri(d["points"].T.copy(), d["triangles"].T.copy(), sort_t=False)
+del d
+stages["mesh"] = time.perf_counter() - t
+
+def f(x, y):
+    return 2 * pi ** 2 * np.sin(pi * x) * np.sin(pi * y)
+
+t = time.perf_counter()
+e = ElementTriP1()
+basis = Basis(m, e)
+A = BilinearForm(lambda u, v, w: dot(grad(u), grad(v))).assemble(basis)
+b = LinearForm(lambda v, w: f(*w.x) * v).assemble(basis)
+stages["assembly"] = time.perf_counter() - t
+t = time.perf_counter()
+D = basis.get_dofs()
+Ac, bc, xc, I = condense(A, b, D=D)
+Ac = Ac.tocsr()
+stages["boundary"] = time.perf_counter() - t
+
+u_nodes = np.sin(pi * m.p[0]) * np.sin(pi * m.p[1])
+target = float(sys.argv[2]) if len(sys.argv) > 2 else 0.0
+hit = {}
+t = time.perf_counter()
+ml = pyamg.ruge_stuben_solver(Ac)
+t_setup = time.perf_counter() - t
+
+def callback(xk):
+    if target > 0 and "time" not in hit and np.abs(xk - u_nodes[I]).max() <= target:
+        hit["time"] = time.perf_counter() - t
+
+x_free = ml.solve(bc, tol=1e-10, accel="cg", callback=callback)
+stages["solve"] = time.perf_counter() - t
+u = np.zeros(m.p.shape[1])
+u[I] = x_free
+
+t = time.perf_counter()
+uh = basis.interpolate(u)
+
+@Functional
+def l2(w):
+    return (w["uh"] - np.sin(pi * w.x[0]) * np.sin(pi * w.x[1])) ** 2
+
+@Functional
+def h1(w):
+    x, y = w.x
+    gx = pi * np.cos(pi * x) * np.sin(pi * y)
+    gy = pi * np.sin(pi * x) * np.cos(pi * y)
+    return (w["uh"].grad[0] - gx) ** 2 + (w["uh"].grad[1] - gy) ** 2
+
+errors = {"L2": float(np.sqrt(l2.assemble(basis, uh=uh))),
+          "H1_semi": float(np.sqrt(h1.assemble(basis, uh=uh))),
+          "max_nodal": float(np.abs(u - u_nodes).max())}
+stages["errors"] = time.perf_counter() - t
+
+t = time.perf_counter()
+
+@Functional
+def interior_residual(w):
+    return w.h ** 2 * f(*w.x) ** 2
+
+eta_K = interior_residual.elemental(basis)
+fbasis = [InteriorFacetBasis(m, e, side=i) for i in [0, 1]]
+ws = {"u" + str(i + 1): fbasis[i].interpolate(u) for i in [0, 1]}
+
+@Functional
+def edge_jump(w):
+    d1, d2, n = grad(w["u1"]), grad(w["u2"]), w.n
+    return w.h * ((d1[0] - d2[0]) * n[0] + (d1[1] - d2[1]) * n[1]) ** 2
+
+eta_E = edge_jump.elemental(fbasis[0], **ws)
+tmp = np.zeros(m.facets.shape[1])
+np.add.at(tmp, fbasis[0].find, eta_E)
+eta_E = np.sum(0.5 * tmp[m.t2f], axis=0)
+estimate = float(np.sqrt(np.sum(eta_K + eta_E)))
+stages["estimate"] = time.perf_counter() - t
+
+t = time.perf_counter()
+m.save("peer_solution.vtu", point_data={"u": u})
+stages["output"] = time.perf_counter() - t
+print(json.dumps({"dofs": int(Ac.shape[0]), "stages": stages, "errors": errors,
+                  "estimate": estimate, "amg_setup": t_setup, "time_to_target": hit.get("time"),
+                  "in_process": time.perf_counter() - t_start}))
+"""
+
+
+#: a wrapper process per measurement, so RUSAGE_CHILDREN is this one child's peak
+WRAP = r"""
+import json, resource, subprocess, sys, time
+t0 = time.perf_counter()
+p = subprocess.run(sys.argv[1:], capture_output=True, text=True)
+wall = time.perf_counter() - t0
+print(json.dumps({"code": p.returncode, "wall": wall, "stdout": p.stdout, "stderr": p.stderr[-3000:],
+                  "peak_mb": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024}))
+"""
+
+
+def measure(cmd: list[str], cwd: str, env: dict) -> dict:
+    """``cmd`` as a fresh process inside a fresh wrapper: wall time, peak RSS, stdout."""
+    p = subprocess.run([sys.executable, "-c", WRAP, *cmd], cwd=cwd, env=env, capture_output=True,
+                       text=True, check=True)
+    r = json.loads(p.stdout)
+    if r["code"] != 0:
+        raise SystemExit(f"{' '.join(cmd[:5])} ... failed ({r['code']}):\n{r['stderr']}")
+    return r
+
+
+def femkit_row(name: str, k: int, tmp: Path, env: dict) -> dict:
+    case = tmp / f"{name}_{k}.yaml"
+    case.write_text(CASE.format(name=f"{name}_{k}", h=H0, k=k, solver=SOLVERS[name]))
+    r = measure([sys.executable, "-m", "femkit.cli", "solve", str(case), "--quiet"], str(tmp), env)
+    res = json.loads((tmp / f"out_{name}_{k}" / "result.json").read_text())
+    r.update(dofs=res["dofs"], stages=res["timings"], errors=res["errors"])
+    return r
+
+
+def peer_row(k: int, tmp: Path, env: dict, target: float) -> dict:
+    mesh = tmp / f"mesh_{k}.npz"
+    if not mesh.exists():
+        subprocess.run([sys.executable, "-c", SAVE_MESH.format(h=H0, k=k, path=str(mesh))], env=env,
+                       check=True)
+    r = measure([sys.executable, "-c", PEER, str(mesh), repr(target)], str(tmp), env)
+    r.update(json.loads(r["stdout"].strip().splitlines()[-1]))
+    return r
+
+
+def _stages(st: dict) -> str:
+    return ", ".join(f"{k} {v:.2f}" for k, v in st.items())
+
+
+def pipeline(levels: list[int]) -> None:
+    env = dict(os.environ)
+    with tempfile.TemporaryDirectory() as d:
+        tmp = Path(d)
+        for k in levels:
+            rows = {name: femkit_row(name, k, tmp, env) for name in SOLVERS}
+            peer = peer_row(k, tmp, env, target=rows["fmg"]["errors"]["max_nodal"])
+            print(f"\n=== unit square h = {H0} refined {k} times: {peer['dofs']:,} unknowns "
+                  "(fresh processes, one thread) ===")
+            print(f"{'job':26s} {'wall s':>7s} {'no mesh':>8s} {'peak MB':>8s}  stages (s)")
+            for name, r in rows.items():
+                st = r["stages"]
+                print(f"{'femkit solve ' + name:26s} {r['wall']:7.2f} {r['wall'] - st.get('mesh', 0):8.2f} "
+                      f"{r['peak_mb']:8.0f}  {_stages(st)}; unattributed "
+                      f"{r['wall'] - sum(st.values()):.2f}")
+            print(f"{'scikit-fem + pyamg RS':26s} {peer['wall']:7.2f} {peer['wall'] - peer['stages']['mesh']:8.2f} "
+                  f"{peer['peak_mb']:8.0f}  {_stages(peer['stages'])}; start-up + imports "
+                  f"{peer['wall'] - peer['in_process']:.2f}")
+            fmg = rows["fmg"]
+            st = fmg["stages"]
+            print(f"errors: femkit fmg L2 {fmg['errors']['L2']:.3e}, max-nodal "
+                  f"{fmg['errors']['max_nodal']:.3e}; peer L2 {peer['errors']['L2']:.3e}, max-nodal "
+                  f"{peer['errors']['max_nodal']:.3e}")
+            print(f"ratio femkit fmg / peer, wall:      {fmg['wall'] / peer['wall']:.3f}  (goal <= 0.15 at 0.5M)")
+            print(f"ratio femkit fmg / peer, peak RSS:  {fmg['peak_mb'] / peer['peak_mb']:.3f}  (goal <= 0.35 at 0.5M)")
+            print(f"ratio (errors + estimate) / solve:  "
+                  f"{(st['errors'] + st['estimate']) / st['solve']:.2f}  (goal <= 1.5)")
+            print(f"ratio whole command / solve stage:  {fmg['wall'] / st['solve']:.1f}  (goal <= 4 at 2M)")
+            ttt = peer.get("time_to_target")
+            if ttt:
+                print(f"ratio fmg solve / pyamg RS to the same max-nodal error "
+                      f"({fmg['errors']['max_nodal']:.2e}, setup {peer['amg_setup']:.2f} s included): "
+                      f"{st['solve'] / (ttt + peer['amg_setup']):.3f}  (goal <= 0.2)")
+            pa = rows["pcg_amg"]
+            print(f"ratio femkit pcg+amg / peer, wall:  {pa['wall'] / peer['wall']:.3f}; peak RSS "
+                  f"{pa['peak_mb'] / peer['peak_mb']:.3f}")
+
+
+def cold(k: int) -> None:
+    """First run after install (empty numba cache) against the second, fmg case."""
+    with tempfile.TemporaryDirectory() as d:
+        tmp = Path(d)
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "numba-cache"))
+        first = femkit_row("fmg", k, tmp, env)
+        second = femkit_row("fmg", k, tmp, env)
+        print(f"\n=== fmg, h = {H0} refined {k} times, {first['dofs']:,} unknowns: empty compile "
+              "cache, then warm ===")
+        for label, r in (("first (cold cache)", first), ("second (warm)", second)):
+            print(f"{label:20s} wall {r['wall']:6.2f} s  {_stages(r['stages'])}")
+        print(f"ratio first / warm: {first['wall'] / second['wall']:.2f}  (goal <= 2)")
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--levels", type=int, nargs="+", default=[5, 6],
+                    help="refinements of the h = 0.05 gmsh square (5: 0.48M, 6: 1.9M unknowns)")
+    ap.add_argument("--cold", type=int, default=None, metavar="K",
+                    help="only the first-run-after-install row at K refinements")
+    args = ap.parse_args(argv)
+    if args.cold is not None:
+        cold(args.cold)
+    else:
+        pipeline(args.levels)
+
+
+if __name__ == "__main__":
+    main()
