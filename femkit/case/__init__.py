@@ -1,6 +1,6 @@
 """Case files: schema validation, safe expressions, loading and running.
 
-``load_case(path, **overrides) -> Case``; ``Case.run(output_dir=None, quiet=False, write=True)``.
+``load_case(path, **overrides) -> Case``; ``Case.run(output_dir=None, quiet=True, write=True)``.
 Problem types (``poisson``, later ``mass_spring``) are dispatched through
 :data:`femkit.case.problems.PROBLEMS`.
 """

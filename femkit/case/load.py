@@ -65,14 +65,15 @@ class Case:
     solver: Any = None
     run_options: dict = field(default_factory=dict)
 
-    def run(self, output_dir: str | os.PathLike | None = None, quiet: bool = False,
+    def run(self, output_dir: str | os.PathLike | None = None, quiet: bool = True,
             write: bool = True, echo=None):
         """Run the case; returns the problem's result object (CaseResult for Poisson).
 
         Parameters
         ----------
         output_dir : overrides ``output.dir``.
-        quiet : when False, print the stage-by-stage summary.
+        quiet : a library stays quiet unless asked: pass ``quiet=False`` to print the
+            stage-by-stage summary (``femkit solve`` does; ``result.summary_lines()`` has it).
         write : when False, nothing is written to disk.
         echo : callable used for printing (default :func:`print`).
         """

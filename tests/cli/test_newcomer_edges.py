@@ -158,3 +158,16 @@ def test_fmg_summary_states_its_criterion_not_a_residual_tolerance(tmp_path, cap
     line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("solver"))
     assert "converged to the discretisation error" in line and "V-cycles" in line
     assert "tolerance" not in line and "not the criterion" in line
+
+
+@pytest.mark.parametrize("case", ["poisson_unit_square.yaml", "scenes/rope_pendulum.yaml"],
+                         ids=["poisson", "scene"])
+def test_python_api_is_quiet_unless_asked(case, capsys, tmp_path):
+    from femkit.case import load_case
+
+    c = load_case(ROOT / "cases" / case, mesh={"h": 0.2}) if "poisson" in case else \
+        load_case(ROOT / "cases" / case, t_end=0.05)
+    c.run(write=False)
+    assert capsys.readouterr().out == ""
+    c.run(write=False, quiet=False)
+    assert capsys.readouterr().out.strip() != ""
