@@ -22,6 +22,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from ...interrupt import active_flag
 from ...io.atomic import EARLIER_RUN, atomic_directory, atomic_write_text
 from ...io.writers import write_csv, write_json
 from .plot import write_final_png, write_gif
@@ -61,12 +62,17 @@ def _frame_mesh(system, x, v, triangles):
 
 
 def write_frames_vtu(directory: str | os.PathLike, system, traj, triangles=None,
-                     subdir: str = "frames") -> list[str]:
-    """One ``.vtu`` per recorded frame in ``directory/subdir``; returns their relative names."""
+                     subdir: str = "frames", stop=None) -> list[str]:
+    """One ``.vtu`` per recorded frame in ``directory/subdir``; returns their relative names.
+
+    ``stop`` (a :class:`~femkit.interrupt.StopFlag`) is checked before each frame: once set,
+    the frames written so far are returned (a Ctrl-C while frames are written is answered)."""
     d = Path(directory)
     (d / subdir).mkdir(parents=True, exist_ok=True)
     names = []
     for k in range(len(traj.times)):
+        if stop:
+            break
         name = f"{subdir}/frame_{k:05d}.vtu"
         _frame_mesh(system, traj.x[k], traj.v[k], triangles).write(d / name)
         names.append(name)
@@ -137,21 +143,27 @@ def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
     final = Path(directory).resolve()
     result.output_dir = final
     files: list[str] = []
+    stop = active_flag()
+    if stop:  # the simulation itself was stopped: write every frame it recorded
+        stop = None
     with atomic_directory(final, EARLIER_RUN) as tmp:
         if opts["vtu"]:
-            frames = write_frames_vtu(tmp, system, traj, tri)
-            write_pvd(tmp / "scene.pvd", traj.times, frames)
+            frames = write_frames_vtu(tmp, system, traj, tri, stop=stop)
+            write_pvd(tmp / "scene.pvd", traj.times[:len(frames)], frames)
             files += ["scene.pvd", *frames]
-        if opts["xdmf"]:
+            if stop:  # stopped while writing frames: keep those, skip the pictures
+                result.output_stop = stop.name
+                result.frames_written = len(frames)
+        if opts["xdmf"] and not stop:
             write_frames_xdmf(tmp / "scene.xdmf", system, traj, tri)
             files += ["scene.xdmf", "scene.h5"]
         if opts["energy_csv"]:
             write_energy_csv(tmp / "energy.csv", traj)
             files.append("energy.csv")
-        if opts["png"]:
+        if opts["png"] and not stop:
             write_final_png(tmp / "final.png", system, traj, result.case.name, triangles=tri)
             files.append("final.png")
-        if opts["gif"]:
+        if opts["gif"] and not stop:
             write_gif(tmp / "animation.gif", system, traj, result.case.name, triangles=tri)
             files.append("animation.gif")
         files.append("result.json")

@@ -1,0 +1,77 @@
+"""One Ctrl-C (or SIGTERM) while a scene writes its frames is answered within a second: the
+frames written so far are kept and listed, result.json says interrupted, exit 130 / 143."""
+
+import json
+import signal
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+
+import pytest
+import yaml
+
+# the console script's path, with a spy that announces the first frame being written
+DRIVER = r"""
+import sys
+import femkit.case.scene.output as output
+
+real = output._frame_mesh
+seen = []
+
+def spy(*args, **kwargs):
+    if not seen:
+        seen.append(1)
+        print("WRITING FRAMES", file=sys.stderr, flush=True)
+    return real(*args, **kwargs)
+
+output._frame_mesh = spy
+from femkit.cli import entry
+sys.argv = ["femkit", "solve", sys.argv[1], "--quiet"]
+entry()
+"""
+
+SCENE = {
+    "problem": "mass_spring",
+    "system": {"type": "rope", "n": 400, "length": 1.0, "k": 500.0, "total_mass": 0.6},
+    "forces": {"gravity": 9.81},
+    "integrator": {"method": "symplectic_euler"},
+    "dt": 1e-4,
+    "t_end": 0.3,                       # 3000 steps, every one a frame: seconds of writing
+    "stability": {"check": False},
+    "output": {"dir": "out", "every": 1, "png": True},
+}
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
+                         ids=["SIGINT", "SIGTERM"])
+def test_signal_while_writing_frames_keeps_a_consistent_marked_output(tmp_path, sig, code):
+    case = tmp_path / "scene.yaml"
+    case.write_text(yaml.safe_dump(SCENE))
+    proc = subprocess.Popen([sys.executable, "-c", DRIVER, str(case)], cwd=tmp_path,
+                            stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
+    try:
+        assert proc.stderr.readline().strip() == "WRITING FRAMES"
+        time.sleep(0.3)
+        assert proc.poll() is None, "frames written before the signal: make the scene longer"
+        t0 = time.perf_counter()
+        proc.send_signal(sig)
+        proc.wait(timeout=60)
+        elapsed = time.perf_counter() - t0
+        err = proc.stderr.read()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == code, err
+    assert elapsed < 1.0, elapsed
+    assert f"interrupted by {sig.name}" in err and "Traceback" not in err
+    out = tmp_path / "out"
+    result = json.loads((out / "result.json").read_text())
+    assert result["interrupted"] is True
+    frames = sorted(p.name for p in (out / "frames").iterdir())
+    listed = [d.get("file") for d in ET.parse(out / "scene.pvd").getroot().iter("DataSet")]
+    assert 0 < len(frames) == len(listed) == result["frames"] < result["steps"] + 1
+    assert listed == [f"frames/{name}" for name in frames]
+    assert result["steps"] == result["steps_planned"]   # the simulation itself had finished
+    assert "final.png" not in {p.name for p in out.iterdir()}
