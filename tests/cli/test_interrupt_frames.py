@@ -3,13 +3,15 @@ frames written so far are kept and listed, result.json says interrupted, exit 13
 
 import json
 import signal
-import subprocess
 import sys
-import time
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import pytest
 import yaml
+
+sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared helper
+from _signals import signal_when_ready  # noqa: E402
 
 # the console script's path, with a spy that announces the first frame being written
 DRIVER = r"""
@@ -48,22 +50,9 @@ SCENE = {
 def test_signal_while_writing_frames_keeps_a_consistent_marked_output(tmp_path, sig, code):
     case = tmp_path / "scene.yaml"
     case.write_text(yaml.safe_dump(SCENE))
-    proc = subprocess.Popen([sys.executable, "-c", DRIVER, str(case)], cwd=tmp_path,
-                            stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
-    try:
-        assert proc.stderr.readline().strip() == "WRITING FRAMES"
-        time.sleep(0.3)
-        assert proc.poll() is None, "frames written before the signal: make the scene longer"
-        t0 = time.perf_counter()
-        proc.send_signal(sig)
-        proc.wait(timeout=60)
-        elapsed = time.perf_counter() - t0
-        err = proc.stderr.read()
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-    assert proc.returncode == code, err
+    returncode, elapsed, err = signal_when_ready(DRIVER, [str(case)], "WRITING FRAMES", sig,
+                                                 cwd=tmp_path)
+    assert returncode == code, err
     assert elapsed < 1.0, elapsed
     assert f"interrupted by {sig.name}" in err and "Traceback" not in err
     out = tmp_path / "out"

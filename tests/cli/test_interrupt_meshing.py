@@ -2,12 +2,14 @@
 console-script entry point, with the shell's exit code and nothing written."""
 
 import signal
-import subprocess
 import sys
-import time
+from pathlib import Path
 
 import pytest
 import yaml
+
+sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared helper
+from _signals import signal_when_ready  # noqa: E402
 
 # The command line as the console script runs it, with a spy announcing (on stderr) each piece
 # of compiled work started under run_interruptible, so the test signals during meshing itself.
@@ -42,23 +44,8 @@ CASE = {
 def test_signal_during_meshing_exits_within_a_second(tmp_path, sig, code):
     case = tmp_path / "case.yaml"
     case.write_text(yaml.safe_dump(CASE))
-    proc = subprocess.Popen([sys.executable, "-c", DRIVER, str(case)], stderr=subprocess.PIPE,
-                            stdout=subprocess.DEVNULL, text=True)
-    try:
-        line = proc.stderr.readline()
-        assert line.strip() == "STARTED meshing", line
-        time.sleep(0.3)  # well inside gmsh's C++ mesher
-        assert proc.poll() is None, "meshing finished before the signal: make the mesh larger"
-        t0 = time.perf_counter()
-        proc.send_signal(sig)
-        proc.wait(timeout=30)
-        elapsed = time.perf_counter() - t0
-        err = proc.stderr.read()
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-    assert proc.returncode == code, err
+    returncode, elapsed, err = signal_when_ready(DRIVER, [str(case)], "STARTED meshing", sig)
+    assert returncode == code, err
     assert elapsed < 1.0, elapsed
     assert f"interrupted by {sig.name} during meshing; nothing written" in err
     assert "Traceback" not in err
