@@ -356,7 +356,7 @@ def cholesky(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter=No
         if tuple(factorization.shape) != prob.A.shape:
             raise InputError(f"factorization is {factorization.shape}, A is {prob.A.shape}")
         setup = 0.0
-    if prob.rhs_norm == 0.0:
+    if prob.b_is_zero:
         res = zero_rhs_result(prob, method="cholesky")
         res.reason = "direct"
         res.info = {**factorization.info, "factorization": factorization}

@@ -178,7 +178,7 @@ def direct(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxi
     prob = prepare(A, b, None, rtol=rtol, atol=atol, maxiter=maxiter, method="direct")
     if isinstance(prob.A, LinearOperator):
         raise InputError("the direct solver needs an explicit matrix, not a LinearOperator")
-    if prob.rhs_norm == 0.0:
+    if prob.b_is_zero:
         res = zero_rhs_result(prob, method="direct")
         res.reason = "direct"
         return res

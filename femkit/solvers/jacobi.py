@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import InputError
 from .checks import (as_apply, check_positive_diagonal, diagonal_of, finish,
                      nonfinite_initial_residual, prepare, zero_rhs_result)
+from .norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
 from .result import SolveResult
 
 
@@ -64,11 +65,16 @@ def jacobi(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxi
         scale = 1.0
     else:
         scale = float(omega)
-    if prob.rhs_norm == 0.0:
+    if prob.b_is_zero:
         return zero_rhs_result(prob, method="jacobi")
-    matvec, b, x, tol = prob.matvec, prob.b, prob.x, prob.tolerance
-    r = b - matvec(x)
-    res = float(np.linalg.norm(r))
+    # the normalised system 2^-e b (femkit.solvers.norms): exact scaling, so the iterates are
+    # those on b; the residual is the true one every iteration, so there is no stagnation verdict
+    e = prob.exponent
+    matvec, b, x = prob.matvec, scaled(prob.b, -e), scaled(prob.x, -e)
+    tol = ldexp_saturating(prob.tolerance, -e)
+    with np.errstate(over="ignore", invalid="ignore"):
+        r = b - matvec(x)
+    res = norm2(r) if np.all(np.isfinite(r)) else float("inf")
     residuals = [res]
     reason, message, k = "maxiter", nonfinite_initial_residual(res), 0
     if message:
@@ -80,26 +86,28 @@ def jacobi(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxi
         x_new = x + step if scale == 1.0 else x + scale * step
         with np.errstate(over="ignore", invalid="ignore"):
             r_new = b - matvec(x_new)
-            res = float(np.linalg.norm(r_new))
+            res = norm2(r_new) if np.all(np.isfinite(r_new)) else float("inf")
         if not math.isfinite(res):
             reason = "non-finite"
             message = (f"jacobi diverged: the residual overflowed at iteration {k + 1} "
-                       f"(last finite residual {residuals[-1]:.3e}, initial {residuals[0]:.3e}); "
-                       f"A is not diagonally dominant enough for omega = {omega}; "
-                       f"returning the last finite iterate")
+                       f"(last finite residual {unscale(residuals[-1], e):.3e}, initial "
+                       f"{unscale(residuals[0], e):.3e}); A is not diagonally dominant enough "
+                       f"for omega = {omega}; returning the last finite iterate")
             break
         x, r = x_new, r_new
         k += 1
         residuals.append(res)
         if callback is not None:
-            callback(x)
+            callback(scaled(x, e))
         if res <= tol:
             reason = "converged"
     if reason == "maxiter":
         growth = residuals[-1] / residuals[0] if residuals[0] > 0 else float("nan")
-        message = (f"maxiter = {prob.maxiter} reached; residual {residuals[-1]:.3e} > tolerance "
-                   f"{tol:.3e} (residual ratio to initial {growth:.3e}"
+        message = (f"maxiter = {prob.maxiter} reached; residual {unscale(residuals[-1], e):.3e} > "
+                   f"tolerance {prob.tolerance:.3e} (residual ratio to initial {growth:.3e}"
                    f"{', diverging' if growth > 1 else ''})")
+    x = scaled(x, e)
+    residuals = unscale_all(residuals, e)
     prob.x = x
     return finish(prob, iterations=k, residuals=residuals, reason=reason, message=message,
                   method="jacobi", info={"omega": float(omega)})
