@@ -481,3 +481,78 @@ class Replacement:
             message += "; the returned x contains non-finite values"
         return finish(self.prob, iterations=iterations, residuals=hist, reason=reason,
                       message=message, method=method, info=info)
+
+
+#: Top-level packages whose exceptions are caught at the solver boundary and re-raised as femkit
+#: errors (:class:`dependency_boundary`); an exception raised in femkit's own code is a bug and
+#: passes unchanged.
+DEPENDENCIES = ("pyamg", "scipy", "numpy", "sksparse", "petsc4py", "numba", "ctypes")
+
+
+def raised_in(exc: BaseException) -> str | None:
+    """The dependency (a name in :data:`DEPENDENCIES`) whose code raised ``exc``, else None."""
+    tb = exc.__traceback__
+    last = None
+    while tb is not None:
+        last, tb = tb, tb.tb_next
+    if last is None:
+        return None
+    top = str(last.tb_frame.f_globals.get("__name__", "")).split(".")[0]
+    return top if top in DEPENDENCIES else None
+
+
+def dependency_error(exc: BaseException, package: str, *, what: str, A=None):
+    """The femkit error for ``exc`` raised inside ``package`` while running ``what``:
+    :class:`~femkit.errors.NotSPDError` when the explicit matrix ``A`` has a zero, negative or
+    non-finite diagonal entry (the dependency broke down on a matrix that is not SPD),
+    :class:`~femkit.errors.SingularSystemError` when the dependency says singular, else
+    :class:`~femkit.errors.SolverError` (breakdown). The message keeps the dependency's own."""
+    from ..errors import SingularSystemError, SolverError
+
+    said = f"{package} raised {type(exc).__name__}: {exc}"
+    if A is not None and (sp.issparse(A) or isinstance(A, np.ndarray)) and A.ndim == 2 \
+            and A.shape[0] == A.shape[1]:
+        d = np.asarray(A.diagonal(), dtype=np.float64)
+        bad = np.flatnonzero(~(d > 0) | ~np.isfinite(d))
+        if bad.size:
+            rows = ", ".join(str(i) for i in bad[:5]) + (" ..." if bad.size > 5 else "")
+            return NotSPDError(f"{what} broke down: A is not symmetric positive definite "
+                               f"({bad.size} row(s) with a zero, negative or non-finite diagonal "
+                               f"entry: {rows}) and {said}")
+    if isinstance(exc, np.linalg.LinAlgError) or "singular" in str(exc).lower():
+        return SingularSystemError(f"{what}: the system is singular ({said})")
+    return SolverError(f"{what} broke down: {said}")
+
+
+class dependency_boundary:
+    """Context manager at a solver's boundary: an exception raised inside a dependency
+    (:data:`DEPENDENCIES`) leaves as the femkit error saying what happened
+    (:func:`dependency_error`), the dependency's exception kept as its ``__cause__``; femkit
+    errors and exceptions of femkit's own code pass unchanged.
+
+    >>> import scipy.sparse as sp
+    >>> from femkit.errors import NotSPDError
+    >>> try:
+    ...     with dependency_boundary("an example", sp.identity(2) * 0):
+    ...         import scipy.linalg; scipy.linalg.cholesky([[float("nan")]])
+    ... except NotSPDError as e:
+    ...     type(e.__cause__).__name__
+    'ValueError'
+    """
+
+    def __init__(self, what: str, A=None):
+        self.what = what
+        self.A = A
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        from ..errors import FemkitError
+
+        if exc is None or not isinstance(exc, Exception) or isinstance(exc, FemkitError):
+            return False
+        package = raised_in(exc)
+        if package is None:
+            return False
+        raise dependency_error(exc, package, what=self.what, A=self.A) from exc

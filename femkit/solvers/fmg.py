@@ -47,7 +47,7 @@ import time
 import numpy as np
 
 from ..errors import InputError
-from .checks import finish, prepare, zero_rhs_result
+from .checks import dependency_boundary, finish, prepare, zero_rhs_result
 from .norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
 from .result import SolveResult
 
@@ -174,8 +174,9 @@ def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | 
     if mg is None:
         if hierarchy is None:
             raise _hierarchy_error("method 'fmg'")
-        mg = Multigrid(prob.A, hierarchy, free=free, sweeps=sweeps,  # symmetry checked above
-                       omega=DEFAULT_OMEGA if omega is None else omega, check_symmetry=False)
+        with dependency_boundary("fmg (multigrid set-up)", prob.A):
+            mg = Multigrid(prob.A, hierarchy, free=free, sweeps=sweeps,  # symmetry checked above
+                           omega=DEFAULT_OMEGA if omega is None else omega, check_symmetry=False)
     elif mg.levels[-1].A.shape != prob.A.shape:
         raise InputError(f"fmg: M was built for {mg.levels[-1].A.shape}, A is {prob.A.shape}")
     top = mg.n_levels - 1

@@ -17,8 +17,8 @@ import numbers
 import numpy as np
 
 from ..errors import InputError
-from .checks import (as_apply, check_positive_diagonal, diagonal_of, finish,
-                     nonfinite_initial_residual, prepare, zero_rhs_result)
+from .checks import (as_apply, check_positive_diagonal, dependency_boundary, diagonal_of,
+                     finish, nonfinite_initial_residual, prepare, zero_rhs_result)
 from .norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
 from .result import SolveResult
 
@@ -82,7 +82,8 @@ def jacobi(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxi
     elif res <= tol:
         reason = "converged"
     while reason == "maxiter" and k < prob.maxiter:
-        step = apply_M(r)
+        with dependency_boundary("jacobi", prob.A):   # a user M from a dependency
+            step = apply_M(r)
         x_new = x + step if scale == 1.0 else x + scale * step
         with np.errstate(over="ignore", invalid="ignore"):
             r_new = b - matvec(x_new)

@@ -23,7 +23,7 @@ from typing import Callable
 import numpy as np
 from scipy.linalg.blas import daxpy
 
-from .checks import Problem, Replacement, as_apply, prepare, zero_rhs_result
+from .checks import Problem, Replacement, as_apply, dependency_boundary, prepare, zero_rhs_result
 from .norms import curvature_check, inner_rounding, norm2
 from .result import SolveResult
 
@@ -186,6 +186,8 @@ def pcg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter
                    symmetric=True, check_symmetry=check_symmetry)
     if prob.b_is_zero:
         return zero_rhs_result(prob, method=method)
-    return _krylov_loop(prob, as_apply(M, prob.n), method=method, callback=callback,
-                        stagnation_window=stagnation_window,
-                        raise_on_breakdown=raise_on_breakdown)
+    pc = f" with preconditioner {getattr(M, 'name', type(M).__name__)!r}" if M is not None else ""
+    with dependency_boundary(f"{method}{pc}", prob.A):   # e.g. a pyamg cycle failing
+        return _krylov_loop(prob, as_apply(M, prob.n), method=method, callback=callback,
+                            stagnation_window=stagnation_window,
+                            raise_on_breakdown=raise_on_breakdown)

@@ -16,7 +16,7 @@ import math
 import numpy as np
 from scipy.linalg.blas import daxpy
 
-from .checks import Replacement, as_apply, prepare, zero_rhs_result
+from .checks import Replacement, as_apply, dependency_boundary, prepare, zero_rhs_result
 from .norms import curvature_check
 from .result import SolveResult
 
@@ -46,7 +46,7 @@ def steepest_descent(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float =
     cyc = Replacement(prob)   # normalised system, residual replacement before any stagnation
     matvec = prob.matvec
     k, ended = 0, ""
-    with np.errstate(over="ignore", invalid="ignore"):
+    with np.errstate(over="ignore", invalid="ignore"), dependency_boundary("sd", prob.A):
         while True:
             r, rr, stop = cyc.start(k, ended=ended)
             if stop:

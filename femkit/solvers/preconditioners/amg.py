@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from ..checks import explicit_csr, unknown_options
+from ..checks import dependency_boundary, explicit_csr, unknown_options
 from .base import Preconditioner
 
 
@@ -91,7 +91,9 @@ def build_sa(A, *, cycle: str = "V", **opts) -> Preconditioner:
 
     _check_opts(pyamg.smoothed_aggregation_solver, opts, "amg_sa")
     t0 = time.perf_counter()
-    ml = pyamg.smoothed_aggregation_solver(_csr(A), **opts)
+    A = _csr(A)
+    with dependency_boundary("preconditioner 'amg_sa' (pyamg set-up)", A):
+        ml = pyamg.smoothed_aggregation_solver(A, **opts)
     return _wrap("amg_sa", ml, cycle, t0)
 
 
@@ -101,7 +103,9 @@ def build_rs(A, *, cycle: str = "V", **opts) -> Preconditioner:
 
     _check_opts(pyamg.ruge_stuben_solver, opts, "amg_rs")
     t0 = time.perf_counter()
-    ml = pyamg.ruge_stuben_solver(_csr(A), **opts)
+    A = _csr(A)
+    with dependency_boundary("preconditioner 'amg_rs' (pyamg set-up)", A):
+        ml = pyamg.ruge_stuben_solver(A, **opts)
     return _wrap("amg_rs", ml, cycle, t0)
 
 
