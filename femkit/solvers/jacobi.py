@@ -5,7 +5,8 @@ is the classical Jacobi iteration. It converges for strictly diagonally dominant
 and for SPD ``A`` exactly when ``0 < omega < 2 / lambda_max(D^-1 A)`` (``omega = 2/3`` is the
 classical smoothing weight). A divergent iteration (residual above :data:`DIVERGENCE_FACTOR`
 times the initial one) stops with ``reason="non-finite"`` (returning the last iterate before) or
-``"maxiter"``, never a silent NaN.
+``"maxiter"``, never a silent NaN; a residual (the true one: recomputed every iteration) with no new
+minimum for ``max(1000, n)`` iterations stops with ``reason="stagnation"`` at the best iterate.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from ..errors import InputError
 from .checks import (as_apply, check_positive_diagonal, dependency_boundary, diagonal_of,
                      finish, nonfinite_initial_residual, prepare, zero_rhs_result)
 from .norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
+from .pcg import STAGNATION_WINDOW
 from .result import SolveResult
 
 
@@ -84,6 +86,11 @@ def jacobi(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxi
     res = norm2(r) if np.all(np.isfinite(r)) else float("inf")
     residuals = [res]
     reason, message, k = "maxiter", nonfinite_initial_residual(res), 0
+    # the residual is the true one: a window without a new minimum is stagnation (the rounding
+    # floor), and x goes back to the best iterate (Jacobi is stationary: a restart from it
+    # repeats the iterations that found nothing better)
+    window = max(STAGNATION_WINDOW, prob.n)
+    best, best_k, best_x = res, 0, x
     if message:
         reason = "non-finite"
     elif res <= tol:
@@ -110,6 +117,15 @@ def jacobi(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxi
             callback(scaled(x, e))
         if res <= tol:
             reason = "converged"
+        elif res < best:
+            best, best_k, best_x = res, k, x
+        elif k - best_k >= window:
+            reason = "stagnation"
+            message = (f"stagnation: the true residual has not decreased for {window} iterations "
+                       f"(best {unscale(best, e):.3e} at iteration {best_k}, the iterate returned; "
+                       f"tolerance {prob.tolerance:.3e}): rounding errors limit the attainable "
+                       f"accuracy")
+            x = best_x
     if reason == "maxiter":
         growth = residuals[-1] / residuals[0] if residuals[0] > 0 else float("nan")
         message = (f"maxiter = {prob.maxiter} reached; residual {unscale(residuals[-1], e):.3e} > "
