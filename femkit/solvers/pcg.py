@@ -51,7 +51,6 @@ def _krylov_loop(prob: Problem, apply_M: Callable | None, *, method: str, callba
     window = max(STAGNATION_WINDOW, prob.n) if stagnation_window is None else stagnation_window
     cyc = Replacement(prob)
     matvec, maxiter, x = prob.matvec, prob.maxiter, cyc.x
-    rounding = inner_rounding(prob.n)
     k, ended = 0, ""
     with np.errstate(over="ignore", invalid="ignore"):
         while True:
@@ -69,7 +68,7 @@ def _krylov_loop(prob: Problem, apply_M: Callable | None, *, method: str, callba
                                      f"residual of shape {r.shape}; M(r) must return an array "
                                      f"of r's shape")
                 rz = float(np.dot(r, z))
-            reason, message = _rz_failure(rz, r, z, k, rounding) or ("maxiter", "")
+            reason, message = _rz_failure(rz, r, z, k) or ("maxiter", "")
             if reason != "maxiter":
                 break
             p = np.array(z, dtype=np.float64, copy=True)
@@ -104,7 +103,7 @@ def _krylov_loop(prob: Problem, apply_M: Callable | None, *, method: str, callba
                 elif k - best_k >= window:
                     ended = "window"
                     break
-                failure = _rz_failure(rz_new, r, z, k, rounding)
+                failure = _rz_failure(rz_new, r, z, k)
                 if failure:
                     reason, message = failure
                     break
@@ -123,15 +122,17 @@ def _krylov_loop(prob: Problem, apply_M: Callable | None, *, method: str, callba
     return cyc.finish(iterations=k, reason=reason, message=message, method=method)
 
 
-def _rz_failure(rz: float, r: np.ndarray, z: np.ndarray, k: int,
-                rounding: float) -> tuple[str, str] | None:
-    """``r^T M r`` judged relative to ``||r|| ||M r||`` (None: positive beyond rounding)."""
-    if rz > 0 and (z is r or rz > rounding * norm2(r) * norm2(z)):
+def _rz_failure(rz: float, r: np.ndarray, z: np.ndarray, k: int) -> tuple[str, str] | None:
+    """``r^T M r`` must be positive (on the normalised system its sign is free of underflow);
+    a non-positive value is judged relative to ``||r|| ||M r||`` for the message."""
+    if rz > 0:
         return None
     if not math.isfinite(rz):
         return "non-finite", f"r^T M r = {rz} at iteration {k}"
-    return "breakdown", (f"r^T M r = {rz:.3e} is not positive beyond rounding at iteration {k}: "
-                         f"the preconditioner is not positive definite")
+    size = "within rounding of 0" if abs(rz) <= inner_rounding(r.size) * norm2(r) * norm2(z) \
+        else "negative"
+    return "breakdown", (f"r^T M r = {rz:.3e} ({size}, relative to ||r|| ||M r||) at iteration "
+                         f"{k}: the preconditioner is not positive definite")
 
 
 def pcg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,

@@ -56,15 +56,16 @@ def vcycle_apply(ml):
     return apply
 
 
-#: Seed of NumPy's global generator during a pyamg set-up (restored afterwards): pyamg draws the
+#: State of NumPy's global generator during a pyamg set-up (``RandomState(SETUP_DRAW)``'s;
+#: the caller's state is restored afterwards): pyamg draws the
 #: start vectors of its spectral-radius estimates (Jacobi prolongation smoothing, smoother
-#: weights) from it, so without a seed the same matrix gets a different preconditioner, and a
+#: weights) from it, so without a fixed state the same matrix gets a different preconditioner, and a
 #: different iteration count, on every call.
-SETUP_SEED = 0
+SETUP_DRAW = 0
 
 
 def _setup(build, A, what: str, opts: dict):
-    """``build(2^-e A, **opts)`` under :data:`SETUP_SEED` and the solver boundary; returns the
+    """``build(2^-e A, **opts)`` under :data:`SETUP_DRAW` and the solver boundary; returns the
     multilevel solver and ``e``.
 
     pyamg sees ``A`` normalised to entries of order one (``2^e`` the binary order of its largest
@@ -78,7 +79,7 @@ def _setup(build, A, what: str, opts: dict):
         A = A.copy()
         A.data = np.ldexp(A.data, -e)
     state = np.random.get_state()
-    np.random.seed(SETUP_SEED)
+    np.random.set_state(np.random.RandomState(SETUP_DRAW).get_state())
     try:
         with dependency_boundary(what, A):
             return build(A, **opts), e
