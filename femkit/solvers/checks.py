@@ -6,7 +6,9 @@ decide ``converged``), so the stopping rule::
 
     ||b - A x||_2 <= max(rtol * ||b||_2, atol)
 
-and the error messages are the same for all of them.
+and the error messages are the same for all of them. Norms are scaled 2-norms and ``b = 0`` is
+decided by ``b``'s entries (:mod:`femkit.solvers.norms`), so the verdict does not change when
+``A`` and ``b`` are scaled together.
 
 Tolerance policy: ``rtol`` and ``atol`` must be finite and non-negative, and at least one
 of them positive. ``rtol = atol = 0`` asks for an exact solution, which floating-point
@@ -27,6 +29,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
 from ..errors import InputError, NotSPDError
+from .norms import binary_exponent, is_zero, norm2
 from .result import SolveResult
 
 #: Relative asymmetry ``||A - A^T||_inf / ||A||_inf`` above which CG-type methods refuse ``A``.
@@ -46,6 +49,8 @@ class Problem:
     maxiter: int
     n: int
     t_start: float = 0.0        # perf_counter() when validation began (for solve_time)
+    b_is_zero: bool = False     # every entry of b is 0 (decided by b, not by its norm)
+    exponent: int = 0           # 2^-exponent b has entries of order one (norms.binary_exponent)
 
 
 def _matvec_of(A) -> Callable[[np.ndarray], np.ndarray]:
@@ -262,10 +267,10 @@ def prepare(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, max
         maxiter = int(maxiter)
     if symmetric and check_symmetry:
         check_symmetric(A, method=method)
-    rhs_norm = float(np.linalg.norm(b))
+    rhs_norm = norm2(b)
     return Problem(A=A, matvec=_matvec_of(A), b=b, x=x, rhs_norm=rhs_norm,
                    tolerance=max(float(rtol) * rhs_norm, float(atol)), maxiter=maxiter, n=n,
-                   t_start=t_start)
+                   t_start=t_start, b_is_zero=is_zero(b), exponent=binary_exponent(b))
 
 
 def as_apply(M, n: int) -> Callable[[np.ndarray], np.ndarray] | None:
@@ -297,10 +302,7 @@ def finish(prob: Problem, *, iterations: int, residuals, reason: str, message: s
     the result is ``converged=False, reason="stagnation"`` with a message saying so.
     """
     x = prob.x
-    if np.all(np.isfinite(x)):
-        true_res = float(np.linalg.norm(prob.b - prob.matvec(x)))
-    else:
-        true_res = float("nan")
+    true_res = true_residual(prob, x)
     ok = bool(np.isfinite(true_res) and true_res <= prob.tolerance)
     if recursive_met and not ok:
         reason = "stagnation"
@@ -327,12 +329,24 @@ def finish(prob: Problem, *, iterations: int, residuals, reason: str, message: s
     )
 
 
+def true_residual(prob: Problem, x: np.ndarray) -> float:
+    """``||b - A x||_2`` (scaled norm), NaN when ``x`` or the product is not finite."""
+    if not np.all(np.isfinite(x)):
+        return float("nan")
+    with np.errstate(over="ignore", invalid="ignore"):
+        r = prob.b - prob.matvec(x)
+    if not np.all(np.isfinite(r)):
+        return float("nan")
+    return norm2(r)
+
+
 def zero_rhs_result(prob: Problem, *, method: str) -> SolveResult:
-    """``b = 0``: the solution is ``x = 0`` exactly, converged after 0 iterations.
+    """``b = 0`` (every entry; :attr:`Problem.b_is_zero`): the solution is ``x = 0`` exactly,
+    converged after 0 iterations.
 
     ``residuals[0]`` is still the initial residual ``||A x0||`` of the given ``x0``.
     """
-    r0 = float(np.linalg.norm(prob.matvec(prob.x))) if np.any(prob.x) else 0.0
+    r0 = norm2(prob.matvec(prob.x)) if np.any(prob.x) else 0.0
     prob.x = np.zeros(prob.n)
     return SolveResult(
         x=prob.x, converged=True, iterations=0, residuals=np.array([r0]), reason="converged",
@@ -357,3 +371,188 @@ def record_iteration(residuals: list, res: float, x: np.ndarray, callback, k: in
     if callback is not None:
         callback(x)
     return "" if np.isfinite(res) else f"residual became {res} at iteration {k}"
+
+
+class Replacement:
+    """The normalised system of an iteration with residual replacement (van der Vorst and Ye,
+    "Residual replacement strategies for Krylov subspace iterative methods for the convergence
+    of true residuals", SIAM J. Sci. Comput. 22(3), 2000).
+
+    The iteration runs on ``b' = 2^-e b``, ``x' = 2^-e x0`` (:mod:`femkit.solvers.norms`: exact
+    scaling, inner products far from under- and overflow) in *cycles*. Every cycle starts with
+    :meth:`start`, which recomputes the true residual ``r = b' - A x'``: the solve is converged
+    when it meets the tolerance, stagnant only when it did not decrease since the previous cycle
+    start, and otherwise the recursion restarts from it. On stagnation ``x`` goes back to the
+    previous cycle start (the smallest true residual), so a restart from the returned ``x``
+    repeats the cycle that failed.
+
+    Attributes: ``b``, ``x`` (updated in place by the iteration), ``tol`` (normalised),
+    ``residuals`` (normalised history, ``residuals[0]`` the initial residual), ``starts``
+    (``(iteration, true residual)`` of every cycle start).
+    """
+
+    def __init__(self, prob: Problem):
+        from .norms import ldexp_saturating, scaled
+
+        self.prob = prob
+        self.e = e = prob.exponent
+        self.b = scaled(prob.b, -e)
+        with np.errstate(over="ignore"):
+            self.x = np.array(scaled(prob.x, -e), dtype=np.float64, copy=True)
+        if not np.all(np.isfinite(self.x)):
+            raise InputError(f"x0 is more than 2^1000 times larger than b ({norm2(prob.x):.3e} "
+                             f"against ||b|| = {prob.rhs_norm:.3e}): start from x0 = 0")
+        self.tol = ldexp_saturating(prob.tolerance, -e)
+        self.residuals: list[float] = []
+        self.starts: list[tuple[int, float]] = []
+        self._best = self.x
+
+    def unscaled(self, value: float) -> float:
+        """A normalised norm in the units of ``b``."""
+        from .norms import unscale
+
+        return unscale(value, self.e)
+
+    def iterate(self) -> np.ndarray:
+        """The current iterate in the units of ``x0`` (for callbacks)."""
+        from .norms import scaled
+
+        return scaled(self.x, self.e)
+
+    def record(self, res: float, k: int, callback) -> tuple[str, tuple[str, str] | None]:
+        """Record the recursive residual norm ``res`` of iteration ``k`` (and call
+        ``callback(x)``): ``("met", None)`` when it meets the tolerance (the cycle ends),
+        ``("", ("non-finite", message))`` when it is not finite, else ``("", None)``."""
+        bad = record_iteration(self.residuals, res, self.iterate() if callback else self.x,
+                               callback, k)
+        if bad:
+            return "", ("non-finite", bad)
+        return ("met" if res <= self.tol else ""), None
+
+    def start(self, k: int, *, ended: str = "", window: int = 0):
+        """Recompute the true residual at iteration ``k`` and decide: returns ``(r, rr, None)``
+        to run a new cycle from ``r`` (``rr = r^T r``), or ``(None, 0, (reason, message))`` to
+        stop. ``ended`` says why the previous cycle ended (``"met"``: its recursive residual met
+        the tolerance; ``"window"``: no new minimum for ``window`` iterations)."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            r = self.b - self.prob.matvec(self.x)
+        res = norm2(r) if np.all(np.isfinite(r)) else float("nan")
+        if not self.residuals:
+            self.residuals.append(res)
+            bad = nonfinite_initial_residual(res)
+            if bad:
+                return None, 0.0, ("non-finite", bad)
+        elif not np.isfinite(res):
+            return None, 0.0, ("non-finite", f"the true residual became {res} at iteration {k}")
+        tolerance = self.prob.tolerance
+        if res <= self.tol:
+            msg = ""
+            if len(self.starts) > 1:
+                msg = (f"true residual {self.unscaled(res):.3e} <= tolerance {tolerance:.3e} "
+                       f"after {k} iterations ({len(self.starts) - 1} residual replacement(s))")
+            return None, 0.0, ("converged", msg)
+        if self.starts and not res < self.starts[-1][1]:
+            k0, res0 = self.starts[-1]
+            why = ("the recursive residual met the tolerance" if ended == "met" else
+                   f"no residual decrease for {window} iterations")
+            self.x = self._best
+            return None, 0.0, ("stagnation", (
+                f"{why} at iteration {k}, but the true residual ||b - A x|| = "
+                f"{self.unscaled(res):.3e} (tolerance {tolerance:.3e}) did not decrease across "
+                f"the residual replacement (it was {self.unscaled(res0):.3e} at iteration {k0}, "
+                f"the iterate returned): rounding errors limit the attainable accuracy; loosen "
+                f"rtol or use a better preconditioner or a direct solver"))
+        self.starts.append((k, res))
+        self._best = self.x.copy()
+        if k >= self.prob.maxiter:
+            return None, 0.0, ("maxiter", f"maxiter = {self.prob.maxiter} reached; residual "
+                                          f"{self.unscaled(res):.3e} > tolerance {tolerance:.3e}")
+        return r, float(np.dot(r, r)), None
+
+    def finish(self, *, iterations: int, reason: str, message: str, method: str,
+               info: dict | None = None) -> SolveResult:
+        """Back to the units of ``b`` and :func:`finish` (the true residual decides)."""
+        from .norms import scaled, unscale_all
+
+        self.prob.x = scaled(self.x, self.e)
+        hist = unscale_all(self.residuals, self.e)
+        info = {**(info or {}), "residual_replacements": max(len(self.starts) - 1, 0)}
+        if reason == "non-finite" and not np.all(np.isfinite(self.prob.x)):
+            message += "; the returned x contains non-finite values"
+        return finish(self.prob, iterations=iterations, residuals=hist, reason=reason,
+                      message=message, method=method, info=info)
+
+
+#: Top-level packages whose exceptions are caught at the solver boundary and re-raised as femkit
+#: errors (:class:`dependency_boundary`); an exception raised in femkit's own code is a bug and
+#: passes unchanged.
+DEPENDENCIES = ("pyamg", "scipy", "numpy", "sksparse", "petsc4py", "numba", "ctypes")
+
+
+def raised_in(exc: BaseException) -> str | None:
+    """The dependency (a name in :data:`DEPENDENCIES`) whose code raised ``exc``, else None."""
+    tb = exc.__traceback__
+    last = None
+    while tb is not None:
+        last, tb = tb, tb.tb_next
+    if last is None:
+        return None
+    top = str(last.tb_frame.f_globals.get("__name__", "")).split(".")[0]
+    return top if top in DEPENDENCIES else None
+
+
+def dependency_error(exc: BaseException, package: str, *, what: str, A=None):
+    """The femkit error for ``exc`` raised inside ``package`` while running ``what``:
+    :class:`~femkit.errors.NotSPDError` when the explicit matrix ``A`` has a zero, negative or
+    non-finite diagonal entry (the dependency broke down on a matrix that is not SPD),
+    :class:`~femkit.errors.SingularSystemError` when the dependency says singular, else
+    :class:`~femkit.errors.SolverError` (breakdown). The message keeps the dependency's own."""
+    from ..errors import SingularSystemError, SolverError
+
+    said = f"{package} raised {type(exc).__name__}: {exc}"
+    if A is not None and (sp.issparse(A) or isinstance(A, np.ndarray)) and A.ndim == 2 \
+            and A.shape[0] == A.shape[1]:
+        d = np.asarray(A.diagonal(), dtype=np.float64)
+        bad = np.flatnonzero(~(d > 0) | ~np.isfinite(d))
+        if bad.size:
+            rows = ", ".join(str(i) for i in bad[:5]) + (" ..." if bad.size > 5 else "")
+            return NotSPDError(f"{what} broke down: A is not symmetric positive definite "
+                               f"({bad.size} row(s) with a zero, negative or non-finite diagonal "
+                               f"entry: {rows}) and {said}")
+    if isinstance(exc, np.linalg.LinAlgError) or "singular" in str(exc).lower():
+        return SingularSystemError(f"{what}: the system is singular ({said})")
+    return SolverError(f"{what} broke down: {said}")
+
+
+class dependency_boundary:
+    """Context manager at a solver's boundary: an exception raised inside a dependency
+    (:data:`DEPENDENCIES`) leaves as the femkit error saying what happened
+    (:func:`dependency_error`), the dependency's exception kept as its ``__cause__``; femkit
+    errors and exceptions of femkit's own code pass unchanged.
+
+    >>> import scipy.sparse as sp
+    >>> from femkit.errors import NotSPDError
+    >>> try:
+    ...     with dependency_boundary("an example", sp.identity(2) * 0):
+    ...         import scipy.linalg; scipy.linalg.cholesky([[float("nan")]])
+    ... except NotSPDError as e:
+    ...     type(e.__cause__).__name__
+    'ValueError'
+    """
+
+    def __init__(self, what: str, A=None):
+        self.what = what
+        self.A = A
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        from ..errors import FemkitError
+
+        if exc is None or not isinstance(exc, Exception) or isinstance(exc, FemkitError):
+            return False
+        package = raised_in(exc)
+        if package is None:
+            return False
+        raise dependency_error(exc, package, what=self.what, A=self.A) from exc

@@ -49,7 +49,8 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
 from ..errors import InputError, NotSPDError
-from .checks import SYMMETRY_TOL, as_operator, asymmetry, finish, prepare, zero_rhs_result
+from .checks import (SYMMETRY_TOL, as_operator, asymmetry, dependency_boundary, finish, prepare,
+                     zero_rhs_result)
 from .result import SolveResult
 
 __all__ = ["CholeskyFactor", "cholesky", "factorize_spd", "clear_symbolic_cache",
@@ -173,7 +174,8 @@ def _symbolic(A: sp.csc_matrix, ordering: str, mode: str = "supernodal") -> tupl
         return sym, True
     cholmod = _cholmod()
     t0 = time.perf_counter()
-    f = cholmod.analyze(A, mode=mode, ordering_method=ordering)
+    with dependency_boundary("cholesky (CHOLMOD analysis)", A):
+        f = cholmod.analyze(A, mode=mode, ordering_method=ordering)
     sym = _Symbolic(f, A.indptr.copy(), A.indices.copy(), ordering, time.perf_counter() - t0, mode)
     _CACHE[key] = sym
     while len(_CACHE) > CACHE_SIZE:
@@ -200,12 +202,13 @@ NOT_SPD_ADVICE = ("use method 'direct' (SuperLU) for indefinite systems, or a de
 def _numeric(run, what: str):
     """Run a CHOLMOD numeric factorisation, mapping a non-positive pivot to NotSPDError."""
     cholmod = _cholmod()
-    try:
-        return run()
-    except cholmod.CholmodNotPositiveDefiniteError as e:
-        raise NotSPDError(
-            f"{what}: the matrix is not positive definite (CHOLMOD met a non-positive pivot: "
-            f"{e}); {NOT_SPD_ADVICE}") from None
+    with dependency_boundary(what):   # any other CHOLMOD failure, its message kept as the cause
+        try:
+            return run()
+        except cholmod.CholmodNotPositiveDefiniteError as e:
+            raise NotSPDError(
+                f"{what}: the matrix is not positive definite (CHOLMOD met a non-positive pivot: "
+                f"{e}); {NOT_SPD_ADVICE}") from e
 
 
 class CholeskyFactor:
@@ -356,7 +359,7 @@ def cholesky(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter=No
         if tuple(factorization.shape) != prob.A.shape:
             raise InputError(f"factorization is {factorization.shape}, A is {prob.A.shape}")
         setup = 0.0
-    if prob.rhs_norm == 0.0:
+    if prob.b_is_zero:
         res = zero_rhs_result(prob, method="cholesky")
         res.reason = "direct"
         res.info = {**factorization.info, "factorization": factorization}

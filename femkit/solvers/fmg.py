@@ -47,7 +47,8 @@ import time
 import numpy as np
 
 from ..errors import InputError
-from .checks import finish, prepare, zero_rhs_result
+from .checks import dependency_boundary, finish, prepare, zero_rhs_result
+from .norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
 from .result import SolveResult
 
 #: Default ratio of algebraic to estimated discretisation error (energy norm) at which FMG stops.
@@ -173,8 +174,9 @@ def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | 
     if mg is None:
         if hierarchy is None:
             raise _hierarchy_error("method 'fmg'")
-        mg = Multigrid(prob.A, hierarchy, free=free, sweeps=sweeps,  # symmetry checked above
-                       omega=DEFAULT_OMEGA if omega is None else omega, check_symmetry=False)
+        with dependency_boundary("fmg (multigrid set-up)", prob.A):
+            mg = Multigrid(prob.A, hierarchy, free=free, sweeps=sweeps,  # symmetry checked above
+                           omega=DEFAULT_OMEGA if omega is None else omega, check_symmetry=False)
     elif mg.levels[-1].A.shape != prob.A.shape:
         raise InputError(f"fmg: M was built for {mg.levels[-1].A.shape}, A is {prob.A.shape}")
     top = mg.n_levels - 1
@@ -189,16 +191,20 @@ def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | 
                                  f"hierarchy's level {lvl} has {len(mg.frees[lvl])} free nodes")
     rho0 = max(_contraction(mg), RHO_FLOOR)
     setup_time = time.perf_counter() - t_setup
-    if prob.rhs_norm == 0.0:
+    if prob.b_is_zero:
         res = zero_rhs_result(prob, method="fmg")
         res.setup_time = setup_time
         return res
 
-    # right-hand sides of every level, coarsest first
+    # right-hand sides of every level, coarsest first, normalised by 2^-e (norms.binary_exponent:
+    # exact, so the cycles are those on b and the energy norms stay far from under/overflow)
+    e = prob.exponent
+    tol = ldexp_saturating(prob.tolerance, -e)
     rhs = [None] * (top + 1)
-    rhs[top] = prob.b
+    rhs[top] = scaled(prob.b, -e)
     for lvl in range(top - 1, -1, -1):
-        rhs[lvl] = levels[lvl].b if levels is not None else mg.restrictions[lvl] @ rhs[lvl + 1]
+        rhs[lvl] = (scaled(levels[lvl].b, -e) if levels is not None
+                    else mg.restrictions[lvl] @ rhs[lvl + 1])
 
     cycles, rho = [0] * (top + 1), rho0
     etas = [float("nan")] * (top + 1)
@@ -209,14 +215,14 @@ def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | 
     stopped_by, reason, message = "maxiter", "maxiter", ""
     if top == 0:  # one level: the coarse factorisation is a direct solve
         prob.x = mg.vcycle(prob.b, 0)
-        residuals = [float(np.linalg.norm(prob.b - prob.A @ prob.x))]
+        residuals = [norm2(prob.b - prob.A @ prob.x)]
         stopped_by, reason = "direct coarse solve", "converged"
     for lvl in range(1, top + 1):
         A_l = mg.levels[lvl].A
         P = mg.prolongations[lvl - 1]
         if levels is not None:
-            full = levels[lvl - 1].expand(x)
-            x = mg.hierarchy.prolongate(full, lvl - 1)[mg.frees[lvl]]
+            full = levels[lvl - 1].expand(scaled(x, e))   # Dirichlet values in b's units
+            x = scaled(mg.hierarchy.prolongate(full, lvl - 1)[mg.frees[lvl]], -e)
         else:
             x = P @ x
         r = rhs[lvl] - A_l @ x
@@ -227,7 +233,8 @@ def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | 
         started = bool(np.any(x_start))  # else eta measures the solution, not an error
         finest = lvl == top
         if finest:
-            residuals.append(float(np.linalg.norm(r)))
+            residuals.append(norm2(r))
+            last_true = None    # true residual at the last residual replacement
         limit = prob.maxiter if finest else MAX_LEVEL_CYCLES
         prev_d = None
         met = False
@@ -244,33 +251,54 @@ def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | 
             alg = rho / (1.0 - rho) * dA
             eta = math.sqrt(max(float(x @ r0) - float(x @ r) - s00 + float(x_start @ r), 0.0) / 3.0)
             if finest:
-                res_norm = float(np.linalg.norm(r))
+                res_norm = norm2(r)
                 residuals.append(res_norm)
                 if callback is not None:
-                    callback(x)
+                    callback(scaled(x, e))
                 if not math.isfinite(res_norm):
                     reason, message = "non-finite", f"residual became {res_norm} at cycle {cycles[lvl]}"
                     break
-                if res_norm <= prob.tolerance:
-                    stopped_by, reason, met = "residual rule", "converged", True
-                    break
+                estimate_met = (target == "discretisation" and credible and started
+                                and alg <= fraction * eta)
+                if res_norm <= tol or estimate_met:
+                    # residual replacement (van der Vorst and Ye 2000) before any verdict
+                    true_r = rhs[lvl] - A_l @ x
+                    true_norm = norm2(true_r)
+                    if true_norm <= tol or (estimate_met and true_norm <= 2.0 * res_norm + tol):
+                        stopped_by = ("residual rule" if res_norm <= tol and true_norm <= tol
+                                      else "discretisation-error estimate")
+                        reason, met = "converged", True
+                        break
+                    if last_true is not None and not true_norm < last_true:
+                        reason = "stagnation"
+                        message = (f"the true residual {unscale(true_norm, e):.3e} did not "
+                                   f"decrease across a residual replacement (it was "
+                                   f"{unscale(last_true, e):.3e}); tolerance "
+                                   f"{prob.tolerance:.3e}: rounding errors limit the attainable "
+                                   f"accuracy")
+                        break
+                    last_true, r = true_norm, true_r
+                    continue
             if not finest and (target == "residual" or not credible or not started) \
                     and cycles[lvl] >= 2:
                 break  # a start for the next level is all a lower level is for here
-            if target == "discretisation" and credible and started and alg <= fraction * eta:
-                if finest:
-                    stopped_by, reason, met = "discretisation-error estimate", "converged", True
+            if not finest and target == "discretisation" and credible and started \
+                    and alg <= fraction * eta:
                 break
         # a start of zeros (the coarser level had no free node) estimates nothing
         etas[lvl] = eta if started else float("nan")
         if math.isfinite(etas[lvl - 1]) and not eta <= ESTIMATE_DECAY * etas[lvl - 1]:
             credible = False  # from now on only the residual rule stops
         if finest:
-            prob.x = x
+            prob.x = scaled(x, e)
             if not met and reason == "maxiter":
                 message = (f"maxiter = {prob.maxiter} V-cycles on the finest level reached; "
-                           f"algebraic error bound {alg:.3e}, estimated discretisation error "
-                           f"{eta:.3e}")
+                           f"algebraic error bound {unscale(alg, e):.3e}, estimated "
+                           f"discretisation error {unscale(eta, e):.3e}")
+    alg, eta = unscale(alg, e), unscale(eta, e)   # energy norms in the units of b
+    etas = [unscale(v, e) for v in etas]
+    if top:
+        residuals = list(unscale_all(residuals, e))
     res = finish(prob, iterations=cycles[top] if top else 0, residuals=residuals,
                  reason="converged" if stopped_by == "residual rule" else reason,
                  message=message, method="fmg", recursive_met=stopped_by == "residual rule")

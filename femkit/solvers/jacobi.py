@@ -3,8 +3,10 @@
 ``x_{k+1} = x_k + omega D^-1 r_k`` with ``r_k = b - A x_k`` and ``D = diag(A)``; ``omega = 1``
 is the classical Jacobi iteration. It converges for strictly diagonally dominant matrices,
 and for SPD ``A`` exactly when ``0 < omega < 2 / lambda_max(D^-1 A)`` (``omega = 2/3`` is the
-classical smoothing weight). A divergent iteration stops with ``reason="non-finite"``
-(returning the last finite iterate) or ``"maxiter"``, never a silent NaN.
+classical smoothing weight). A divergent iteration (residual above :data:`DIVERGENCE_FACTOR`
+times the initial one) stops with ``reason="non-finite"`` (returning the last iterate before) or
+``"maxiter"``, never a silent NaN; a residual (the true one: recomputed every iteration) with no new
+minimum for ``max(1000, n)`` iterations stops with ``reason="stagnation"`` at the best iterate.
 """
 
 from __future__ import annotations
@@ -17,9 +19,17 @@ import numbers
 import numpy as np
 
 from ..errors import InputError
-from .checks import (as_apply, check_positive_diagonal, diagonal_of, finish,
-                     nonfinite_initial_residual, prepare, zero_rhs_result)
+from .checks import (as_apply, check_positive_diagonal, dependency_boundary, diagonal_of,
+                     finish, nonfinite_initial_residual, prepare, zero_rhs_result)
+from .norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
+from .pcg import STAGNATION_WINDOW
 from .result import SolveResult
+
+
+#: Growth of the residual over the initial one at which the iteration is declared divergent
+#: (``reason="non-finite"``): a relative, scale-invariant test, met long before the iterates of
+#: any representable system overflow, so the verdict and its iteration do not depend on units.
+DIVERGENCE_FACTOR = 1e100
 
 
 def jacobi(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
@@ -64,42 +74,65 @@ def jacobi(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxi
         scale = 1.0
     else:
         scale = float(omega)
-    if prob.rhs_norm == 0.0:
+    if prob.b_is_zero:
         return zero_rhs_result(prob, method="jacobi")
-    matvec, b, x, tol = prob.matvec, prob.b, prob.x, prob.tolerance
-    r = b - matvec(x)
-    res = float(np.linalg.norm(r))
+    # the normalised system 2^-e b (femkit.solvers.norms): exact scaling, so the iterates are
+    # those on b; the residual is the true one every iteration, so there is no stagnation verdict
+    e = prob.exponent
+    matvec, b, x = prob.matvec, scaled(prob.b, -e), scaled(prob.x, -e)
+    tol = ldexp_saturating(prob.tolerance, -e)
+    with np.errstate(over="ignore", invalid="ignore"):
+        r = b - matvec(x)
+    res = norm2(r) if np.all(np.isfinite(r)) else float("inf")
     residuals = [res]
     reason, message, k = "maxiter", nonfinite_initial_residual(res), 0
+    # the residual is the true one: a window without a new minimum is stagnation (the rounding
+    # floor), and x goes back to the best iterate (Jacobi is stationary: a restart from it
+    # repeats the iterations that found nothing better)
+    window = max(STAGNATION_WINDOW, prob.n)
+    best, best_k, best_x = res, 0, x
     if message:
         reason = "non-finite"
     elif res <= tol:
         reason = "converged"
     while reason == "maxiter" and k < prob.maxiter:
-        step = apply_M(r)
+        with dependency_boundary("jacobi", prob.A):   # a user M from a dependency
+            step = apply_M(r)
         x_new = x + step if scale == 1.0 else x + scale * step
         with np.errstate(over="ignore", invalid="ignore"):
             r_new = b - matvec(x_new)
-            res = float(np.linalg.norm(r_new))
-        if not math.isfinite(res):
+            res = norm2(r_new) if np.all(np.isfinite(r_new)) else float("inf")
+        if not res <= DIVERGENCE_FACTOR * residuals[0]:   # also NaN / inf
             reason = "non-finite"
-            message = (f"jacobi diverged: the residual overflowed at iteration {k + 1} "
-                       f"(last finite residual {residuals[-1]:.3e}, initial {residuals[0]:.3e}); "
-                       f"A is not diagonally dominant enough for omega = {omega}; "
-                       f"returning the last finite iterate")
+            message = (f"jacobi diverged: the residual grew beyond {DIVERGENCE_FACTOR:.0e} times "
+                       f"the initial one at iteration {k + 1} (last residual "
+                       f"{unscale(residuals[-1], e):.3e}, initial {unscale(residuals[0], e):.3e}); "
+                       f"A is not diagonally dominant enough for omega = {omega}; returning the "
+                       f"last iterate before")
             break
         x, r = x_new, r_new
         k += 1
         residuals.append(res)
         if callback is not None:
-            callback(x)
+            callback(scaled(x, e))
         if res <= tol:
             reason = "converged"
+        elif res < best:
+            best, best_k, best_x = res, k, x
+        elif k - best_k >= window:
+            reason = "stagnation"
+            message = (f"stagnation: the true residual has not decreased for {window} iterations "
+                       f"(best {unscale(best, e):.3e} at iteration {best_k}, the iterate returned; "
+                       f"tolerance {prob.tolerance:.3e}): rounding errors limit the attainable "
+                       f"accuracy")
+            x = best_x
     if reason == "maxiter":
         growth = residuals[-1] / residuals[0] if residuals[0] > 0 else float("nan")
-        message = (f"maxiter = {prob.maxiter} reached; residual {residuals[-1]:.3e} > tolerance "
-                   f"{tol:.3e} (residual ratio to initial {growth:.3e}"
+        message = (f"maxiter = {prob.maxiter} reached; residual {unscale(residuals[-1], e):.3e} > "
+                   f"tolerance {prob.tolerance:.3e} (residual ratio to initial {growth:.3e}"
                    f"{', diverging' if growth > 1 else ''})")
+    x = scaled(x, e)
+    residuals = unscale_all(residuals, e)
     prob.x = x
     return finish(prob, iterations=k, residuals=residuals, reason=reason, message=message,
                   method="jacobi", info={"omega": float(omega)})

@@ -23,8 +23,8 @@ from typing import Callable
 import numpy as np
 from scipy.linalg.blas import daxpy
 
-from .checks import (Problem, as_apply, finish, nonfinite_initial_residual, prepare,
-                     record_iteration, zero_rhs_result)
+from .checks import Problem, Replacement, as_apply, dependency_boundary, prepare, zero_rhs_result
+from .norms import curvature_check, inner_rounding, norm2
 from .result import SolveResult
 
 #: Smallest stagnation window: iterations without a new best residual after which the iteration
@@ -39,110 +39,100 @@ STAGNATION_WINDOW = 1000
 def _krylov_loop(prob: Problem, apply_M: Callable | None, *, method: str, callback=None,
                  stagnation_window: int | None = None,
                  raise_on_breakdown: bool = False) -> SolveResult:
-    """Shared CG / PCG loop (``apply_M=None``: plain CG, ``z = r`` without a copy)."""
-    if stagnation_window is None:
-        stagnation_window = max(STAGNATION_WINDOW, prob.n)
-    from ..errors import NotSPDError
+    """Shared CG / PCG loop (``apply_M=None``: plain CG, ``z = r`` without a copy).
 
-    matvec, b, x, tol, maxiter = prob.matvec, prob.b, prob.x, prob.tolerance, prob.maxiter
-    r = b - matvec(x)
-    rr = float(np.dot(r, r))
-    res = math.sqrt(rr)
-    residuals = [res]
-    if res <= tol:
-        return finish(prob, iterations=0, residuals=residuals, reason="converged",
-                      method=method, recursive_met=True)
-    bad = nonfinite_initial_residual(res)
-    if bad:
-        return finish(prob, iterations=0, residuals=residuals, reason="non-finite",
-                      message=bad, method=method)
-    if apply_M is None:
-        z, rz = r, rr
-    else:
-        z = apply_M(r)
-        if np.shape(z) != r.shape:
-            from ..errors import InputError
+    Runs on the normalised system in cycles with residual replacement
+    (:class:`~femkit.solvers.checks.Replacement`): a cycle ends when the recursive residual meets
+    the tolerance or has not reached a new minimum for ``stagnation_window`` iterations; the
+    true residual then decides between converged, stagnation and a restart of the recursion.
+    """
+    from ..errors import InputError, NotSPDError
 
-            raise InputError(f"the preconditioner returned shape {np.shape(z)} for a residual of "
-                             f"shape {r.shape}; M(r) must return an array of r's shape")
-        rz = float(np.dot(r, z))
-    reason, message = "maxiter", ""
-    if not rz > 0:
-        reason, message = _rz_failure(rz, 0)
-        return _stop(prob, 0, residuals, reason, message, method, raise_on_breakdown, NotSPDError)
-    p = np.array(z, dtype=np.float64, copy=True)
-    best, best_k = res, 0
-    k = 0
-    recursive_met = False
-    while k < maxiter:
-        q = matvec(p)
-        pq = float(np.dot(p, q))
-        if not pq > 0:
-            if math.isfinite(pq):
-                reason = "breakdown"
-                message = (f"indefinite direction: p^T A p = {pq:.3e} at iteration {k + 1}; "
-                           f"A is not positive definite")
+    window = max(STAGNATION_WINDOW, prob.n) if stagnation_window is None else stagnation_window
+    cyc = Replacement(prob)
+    matvec, maxiter, x = prob.matvec, prob.maxiter, cyc.x
+    k, ended = 0, ""
+    with np.errstate(over="ignore", invalid="ignore"):
+        while True:
+            r, rr, stop = cyc.start(k, ended=ended, window=window)
+            if stop:
+                reason, message = stop
+                break
+            x = cyc.x
+            if apply_M is None:
+                z, rz = r, rr
             else:
-                reason, message = "non-finite", f"p^T A p = {pq} at iteration {k + 1}"
-            break
-        alpha = rz / pq
-        daxpy(p, x, a=alpha)
-        daxpy(q, r, a=-alpha)
-        if apply_M is None:
-            rr = float(np.dot(r, r))
-            rz_new = rr
-        else:
-            z = apply_M(r)
-            rz_new = float(np.dot(r, z))
-            rr = float(np.dot(r, r))
-        k += 1
-        res = math.sqrt(rr) if rr >= 0 else float("nan")
-        bad = record_iteration(residuals, res, x, callback, k)
-        if bad:
-            reason, message = "non-finite", bad
-            break
-        if res <= tol:
-            reason, recursive_met = "converged", True
-            break
-        if res < best:
-            best, best_k = res, k
-        elif k - best_k >= stagnation_window:
-            reason = "stagnation"
-            message = (f"no residual decrease for {stagnation_window} iterations "
-                       f"(best {best:.3e} at iteration {best_k}, tolerance {tol:.3e})")
-            break
-        if not rz_new > 0:
-            reason, message = _rz_failure(rz_new, k)
-            break
-        beta = rz_new / rz
-        rz = rz_new
-        if apply_M is None:
-            p *= beta
-            p += r
-        else:
-            p *= beta
-            p += z
-    else:
-        message = f"maxiter = {maxiter} reached; residual {res:.3e} > tolerance {tol:.3e}"
-    return _stop(prob, k, residuals, reason, message, method, raise_on_breakdown, NotSPDError,
-                 recursive_met=recursive_met)
-
-
-def _rz_failure(rz: float, k: int) -> tuple[str, str]:
-    if math.isfinite(rz):
-        return "breakdown", (f"r^T M r = {rz:.3e} <= 0 at iteration {k}: "
-                             f"the preconditioner is not positive definite")
-    return "non-finite", f"r^T M r = {rz} at iteration {k}"
-
-
-def _stop(prob, k, residuals, reason, message, method, raise_on_breakdown, err, *,
-          recursive_met=False) -> SolveResult:
+                z = apply_M(r)
+                if np.shape(z) != r.shape:
+                    raise InputError(f"the preconditioner returned shape {np.shape(z)} for a "
+                                     f"residual of shape {r.shape}; M(r) must return an array "
+                                     f"of r's shape")
+                rz = float(np.dot(r, z))
+            reason, message = _rz_failure(rz, r, z, k) or ("maxiter", "")
+            if reason != "maxiter":
+                break
+            p = np.array(z, dtype=np.float64, copy=True)
+            best, best_k = math.sqrt(rr), k
+            ended = ""
+            while k < maxiter:
+                q = matvec(p)
+                pq = float(np.dot(p, q))
+                failure = curvature_check(pq, p, q, k=k + 1)
+                if failure:
+                    reason, message = failure
+                    break
+                alpha = rz / pq
+                daxpy(p, x, a=alpha)
+                daxpy(q, r, a=-alpha)
+                if apply_M is None:
+                    rr = float(np.dot(r, r))
+                    rz_new = rr
+                else:
+                    z = apply_M(r)
+                    rz_new = float(np.dot(r, z))
+                    rr = float(np.dot(r, r))
+                k += 1
+                res = math.sqrt(rr) if rr >= 0 else float("nan")
+                ended, stop = cyc.record(res, k, callback)
+                if stop:
+                    reason, message = stop
+                if ended or stop:
+                    break
+                if res < best:
+                    best, best_k = res, k
+                elif k - best_k >= window:
+                    ended = "window"
+                    break
+                failure = _rz_failure(rz_new, r, z, k)
+                if failure:
+                    reason, message = failure
+                    break
+                beta = rz_new / rz
+                rz = rz_new
+                p *= beta
+                p += z
+            else:
+                reason, message = "maxiter", (
+                    f"maxiter = {maxiter} reached; residual {cyc.unscaled(res):.3e} > "
+                    f"tolerance {prob.tolerance:.3e}")
+            if not ended:   # breakdown, non-finite or maxiter inside the recursion
+                break
     if reason == "breakdown" and raise_on_breakdown:
-        raise err(f"{method}: {message}")
-    if reason == "non-finite" and not np.all(np.isfinite(prob.x)):
-        message += "; the returned x contains non-finite values"
-    return finish(prob, iterations=k, residuals=residuals, reason=reason, message=message,
-                  method=method, recursive_met=recursive_met)
+        raise NotSPDError(f"{method}: {message}")
+    return cyc.finish(iterations=k, reason=reason, message=message, method=method)
+
+
+def _rz_failure(rz: float, r: np.ndarray, z: np.ndarray, k: int) -> tuple[str, str] | None:
+    """``r^T M r`` must be positive (on the normalised system its sign is free of underflow);
+    a non-positive value is judged relative to ``||r|| ||M r||`` for the message."""
+    if rz > 0:
+        return None
+    if not math.isfinite(rz):
+        return "non-finite", f"r^T M r = {rz} at iteration {k}"
+    size = "within rounding of 0" if abs(rz) <= inner_rounding(r.size) * norm2(r) * norm2(z) \
+        else "negative"
+    return "breakdown", (f"r^T M r = {rz:.3e} ({size}, relative to ||r|| ||M r||) at iteration "
+                         f"{k}: the preconditioner is not positive definite")
 
 
 def pcg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
@@ -195,8 +185,10 @@ def pcg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter
     method = "pcg" if M is not None else "cg"
     prob = prepare(A, b, x0, rtol=rtol, atol=atol, maxiter=maxiter, method=method,
                    symmetric=True, check_symmetry=check_symmetry)
-    if prob.rhs_norm == 0.0:
+    if prob.b_is_zero:
         return zero_rhs_result(prob, method=method)
-    return _krylov_loop(prob, as_apply(M, prob.n), method=method, callback=callback,
-                        stagnation_window=stagnation_window,
-                        raise_on_breakdown=raise_on_breakdown)
+    pc = f" with preconditioner {getattr(M, 'name', type(M).__name__)!r}" if M is not None else ""
+    with dependency_boundary(f"{method}{pc}", prob.A):   # e.g. a pyamg cycle failing
+        return _krylov_loop(prob, as_apply(M, prob.n), method=method, callback=callback,
+                            stagnation_window=stagnation_window,
+                            raise_on_breakdown=raise_on_breakdown)

@@ -2,7 +2,9 @@
 
 For SPD ``A``: ``r = b - A x``, ``alpha = (r, z) / (z, A z)`` with ``z = M r`` (``z = r``
 without preconditioner), ``x += alpha z``, ``r -= alpha A z``. One product per iteration;
-the residual is recursive, re-checked against the true residual at exit.
+the residual is recursive: when it meets the tolerance the true residual is recomputed and, if it
+does not, the recursion restarts from it (residual replacement, van der Vorst and Ye 2000);
+stagnation is declared only when the true residual stops decreasing across a replacement.
 """
 
 from __future__ import annotations
@@ -14,8 +16,8 @@ import math
 import numpy as np
 from scipy.linalg.blas import daxpy
 
-from .checks import (as_apply, finish, nonfinite_initial_residual, prepare, record_iteration,
-                     zero_rhs_result)
+from .checks import Replacement, as_apply, dependency_boundary, prepare, zero_rhs_result
+from .norms import curvature_check
 from .result import SolveResult
 
 
@@ -38,39 +40,41 @@ def steepest_descent(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float =
     """
     prob = prepare(A, b, x0, rtol=rtol, atol=atol, maxiter=maxiter, method="sd",
                    symmetric=True, check_symmetry=check_symmetry)
-    if prob.rhs_norm == 0.0:
+    if prob.b_is_zero:
         return zero_rhs_result(prob, method="sd")
     apply_M = as_apply(M, prob.n)
-    matvec, x, tol = prob.matvec, prob.x, prob.tolerance
-    r = prob.b - matvec(x)
-    res = float(np.linalg.norm(r))
-    residuals = [res]
-    reason, message, k, met = "maxiter", nonfinite_initial_residual(res), 0, res <= tol
-    if message:
-        reason = "non-finite"
-    elif met:
-        reason = "converged"
-    while reason == "maxiter" and k < prob.maxiter:
-        z = r if apply_M is None else apply_M(r)
-        q = matvec(z)
-        zq = float(np.dot(z, q))
-        if not zq > 0:
-            reason = "breakdown" if math.isfinite(zq) else "non-finite"
-            message = (f"indefinite direction: z^T A z = {zq:.3e} at iteration {k + 1}"
-                       if reason == "breakdown" else f"z^T A z = {zq} at iteration {k + 1}")
-            break
-        alpha = float(np.dot(r, z)) / zq
-        daxpy(z, x, a=alpha)
-        daxpy(q, r, a=-alpha)
-        k += 1
-        res = float(np.linalg.norm(r))
-        bad = record_iteration(residuals, res, x, callback, k)
-        if bad:
-            reason, message = "non-finite", bad
-            break
-        if res <= tol:
-            reason, met = "converged", True
-    if reason == "maxiter":
-        message = f"maxiter = {prob.maxiter} reached; residual {res:.3e} > tolerance {tol:.3e}"
-    return finish(prob, iterations=k, residuals=residuals, reason=reason, message=message,
-                  method="sd", recursive_met=met)
+    cyc = Replacement(prob)   # normalised system, residual replacement before any stagnation
+    matvec = prob.matvec
+    k, ended = 0, ""
+    with np.errstate(over="ignore", invalid="ignore"), dependency_boundary("sd", prob.A):
+        while True:
+            r, rr, stop = cyc.start(k, ended=ended)
+            if stop:
+                reason, message = stop
+                break
+            x, ended = cyc.x, ""
+            reason, message = "maxiter", ""
+            while k < prob.maxiter:
+                z = r if apply_M is None else apply_M(r)
+                q = matvec(z)
+                zq = float(np.dot(z, q))
+                failure = curvature_check(zq, z, q, k=k + 1, what="z^T A z")
+                if failure:
+                    reason, message = failure
+                    break
+                k += 1
+                alpha = float(np.dot(r, z)) / zq
+                daxpy(z, x, a=alpha)
+                daxpy(q, r, a=-alpha)
+                res = math.sqrt(float(np.dot(r, r)))
+                ended, stop = cyc.record(res, k, callback)
+                if stop:
+                    reason, message = stop
+                if ended or stop:
+                    break
+            else:
+                message = (f"maxiter = {prob.maxiter} reached; residual {cyc.unscaled(res):.3e} "
+                           f"> tolerance {prob.tolerance:.3e}")
+            if not ended:
+                break
+    return cyc.finish(iterations=k, reason=reason, message=message, method="sd")

@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import InputError, SolverError, StabilityWarning
+from ...solvers.norms import norm2
 from ...solvers.spec import SolverSpec
 
 __all__ = [
@@ -335,7 +336,7 @@ def _solve_reusing_factor(A, b: np.ndarray, ctx: StepContext, key: str, x0=None,
 
     kept = ctx.cache.get(key)
     b = np.asarray(b, dtype=float)
-    if kept is not None and tuple(kept.factor.shape) == A.shape and float(np.linalg.norm(b)) > 0.0:
+    if kept is not None and tuple(kept.factor.shape) == A.shape and b.any():
         t0 = time.perf_counter()
         spec = replace(ctx.linear_solver, method="pcg", preconditioner=kept.factor,
                        maxiter=REUSE_MAX_ITERATIONS, options={"check_symmetry": False})
@@ -362,9 +363,9 @@ def _solve_direct_reusing_ordering(A, b: np.ndarray, ctx: StepContext,
 
     ctx.count("linear_solves")
     b = np.asarray(b, dtype=float)
-    bnorm = float(np.linalg.norm(b))
-    if bnorm == 0.0:
+    if not b.any():   # b = 0 decided by its entries, not by a norm that may underflow
         return np.zeros_like(b)
+    bnorm = norm2(b)
     A = sp.csr_matrix(A)
     t_factor = time.perf_counter()
     factor = _ordered_factor(A, ctx)
@@ -383,7 +384,7 @@ def _checked_solve(factor, A, b: np.ndarray, bnorm: float, ctx: StepContext, nam
     t0 = time.perf_counter()
     x = factor.solve(b)
     _add_time(ctx, "time_solve", time.perf_counter() - t0)
-    res = float(np.linalg.norm(b - A @ x))
+    res = norm2(b - A @ x)
     rtol, atol = ctx.linear_solver.rtol, ctx.linear_solver.atol
     if not (np.isfinite(res) and res <= max(rtol * bnorm, atol)):
         raise SolverError(
@@ -458,9 +459,9 @@ def solve_cholesky(A, b: np.ndarray, ctx: StepContext, pattern, key: str = "chol
 
     ctx.count("linear_solves")
     b = np.asarray(b, dtype=float)
-    bnorm = float(np.linalg.norm(b))
-    if bnorm == 0.0:
+    if not b.any():
         return np.zeros_like(b)
+    bnorm = norm2(b)
     kept = ctx.cache.get(key)
     t0 = time.perf_counter()
     # Coordinate pairs (x-y, y-z ...) whose couplings have all been exactly zero so far (the

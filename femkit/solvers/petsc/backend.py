@@ -144,7 +144,7 @@ def ksp_solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None 
         try:
             ksp.setFromOptions()
         except PETSc.Error as exc:
-            raise petsc_error(exc, what) from None
+            raise petsc_error(exc, what) from exc
 
     with popts.scoped(prefix, {**extra, **user}):
         # reading the options fails alike on every rank: raised on all, no MPI_Abort needed
@@ -154,16 +154,17 @@ def ksp_solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None 
             ksp.setUp()
             setup = time.perf_counter() - t0
         except PETSc.Error as exc:
-            raise petsc_error(exc, what) from None
+            raise petsc_error(exc, what) from exc
         collective(mpi, popts.check_used, prefix, user)
         t0 = time.perf_counter()
-        if bnorm == 0.0 and x0 is None:
+        # b = 0 decided by its entries (max |b_i|), not by a 2-norm that may underflow
+        if b.norm(PETSc.NormType.NORM_INFINITY) == 0.0 and x0 is None:
             its, code = 0, None
         else:
             try:
                 ksp.solve(b, x)
             except PETSc.Error as exc:
-                raise petsc_error(exc, f"the solve ({method}/{pc_name})") from None
+                raise petsc_error(exc, f"the solve ({method}/{pc_name})") from exc
             its, code = ksp.getIterationNumber(), ksp.getConvergedReason()
         solve = time.perf_counter() - t0
     r = b.duplicate()

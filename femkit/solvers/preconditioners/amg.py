@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from ..checks import explicit_csr, unknown_options
+from ..checks import dependency_boundary, explicit_csr, unknown_options
 from .base import Preconditioner
 
 
@@ -56,8 +56,42 @@ def vcycle_apply(ml):
     return apply
 
 
-def _wrap(name: str, ml, cycle: str, t0: float) -> Preconditioner:
-    apply = vcycle_apply(ml) if cycle == "V" else ml.aspreconditioner(cycle=cycle).matvec
+#: State of NumPy's global generator during a pyamg set-up (``RandomState(SETUP_DRAW)``'s;
+#: the caller's state is restored afterwards): pyamg draws the
+#: start vectors of its spectral-radius estimates (Jacobi prolongation smoothing, smoother
+#: weights) from it, so without a fixed state the same matrix gets a different preconditioner, and a
+#: different iteration count, on every call.
+SETUP_DRAW = 0
+
+
+def _setup(build, A, what: str, opts: dict):
+    """``build(2^-e A, **opts)`` under :data:`SETUP_DRAW` and the solver boundary; returns the
+    multilevel solver and ``e``.
+
+    pyamg sees ``A`` normalised to entries of order one (``2^e`` the binary order of its largest
+    entry; an exact scaling): LAPACK, behind pyamg's coarse ``pinv``, rescales matrices whose
+    norm is below ~1e-138 or above ~1e138 by a factor that is not a power of two, so without it
+    the same system in other units got a different preconditioner."""
+    from ..norms import binary_exponent
+
+    e = binary_exponent(A.data)
+    if e:
+        A = A.copy()
+        A.data = np.ldexp(A.data, -e)
+    state = np.random.get_state()
+    np.random.set_state(np.random.RandomState(SETUP_DRAW).get_state())
+    try:
+        with dependency_boundary(what, A):
+            return build(A, **opts), e
+    finally:
+        np.random.set_state(state)
+
+
+def _wrap(name: str, built, cycle: str, t0: float) -> Preconditioner:
+    ml, e = built
+    cycle_apply = vcycle_apply(ml) if cycle == "V" else ml.aspreconditioner(cycle=cycle).matvec
+    # ml approximates (2^-e A)^-1 = 2^e A^-1
+    apply = cycle_apply if e == 0 else (lambda r: np.ldexp(cycle_apply(r), -e))
     dt = time.perf_counter() - t0
     info = {
         "levels": len(ml.levels),
@@ -66,6 +100,7 @@ def _wrap(name: str, ml, cycle: str, t0: float) -> Preconditioner:
         "cycle": cycle,
         "coarse_size": int(ml.levels[-1].A.shape[0]),
         "hierarchy": ml,
+        "scale_exponent": int(e),
     }
     return Preconditioner(name, apply, ml.levels[0].A.shape[0], dt, info)
 
@@ -91,8 +126,9 @@ def build_sa(A, *, cycle: str = "V", **opts) -> Preconditioner:
 
     _check_opts(pyamg.smoothed_aggregation_solver, opts, "amg_sa")
     t0 = time.perf_counter()
-    ml = pyamg.smoothed_aggregation_solver(_csr(A), **opts)
-    return _wrap("amg_sa", ml, cycle, t0)
+    built = _setup(pyamg.smoothed_aggregation_solver, _csr(A),
+                   "preconditioner 'amg_sa' (pyamg set-up)", opts)
+    return _wrap("amg_sa", built, cycle, t0)
 
 
 def build_rs(A, *, cycle: str = "V", **opts) -> Preconditioner:
@@ -101,8 +137,9 @@ def build_rs(A, *, cycle: str = "V", **opts) -> Preconditioner:
 
     _check_opts(pyamg.ruge_stuben_solver, opts, "amg_rs")
     t0 = time.perf_counter()
-    ml = pyamg.ruge_stuben_solver(_csr(A), **opts)
-    return _wrap("amg_rs", ml, cycle, t0)
+    built = _setup(pyamg.ruge_stuben_solver, _csr(A), "preconditioner 'amg_rs' (pyamg set-up)",
+                   opts)
+    return _wrap("amg_rs", built, cycle, t0)
 
 
 #: Default AMG flavour behind the ``amg`` alias.

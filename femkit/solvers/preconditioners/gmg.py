@@ -33,7 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...errors import HierarchyError, InputError
-from ..checks import check_positive_diagonal, check_symmetric, explicit_csr
+from ..checks import check_positive_diagonal, check_symmetric, dependency_boundary, explicit_csr
 from .base import Preconditioner
 
 #: Over-relaxation of the smoothing sweeps. Measured V(2,2) energy-norm factors (asymptotic, 7
@@ -402,8 +402,9 @@ def build(A, *, hierarchy=None, free=None, sweeps: int = 2, omega: float = DEFAU
     if hierarchy is None:
         raise _hierarchy_error("preconditioner 'gmg'")
     t0 = time.perf_counter()
-    mg = Multigrid(A, hierarchy, free=free, sweeps=sweeps, coarse_operators=coarse_operators,
-                   omega=omega, check_symmetry=False)  # pcg checks A once
+    with dependency_boundary("preconditioner 'gmg' (set-up)", A):
+        mg = Multigrid(A, hierarchy, free=free, sweeps=sweeps, coarse_operators=coarse_operators,
+                       omega=omega, check_symmetry=False)  # pcg checks A once
     info = dict(mg.info)
     info["hierarchy"] = mg
     return Preconditioner("gmg", mg.vcycle, mg.levels[-1].A.shape[0],
