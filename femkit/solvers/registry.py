@@ -23,7 +23,7 @@ from ..errors import InputError
 from ..registry import Registry
 from . import defaults
 from .defaults import default_preconditioner
-from .pairing import check_pairing
+from .pairing import PRECONDITIONED_METHOD, check_pairing
 from .cg import cg
 from .checks import check_options
 from .cholesky import cholesky
@@ -55,10 +55,14 @@ class Traits:
     own_setup_time : bool
         The method times its own setup (factorisation, multigrid setup) in ``setup_time``;
         :func:`solve` then reports ``solve_time`` as the rest.
+    needs_hierarchy : bool
+        Geometric multigrid: the caller passes a :class:`~femkit.mesh.MeshHierarchy`
+        (``hierarchy=``, ``free=``) at solve time.
     """
 
     matrix_free: bool = False
     own_setup_time: bool = False
+    needs_hierarchy: bool = False
 
 
 def declare(entry: Callable, **traits) -> Callable:
@@ -78,7 +82,7 @@ SOLVERS.register("sd", steepest_descent)
 SOLVERS.register("cg", declare(cg, matrix_free=True))
 SOLVERS.register("pcg", declare(pcg, matrix_free=True))
 SOLVERS.register("direct", declare(direct, own_setup_time=True))
-SOLVERS.register("fmg", declare(fmg, own_setup_time=True))
+SOLVERS.register("fmg", declare(fmg, own_setup_time=True, needs_hierarchy=True))
 SOLVERS.register("cholesky", declare(cholesky, own_setup_time=True))
 
 
@@ -95,7 +99,7 @@ PRECONDITIONERS.register("ic0", _ic0.build)
 PRECONDITIONERS.register("amg_sa", _amg.build_sa)
 PRECONDITIONERS.register("amg_rs", _amg.build_rs)
 PRECONDITIONERS.register("amg", _amg.build)
-PRECONDITIONERS.register("gmg", _gmg.build)
+PRECONDITIONERS.register("gmg", declare(_gmg.build, needs_hierarchy=True))
 
 
 class FemkitBackend:
@@ -240,7 +244,7 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
         setup = time.perf_counter() - t0
         pc_name = preconditioner
     t0 = time.perf_counter()
-    if method == "pcg":
+    if method == PRECONDITIONED_METHOD:
         res = fn(A, b, x0, rtol=rtol, atol=atol, maxiter=maxiter, M=M, callback=callback,
                  **options)
     else:

@@ -54,6 +54,7 @@ import numpy as np
 
 from ..errors import InputError, SolverError
 from .factor import Factor, PermutedFactor
+from .pairing import PRECONDITIONED_METHOD
 from .registry import PRECONDITIONERS, SOLVERS, matrix_free_names, traits
 
 __all__ = ["LinearSession", "check_matrix_free", "matrix_free_message", "MATRIX_FREE_MESSAGE",
@@ -91,7 +92,7 @@ def check_matrix_free(name: str, spec) -> None:
                          f"backend {spec.backend!r} needs the assembled matrix")
     if not traits(SOLVERS, spec.method).matrix_free:
         raise InputError(f"{name}: {MATRIX_FREE_MESSAGE}; got linear solver {spec.method!r}")
-    pc = spec.preconditioner if spec.method == "pcg" else "none"
+    pc = spec.preconditioner if spec.method == PRECONDITIONED_METHOD else "none"
     if not traits(PRECONDITIONERS, pc).matrix_free:
         raise InputError(f"{name}: {MATRIX_FREE_MESSAGE}; preconditioner {pc!r} needs the "
                          f"assembled matrix")
@@ -170,7 +171,7 @@ class LinearSession:
         if spec.backend != "femkit":
             kw.update(backend=spec.backend, petsc_options=spec.petsc_options or None)
         return solve(A, b, x0, method=spec.method,
-                     preconditioner=spec.preconditioner if spec.method == "pcg" else None,
+                     preconditioner=spec.preconditioner if spec.method == PRECONDITIONED_METHOD else None,
                      callback=callback, preconditioner_options=pc_options or None,
                      **kw, **options)
 
@@ -202,7 +203,7 @@ class LinearSession:
         spec = self.spec
         if isinstance(A, LinearOperator):
             check_matrix_free("matrix-free solve", spec)
-            if spec.method == "pcg" and spec.preconditioner == "jacobi":
+            if spec.method == PRECONDITIONED_METHOD and spec.preconditioner == "jacobi":
                 if diagonal is None:
                     raise InputError("matrix-free pcg with jacobi needs the operator's diagonal")
                 spec = replace(spec, preconditioner_options={**spec.preconditioner_options,

@@ -122,7 +122,10 @@ class SolverSpec:
     def needs_hierarchy(self) -> bool:
         """Geometric multigrid (``method: fmg`` or ``preconditioner: gmg``): the caller passes a
         :class:`~femkit.mesh.MeshHierarchy` (``hierarchy=``, ``free=``) at solve time."""
-        return self.method == "fmg" or self.preconditioner == "gmg"
+        from .registry import PRECONDITIONERS, SOLVERS, traits
+
+        return (traits(SOLVERS, self.method).needs_hierarchy
+                or traits(PRECONDITIONERS, self.preconditioner).needs_hierarchy)
 
     def to_dict(self) -> dict:
         """The spec as a mapping (what ``result.json`` and the validated case data hold)."""
