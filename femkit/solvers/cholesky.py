@@ -50,7 +50,7 @@ from scipy.sparse.linalg import LinearOperator
 
 from ..errors import InputError, NotSPDError
 from .checks import SYMMETRY_TOL, as_operator, asymmetry, finish, prepare, zero_rhs_result
-from .defaults import DEFAULT_RTOL
+from .defaults import DEFAULT_ATOL, DEFAULT_ENGINE, DEFAULT_RTOL
 from .factor import NOT_SPD_ADVICE, Factor
 from .result import SolveResult
 
@@ -256,7 +256,7 @@ class CholeskyFactor(Factor):
 
 
 def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, mode: str = "supernodal",
-                  engine: str = "cholmod", check_symmetry: bool = True):
+                  engine: str = DEFAULT_ENGINE, check_symmetry: bool = True):
     """Cholesky factorisation of a sparse SPD matrix, reusing the cached symbolic analysis of
     its pattern (module docstring).
 
@@ -316,9 +316,9 @@ def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, mode: str = "supernoda
     return CholeskyFactor(f, Ac.shape, sym, reused, dt)
 
 
-def cholesky(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter=None, M=None,
-             callback=None, factorization: CholeskyFactor | None = None,
-             ordering: str = DEFAULT_ORDERING, engine: str = "cholmod",
+def cholesky(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+             maxiter=None, M=None, callback=None, factorization: CholeskyFactor | None = None,
+             ordering: str = DEFAULT_ORDERING, engine: str = DEFAULT_ENGINE,
              check_symmetry: bool = True) -> SolveResult:
     """Solve ``A x = b`` for SPD ``A`` by sparse Cholesky (see :func:`factorize_spd`).
 

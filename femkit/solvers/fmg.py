@@ -48,7 +48,7 @@ import numpy as np
 
 from ..errors import InputError
 from .checks import finish, prepare, zero_rhs_result
-from .defaults import DEFAULT_RTOL
+from .defaults import DEFAULT_ATOL, DEFAULT_RTOL
 from .result import SolveResult
 
 #: Default ratio of algebraic to estimated discretisation error (energy norm) at which FMG stops.
@@ -95,8 +95,9 @@ def _contraction(mg, *, max_size: int = 20000, steps: int = 6, draw: int = 0) ->
     return rho
 
 
-def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
-        M=None, callback=None, hierarchy=None, free=None, levels=None, sweeps: int = 2,
+def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+        maxiter: int | None = None, M=None, callback=None, hierarchy=None, free=None,
+        levels=None, sweeps: int = 2,
         omega: float | None = None, fraction: float = DEFAULT_FRACTION,
         target: str = "discretisation", check_symmetry: bool = True) -> SolveResult:
     """Full multigrid on a nested mesh hierarchy, stopped at the discretisation error.

@@ -53,6 +53,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..errors import InputError, SolverError
+from . import defaults
 from .factor import Factor, PermutedFactor
 from .pairing import PRECONDITIONED_METHOD
 from .registry import PRECONDITIONERS, SOLVERS, matrix_free_names, traits
@@ -139,7 +140,7 @@ class LinearSession:
     def engine(self) -> str:
         """The factorisation library of ``cholesky`` (``options: {engine}``): ``cholmod``
         (default) or ``pardiso`` (:data:`femkit.solvers.cholesky.ENGINES`)."""
-        return self.spec.options.get("engine", "cholmod")
+        return self.spec.options.get("engine", defaults.DEFAULT_ENGINE)
 
     def _count(self, key: str, n: int = 1) -> None:
         self.stats[key] = self.stats.get(key, 0) + n
@@ -241,7 +242,7 @@ class LinearSession:
 
             engine = self.engine
             return factorize_spd(A, ordering="nesdis", engine=engine,
-                                 mode="simplicial" if engine == "cholmod" else "supernodal")
+                                 mode="supernodal" if engine == "pardiso" else "simplicial")
         return factorize(A)
 
     def _ordered_factor(self, A) -> Factor:

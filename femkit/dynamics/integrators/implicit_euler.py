@@ -19,7 +19,7 @@ With the ``direct`` (or ``cholesky``) solver and ``reuse_factorization=True`` (o
 ``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
 earlier step's matrix is kept (when it is SPD) and later steps solve by PCG preconditioned with
 it, to ``ctx.linear_solver.rtol`` on the true residual, renewing the factor when a PCG solve costs more than
-the average per solve since the factorisation (:meth:`femkit.solvers.session.LinearSession.solve`): the same step to
+the average per solve since the factorisation (:meth:`~femkit.solvers.session.LinearSession.solve`): the same step to
 that tolerance at a fraction of the cost while the matrix changes slowly. ``reuse_factorization=False``: one factorisation per step.
 
 ``matrix_free=True`` (matrix-free CG: Baraff & Witkin 1998; Saad 2003, section 6.7) solves the same system without assembling
