@@ -5,15 +5,23 @@
 ['central_difference', 'explicit_euler', 'fast_mass_spring']
 """
 
-import importlib
-import pkgutil
-
 from .base import Integrator, StepContext, StepperState
 from .registry import INTEGRATORS, get_integrator
-
-# an integrator's module registers it when imported (``@register``), so every module of this
-# package is imported here: adding an integrator is adding its file
-for _m in pkgutil.iter_modules(__path__):
-    importlib.import_module(f"{__name__}.{_m.name}")
+from . import (  # noqa: F401  (registration side effects)
+    explicit_euler,
+    symplectic_euler,
+    heun,
+    midpoint,
+    rk4,
+    verlet,
+    velocity_verlet,
+    leapfrog,
+    central_difference,
+    implicit_euler,
+    newton,
+    newmark,
+    variational_symplectic,
+    fast_mass_spring,
+)
 
 __all__ = ["INTEGRATORS", "get_integrator", "Integrator", "StepContext", "StepperState"]
