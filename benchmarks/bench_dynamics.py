@@ -163,7 +163,7 @@ def main(quick: bool = False) -> None:
 def matrix_free_rows(system, quick: bool = False) -> None:
     """Baraff-Witkin (clamp, dt = 1/60): assembled direct / assembled PCG-Jacobi / matrix-free
     PCG-Jacobi; time per step, PCG iterations per step, assembled-matrix memory."""
-    from femkit.dynamics.integrators.base import restrict
+    from femkit.solvers.operators import restrict
 
     h = 1.0 / 60.0
     reps = 2 if quick else 4
@@ -388,7 +388,7 @@ def engine_rows() -> None:
     its own fill differs by ~10%)."""
     import numpy as np
 
-    from femkit.dynamics.integrators.base import restrict
+    from femkit.solvers.operators import restrict
     from femkit.solvers import factorize_spd
     from femkit.solvers.pardiso import available
 

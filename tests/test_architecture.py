@@ -23,21 +23,30 @@ def _modules(layer: str) -> list[Path]:
     return sorted((PKG / layer).rglob("*.py"))
 
 
-def _imports_of(source: str, package: list[str]) -> set[str]:
-    """Absolute names of every femkit module ``source`` imports, anywhere in it, with
-    relative imports resolved against ``package`` (e.g. ``["femkit", "dynamics"]``)."""
-    out = set()
+def _import_statements(source: str, package: list[str]):
+    """``(module, names)`` of every import statement anywhere in ``source`` (``names`` empty
+    for ``import module``), relative imports resolved against ``package`` (e.g.
+    ``["femkit", "dynamics"]``)."""
     for node in ast.walk(ast.parse(source)):
         if isinstance(node, ast.Import):
-            out |= {a.name for a in node.names}
+            for a in node.names:
+                yield a.name, []
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 base = package[: len(package) - node.level + 1]
                 mod = ".".join(base + ([node.module] if node.module else []))
             else:
                 mod = node.module or ""
-            out.add(mod)
-            out |= {f"{mod}.{a.name}" for a in node.names}
+            yield mod, [a.name for a in node.names]
+
+
+def _imports_of(source: str, package: list[str]) -> set[str]:
+    """Absolute names of every femkit module ``source`` imports, anywhere in it, with
+    relative imports resolved against ``package`` (e.g. ``["femkit", "dynamics"]``)."""
+    out = set()
+    for mod, names in _import_statements(source, package):
+        out.add(mod)
+        out |= {f"{mod}.{n}" for n in names}
     return {m for m in out if m == "femkit" or m.startswith("femkit.")}
 
 
@@ -121,3 +130,75 @@ def test_sources_cite_publications_not_documents_outside_the_repository():
            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines())
            if any(w in line for w in words)]
     assert not bad
+
+
+# ----------------------------------------------------------------------------- import cycles
+#: Packages whose modules must not import each other in a cycle (extend to "femkit" as a whole
+#: once the application layers are free of cycles too).
+NO_CYCLES = ("mesh", "fem", "solvers", "dynamics")
+
+
+def _module_graph(pkg: Path = PKG) -> dict[str, set[str]]:
+    """Module -> the femkit modules it imports (lazy imports included). A name imported from
+    a package is an import of that submodule when it is one (``from . import defaults``), else
+    of the package's ``__init__``; the implicit import of parent packages is not an edge."""
+    def name_of(p: Path) -> str:
+        parts = list(p.relative_to(pkg.parent).with_suffix("").parts)
+        return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+    files = {name_of(p): p for p in pkg.rglob("*.py")}
+    graph = {}
+    for name, path in files.items():
+        package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+        edges = set()
+        for mod, names in _import_statements(path.read_text(encoding="utf-8"), package):
+            subs = {f"{mod}.{n}" for n in names} & files.keys()
+            edges |= subs
+            if mod in files and (not names or len(subs) < len(names)):
+                edges.add(mod)
+        graph[name] = edges - {name}
+    return graph
+
+
+def _cycles(graph: dict[str, set[str]], within: str) -> list[list[str]]:
+    """The strongly connected components of more than one module among ``within``'s modules
+    (Tarjan's algorithm), each sorted."""
+    nodes = {n for n in graph if n == within or n.startswith(within + ".")}
+    index, low, stack, on, out = {}, {}, [], set(), []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph[v] & nodes:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while not comp or comp[-1] != v:
+                comp.append(stack.pop())
+                on.discard(comp[-1])
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(nodes):
+        if v not in index:
+            visit(v)
+    return out
+
+
+@pytest.mark.parametrize("layer", NO_CYCLES)
+def test_no_import_cycle_inside_the_layer(layer):
+    assert _cycles(_module_graph(), f"femkit.{layer}") == []
+
+
+def test_the_cycle_checker_finds_cycles_and_resolves_submodule_imports():
+    graph = {"femkit.a": {"femkit.a.x"}, "femkit.a.x": {"femkit.a.y"},
+             "femkit.a.y": {"femkit.a.x"}, "femkit.a.z": set()}
+    assert _cycles(graph, "femkit.a") == [["femkit.a.x", "femkit.a.y"]]
+    g = _module_graph()
+    assert "femkit.solvers.defaults" in g["femkit.solvers.registry"]   # `from . import defaults`
+    assert "femkit.solvers" not in g["femkit.solvers.registry"]        # ... not the package

@@ -14,7 +14,7 @@ which prefixes load-time errors with the key path.
 >>> solver_spec({"method": "cg", "preconditioner": "ic0"}, "solver")
 Traceback (most recent call last):
 ...
-femkit.errors.CaseFileError: solver.preconditioner: 'ic0' needs method 'pcg', not 'cg' (drop it or use method: pcg)
+femkit.errors.CaseFileError: solver.preconditioner: preconditioner 'ic0' is only valid with method 'pcg', not 'cg' (use method 'pcg', or no preconditioner)
 >>> IntegratorSpec.from_mapping("rk4", "integrator").method
 'rk4'
 """

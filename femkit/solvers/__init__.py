@@ -10,21 +10,24 @@ True
 Importing this package imports numpy and scipy only (pyamg and numba load on first use).
 """
 
-from .backend import FemkitBackend, LinearSolverBackend
+from .backend import LinearSolverBackend
 from .cg import cg
 from .cholesky import CholeskyFactor, cholesky, factorize_spd
-from .direct import Factor, direct, factorize
+from .direct import direct, factorize
+from .factor import Factor
 from .jacobi import jacobi
 from .pcg import pcg
 from .preconditioners.base import Preconditioner
-from .registry import (PRECONDITIONERS, SOLVERS, get_preconditioner, get_solver, solve)
+from .registry import (BACKENDS, PRECONDITIONERS, SOLVERS, FemkitBackend, get_preconditioner,
+                       get_solver, solve)
 from .result import REASONS, SolveResult
+from .session import LinearSession
 from .spec import SolverSpec
 from .steepest_descent import steepest_descent
 
 __all__ = [
-    "PRECONDITIONERS", "SOLVERS", "REASONS", "CholeskyFactor", "Factor", "FemkitBackend",
-    "LinearSolverBackend", "Preconditioner", "SolveResult", "SolverSpec", "cg", "cholesky",
+    "BACKENDS", "PRECONDITIONERS", "SOLVERS", "REASONS", "CholeskyFactor", "Factor", "FemkitBackend",
+    "LinearSession", "LinearSolverBackend", "Preconditioner", "SolveResult", "SolverSpec", "cg", "cholesky",
     "direct", "factorize_spd",
     "factorize", "get_preconditioner", "get_solver", "jacobi", "pcg", "solve",
     "steepest_descent",

@@ -1,8 +1,10 @@
-"""The contract a linear-solver backend implements, and the registry of backends.
+"""The contract a linear-solver backend implements.
 
-femkit's own solvers (:func:`femkit.solvers.solve`) are the reference backend (``femkit``);
-``petsc`` is :class:`femkit.solvers.petsc.PetscBackend` (imported only when asked for).
-:data:`BACKENDS` maps the names to factories; ``solve(..., backend="petsc")`` uses it.
+femkit's own solvers (:func:`femkit.solvers.solve`) are the reference backend (``femkit``,
+:class:`femkit.solvers.registry.FemkitBackend`); ``petsc`` is
+:class:`femkit.solvers.petsc.PetscBackend` (imported only when asked for). The names map to
+factories in :data:`femkit.solvers.registry.BACKENDS`, the one table of solver names;
+``solve(..., backend="petsc")`` uses it.
 The PETSc backend maps femkit names onto KSP/PC types (``cg``/``pcg`` -> ``KSPCG``, ``direct``
 -> ``KSPPREONLY`` + ``PCLU``/``PCCHOLESKY``, ``jacobi`` -> ``PCJACOBI``, ``ic0`` ->
 ``PCBJACOBI`` + ``PCICC`` with zero levels, ``amg_sa`` -> ``PCGAMG``, ``amg``/``amg_rs`` ->
@@ -17,13 +19,10 @@ recomputes the true residual at exit and sets ``converged`` from it.
 
 from __future__ import annotations
 
-from .defaults import DEFAULT_RTOL
-
 from typing import Callable, Protocol, runtime_checkable
 
 import numpy as np
 
-from ..registry import Registry
 from .result import SolveResult
 
 
@@ -42,42 +41,10 @@ class LinearSolverBackend(Protocol):
         ...
 
     def solve(self, A, b: np.ndarray, x0: np.ndarray | None = None, *, method: str = "pcg",
-              preconditioner: str | None = None, rtol: float = DEFAULT_RTOL, atol: float = 0.0,
-              maxiter: int | None = None, callback: Callable | None = None,
-              **options) -> SolveResult:
-        """Same contract as :func:`femkit.solvers.solve`; unknown names raise
+              preconditioner: str | None = None, rtol: float | None = None,
+              atol: float | None = None, maxiter: int | None = None,
+              callback: Callable | None = None, **options) -> SolveResult:
+        """Same contract as :func:`femkit.solvers.solve` (``rtol``/``atol`` ``None``: the
+        defaults of :mod:`femkit.solvers.defaults`); unknown names raise
         :class:`~femkit.errors.UnknownNameError`."""
         ...
-
-
-class FemkitBackend:
-    """The in-process reference backend (femkit's own solvers)."""
-
-    name = "femkit"
-
-    def methods(self) -> list[str]:
-        from .registry import SOLVERS
-
-        return SOLVERS.names()
-
-    def preconditioners(self) -> list[str]:
-        from .registry import PRECONDITIONERS
-
-        return PRECONDITIONERS.names()
-
-    def solve(self, A, b, x0=None, **kwargs) -> SolveResult:
-        from .registry import solve
-
-        return solve(A, b, x0, **kwargs)
-
-
-def _petsc_backend() -> LinearSolverBackend:
-    from .petsc.backend import PetscBackend  # lazy: petsc4py only when asked for
-
-    return PetscBackend()
-
-
-#: backend name -> factory returning a :class:`LinearSolverBackend`
-BACKENDS: Registry = Registry("solver backend")
-BACKENDS.register("femkit", FemkitBackend)
-BACKENDS.register("petsc", _petsc_backend)

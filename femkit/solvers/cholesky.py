@@ -51,6 +51,8 @@ from scipy.sparse.linalg import LinearOperator
 from ..errors import InputError, NotSPDError
 from .checks import (SYMMETRY_TOL, as_operator, asymmetry, dependency_boundary, finish, prepare,
                      zero_rhs_result)
+from .defaults import DEFAULT_ATOL, DEFAULT_ENGINE, DEFAULT_RTOL
+from .factor import NOT_SPD_ADVICE, Factor
 from .result import SolveResult
 
 __all__ = ["CholeskyFactor", "cholesky", "factorize_spd", "clear_symbolic_cache",
@@ -194,11 +196,6 @@ def symbolic_cache_info() -> list[dict]:
              "analysis_time": s.analysis_time} for k, s in _CACHE.items()]
 
 
-#: The advice every NotSPDError of both Cholesky engines ends with.
-NOT_SPD_ADVICE = ("use method 'direct' (SuperLU) for indefinite systems, or a definiteness fix "
-                  "(fix='clamp') for spring Jacobians")
-
-
 def _numeric(run, what: str):
     """Run a CHOLMOD numeric factorisation, mapping a non-positive pivot to NotSPDError."""
     cholmod = _cholmod()
@@ -211,11 +208,11 @@ def _numeric(run, what: str):
                 f"{e}); {NOT_SPD_ADVICE}") from e
 
 
-class CholeskyFactor:
+class CholeskyFactor(Factor):
     """``P A P^T = L L^T`` of a sparse SPD matrix (CHOLMOD supernodal), reusable for many solves.
 
-    Same interface as :class:`femkit.solvers.direct.Factor`: ``solve(b)`` (``b`` of shape
-    ``(n,)`` or ``(n, k)``), ``shape``, ``symmetric`` (True), ``setup_time``, ``info``.
+    The :class:`~femkit.solvers.factor.Factor` interface: ``solve(b)`` (``b`` of shape
+    ``(n,)`` or ``(n, k)``), ``refactor(A)``, ``shape``, ``symmetric`` (True), ``setup_time``, ``info``.
 
     Attributes
     ----------
@@ -257,19 +254,12 @@ class CholeskyFactor:
         self.info.update(symbolic_reused=True, symbolic_uses=self._sym.uses, numeric_time=dt)
         return self
 
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        """Return ``A^-1 b`` (``b`` of shape ``(n,)`` or ``(n, k)``)."""
-        b = np.asarray(b, dtype=np.float64)
-        if b.shape[0] != self.shape[0]:
-            raise InputError(f"b has {b.shape[0]} rows, the factor is {self.shape[0]} x {self.shape[1]}")
+    def _solve(self, b: np.ndarray) -> np.ndarray:
         return self._f(b)
-
-    __call__ = solve
-    matvec = solve
 
 
 def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, mode: str = "supernodal",
-                  engine: str = "cholmod", check_symmetry: bool = True):
+                  engine: str = DEFAULT_ENGINE, check_symmetry: bool = True):
     """Cholesky factorisation of a sparse SPD matrix, reusing the cached symbolic analysis of
     its pattern (module docstring).
 
@@ -329,9 +319,9 @@ def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, mode: str = "supernoda
     return CholeskyFactor(f, Ac.shape, sym, reused, dt)
 
 
-def cholesky(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter=None, M=None,
-             callback=None, factorization: CholeskyFactor | None = None,
-             ordering: str = DEFAULT_ORDERING, engine: str = "cholmod",
+def cholesky(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+             maxiter=None, M=None, callback=None, factorization: CholeskyFactor | None = None,
+             ordering: str = DEFAULT_ORDERING, engine: str = DEFAULT_ENGINE,
              check_symmetry: bool = True) -> SolveResult:
     """Solve ``A x = b`` for SPD ``A`` by sparse Cholesky (see :func:`factorize_spd`).
 

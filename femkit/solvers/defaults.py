@@ -10,6 +10,9 @@ key                    default
 ``preconditioner``     ``amg`` for ``pcg`` (smoothed aggregation), ``none`` otherwise
 ``method``             per problem type: ``pcg`` for Poisson, ``direct`` for the linear
                        systems of implicit mass-spring integrators
+``engine``             ``cholmod``: the factorisation library of ``cholesky``
+``comparison rtol``    ``1e-8``: the solvers a study compares by cost (adaptive,
+                       stability) stop here unless the study file names its own
 =====================  ===========================================================
 
 docs/case-files.md documents the same table for users.
@@ -23,6 +26,10 @@ DEFAULT_RTOL: float = 1e-10
 DEFAULT_ATOL: float = 0.0
 #: Preconditioner of ``pcg`` when none is named (other methods take none).
 DEFAULT_PRECONDITIONER: str = "amg"
+#: Factorisation library of the ``cholesky`` method (``options: {engine}``).
+DEFAULT_ENGINE: str = "cholmod"
+#: Relative tolerance of the default solver lists of the studies that compare solvers' cost.
+COMPARISON_RTOL: float = 1e-8
 #: Default method per problem type.
 DEFAULT_METHOD: dict[str, str] = {"poisson": "pcg", "mass_spring": "direct"}
 

@@ -12,14 +12,14 @@ always passes it (same fill, same time).
 
 Time-stepping code factors once and reuses the factor::
 
-    F = factorize(K)          # Factor
+    F = factorize(K)          # a Factor (femkit.solvers.factor)
     x = F.solve(b)            # many times
     res = direct(K, b, factorization=F)   # same, as a SolveResult
 """
 
 from __future__ import annotations
 
-from .defaults import DEFAULT_RTOL
+from .defaults import DEFAULT_ATOL, DEFAULT_RTOL
 
 import time
 
@@ -30,6 +30,7 @@ from scipy.sparse.linalg import LinearOperator
 from ..errors import InputError
 from .checks import (SYMMETRY_TOL, as_operator, asymmetry, dependency_boundary, finish, prepare,
                      zero_rhs_result)
+from .factor import Factor
 from .result import SolveResult
 
 #: SuperLU ``diag_pivot_thresh`` in symmetric mode: the diagonal is the pivot unless it is below
@@ -37,8 +38,9 @@ from .result import SolveResult
 DIAG_PIVOT_THRESH = 1e-3
 
 
-class Factor:
-    """An LU (or symmetric-mode LU) factorisation of a sparse matrix, reusable for many solves.
+class SuperLUFactor(Factor):
+    """An LU (or symmetric-mode LU) factorisation by SuperLU (the :class:`~femkit.solvers.factor.Factor`
+    interface; no separate numeric phase, so :meth:`refactor` is not offered).
 
     Attributes
     ----------
@@ -64,15 +66,8 @@ class Factor:
         with ``permc_spec="NATURAL"`` reuses this ordering (same fill) for a matrix of equal pattern."""
         return self._lu.perm_c
 
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        """Return ``A^-1 b`` (``b`` of shape ``(n,)`` or ``(n, k)``)."""
-        b = np.asarray(b, dtype=np.float64)
-        if b.shape[0] != self.shape[0]:
-            raise InputError(f"b has {b.shape[0]} rows, the factor is {self.shape[0]} x {self.shape[1]}")
+    def _solve(self, b: np.ndarray) -> np.ndarray:
         return self._lu.solve(b)
-
-    __call__ = solve
-    matvec = solve
 
 
 def factorize(A, *, spd: bool | None = None, permc_spec: str | None = None) -> Factor:
@@ -107,8 +102,6 @@ def factorize(A, *, spd: bool | None = None, permc_spec: str | None = None) -> F
     >>> F.symmetric, np.round(F.solve(np.ones(4)), 12).tolist()
     (True, [2.0, 3.0, 3.0, 2.0])
     """
-    from scipy.sparse.linalg import splu
-
     if spd is True:
         if permc_spec is not None:
             raise InputError("permc_spec is a SuperLU option; spd=True factorises by Cholesky")
@@ -147,11 +140,11 @@ def superlu_factor(A, *, symmetric: bool | None = None, permc_spec: str | None =
     info = {"nnz_A": int(Ac.nnz), "nnz_L": int(lu.L.nnz), "nnz_U": int(lu.U.nnz),
             "fill_ratio": float((lu.L.nnz + lu.U.nnz) / max(Ac.nnz, 1)),
             "permc_spec": permc, "symmetric": bool(spd)}
-    return Factor(lu, Ac.shape, bool(spd), dt, info)
+    return SuperLUFactor(lu, Ac.shape, bool(spd), dt, info)
 
 
-def direct(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter=None, M=None,
-           callback=None, factorization: Factor | None = None,
+def direct(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+           maxiter=None, M=None, callback=None, factorization: Factor | None = None,
            spd: bool | None = None) -> SolveResult:
     """Solve ``A x = b`` with a sparse LU factorisation (see :func:`factorize`).
 

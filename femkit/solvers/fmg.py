@@ -48,6 +48,7 @@ import numpy as np
 
 from ..errors import InputError
 from .checks import dependency_boundary, finish, prepare, zero_rhs_result
+from .defaults import DEFAULT_ATOL, DEFAULT_RTOL
 from .norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
 from .result import SolveResult
 
@@ -95,8 +96,9 @@ def _contraction(mg, *, max_size: int = 20000, steps: int = 6, draw: int = 0) ->
     return rho
 
 
-def fmg(A, b, x0=None, *, rtol: float = 1e-8, atol: float = 0.0, maxiter: int | None = None,
-        M=None, callback=None, hierarchy=None, free=None, levels=None, sweeps: int = 2,
+def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+        maxiter: int | None = None, M=None, callback=None, hierarchy=None, free=None,
+        levels=None, sweeps: int = 2,
         omega: float | None = None, fraction: float = DEFAULT_FRACTION,
         target: str = "discretisation", check_symmetry: bool = True) -> SolveResult:
     """Full multigrid on a nested mesh hierarchy, stopped at the discretisation error.

@@ -34,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError, NotSPDError
-from .cholesky import NOT_SPD_ADVICE
+from .factor import NOT_SPD_ADVICE, Factor
 
 __all__ = ["PardisoFactor", "available", "factorize_pardiso"]
 
@@ -103,10 +103,10 @@ _ERRORS = {-1: "input inconsistent", -2: "not enough memory", -3: "reordering pr
            -10: "error opening out-of-core files", -11: "read/write error with OOC files"}
 
 
-class PardisoFactor:
+class PardisoFactor(Factor):
     """``A = L L^T`` of a sparse SPD matrix by MKL PARDISO, reusable for many solves.
 
-    The same interface as :class:`femkit.solvers.cholesky.CholeskyFactor`: ``solve(b)`` (``b``
+    The :class:`~femkit.solvers.factor.Factor` interface: ``solve(b)`` (``b``
     of shape ``(n,)`` or ``(n, k)``), ``refactor(A)`` (numeric phase on the kept analysis),
     ``shape``, ``symmetric`` (True), ``setup_time`` and ``info`` (``backend``, ``ordering``,
     ``symbolic_reused``, ``symbolic_uses``, ``analysis_time``, ``numeric_time``, ``nnz_L``).
@@ -192,19 +192,12 @@ class PardisoFactor:
         self._numeric(np.ascontiguousarray(A.data[self._upper], dtype=np.float64))
         return self
 
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        """Return ``A^-1 b`` (``b`` of shape ``(n,)`` or ``(n, k)``)."""
-        b = np.asarray(b, dtype=np.float64)
-        if b.shape[0] != self.shape[0]:
-            raise InputError(f"b has {b.shape[0]} rows, the factor is {self.shape[0]} x {self.shape[1]}")
+    def _solve(self, b: np.ndarray) -> np.ndarray:
         k = 1 if b.ndim == 1 else b.shape[1]
         bf = np.asfortranarray(b)  # PARDISO stores the right-hand sides column after column
         x = np.empty_like(bf, order="F")
         self._call(33, self._a, bf, x, k)
         return np.ascontiguousarray(x)
-
-    __call__ = solve
-    matvec = solve
 
     def __del__(self):  # release PARDISO's internal memory (phase -1)
         try:

@@ -1,21 +1,29 @@
-"""Solver and preconditioner registries, and :func:`solve`, the high-level entry.
+"""Solver, preconditioner and backend registries, and :func:`solve`, the high-level entry.
 
 ``SOLVERS``: ``jacobi``, ``sd``, ``cg``, ``pcg``, ``direct`` (SuperLU), ``cholesky`` (CHOLMOD,
 SPD only), ``fmg``. ``PRECONDITIONERS``: ``none``, ``jacobi``, ``ic0``, ``amg_sa``, ``amg_rs``,
 ``amg`` (= ``amg_sa``) and ``gmg`` (geometric multigrid; needs ``hierarchy=``). Preconditioner
 factories are ``build(A, **opts) -> Preconditioner`` (or ``None`` for ``none``); importing
-this module imports neither pyamg nor numba.
+this module imports neither pyamg nor numba. ``BACKENDS``: ``femkit`` (these solvers) and
+``petsc`` (:mod:`femkit.solvers.petsc`, imported only when asked for).
+
+Every entry declares what callers need to know about it as :class:`Traits` (``declare``): a
+method or preconditioner that works from products ``A d`` alone (``matrix_free``), a method
+that reports its own setup time (a factorisation, a multigrid setup). Nothing else in femkit
+keeps a list of solver names.
 """
 
 from __future__ import annotations
 
-from .defaults import DEFAULT_RTOL, default_preconditioner
-
 import time
+from dataclasses import dataclass
 from typing import Callable
 
 from ..errors import InputError
 from ..registry import Registry
+from . import defaults
+from .defaults import default_preconditioner
+from .pairing import PRECONDITIONED_METHOD, check_pairing
 from .cg import cg
 from .checks import check_options
 from .cholesky import cholesky
@@ -32,14 +40,50 @@ from .steepest_descent import steepest_descent
 
 SOLVERS: Registry = Registry("solver")
 PRECONDITIONERS: Registry = Registry("preconditioner")
+BACKENDS: Registry = Registry("solver backend")
+
+
+@dataclass(frozen=True)
+class Traits:
+    """What a registered method or preconditioner declares about itself.
+
+    Attributes
+    ----------
+    matrix_free : bool
+        Works from products ``A d`` (and, for a preconditioner, ``diag(A)``) alone, so an
+        operator that is never assembled may be solved with it.
+    own_setup_time : bool
+        The method times its own setup (factorisation, multigrid setup) in ``setup_time``;
+        :func:`solve` then reports ``solve_time`` as the rest.
+    needs_hierarchy : bool
+        Geometric multigrid: the caller passes a :class:`~femkit.mesh.MeshHierarchy`
+        (``hierarchy=``, ``free=``) at solve time.
+    """
+
+    matrix_free: bool = False
+    own_setup_time: bool = False
+    needs_hierarchy: bool = False
+
+
+def declare(entry: Callable, **traits) -> Callable:
+    """Attach :class:`Traits` to a solver function or preconditioner factory; returns it."""
+    entry.traits = Traits(**traits)
+    return entry
+
+
+def traits(registry: Registry, name: str) -> Traits:
+    """The :class:`Traits` of ``name`` in ``registry`` (``SOLVERS`` or ``PRECONDITIONERS``;
+    :class:`~femkit.errors.UnknownNameError` for an unknown name)."""
+    return getattr(registry.get(name), "traits", Traits())
+
 
 SOLVERS.register("jacobi", jacobi)
 SOLVERS.register("sd", steepest_descent)
-SOLVERS.register("cg", cg)
-SOLVERS.register("pcg", pcg)
-SOLVERS.register("direct", direct)
-SOLVERS.register("fmg", fmg)
-SOLVERS.register("cholesky", cholesky)
+SOLVERS.register("cg", declare(cg, matrix_free=True))
+SOLVERS.register("pcg", declare(pcg, matrix_free=True))
+SOLVERS.register("direct", declare(direct, own_setup_time=True))
+SOLVERS.register("fmg", declare(fmg, own_setup_time=True, needs_hierarchy=True))
+SOLVERS.register("cholesky", declare(cholesky, own_setup_time=True))
 
 
 def _no_preconditioner(A, **opts):
@@ -49,14 +93,65 @@ def _no_preconditioner(A, **opts):
     return None
 
 
-PRECONDITIONERS.register("none", _no_preconditioner)
-PRECONDITIONERS.register("jacobi", _pjacobi.build)
+PRECONDITIONERS.register("none", declare(_no_preconditioner, matrix_free=True))
+PRECONDITIONERS.register("jacobi", declare(_pjacobi.build, matrix_free=True))  # diag(A) only
 PRECONDITIONERS.register("ic0", _ic0.build)
 PRECONDITIONERS.register("amg_sa", _amg.build_sa)
 PRECONDITIONERS.register("amg_rs", _amg.build_rs)
 PRECONDITIONERS.register("amg", _amg.build)
-PRECONDITIONERS.register("gmg", _gmg.build)
+PRECONDITIONERS.register("gmg", declare(_gmg.build, needs_hierarchy=True))
 
+
+class FemkitBackend:
+    """The in-process reference backend (femkit's own solvers, :func:`solve`)."""
+
+    name = "femkit"
+
+    def methods(self) -> list[str]:
+        return SOLVERS.names()
+
+    def preconditioners(self) -> list[str]:
+        return PRECONDITIONERS.names()
+
+    def solve(self, A, b, x0=None, **kwargs) -> SolveResult:
+        return solve(A, b, x0, **kwargs)
+
+
+def _petsc_backend():
+    from .petsc.backend import PetscBackend  # lazy: petsc4py only when asked for
+
+    return PetscBackend()
+
+
+#: backend name -> factory returning a :class:`~femkit.solvers.backend.LinearSolverBackend`
+BACKENDS.register("femkit", FemkitBackend)
+BACKENDS.register("petsc", _petsc_backend)
+
+
+def matrix_free_names() -> tuple[list[str], list[str]]:
+    """``(methods, preconditioners)`` declared ``matrix_free`` (preconditioner ``none`` left out)."""
+    return ([n for n in SOLVERS.names() if traits(SOLVERS, n).matrix_free],
+            [n for n in PRECONDITIONERS.names()
+             if n != "none" and traits(PRECONDITIONERS, n).matrix_free])
+
+
+def lookup(method: str, preconditioner: str | None) -> tuple[Callable, str, Callable]:
+    """The one solver-name lookup: ``(solver function, preconditioner name, preconditioner
+    factory)`` for the names of a solve (``preconditioner=None``: the method's default).
+
+    Raises
+    ------
+    UnknownNameError
+        Unknown method or preconditioner (``exc.kind`` says which; the valid names are listed).
+    InputError
+        A preconditioner with a method other than ``pcg`` (:func:`~femkit.solvers.pairing.check_pairing`).
+    """
+    fn = SOLVERS.get(method)
+    if preconditioner is None:
+        preconditioner = default_preconditioner(method)
+    factory = PRECONDITIONERS.get(preconditioner)
+    check_pairing(method, preconditioner)
+    return fn, preconditioner, factory
 
 
 def get_solver(name: str) -> Callable[..., SolveResult]:
@@ -70,7 +165,7 @@ def get_preconditioner(name: str) -> Callable:
 
 
 def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = None,
-          rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None, callback=None,
+          rtol: float | None = None, atol: float | None = None, maxiter: int | None = None, callback=None,
           preconditioner_options: dict | None = None, backend: str = "femkit",
           **options) -> SolveResult:
     """Solve ``A x = b`` with a registered method and preconditioner, by name.
@@ -89,12 +184,13 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
         ``amg`` for ``pcg`` and nothing for the others (:mod:`femkit.solvers.defaults`).
         A preconditioner object/callable may be passed instead of a name (``pcg`` only).
     rtol, atol, maxiter, callback
-        As in every method.
+        As in every method; ``rtol``/``atol`` ``None``: the defaults of
+        :mod:`femkit.solvers.defaults`, read at call time.
     preconditioner_options : dict, optional
         Keyword arguments of the preconditioner factory (e.g. ``{"shift": 1e-2}`` for ic0);
         an unknown name raises :class:`~femkit.errors.InputError` listing the valid ones.
     backend : str
-        A name in :data:`femkit.solvers.backend.BACKENDS`: ``femkit`` (these solvers) or
+        A name in :data:`BACKENDS`: ``femkit`` (these solvers) or
         ``petsc`` (the same names on PETSc KSP/PC, one process; options ``omega``,
         ``petsc_options``; needs petsc4py, else
         :class:`~femkit.errors.BackendUnavailableError`).
@@ -116,9 +212,9 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     >>> r.converged, r.method, r.preconditioner
     (True, 'pcg', 'jacobi')
     """
+    rtol = defaults.DEFAULT_RTOL if rtol is None else rtol
+    atol = defaults.DEFAULT_ATOL if atol is None else atol
     if backend != "femkit":
-        from .backend import BACKENDS
-
         factory = BACKENDS.get(backend)
         if preconditioner_options:
             raise InputError(f"preconditioner_options are not used by the {backend} backend "
@@ -134,18 +230,11 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     M = None
     setup = 0.0
     if preconditioner is not None and not isinstance(preconditioner, str):
-        if method != "pcg":
-            raise InputError(f"a preconditioner is only valid with method 'pcg', not {method!r}")
         M = preconditioner
         pc_name = getattr(M, "name", type(M).__name__)
+        check_pairing(method, pc_name)
     else:
-        if preconditioner is None:
-            preconditioner = default_preconditioner(method)
-        factory = PRECONDITIONERS.get(preconditioner)
-        if preconditioner != "none" and method != "pcg":
-            raise InputError(
-                f"preconditioner {preconditioner!r} is only valid with method 'pcg', not "
-                f"{method!r} (use method='pcg', or preconditioner=None)")
+        _, preconditioner, factory = lookup(method, preconditioner)
         if preconditioner_options and preconditioner == "none":
             raise InputError("preconditioner_options given but no preconditioner is used")
         check_options(factory, preconditioner_options or {},
@@ -155,7 +244,7 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
         setup = time.perf_counter() - t0
         pc_name = preconditioner
     t0 = time.perf_counter()
-    if method == "pcg":
+    if method == PRECONDITIONED_METHOD:
         res = fn(A, b, x0, rtol=rtol, atol=atol, maxiter=maxiter, M=M, callback=callback,
                  **options)
     else:
@@ -163,7 +252,7 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     elapsed = time.perf_counter() - t0
     res.method = method
     res.preconditioner = pc_name
-    if method in ("direct", "cholesky", "fmg"):  # their own setup_time: factorisation, multigrid
+    if getattr(fn, "traits", Traits()).own_setup_time:  # factorisation, multigrid setup
         res.solve_time = elapsed - res.setup_time
     else:
         res.setup_time = setup

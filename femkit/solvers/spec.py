@@ -2,8 +2,10 @@
 
 The one description of "how to solve" in femkit: case files (``solver:``), scenes
 (``linear_solver:``), studies (``solvers:``) and the implicit integrators all hold a
-:class:`SolverSpec`, and :meth:`SolverSpec.solve` is the one translator to
-:func:`femkit.solvers.solve`. Defaults come from :mod:`femkit.solvers.defaults`.
+:class:`SolverSpec`; :meth:`SolverSpec.session` opens a
+:class:`~femkit.solvers.session.LinearSession` for a sequence of solves (the one translator to
+:func:`femkit.solvers.solve`). Defaults come from :mod:`femkit.solvers.defaults`, read when a
+spec is made.
 
 >>> import numpy as np, scipy.sparse as sp
 >>> spec = SolverSpec.from_mapping({"method": "pcg", "preconditioner": "jacobi"})
@@ -20,6 +22,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, Callable, Mapping
 
 from ..errors import InputError, UnknownNameError, with_prefix
+from . import defaults
 
 __all__ = ["SolverSpec"]
 
@@ -45,8 +48,8 @@ class SolverSpec:
 
     method: str
     preconditioner: str = "none"
-    rtol: float = 1e-10
-    atol: float = 0.0
+    rtol: float = field(default_factory=lambda: defaults.DEFAULT_RTOL)
+    atol: float = field(default_factory=lambda: defaults.DEFAULT_ATOL)
     maxiter: int | None = None
     options: dict = field(default_factory=dict)
     preconditioner_options: dict = field(default_factory=dict)
@@ -69,14 +72,16 @@ class SolverSpec:
             A preconditioner with a method other than ``pcg``; an unknown option name.
         """
         from .checks import check_options
-        from .defaults import DEFAULT_ATOL, DEFAULT_RTOL, default_preconditioner
-        from .registry import PRECONDITIONERS, SOLVERS
+        from .registry import BACKENDS, lookup
 
-        def lookup(registry, name, key):
+        def names(method, pc):
             try:
-                return registry.get(name)
+                return lookup(method, pc)
             except UnknownNameError as exc:
+                key = "method" if exc.kind == "solver" else "preconditioner"
                 raise with_prefix(exc, f"{where}.{key}") from None
+            except InputError as exc:
+                raise with_prefix(exc, f"{where}.preconditioner") from None
 
         def options_of(fn, opts, key, exclude=()):
             try:
@@ -86,21 +91,15 @@ class SolverSpec:
 
         d = dict(data or {})
         method = d.get("method") or default_method
-        fn = lookup(SOLVERS, method, "method")
-        pc = d.get("preconditioner")
-        if pc is None:
-            pc = default_preconditioner(method)
-        factory = lookup(PRECONDITIONERS, pc, "preconditioner")
-        if pc != "none" and method != "pcg":
-            raise InputError(f"{where}.preconditioner: {pc!r} needs method 'pcg', not "
-                                f"{method!r} (drop it or use method: pcg)")
+        fn, pc, factory = names(method, d.get("preconditioner"))
         options = dict(d.get("options") or {})
         pc_options = dict(d.get("preconditioner_options") or {})
         backend = d.get("backend") or "femkit"
         petsc_options = dict(d.get("petsc_options") or {})
-        from .backend import BACKENDS
-
-        lookup(BACKENDS, backend, "backend")
+        try:
+            BACKENDS.get(backend)
+        except UnknownNameError as exc:
+            raise with_prefix(exc, f"{where}.backend") from None
         if backend == "petsc":
             _check_petsc(method, pc, options, pc_options, petsc_options, where)
         else:
@@ -113,8 +112,8 @@ class SolverSpec:
         label = d.get("label") or ((method if pc == "none" else f"{method}+{pc}")
                                    + (f" ({backend})" if backend != "femkit" else ""))
         return cls(method=method, preconditioner=pc,
-                   rtol=float(d.get("rtol", DEFAULT_RTOL)),
-                   atol=float(d.get("atol", DEFAULT_ATOL)),
+                   rtol=float(d.get("rtol", defaults.DEFAULT_RTOL)),
+                   atol=float(d.get("atol", defaults.DEFAULT_ATOL)),
                    maxiter=d.get("maxiter"), options=options,
                    preconditioner_options=pc_options, label=label, backend=backend,
                    petsc_options=petsc_options)
@@ -123,7 +122,10 @@ class SolverSpec:
     def needs_hierarchy(self) -> bool:
         """Geometric multigrid (``method: fmg`` or ``preconditioner: gmg``): the caller passes a
         :class:`~femkit.mesh.MeshHierarchy` (``hierarchy=``, ``free=``) at solve time."""
-        return self.method == "fmg" or self.preconditioner == "gmg"
+        from .registry import PRECONDITIONERS, SOLVERS, traits
+
+        return (traits(SOLVERS, self.method).needs_hierarchy
+                or traits(PRECONDITIONERS, self.preconditioner).needs_hierarchy)
 
     def to_dict(self) -> dict:
         """The spec as a mapping (what ``result.json`` and the validated case data hold)."""
@@ -137,26 +139,23 @@ class SolverSpec:
             d["label"] = ""
         return SolverSpec.from_mapping(d)
 
+    def session(self, stats: dict | None = None):
+        """A :class:`~femkit.solvers.session.LinearSession` solving with this spec (factor,
+        ordering and preconditioner reuse over a sequence of solves); counters go to ``stats``."""
+        from .session import LinearSession
+
+        return LinearSession(self, stats)
+
     def solve(self, A, b, x0=None, *, callback: Callable | None = None, **overrides):
-        """Solve ``A x = b`` with this spec: the one translator to :func:`femkit.solvers.solve`.
+        """Solve ``A x = b`` once with this spec (:meth:`LinearSession.run
+        <femkit.solvers.session.LinearSession.run>`, the one translator to
+        :func:`femkit.solvers.solve`).
 
         ``overrides`` (e.g. ``atol``) replace the spec's own stopping-rule values;
         ``options=`` / ``preconditioner_options=`` add run-time objects to the spec's own (the
         mesh hierarchy of geometric multigrid, see :attr:`needs_hierarchy`).
         """
-        from ..solvers import solve
-
-        pc_options = {**self.preconditioner_options, **overrides.pop("preconditioner_options", {})}
-        options = {**self.options, **overrides.pop("options", {})}
-        kw = dict(rtol=self.rtol, atol=self.atol, maxiter=self.maxiter)
-        kw.update(overrides)
-        if self.backend != "femkit":
-            kw.update(backend=self.backend, petsc_options=self.petsc_options or None)
-        return solve(A, b, x0, method=self.method,
-                     preconditioner=self.preconditioner if self.method == "pcg" else None,
-                     callback=callback,
-                     preconditioner_options=pc_options or None,
-                     **kw, **options)
+        return self.session().run(A, b, x0, callback=callback, **overrides)
 
 
 def _check_petsc(method: str, pc: str, options: dict, pc_options: dict, petsc_options: dict,

@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 
 from ..case.specs import INTEGRATOR_SCHEMA, solver_schema
+from ..solvers.defaults import COMPARISON_RTOL
 
 POS = {"type": "number", "exclusiveMinimum": 0}
 POSINT = {"type": "integer", "minimum": 1}
@@ -50,7 +51,7 @@ POISSON = {
         "max_level": {"type": "integer", "minimum": 1},
     }),
     "solvers": {"type": "array", "items": SOLVER, "minItems": 1,
-                "default": [{"method": "pcg", "preconditioner": "amg", "rtol": 1e-10}]},
+                "default": [{"method": "pcg", "preconditioner": "amg"}]},
     "quadrature": {"type": "array", "items": {"type": "string"}, "minItems": 1, "default": ["barycentric"]},
     "error_order": {**POSINT, "default": 5},
     "reference": {"enum": ["none", "scikit-fem"], "default": "none"},
@@ -69,7 +70,7 @@ ADAPTIVE = {
     "max_levels": {**POSINT, "default": 40},
     "fit_min_dofs": {**POSINT, "default": 200},
     "solvers": {"type": "array", "items": SOLVER, "minItems": 1, "maxItems": 1,
-                "default": [{"method": "pcg", "preconditioner": "amg", "rtol": 1e-8}]},
+                "default": [{"method": "pcg", "preconditioner": "amg", "rtol": COMPARISON_RTOL}]},
 }
 
 SCENE = _obj({
@@ -117,10 +118,10 @@ STABILITY = {
               "items": {"oneOf": [{"type": "string"}, STRESS_CASE],
                         "x-message": "must be a stress case file path or an inline stress case"}},
     "solvers": {"type": "array", "items": SOLVER, "minItems": 1,
-                "default": [{"method": "pcg", "preconditioner": "amg_sa", "rtol": 1e-8},
-                            {"method": "pcg", "preconditioner": "amg_rs", "rtol": 1e-8},
-                            {"method": "pcg", "preconditioner": "jacobi", "rtol": 1e-8},
-                            {"method": "cg", "rtol": 1e-8}]},
+                "default": [{"method": "pcg", "preconditioner": "amg_sa", "rtol": COMPARISON_RTOL},
+                            {"method": "pcg", "preconditioner": "amg_rs", "rtol": COMPARISON_RTOL},
+                            {"method": "pcg", "preconditioner": "jacobi", "rtol": COMPARISON_RTOL},
+                            {"method": "cg", "rtol": COMPARISON_RTOL}]},
     "integrators": {"type": "array", "items": INTEGRATOR, "minItems": 1,
                     "default": ["explicit_euler", "symplectic_euler", "verlet", "rk4"]},
     "case_overrides": {"type": "object", "description": "per case name: keys merged over that case"},

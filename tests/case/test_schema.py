@@ -58,7 +58,7 @@ BAD = [
     ("unknown-preconditioner", lambda d: d["solver"].update(method="pcg", preconditioner="ilu"),
      UnknownNameError, ["solver.preconditioner", "'ilu'", "amg", "ic0", "jacobi"]),
     ("preconditioner-without-pcg", lambda d: d["solver"].update(preconditioner="amg"),
-     CaseFileError, ["solver.preconditioner", "needs method 'pcg'"]),
+     CaseFileError, ["solver.preconditioner", "only valid with method 'pcg'"]),
     ("unknown-geometry", lambda d: d["mesh"].update(geometry="circle"), UnknownNameError,
      ["mesh.geometry", "'circle'", "disk", "l_shape"]),
     ("bad-geometry-param", lambda d: d["mesh"].update(params={"radius": 2}), CaseFileError,

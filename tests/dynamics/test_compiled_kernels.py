@@ -10,7 +10,7 @@ import scipy.sparse as sp
 from femkit.dynamics.forces import Gravity, GroundContact, RayleighDamping, ViscousDamping
 from femkit.dynamics.forces.springs import hooke_forces, spring_geometry
 from femkit.dynamics.integrators import StepContext, get_integrator
-from femkit.dynamics.integrators.base import restrict
+from femkit.solvers.operators import restrict
 from femkit.dynamics.kernels.assembly import FreePattern, assemble_with_forces
 from femkit.dynamics.kernels.spring_kernels import local_global_rhs, spring_forces
 from femkit.dynamics.system import MassSpringSystem

@@ -15,7 +15,8 @@ from femkit.dynamics.forces import (Gravity, GroundContact, RayleighDamping, Sph
                                     ViscousDamping)
 from femkit.dynamics.integrators import StepContext, get_integrator
 from femkit.solvers import SolverSpec
-from femkit.dynamics.integrators.base import MATRIX_FREE_MESSAGE, restrict
+from femkit.solvers.operators import restrict
+from femkit.solvers.session import MATRIX_FREE_MESSAGE
 from femkit.dynamics.topology import cloth_grid
 from femkit.errors import InputError
 

@@ -75,8 +75,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
-from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
-                   factorize_linear, restrict)
+from ...solvers.operators import restrict
+from .base import Integrator, StepContext, StepperState, box_length, check_iteration_options
 from .registry import register
 
 _KEY_ATTRS = ("mass", "k", "rest", "damping", "springs", "pinned", "forces")
@@ -212,7 +212,7 @@ class FastMassSpring(Integrator):
         G = system.difference_operators[0]
         G_free = G[:, free].tocsr()
         ops = _Operators(
-            factor=factorize_linear(restrict(A, free), ctx),
+            factor=ctx.session.factorize(restrict(A, free)),
             free=free,
             pinned=pinned,
             m_free=mass[free][:, None],

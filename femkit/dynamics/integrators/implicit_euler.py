@@ -19,7 +19,7 @@ With the ``direct`` (or ``cholesky``) solver and ``reuse_factorization=True`` (o
 ``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
 earlier step's matrix is kept (when it is SPD) and later steps solve by PCG preconditioned with
 it, to ``ctx.linear_solver.rtol`` on the true residual, renewing the factor when a PCG solve costs more than
-the average per solve since the factorisation (:func:`.base.solve_linear`): the same step to
+the average per solve since the factorisation (:meth:`~femkit.solvers.session.LinearSession.solve`): the same step to
 that tolerance at a fraction of the cost while the matrix changes slowly. ``reuse_factorization=False``: one factorisation per step.
 
 ``matrix_free=True`` (matrix-free CG: Baraff & Witkin 1998; Saad 2003, section 6.7) solves the same system without assembling
@@ -45,8 +45,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .base import (Integrator, StepContext, StepperState, check_matrix_free_options, free_operator,
-                   restrict, solve_compiled, solve_linear, uses_cholesky)
+from ...solvers.operators import free_operator, restrict
+from .base import Integrator, StepContext, StepperState, check_matrix_free_options
 from .registry import register
 
 
@@ -93,9 +93,9 @@ class ImplicitEuler(Integrator):
             op, diag, Kop = self.operator(system, x, h)
             m = np.repeat(system.mass, system.dim)
             b = h * (f - (h + rk) * Kop(vf).reshape(-1) - rm * m * vf)
-            dv = solve_linear(op, b[free], ctx, diagonal=diag)
+            dv = ctx.session.solve(op, b[free], diagonal=diag)
             return self._advance(state, vf, free, dv, h)
-        if uses_cholesky(ctx, self):
+        if ctx.session.factors_on_pattern:
             return self._step_compiled(system, state, h, ctx)
         K = system.stiffness_matrix(x, fix=self.fix)
         M = system.mass_matrix()
@@ -104,14 +104,14 @@ class ImplicitEuler(Integrator):
         if D.nnz:
             A = A + h * D
         b = h * (f - (h + rk) * (K @ vf) - rm * (M @ vf))
-        dv = solve_linear(restrict(A, free), b[free], ctx, system=system,
-                          reuse_key="implicit_euler_factor" if self.reuse_factorization else None)
+        dv = ctx.session.solve(restrict(A, free), b[free], refactor=True,
+                               keep="implicit_euler_factor" if self.reuse_factorization else None)
         return self._advance(state, vf, free, dv, h)
 
     def _step_compiled(self, system, state: StepperState, h: float, ctx: StepContext) -> StepperState:
         """The same step with ``cholesky``: matrix values, spring forces and ``K v`` from one
         compiled pass into the cached free-dof pattern, then a Cholesky refactorisation on the
-        cached symbolic analysis (:func:`.base.solve_cholesky`)."""
+        kept symbolic analysis (:meth:`femkit.solvers.session.LinearSession.solve_on_pattern`)."""
         from ..kernels.assembly import assemble_with_forces, free_pattern
 
         rm, rk = system.rayleigh
@@ -123,8 +123,8 @@ class ImplicitEuler(Integrator):
                                            kcoef=a_k, dcoef=h, fix=self.fix)
         vf = v.reshape(-1)
         b = h * (f.reshape(-1) - (h + rk) * kv.reshape(-1) - rm * m * vf)
-        dv = solve_compiled(pat.matrix(data), b[pat.free], ctx, pat,
-                            "implicit_euler_factor" if self.reuse_factorization else None)
+        dv = ctx.session.solve_on_pattern(pat.matrix(data), b[pat.free], pat,
+                                          "implicit_euler_factor" if self.reuse_factorization else None)
         return self._advance(state, vf, pat.free, dv, h)
 
     @staticmethod

@@ -27,7 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
-from .base import Integrator, StepContext, StepperState, note_unconverged, restrict, solve_linear
+from ...solvers.operators import restrict
+from .base import Integrator, StepContext, StepperState, note_unconverged
 from .registry import register
 
 
@@ -102,7 +103,7 @@ class Newmark(Integrator):
             D = system.damping_matrix(x_new)
             if D.nnz:
                 J = J + (h * gamma) * D
-            da = solve_linear(restrict(J, free), r[free], ctx, system=system)
+            da = ctx.session.solve(restrict(J, free), r[free], refactor=True)
             a_new[free] -= da
             # a correction at round-off of a+ itself: Newton has nothing left to improve
             stalled = np.abs(da).max(initial=0.0) <= 8.0 * np.finfo(float).eps * np.abs(a_new).max(initial=0.0)

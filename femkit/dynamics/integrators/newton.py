@@ -22,7 +22,7 @@ With the ``direct`` (or ``cholesky``) solver and ``reuse_factorization=True`` (o
 earlier Newton matrix (this step's or a previous step's) is kept and later Newton systems are
 solved by PCG preconditioned with it, to the same relative residual ``ctx.linear_solver.rtol`` on the true
 residual; the factor is renewed when a PCG solve costs more than the average cost per solve
-since the factorisation (see :func:`.base.solve_linear`; ``ctx.stats``: ``factorizations``,
+since the factorisation (see :meth:`femkit.solvers.session.LinearSession.solve`; ``ctx.stats``: ``factorizations``,
 ``refactorizations``, ``linear_iterations``, ``time_pcg``).
 Each Newton direction is the same to that tolerance, so the iterates are those of Newton with
 exact solves; only the cost changes (one factorisation typically serves several steps).
@@ -38,7 +38,7 @@ assembled path to the linear solver's tolerance.
 With the ``cholesky`` solver each Newton matrix is written by one compiled pass over the springs
 into the free-dof pattern cached for the run (the clamp applied in the same pass; ``C`` assembled
 once per step on the same pattern) and refactorised by CHOLMOD on the symbolic analysis of the
-first iteration (:func:`.base.solve_cholesky`).
+first iteration (:meth:`femkit.solvers.session.LinearSession.solve_on_pattern`).
 
 First order; unconditionally stable.
 """
@@ -50,9 +50,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
+from ...solvers.operators import free_operator, restrict
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
-                   check_matrix_free_options, free_operator, note_unconverged, restrict,
-                   solve_compiled, solve_linear, uses_cholesky)
+                   check_matrix_free_options, note_unconverged)
 from .registry import register
 
 
@@ -120,7 +120,7 @@ class NewtonImplicitEuler(Integrator):
         xn = state.x.reshape(-1)
         M = system.mass_matrix()
         m = M.diagonal()
-        compiled = uses_cholesky(ctx, self)
+        compiled = ctx.session.factors_on_pattern and not self.matrix_free
         if self.matrix_free:
             C = self.damping_operator(system, state.x)
             c_apply = C[0]
@@ -170,17 +170,19 @@ class NewtonImplicitEuler(Integrator):
             dx = np.zeros_like(x)
             if self.matrix_free:
                 op, diag = self.newton_operator(system, x.reshape(shape), h, C)
-                dx[free] = solve_linear(op, -grad[free], ctx, diagonal=diag)
+                dx[free] = ctx.session.solve(op, -grad[free], diagonal=diag)
             elif compiled:
                 data = assemble_with_forces(pat, system, x.reshape(shape), zero_v, state.t,
                                             diagonal=m, kcoef=h * h, dcoef=0.0, fix=self.fix)[0]
                 data += h * c_data
-                dx[free] = solve_compiled(pat.matrix(data), -grad[free], ctx, pat,
-                                          "newton_factor" if self.reuse_factorization else None)
+                dx[free] = ctx.session.solve_on_pattern(
+                    pat.matrix(data), -grad[free], pat,
+                    "newton_factor" if self.reuse_factorization else None)
             else:
                 H = M + (h * h) * system.stiffness_matrix(x.reshape(shape), fix=self.fix) + h * C
-                dx[free] = solve_linear(restrict(H, free), -grad[free], ctx, system=system,
-                                        reuse_key="newton_factor" if self.reuse_factorization else None)
+                dx[free] = ctx.session.solve(
+                    restrict(H, free), -grad[free], refactor=True,
+                    keep="newton_factor" if self.reuse_factorization else None)
             slope = grad[free] @ dx[free]
             t = 1.0
             if slope < 0.0:

@@ -23,8 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...solvers.operators import restrict
 from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
-                   note_unconverged, restrict, solve_linear)
+                   note_unconverged)
 from .registry import register
 
 
@@ -64,7 +65,7 @@ class VariationalSymplectic(Integrator):
             D = system.damping_matrix(q.reshape(shape))
             if D.nnz:
                 J = J + (2.0 / h) * D
-            dq = solve_linear(restrict(J, free), -R[free], ctx, system=system)
+            dq = ctx.session.solve(restrict(J, free), -R[free], refactor=True)
             q[free] += dq
             if np.abs(dq).max(initial=0.0) <= self.tol * length:
                 break

@@ -67,7 +67,7 @@ class FreePattern:
         counts = np.bincount(uniq // nf, minlength=nf) if nf else np.zeros(0, np.int64)
         self.indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
         self.nnz = len(uniq)
-        # the coordinate pair (p, q) -> p*d + q an entry couples (see solve_cholesky)
+        # the coordinate pair (p, q) -> p*d + q an entry couples (see entry_group)
         coord = free % d
         rows = np.repeat(np.arange(nf), np.diff(self.indptr))
         self.coordinate_pair = (coord[rows] * d + coord[self.indices]).astype(np.int8)
@@ -75,6 +75,24 @@ class FreePattern:
         self.free = free
         self.shape = (nf, nf)
         self.ndof = ndof
+
+    @property
+    def entry_group(self) -> np.ndarray:
+        """The group of each entry for :meth:`femkit.solvers.session.LinearSession.solve_on_pattern`:
+        its coordinate pair (groups that stay all zero, e.g. the out-of-plane couplings of a
+        planar cloth, are left out of the factor)."""
+        return self.coordinate_pair
+
+    @property
+    def n_groups(self) -> int:
+        """Number of coordinate pairs, ``d * d``."""
+        return self.dim * self.dim
+
+    @property
+    def kept_groups(self) -> np.ndarray:
+        """The same-coordinate pairs ``(p, p)``, always factorised (the clamp zeroes and restores
+        them spring by spring)."""
+        return np.arange(self.dim) * (self.dim + 1)
 
     def matrix(self, data: np.ndarray) -> sp.csr_matrix:
         """The CSR matrix with these values (the pattern arrays are shared, not copied)."""

@@ -20,6 +20,7 @@ from typing import Callable
 import numpy as np
 
 from ...errors import InputError
+from .. import defaults
 from ..defaults import DEFAULT_RTOL
 from ..checks import check_symmetric, check_tolerances, explicit_csr, real_array, unknown_options
 from ..result import SolveResult
@@ -220,10 +221,12 @@ class PetscBackend:
         return names.preconditioners()
 
     def solve(self, A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = None,
-              rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
+              rtol: float | None = None, atol: float | None = None, maxiter: int | None = None,
               callback: Callable | None = None, **options) -> SolveResult:
         """Same contract as :func:`femkit.solvers.solve`; extra options ``omega`` (jacobi),
         ``petsc_options`` (dict) and ``check_symmetry`` (bool, scipy input)."""
+        rtol = defaults.DEFAULT_RTOL if rtol is None else rtol
+        atol = defaults.DEFAULT_ATOL if atol is None else atol
         unknown_options(sorted(set(options) - set(EXTRA_OPTIONS)), list(EXTRA_OPTIONS),
                         what="the petsc backend")
         check_symmetry = options.pop("check_symmetry", True)

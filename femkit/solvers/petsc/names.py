@@ -23,7 +23,9 @@ for this operator (6 CG iterations at 1e6 unknowns against 22 for GAMG).
 
 from __future__ import annotations
 
-from ...errors import InputError, UnknownNameError
+from ...errors import UnknownNameError
+from ..defaults import default_preconditioner
+from ..pairing import check_pairing
 
 #: method -> KSP type
 KSP_TYPES = {"cg": "cg", "pcg": "cg", "jacobi": "richardson", "direct": "preonly"}
@@ -40,9 +42,6 @@ PC_TYPES = {
 
 #: what ``direct`` uses
 DIRECT = ("cholesky", {"pc_factor_mat_solver_type": "mumps"})
-
-#: default preconditioner of ``pcg`` (as in :data:`femkit.solvers.registry.DEFAULT_PRECONDITIONER`)
-DEFAULT_PRECONDITIONER = "amg"
 
 
 def methods() -> list[str]:
@@ -68,21 +67,16 @@ def resolve(method: str, preconditioner: str | None) -> tuple[str, str, str, dic
     if method not in KSP_TYPES:
         raise UnknownNameError("petsc solver", method, KSP_TYPES)
     if method == "direct":
-        if preconditioner not in (None, "none"):
-            raise InputError(f"preconditioner {preconditioner!r} is only valid with method 'pcg', "
-                             f"not 'direct'")
+        check_pairing(method, preconditioner)
         return "preonly", "mumps_cholesky", DIRECT[0], dict(DIRECT[1])
     if method == "jacobi":
-        if preconditioner not in (None, "none", "jacobi"):
-            raise InputError(f"preconditioner {preconditioner!r} is only valid with method 'pcg', "
-                             f"not 'jacobi'")
+        if preconditioner != "jacobi":  # the jacobi iteration is PCJACOBI under Richardson
+            check_pairing(method, preconditioner)
         return "richardson", "jacobi", "jacobi", {}
     if preconditioner is None:
-        preconditioner = DEFAULT_PRECONDITIONER if method == "pcg" else "none"
+        preconditioner = default_preconditioner(method)
     if preconditioner not in PC_TYPES:
         raise UnknownNameError("petsc preconditioner", preconditioner, PC_TYPES)
-    if method == "cg" and preconditioner != "none":
-        raise InputError(f"preconditioner {preconditioner!r} is only valid with method 'pcg', "
-                         f"not 'cg'")
+    check_pairing(method, preconditioner)
     pc_type, extra = PC_TYPES[preconditioner]
     return "cg", preconditioner, pc_type, dict(extra)

@@ -1,0 +1,87 @@
+"""The default ``rtol`` has one home, :data:`femkit.solvers.defaults.DEFAULT_RTOL`: changing it
+there changes it for the Python API, case files, scene files and study files alike.
+
+Each route is tested with the default patched to a value no file or signature names
+(``PATCHED``); the solves then stop at ``PATCHED * ||b||`` (a test that fails whenever some
+route keeps a default of its own).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import yaml
+
+import femkit
+from femkit.solvers import SolverSpec, defaults, solve
+
+PATCHED = 3.7e-7
+
+
+@pytest.fixture
+def patched(monkeypatch):
+    monkeypatch.setattr(defaults, "DEFAULT_RTOL", PATCHED)
+    return PATCHED
+
+
+def _laplacian(n=30):
+    return sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n), format="csr")
+
+
+@pytest.mark.parametrize("method", ["cg", "pcg", "jacobi", "direct",
+                                    pytest.param("cholesky", marks=pytest.mark.cholmod)])
+def test_python_api_solve_stops_at_the_patched_default(patched, method):
+    b = np.linspace(1.0, 2.0, 30)
+    res = solve(_laplacian(), b, method=method, maxiter=100000)
+    assert res.tolerance == pytest.approx(patched * np.linalg.norm(b), rel=1e-12)
+
+
+@pytest.mark.parametrize("make", [lambda: SolverSpec("cg"), lambda: SolverSpec.from_mapping({}),
+                                  lambda: SolverSpec.from_mapping({"method": "direct"})],
+                         ids=["constructor", "from_mapping", "from_mapping_direct"])
+def test_solver_specs_take_the_patched_default(patched, make):
+    assert make().rtol == patched
+
+
+def _write(path, data):
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_a_case_file_without_rtol_solves_to_the_patched_default(patched, tmp_path):
+    case = {"problem": "poisson", "name": "rtol_default", "mesh": {"geometry": "unit_square", "h": 0.25},
+            "source": "1", "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
+            "solver": {"method": "cg"}}
+    c = femkit.load_case(_write(tmp_path / "case.yaml", case))
+    assert c.solver.rtol == patched
+    res = c.run(write=False, quiet=True).solve
+    assert res.converged and res.tolerance == pytest.approx(
+        patched * res.residuals[0], rel=1e-12)   # x0 = 0: the first residual is ||b||
+
+
+def test_a_scene_file_without_rtol_steps_with_the_patched_default(patched, tmp_path):
+    from femkit.case.scene.run import build_context
+
+    scene = {"problem": "mass_spring", "name": "rtol_default",
+             "system": {"type": "single_spring", "k": 100.0, "m": 1.0},
+             "integrator": {"method": "implicit_euler"}, "linear_solver": {"method": "cg"},
+             "dt": 0.01, "t_end": 0.02}
+    c = femkit.load_case(_write(tmp_path / "scene.yaml", scene))
+    assert c.solver.rtol == patched
+    assert build_context(c).session.spec.rtol == patched
+
+
+def test_a_study_file_without_rtol_and_the_study_default_take_the_patched_default(patched, tmp_path):
+    from femkit.study.load import load_study
+
+    study = {"kind": "poisson_convergence",
+             "problem": {"mesh": {"geometry": "unit_square"}, "source": "2*pi**2*sin(pi*x)*sin(pi*y)",
+                         "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
+                         "exact": {"u": "sin(pi*x)*sin(pi*y)",
+                                   "grad": ["pi*cos(pi*x)*sin(pi*y)", "pi*sin(pi*x)*cos(pi*y)"]}},
+             "levels": {"h0": 0.5, "count": 2}}
+    default = load_study(_write(tmp_path / "default.yaml", study))
+    assert [s.rtol for s in default.solvers] == [patched]
+    named = load_study(_write(tmp_path / "named.yaml", {**study, "solvers": [{"method": "cg"}]}))
+    assert [s.rtol for s in named.solvers] == [patched]

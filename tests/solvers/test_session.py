@@ -1,0 +1,142 @@
+"""The linear-solve session: what it reuses over a sequence of solves (orderings, symbolic
+analyses, kept factors as preconditioners), that every answer meets the spec's stopping rule,
+and that its matrix-free rule is the registry's own declaration (one table)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from scipy.sparse.linalg import aslinearoperator, spsolve
+
+from femkit.errors import InputError, SolverError
+from femkit.solvers import SOLVERS, SolverSpec
+from femkit.solvers.registry import declare, traits
+from femkit.solvers.session import LinearSession, check_matrix_free, matrix_free_message
+
+from .conftest import poisson_2d
+
+
+def _family(m=10, k=4):
+    """``k`` SPD matrices of one pattern with different values (a matrix refactorised per step)."""
+    A = poisson_2d(m)
+    return [(A + (1.0 + j) * sp.identity(A.shape[0])).tocsr() for j in range(k)]
+
+
+def _rhs(n):
+    return np.cos(np.arange(n, dtype=float))
+
+
+def _residual_ok(A, x, b, rtol):
+    return np.linalg.norm(b - A @ x) <= rtol * np.linalg.norm(b)
+
+
+def test_direct_refactor_orders_once_per_pattern_and_answers_each_matrix():
+    s = SolverSpec("direct").session()
+    mats = _family()
+    b = _rhs(mats[0].shape[0])
+    for A in mats:
+        x = s.solve(A, b, refactor=True)
+        np.testing.assert_allclose(x, spsolve(A.tocsc(), b), rtol=1e-10)
+    assert s.stats["orderings"] == 1 and s.stats["factorizations"] == len(mats)
+    other = poisson_2d(9).tocsr()                       # a new pattern is ordered afresh
+    s.solve(other, _rhs(81), refactor=True)
+    assert s.stats["orderings"] == 2
+
+
+def test_a_kept_factor_preconditions_later_solves_to_the_spec_tolerance():
+    spec = SolverSpec("direct", rtol=1e-10)
+    s = spec.session()
+    mats = _family(k=5)
+    b = _rhs(mats[0].shape[0])
+    for A in mats:
+        x = s.solve(A, b, refactor=True, keep="k")
+        assert _residual_ok(A, x, b, spec.rtol)
+    assert s.stats["factorizations"] < len(mats)      # some solves were PCG with the kept factor
+    assert s.stats["linear_iterations"] > 0
+
+
+@pytest.mark.cholmod
+def test_solve_on_pattern_refactorises_on_one_symbolic_analysis():
+    class Pattern:                                     # one group: every entry always factorised
+        n_groups = 1
+        kept_groups = np.array([0])
+
+        def __init__(self, A):
+            self.entry_group = np.zeros(A.nnz, dtype=np.int8)
+
+    mats = _family(k=4)
+    pat = Pattern(mats[0])
+    s = SolverSpec("cholesky").session()
+    b = _rhs(mats[0].shape[0])
+    for A in mats:
+        x = s.solve_on_pattern(A, b, pat)
+        assert _residual_ok(A, x, b, s.spec.rtol)
+    assert s.stats["factorizations"] == 4 and s.stats["symbolic_reuses"] >= 3
+
+
+def test_factorize_keeps_one_factor_for_block_solves():
+    A = poisson_2d(8)
+    s = SolverSpec("direct").session()
+    F = s.factorize(A)
+    B = np.random.default_rng(1).standard_normal((A.shape[0], 2))
+    np.testing.assert_allclose(A @ F.solve(B), B, atol=1e-11)
+    assert s.stats["factorizations"] == 1
+
+
+def test_a_zero_right_hand_side_gives_zero_without_factorising():
+    s = SolverSpec("direct").session()
+    x = s.solve(poisson_2d(5).tocsr(), np.zeros(25), refactor=True)
+    assert not x.any() and s.stats.get("factorizations", 0) == 0
+
+
+def test_an_unconverged_iterative_solve_is_a_solver_error():
+    s = SolverSpec("cg", maxiter=2).session()
+    with pytest.raises(SolverError, match="did not converge"):
+        s.solve(poisson_2d(10), _rhs(100))
+
+
+def test_matrix_free_solves_use_the_diagonal_for_jacobi():
+    A = poisson_2d(8)
+    b = _rhs(64)
+    s = SolverSpec("pcg", "jacobi").session()
+    x = s.solve(aslinearoperator(A), b, diagonal=A.diagonal())
+    assert _residual_ok(A, x, b, s.spec.rtol)
+    with pytest.raises(InputError, match="needs the operator's diagonal"):
+        s.solve(aslinearoperator(A), b)
+
+
+@pytest.mark.parametrize("spec", [SolverSpec("direct"), SolverSpec("jacobi"),
+                                  SolverSpec("pcg", "ic0")], ids=["direct", "jacobi", "pcg+ic0"])
+def test_matrix_free_refuses_solvers_that_need_the_matrix(spec):
+    with pytest.raises(InputError, match=r"matrix-free needs an iterative solver: cg or pcg \(jacobi\)"):
+        spec.session().solve(aslinearoperator(poisson_2d(4)), np.ones(16))
+
+
+def test_keeping_a_factor_needs_femkit_s_backend():
+    s = SolverSpec.from_mapping({"method": "direct", "backend": "petsc"}).session()
+    with pytest.raises(InputError, match="backend 'petsc' is not supported"):
+        s.solve(poisson_2d(4).tocsr(), np.ones(16), refactor=True, keep="k")
+
+
+@pytest.fixture
+def registered_solver():
+    """A new matrix-free method registered for the test only (plain CG under another name)."""
+    from femkit.solvers.cg import cg
+
+    def newcomer(A, b, x0=None, **kw):
+        return cg(A, b, x0, **kw)
+
+    SOLVERS.register("newcomer", declare(newcomer, matrix_free=True))
+    yield "newcomer"
+    SOLVERS.remove("newcomer")
+
+
+def test_the_matrix_free_rule_is_what_the_registry_entries_declare(registered_solver):
+    assert traits(SOLVERS, registered_solver).matrix_free
+    assert "newcomer" in matrix_free_message()
+    spec = SolverSpec(registered_solver)
+    check_matrix_free("implicit_euler", spec)          # accepted with no list edited
+    A = poisson_2d(6)
+    x = LinearSession(spec).solve(aslinearoperator(A), _rhs(36))
+    assert _residual_ok(A, x, _rhs(36), spec.rtol)
