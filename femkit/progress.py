@@ -23,7 +23,7 @@ import sys
 import time
 from typing import Iterable, Iterator, TypeVar
 
-from .cost.plan import format_seconds
+from .timing import format_seconds
 
 __all__ = ["Progress", "progress", "StageProgress"]
 

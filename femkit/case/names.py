@@ -48,7 +48,7 @@ def check_geometry_spec(spec: dict, where: str) -> None:
     """
     from ..mesh.geometries import GEOMETRIES
 
-    factory = lookup(GEOMETRIES, spec["geometry"], f"{where}.geometry")
+    factory = lookup(GEOMETRIES, spec["geometry"], f"{where}.geometry").build
     params = spec.get("params") or {}
     signature = inspect.signature(factory)
     try:

@@ -46,7 +46,10 @@ def _meshes(study, spec, timer_list):
         return meshes, lambda level: None
     count = lv["count"] if "max_level" not in lv else min(lv["count"], lv["max_level"] + 1)
     timed(0, lambda: spec.base_mesh(lv["h0"]))
+    from ..case.cost import check_mesh_fits
+
     for i in range(1, count):
+        check_mesh_fits(triangles=meshes[-1].n_triangles, refine=1)  # before numpy allocates
         timed(i, lambda: refine(meshes[-1], 1))
 
     prols: list = []  # built once, on the first request that reaches them
