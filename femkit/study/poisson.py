@@ -15,8 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..interrupt import active_flag
+from ..progress import progress
 from .fit import fit_rate
-from .progress import progress
 from .timing import StageTimer, time_call
 
 
@@ -199,7 +200,8 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
     records = []
     systems = {}  # (level, rule) -> system: fmg's lower levels (its coarse right-hand sides)
     jobs = [(lvl, rule) for lvl in range(len(meshes)) for rule in rules]
-    for lvl, rule in progress(jobs, total=len(jobs), desc=f"{study.name}", enabled=progress_enabled):
+    for lvl, rule in progress(jobs, total=len(jobs), desc=f"{study.name}", unit="run",
+                                 enabled=progress_enabled, stop=active_flag()):
         mesh = meshes[lvl]
         ta = time_call(lambda: _assemble(spec, mesh, rule), repeats=repeats, warmup=0)
         prob, K, F = ta.value

@@ -28,7 +28,7 @@ import numpy as np
 
 from ...errors import CaseFileError, ExpressionError, InputError
 from ...interrupt import Interrupted
-from ...progress import StageProgress
+from ...progress import Progress
 from ..expressions import compile_expression
 from ..load import Case
 from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
@@ -475,8 +475,8 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         target = output_location(output_dir or case.data["output"]["dir"])
     stop = case.run_options.get("stop")
     plan = case.run_options.get("plan")
-    report = StageProgress([(st.name, st.seconds) for st in plan.stages] if plan else [],
-                           case.name, quiet=quiet)
+    report = Progress.planned([(st.name, st.seconds) for st in plan.stages] if plan else [],
+                              case.name, quiet=quiet)
 
     def check_stop(where: str) -> None:  # a signal during a stage stops after it
         report.done(where, *(("refine",) if where == "mesh" else ()))  # mesh includes refine
