@@ -158,3 +158,56 @@ def test_sources_cite_publications_not_documents_outside_the_repository():
            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines())
            if any(w in line for w in words)]
     assert not bad
+
+
+def _calls(tree: ast.AST) -> set[str]:
+    """Dotted names called in ``tree`` (``meshio.write(...)`` -> ``"meshio.write"``)."""
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call):
+            parts, f = [], node.func
+            while isinstance(f, ast.Attribute):
+                parts.append(f.attr)
+                f = f.value
+            if isinstance(f, ast.Name):
+                out.add(".".join([f.id] + parts[::-1]))
+    return out
+
+
+def _modules_where(predicate) -> list[str]:
+    return sorted(str(p.relative_to(PKG)) for p in PKG.rglob("*.py")
+                  if predicate(ast.parse(p.read_text(encoding="utf-8"))))
+
+
+def test_one_vtk_writer():
+    """meshio's writer is called in one place: femkit.mesh.vtk.write_cells."""
+    assert _modules_where(lambda t: _calls(t) & {"meshio.write", "meshio.Mesh"}) == ["mesh/vtk.py"]
+
+
+def test_one_scikit_fem_reference():
+    """scikit-fem is imported by one module: the reference of femkit check and the studies."""
+    def imports_skfem(tree):
+        return any(isinstance(n, (ast.Import, ast.ImportFrom)) and any(
+            (getattr(n, "module", None) or a.name).split(".")[0] == "skfem" for a in n.names)
+            for n in ast.walk(tree))
+    assert _modules_where(imports_skfem) == ["case/poisson/reference.py"]
+
+
+def test_one_stage_timer():
+    """No module keeps its own ``perf_counter`` stage table: stage timing is timing.StageTimer."""
+    def times_stages(tree):
+        for fn in ast.walk(tree):
+            if isinstance(fn, ast.FunctionDef) and any(
+                    "contextmanager" in ast.unparse(d) for d in fn.decorator_list):
+                if "perf_counter" in ast.unparse(fn):
+                    return True
+        return False
+    assert _modules_where(times_stages) == ["timing.py"]
+
+
+def test_one_progress_interface():
+    """Progress classes and progress iterators live in femkit/progress.py only."""
+    def defines_progress(tree):
+        return any(isinstance(n, (ast.ClassDef, ast.FunctionDef)) and "progress" in n.name.lower()
+                   for n in ast.walk(tree))
+    assert _modules_where(defines_progress) == ["progress.py"]
