@@ -48,7 +48,7 @@ def geometry_domain(geometry: str, params: dict | None = None) -> tuple[int, flo
     from ..mesh.geometries import GEOMETRIES
 
     entry = GEOMETRIES.get(geometry)
-    size, lines = entry.measures(geometry, params)
+    size, lines = entry.measures(params)
     return entry.dim, size, lines
 
 

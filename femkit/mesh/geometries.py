@@ -71,6 +71,7 @@ class Geometry:
 
     Attributes
     ----------
+    name : the registered name
     build : ``build(h, **params) -> Mesh``
     measure : ``measure(**params) -> (measure, line_measure)``: area and mesh-line length (2D),
         or volume and mesh-surface area (3D); same parameters and defaults as ``build``
@@ -78,6 +79,7 @@ class Geometry:
     boundary_tags, cell_tags : the tag names of a generated mesh
     """
 
+    name: str
     build: Callable[..., Mesh]
     measure: Callable[..., tuple[float, float]]
     dim: int = 2
@@ -89,15 +91,15 @@ class Geometry:
         """Names of the geometry's parameters (those of ``build`` after ``h``)."""
         return [n for n in inspect.signature(self.build).parameters if n != "h"]
 
-    def check_params(self, name: str, h, params: dict) -> None:
+    def check_params(self, h, params: dict) -> None:
         """Raise :class:`~femkit.errors.InputError` when ``params`` do not fit ``build``."""
         try:
             inspect.signature(self.build).bind(h, **params)
         except TypeError as exc:
-            raise InputError(f"geometry {name!r}: {exc}; valid parameters: "
+            raise InputError(f"geometry {self.name!r}: {exc}; valid parameters: "
                              f"{', '.join(self.parameters) or '(none)'}") from None
 
-    def measures(self, name: str, params: dict | None = None) -> tuple[float, float]:
+    def measures(self, params: dict | None = None) -> tuple[float, float]:
         """``(measure, line_measure)`` of the geometry with ``params`` (floats, measure > 0).
 
         Raises
@@ -106,15 +108,15 @@ class Geometry:
             Unknown parameters, or parameters giving no positive measure.
         """
         params = dict(params or {})
-        self.check_params(name, 1.0, params)
+        self.check_params(1.0, params)
         try:
             size, lines = self.measure(**params)
         except (TypeError, ValueError) as exc:
-            raise InputError(f"geometry {name!r}: {exc}") from None
+            raise InputError(f"geometry {self.name!r}: {exc}") from None
         size, lines = float(size), float(lines)
         if not (math.isfinite(size) and size > 0 and math.isfinite(lines) and lines >= 0):
             what = "area" if self.dim == 2 else "volume"
-            raise InputError(f"geometry {name!r} with {params} has no positive {what}")
+            raise InputError(f"geometry {self.name!r} with {params} has no positive {what}")
         return size, lines
 
 
@@ -133,7 +135,7 @@ def register_geometry(name: str, *, measure: Callable[..., tuple[float, float]],
         raise ValueError(f"geometry {name!r}: dim must be 2 or 3, got {dim!r}")
 
     def decorator(build: Callable[..., Mesh]) -> Callable[..., Mesh]:
-        GEOMETRIES.register(name, Geometry(build, measure, dim, tuple(boundary_tags),
+        GEOMETRIES.register(name, Geometry(name, build, measure, dim, tuple(boundary_tags),
                                            tuple(cell_tags)))
         return build
 
@@ -588,5 +590,5 @@ def generate(geometry: str, h: float, **params) -> Mesh:
         Bad or unknown parameters.
     """
     entry = GEOMETRIES.get(geometry)
-    entry.check_params(geometry, h, params)
+    entry.check_params(h, params)
     return entry.build(h, **params)
