@@ -144,3 +144,13 @@ def test_a_3d_geometry_is_not_costed_as_triangles():
         assert plan.stages == [] and "no cost model for 3D meshes" in plan.assumptions[0]
     finally:
         GEOMETRIES.remove("test_cube")
+
+
+def test_a_case_with_parameters_the_geometry_lacks_is_refused_at_load():
+    import femkit
+    from femkit.errors import CaseFileError
+
+    with pytest.raises(CaseFileError, match=r"mesh.params: \['radius'\] do not fit geometry "
+                                            r"'annulus'; valid parameters: r_inner, r_outer, centre"):
+        femkit.load_case("cases/poisson_unit_square.yaml",
+                         mesh={"geometry": "annulus", "params": {"radius": 2.0}})
