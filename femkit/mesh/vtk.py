@@ -10,16 +10,16 @@ and the two XML index files ParaView opens over several ``.vtu`` files.
   declarations read back from the first piece so the index always matches what was written.
 
 Both index formats are VTK's XML file formats ("VTK File Formats", Kitware, VTK User's Guide,
-section "Parallel XML files" and "Collection files"). meshio is imported inside the functions.
+section "Parallel XML files" and "Collection files"). meshio and the XML modules (whose
+``xml.sax`` pulls in ``urllib`` and ``ssl``) are imported inside the functions, so importing
+:mod:`femkit.mesh` stays cheap.
 """
 
 from __future__ import annotations
 
 import os
-import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Sequence
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -76,7 +76,7 @@ def write_cells(path: str | os.PathLike, points: np.ndarray, cells: Sequence[tup
     return Path(p)
 
 
-def _atomic_xml(path: Path, text: str | None = None, tree: ET.ElementTree | None = None) -> Path:
+def _atomic_xml(path: Path, text: str | None = None, tree=None) -> Path:
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
     if tree is not None:
@@ -89,6 +89,8 @@ def _atomic_xml(path: Path, text: str | None = None, tree: ET.ElementTree | None
 
 def write_collection(path: str | os.PathLike, times: Sequence[float], files: Sequence[str]) -> Path:
     """A ParaView collection (``.pvd``) listing ``files`` at ``times`` (written atomically)."""
+    from xml.sax.saxutils import quoteattr
+
     rows = "\n".join(f'    <DataSet timestep="{float(t)!r}" group="" part="0" file={quoteattr(f)}/>'
                      for t, f in zip(times, files))
     text = ('<?xml version="1.0"?>\n'
@@ -100,6 +102,8 @@ def write_collection(path: str | os.PathLike, times: Sequence[float], files: Seq
 def _declarations(piece: Path) -> dict[str, list[dict]]:
     """``{"PointData": [...], "CellData": [...], "Points": [...]}``: the DataArray attributes
     (type, Name, NumberOfComponents) of a ``.vtu`` piece."""
+    import xml.etree.ElementTree as ET
+
     root = ET.parse(piece).getroot()
     grid = root.find("UnstructuredGrid/Piece")
     out = {}
@@ -115,6 +119,8 @@ def write_parallel_index(path: str | os.PathLike, first_piece: str | os.PathLike
                          pieces: Sequence[str]) -> Path:
     """A ``.pvtu`` index of ``pieces`` (names relative to it), declaring the arrays that
     ``first_piece`` holds (written atomically)."""
+    import xml.etree.ElementTree as ET
+
     decl = _declarations(Path(first_piece))
     vtk = ET.Element("VTKFile", type="PUnstructuredGrid", version="1.0", byte_order="LittleEndian")
     grid = ET.SubElement(vtk, "PUnstructuredGrid", GhostLevel="0")

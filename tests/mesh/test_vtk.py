@@ -55,3 +55,18 @@ def test_parallel_index_declares_the_pieces_arrays(tmp_path):
     assert [a.get("Name") for a in grid.find("PPointData")] == ["u"]
     assert [a.get("Name") for a in grid.find("PCellData")] == ["rank"]
     assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_importing_the_mesh_package_loads_no_writer_modules():
+    """meshio and the XML modules (xml.sax pulls in urllib and ssl) load only when writing."""
+    import subprocess
+    import sys
+
+    from cost_probe import child_env
+
+    code = ("import sys, femkit.mesh, femkit.mesh.vtk; "
+            "print(sorted(m for m in ('meshio', 'xml.sax', 'xml.etree.ElementTree', 'ssl') "
+            "if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, env=child_env())
+    assert out.stdout.strip() == "[]"
