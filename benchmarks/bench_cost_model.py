@@ -1,7 +1,7 @@
 """The cost model against measured runs: triangles, peak memory and time, up to ~4M triangles.
 
 Each configuration is planned (:func:`femkit.cost.plan_poisson`) and then run in a fresh
-process (:func:`femkit.cost.probe.measure_poisson_subprocess`: the library pipeline, stage by
+process (``cost_probe.measure_poisson_subprocess`` beside this script: the library pipeline, stage by
 stage, peak resident memory from VmHWM). Predicted seconds are scaled by the machine speed
 measured just before and after each run (:func:`femkit.cost.machine_speed`, median of the
 probe: the current load included), so a loaded machine does not count against the model. Ratios are predicted / measured; targets (issue 12): triangles within
@@ -20,8 +20,9 @@ import sys
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
+from cost_probe import domain, measure_poisson_subprocess  # noqa: E402
+
 from femkit.cost import machine_speed, plan_poisson  # noqa: E402
-from femkit.cost.probe import measure_poisson_subprocess  # noqa: E402
 
 #: (label, measure_poisson keyword arguments): the bundled Poisson cases' meshes and solvers,
 #: then refined unit squares.
@@ -50,7 +51,8 @@ def main(argv=None) -> int:
     print("| run | triangles pred / meas | ratio | peak memory pred / meas | ratio | time pred / meas | ratio | speed |")
     print("|---|---|---|---|---|---|---|---|")
     for label, kw in CONFIGS:
-        plan_kw = {k: v for k, v in kw.items() if k != "method"}
+        plan_kw = {k: v for k, v in kw.items() if k not in ("method", "geometry", "params")}
+        plan_kw.update(domain(kw["geometry"], kw.get("params")))
         method = kw.get("method", "pcg")
         plan = plan_poisson(method=method, **plan_kw)
         if plan.sizes["triangles"] > args.max_triangles:

@@ -1,6 +1,6 @@
 """Fit the cost model's constants (femkit/cost/constants.json) from measured runs on this machine.
 
-Every run is :func:`femkit.cost.probe.measure_poisson` in a fresh process (BLAS on one thread):
+Every run is ``cost_probe.measure_poisson`` (beside this script) in a fresh process (BLAS on one thread):
 per stage the wall time and the peak resident memory above the start (VmHWM reset per stage).
 The fit follows the model in femkit/cost/poisson.py: per stage ``fixed + a * triangles`` with
 the fixed part the libraries loaded by then (gmsh, numba, pyamg, matplotlib: measured here by
@@ -27,15 +27,15 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
+from cost_probe import child_env, domain, measure_poisson_subprocess  # noqa: E402
+
 from femkit.cost.constants import load_constants  # noqa: E402
-from femkit.cost.geometry import domain_measures  # noqa: E402
 from femkit.cost.poisson import fixed_bytes, solver_key  # noqa: E402
-from femkit.cost.probe import child_env, measure_poisson_subprocess  # noqa: E402
 
 
 def _import_cost(module: str) -> tuple[float, float]:
     """(bytes, seconds) of importing ``module`` after femkit's baseline imports (fresh process)."""
-    code = ("import time, json; from femkit.cost.probe import preload; preload(); "
+    code = ("import time, json; from cost_probe import preload; preload(); "
             "from femkit.cost.memory import current_rss; a = current_rss(); t = time.perf_counter(); "
             f"import {module}; t = time.perf_counter() - t; print(json.dumps([current_rss() - a, t]))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
@@ -49,8 +49,9 @@ def fit_triangle_count(hs=(0.04, 0.02, 0.01)) -> dict:
     from femkit.mesh import GEOMETRIES, boundary_edges_topological, generate
 
     rows, rhs, bfrac = [], [], []
-    for g in GEOMETRIES.names():
-        area, length = domain_measures(g)
+    for g in (name for name in GEOMETRIES.names() if GEOMETRIES.get(name).dim == 2):
+        d = domain(g)
+        area, length = d["area"], d["line_length"]
         for h in hs:
             mesh = generate(g, h)
             rows.append([area / h ** 2, length / h])

@@ -107,7 +107,7 @@ def _max_memory(args) -> float | None:
 
 def _run_solve(args) -> int:
     from .case import load_case
-    from .case.cost import check_case, plan_case
+    from .case.budget import check_case, plan_case
     from .interrupt import exit_code, stop_on_signals
 
     overrides = {"solver": {"backend": args.backend}} if args.backend else {}

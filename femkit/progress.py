@@ -1,7 +1,15 @@
-"""Progress of long loops: a tqdm bar on a terminal, plain log lines elsewhere, nothing when quiet.
+"""Progress of long work: a tqdm bar on a terminal, plain log lines elsewhere, nothing when quiet.
 
-One helper for every long loop (time steps of a scene, jobs of a study, iterations of a long
-solve). On a terminal it shows a tqdm bar; when stderr is not a terminal (a log file, a batch
+One interface, :class:`Progress`, for every long piece of work, in three uses:
+
+* counted work (time steps of a scene, runs of a study): ``Progress(total, desc)`` and
+  ``update()``; :func:`progress` is the same object wrapped round an iterable, and with
+  ``stop=`` (a :class:`femkit.interrupt.StopFlag`) it raises
+  :class:`~femkit.interrupt.Interrupted` before the next item once a stop was requested;
+* planned stages (a Poisson run whose stage times were predicted by a cost plan):
+  :meth:`Progress.planned` and ``done(stage)``, see there.
+
+On a terminal it shows a tqdm bar; when stderr is not a terminal (a log file, a batch
 job, CI) it prints one line per ``every_fraction`` (10 %) of the work, or per ``every_seconds``
 (60 s) when that comes first, with the elapsed time and the predicted remaining time (linear
 extrapolation from the rate so far), so a log shows that a long run is alive::
@@ -23,9 +31,9 @@ import sys
 import time
 from typing import Iterable, Iterator, TypeVar
 
-from .cost.plan import format_seconds
+from .timing import format_seconds
 
-__all__ = ["Progress", "progress", "StageProgress"]
+__all__ = ["Progress", "progress"]
 
 T = TypeVar("T")
 
@@ -75,6 +83,8 @@ class Progress:
         self._next_time = self.start + self.every_seconds
         self._bar = None
         self.lines = 0
+        self.predicted: dict[str, float] = {}  # planned stages (see planned)
+        self.done_predicted = 0.0
         if mode == "bar":
             from tqdm import tqdm
 
@@ -117,6 +127,51 @@ class Progress:
                 while self._next_count <= self.count:
                     self._next_count += self._step
 
+    @classmethod
+    def planned(cls, stages, desc: str, *, quiet: bool = False, stream=None,
+                min_seconds: float = 30.0, clock=time.monotonic) -> "Progress":
+        """Progress of a run made of stages whose durations were predicted (a
+        :class:`femkit.cost.Plan`'s ``(name, seconds)``).
+
+        After each stage, :meth:`done` prints ``desc: assembly done, elapsed 12 s, remaining
+        ~30 s`` (lines, also on a terminal), the remaining time being the predicted time of the
+        stages left, scaled by how the elapsed time compares with its prediction. Only for runs
+        predicted to take at least ``min_seconds`` (a short run stays silent), never when
+        ``quiet``.
+
+        >>> import io
+        >>> out = io.StringIO()
+        >>> clock = iter([0.0, 10.0, 30.0]).__next__
+        >>> sp = Progress.planned([("mesh", 5.0), ("solve", 15.0)], "demo", stream=out,
+        ...                       min_seconds=0, clock=clock)
+        >>> sp.done("mesh"); sp.done("solve")
+        >>> out.getvalue().splitlines()
+        ['demo: mesh done, elapsed 10 s, remaining ~30 s', 'demo: solve done, elapsed 30 s']
+        """
+        predicted = {name: float(sec) for name, sec in stages}
+        active = not quiet and sum(predicted.values()) >= min_seconds
+        bar = cls(None, desc, unit="stage", mode="lines" if active else "off", stream=stream,
+                  clock=clock)
+        bar.predicted = predicted
+        return bar
+
+    def done(self, stage: str, *also: str) -> None:
+        """Report that planned ``stage`` finished, with the planned stages ``also`` that the run
+        did inside it (e.g. ``done("mesh", "refine")``) and every planned stage before them."""
+        if self.mode == "off":
+            return
+        elapsed = self.clock() - self.start
+        names = list(self.predicted)
+        last = max((names.index(n) for n in (stage, *also) if n in self.predicted), default=-1)
+        for name in names[: last + 1]:
+            self.done_predicted += self.predicted.pop(name)
+        left = sum(self.predicted.values())
+        line = f"{self.desc}: {stage} done, elapsed {format_seconds(elapsed)}"
+        if left > 0:
+            pace = elapsed / self.done_predicted if self.done_predicted > 0 else 1.0
+            line += f", remaining ~{format_seconds(left * pace)}"
+        self._emit(line)
+
     def note(self, text: str) -> None:
         """Print a message between progress lines (through tqdm on a terminal)."""
         if self.mode == "off":
@@ -142,8 +197,12 @@ class Progress:
 
 
 def progress(items: Iterable[T], *, total: int | None = None, desc: str = "", unit: str = "job",
-             enabled: bool | None = None, mode: str = "auto", stream=None) -> Iterator[T]:
+             enabled: bool | None = None, mode: str = "auto", stream=None,
+             stop=None) -> Iterator[T]:
     """Iterate over ``items`` reporting progress (:class:`Progress`); ``enabled=False`` is quiet.
+
+    ``stop``: a :class:`femkit.interrupt.StopFlag`; once set, the next item is not started:
+    :class:`~femkit.interrupt.Interrupted` is raised naming it (``before run 3 of 8 (2 done)``).
 
     >>> list(progress(range(3), enabled=False))
     [0, 1, 2]
@@ -155,54 +214,13 @@ def progress(items: Iterable[T], *, total: int | None = None, desc: str = "", un
             total = None
     bar = Progress(total, desc, unit=unit, mode=mode, quiet=enabled is False, stream=stream)
     try:
-        for item in items:
+        for i, item in enumerate(items):
+            if stop:
+                from .interrupt import Interrupted
+
+                of = f" of {total}" if total else ""
+                raise Interrupted(stop, where=f"before {unit} {i + 1}{of} ({i} done)")
             yield item
             bar.update()
     finally:
         bar.close()
-
-
-class StageProgress:
-    """Progress of a run made of stages whose durations were predicted (a :class:`femkit.cost.Plan`).
-
-    After each stage, :meth:`done` prints ``desc: assembly done, elapsed 12 s, remaining ~30 s``
-    on stderr, the remaining time being the predicted time of the stages left, scaled by how
-    the elapsed time compares with its prediction. Only for runs predicted to take at least
-    ``min_seconds`` (a short run stays silent), never when ``quiet``.
-
-    >>> import io
-    >>> out = io.StringIO()
-    >>> clock = iter([0.0, 10.0, 30.0]).__next__
-    >>> sp = StageProgress([("mesh", 5.0), ("solve", 15.0)], "demo", stream=out, min_seconds=0,
-    ...                    clock=clock)
-    >>> sp.done("mesh"); sp.done("solve")
-    >>> out.getvalue().splitlines()
-    ['demo: mesh done, elapsed 10 s, remaining ~30 s', 'demo: solve done, elapsed 30 s']
-    """
-
-    def __init__(self, stages, desc: str, *, quiet: bool = False, stream=None,
-                 min_seconds: float = 30.0, clock=time.monotonic):
-        self.predicted = {name: float(sec) for name, sec in stages}
-        self.total = sum(self.predicted.values())
-        self.desc, self.clock = desc, clock
-        self.stream = stream if stream is not None else sys.stderr
-        self.active = not quiet and self.total >= min_seconds
-        self.start = clock()
-        self.done_predicted = 0.0
-
-    def done(self, stage: str, *also: str) -> None:
-        """Report that ``stage`` finished, with the planned stages ``also`` that the run did
-        inside it (e.g. ``done("mesh", "refine")``) and every planned stage before them."""
-        if not self.active:
-            return
-        elapsed = self.clock() - self.start
-        names = list(self.predicted)
-        last = max((names.index(n) for n in (stage, *also) if n in self.predicted), default=-1)
-        for name in names[: last + 1]:
-            self.done_predicted += self.predicted.pop(name)
-        left = sum(self.predicted.values())
-        line = f"{self.desc}: {stage} done, elapsed {format_seconds(elapsed)}"
-        if left > 0:
-            pace = elapsed / self.done_predicted if self.done_predicted > 0 else 1.0
-            line += f", remaining ~{format_seconds(left * pace)}"
-        print(line, file=self.stream, flush=True)

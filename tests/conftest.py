@@ -1,7 +1,11 @@
 """Shared test setup: pinned BLAS threads, headless plotting."""
 
 import os
+import sys
+from pathlib import Path
 
+# benchmarks/cost_probe.py (the measuring probe, child_env) is imported by the cost tests
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("MKL_NUM_THREADS", "1")

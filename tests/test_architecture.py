@@ -1,9 +1,11 @@
 """The layering of femkit, checked from the source: library layers never reach the application.
 
 Layers: ``mesh -> fem -> solvers <- dynamics`` know nothing of files; ``case`` (case and scene
-files), ``study`` and ``cli`` sit on top. Every import is read from the AST of every module,
+files), ``study`` and ``cli`` sit on top. ``cost/`` is a base of pure functions of numbers
+below the application: it imports only the shared leaves, and the library never imports it
+(the application plans and guards). Every import is read from the AST of every module,
 imports inside functions (lazy ones) included, and no string names an application module for
-importlib to load.
+importlib to load. Import cycles: ``tests/test_no_import_cycles.py``.
 """
 
 from __future__ import annotations
@@ -17,6 +19,10 @@ import pytest
 PKG = Path(__file__).resolve().parents[1] / "femkit"
 LIBRARY = ("mesh", "fem", "solvers", "dynamics")
 APPLICATION = ("case", "study", "cli")
+#: What the library must never import: the application and the cost model (planned above it).
+ABOVE_THE_LIBRARY = APPLICATION + ("cost",)
+#: Shared leaves any layer may import; they import only one another.
+LEAVES = ("errors", "registry", "timing", "validation", "_version", "progress", "interrupt")
 
 
 def _modules(layer: str) -> list[Path]:
@@ -61,10 +67,35 @@ def _forbidden(names: set[str], layers) -> list[str]:
 
 
 @pytest.mark.parametrize("layer", LIBRARY)
-def test_library_layers_never_import_the_application(layer):
+def test_library_layers_never_import_the_application_or_cost(layer):
+    """No import from mesh/, fem/, solvers/, dynamics/ into cost/, case/, study/ or cli."""
     files = _modules(layer)
     assert len(files) > 3
-    bad = {str(p.relative_to(PKG)): _forbidden(_imported(p), APPLICATION) for p in files}
+    bad = {str(p.relative_to(PKG)): _forbidden(_imported(p), ABOVE_THE_LIBRARY) for p in files}
+    assert not {k: v for k, v in bad.items() if v}
+
+
+def _outside(names: set[str], allowed) -> list[str]:
+    """The femkit modules in ``names`` that are not ``femkit.<a>`` or below it for ``a`` in
+    ``allowed``."""
+    return sorted(n for n in names if not any(n == f"femkit.{a}" or n.startswith(f"femkit.{a}.")
+                                              for a in allowed))
+
+
+def test_cost_imports_no_library_or_application_module():
+    """cost/ is a base: sizes in, seconds and bytes out; it imports only the shared leaves."""
+    files = _modules("cost")
+    assert len(files) > 3
+    bad = {str(p.relative_to(PKG)): _outside(_imported(p), LEAVES + ("cost",)) for p in files}
+    assert not {k: v for k, v in bad.items() if v}
+
+
+def test_shared_leaves_import_only_leaves():
+    """The leaves sit below every layer (cost included): a leaf importing a layer would put that
+    layer under everything that uses the leaf."""
+    files = [PKG / f"{leaf}.py" for leaf in LEAVES]
+    assert all(p.is_file() for p in files)
+    bad = {p.name: _outside(_imported(p), LEAVES) for p in files}
     assert not {k: v for k, v in bad.items() if v}
 
 
@@ -116,6 +147,12 @@ def test_the_checker_sees_lazy_and_relative_imports():
     names = _imports_of(src, ["femkit", "dynamics"])
     assert "femkit.case.load" in names
     assert _forbidden(names, APPLICATION) == ["femkit.case.load", "femkit.case.load.load_case"]
+    lazy_cost = _imports_of("def g():\n    from ..cost.budget import check_budget\n", ["femkit", "mesh"])
+    assert _forbidden(lazy_cost, ABOVE_THE_LIBRARY) == ["femkit.cost.budget",
+                                                        "femkit.cost.budget.check_budget"]
+    in_cost = _imports_of("from ..errors import InputError\ndef h():\n    from ..mesh import generate\n",
+                          ["femkit", "cost"])
+    assert _outside(in_cost, LEAVES + ("cost",)) == ["femkit.mesh", "femkit.mesh.generate"]
     assert IMPORT_STRING.match("femkit.dynamics.scene:run_scene") is None
     assert IMPORT_STRING.match("femkit.case.scene.run:run_scene")
 
@@ -202,3 +239,56 @@ def test_the_cycle_checker_finds_cycles_and_resolves_submodule_imports():
     g = _module_graph()
     assert "femkit.solvers.defaults" in g["femkit.solvers.registry"]   # `from . import defaults`
     assert "femkit.solvers" not in g["femkit.solvers.registry"]        # ... not the package
+
+
+def _calls(tree: ast.AST) -> set[str]:
+    """Dotted names called in ``tree`` (``meshio.write(...)`` -> ``"meshio.write"``)."""
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call):
+            parts, f = [], node.func
+            while isinstance(f, ast.Attribute):
+                parts.append(f.attr)
+                f = f.value
+            if isinstance(f, ast.Name):
+                out.add(".".join([f.id] + parts[::-1]))
+    return out
+
+
+def _modules_where(predicate) -> list[str]:
+    return sorted(str(p.relative_to(PKG)) for p in PKG.rglob("*.py")
+                  if predicate(ast.parse(p.read_text(encoding="utf-8"))))
+
+
+def test_one_vtk_writer():
+    """meshio's writer is called in one place: femkit.mesh.vtk.write_cells."""
+    assert _modules_where(lambda t: _calls(t) & {"meshio.write", "meshio.Mesh"}) == ["mesh/vtk.py"]
+
+
+def test_one_scikit_fem_reference():
+    """scikit-fem is imported by one module: the reference of femkit check and the studies."""
+    def imports_skfem(tree):
+        return any(isinstance(n, (ast.Import, ast.ImportFrom)) and any(
+            (getattr(n, "module", None) or a.name).split(".")[0] == "skfem" for a in n.names)
+            for n in ast.walk(tree))
+    assert _modules_where(imports_skfem) == ["case/poisson/reference.py"]
+
+
+def test_one_stage_timer():
+    """No module keeps its own ``perf_counter`` stage table: stage timing is timing.StageTimer."""
+    def times_stages(tree):
+        for fn in ast.walk(tree):
+            if isinstance(fn, ast.FunctionDef) and any(
+                    "contextmanager" in ast.unparse(d) for d in fn.decorator_list):
+                if "perf_counter" in ast.unparse(fn):
+                    return True
+        return False
+    assert _modules_where(times_stages) == ["timing.py"]
+
+
+def test_one_progress_interface():
+    """Progress classes and progress iterators live in femkit/progress.py only."""
+    def defines_progress(tree):
+        return any(isinstance(n, (ast.ClassDef, ast.FunctionDef)) and "progress" in n.name.lower()
+                   for n in ast.walk(tree))
+    assert _modules_where(defines_progress) == ["progress.py"]

@@ -1,29 +1,107 @@
-"""The cost of a case or scene file before it runs: its plan, the budget check, the stop flag.
+"""The cost of a case or scene file before it runs: its plan, the budget checks, the stop flag.
 
-:func:`plan_case` translates a loaded case into a :class:`femkit.cost.Plan` through its
-problem type (``PROBLEMS[...].plan``); :func:`check_case` checks it against the case's
-``limits:``, the command line's ``--max-memory`` and the available memory, refusing with
-:class:`~femkit.errors.BudgetExceededError` (exit code 2, one line) unless forced. Run options
-travel in ``case.run_options``: ``limits`` (:class:`femkit.cost.Limits`, from the file), ``force``
-(skip every budget, also the library's own memory checks), ``stop`` (a
-:class:`femkit.interrupt.StopFlag` the runners check between steps and iterations) and
-``plan`` (set by :func:`check_case`: a Poisson run predicted to last 30 s or more prints a
-line on stderr after each stage with the elapsed and the predicted remaining time).
+The cost model (:mod:`femkit.cost`) takes numbers; this module turns a case into them and runs
+the checks, so no library layer plans anything:
+
+* :func:`geometry_domain` reads a geometry's area and line length from its entry in
+  :data:`femkit.mesh.GEOMETRIES` (one registration declares a geometry and its measure);
+* :func:`check_mesh_fits` is the memory guard the runners call before generating or refining a
+  mesh (:func:`femkit.mesh.generate`, :func:`femkit.mesh.refine` do not check themselves): a
+  mesh whose predicted memory exceeds the available memory is refused before gmsh or numpy
+  start (:class:`~femkit.errors.BudgetExceededError`, one line with the ``h`` that fits);
+* :func:`measure_step_seconds` times a scene's first batch of steps (what ``plan_scene`` is
+  given as ``step_seconds``);
+* :func:`plan_poisson_case` and :func:`plan_scene_case` are the plans of the two problem
+  types (``PROBLEMS[...].plan``); :mod:`femkit.case.budget` checks a case's plan against its
+  limits before it runs.
+
+Nothing here imports another module of ``femkit.case``: the runners import this module (the
+guard), so it stays below them.
 """
 
 from __future__ import annotations
 
-import sys
+import math
+import time
 
-from ..cost import Limits, Plan, check_budget, plan_poisson, plan_scene
-from .load import Case
+from ..cost import Plan, check_budget, plan_mesh, plan_poisson, plan_scene
 
-__all__ = ["plan_case", "check_case", "plan_poisson_case", "plan_scene_case"]
+__all__ = ["plan_poisson_case", "plan_scene_case", "geometry_domain", "check_mesh_fits",
+           "measure_step_seconds", "OVERRIDE"]
 
+#: How a user overrides a refused budget (quoted in the one-line refusal).
 OVERRIDE = "--force"
 
 
-def plan_poisson_case(case: Case, *, measure: bool = True) -> Plan:
+def geometry_domain(geometry: str, params: dict | None = None) -> tuple[int, float, float]:
+    """``(dim, measure, line_measure)`` of a registered geometry with its parameters.
+
+    In 2D the area and the length of every mesh line (see :mod:`femkit.mesh.geometries`).
+
+    Raises
+    ------
+    UnknownNameError
+        Not a registered geometry (the message lists them).
+    InputError
+        Parameters that do not fit the geometry or give no positive measure.
+    """
+    from ..mesh.geometries import GEOMETRIES
+
+    entry = GEOMETRIES.get(geometry)
+    size, lines = entry.measures(params)
+    return entry.dim, size, lines
+
+
+def check_mesh_fits(*, geometry: str | None = None, h: float | None = None,
+                    params: dict | None = None, triangles: float | None = None, refine: int = 0,
+                    force: bool = False, override: str = OVERRIDE) -> None:
+    """Refuse a mesh generation (``geometry``, ``h``, ``params``) or a refinement of a mesh of
+    ``triangles`` triangles ``refine`` times whose predicted memory exceeds the available
+    memory; call it before :func:`femkit.mesh.generate` / :func:`femkit.mesh.refine`.
+
+    Only the mesh stages are planned (:func:`femkit.cost.plan_mesh`). A 3D geometry is not
+    checked (the model counts triangles); ``force`` skips the check.
+
+    Raises
+    ------
+    BudgetExceededError
+        The mesh alone would not fit in the available memory.
+    """
+    if force:
+        return
+    if triangles is not None:
+        plan = plan_mesh(triangles=triangles, refine=refine)
+    else:
+        dim, area, length = geometry_domain(geometry, params)
+        if dim != 2:
+            return
+        plan = plan_mesh(area=area, line_length=length, h=h, refine=refine, name=geometry,
+                         params=params)
+    check_budget(plan, override=override)
+
+
+def measure_step_seconds(system, integrator, dt: float, *, ctx=None, batch: int = 20,
+                         max_seconds: float = 1.0, **integrator_options) -> float:
+    """Seconds per step of ``integrator`` on ``system``, timed on a first batch of steps.
+
+    One warm-up step first (imports, symbolic factorisations, caches of ``ctx``: paid once per
+    run, not per step), then up to ``batch`` steps (stopping early after ``max_seconds``) from
+    the system's initial state without stability checks.
+    """
+    from ..dynamics.integrators import StepContext
+    from ..dynamics.simulate import simulate
+
+    ctx = ctx if ctx is not None else StepContext()
+    quiet = dict(check_stability=False, energy_growth_limit=math.inf, **integrator_options)
+    simulate(system, integrator, dt, dt, ctx=ctx, **quiet)
+    budget_end = time.perf_counter() + float(max_seconds)
+    t0 = time.perf_counter()
+    traj = simulate(system, integrator, dt, batch * dt, ctx=ctx, record_every=batch,
+                    stop=lambda: time.perf_counter() > budget_end, **quiet)
+    return (time.perf_counter() - t0) / max(traj.steps, 1)
+
+
+def plan_poisson_case(case, *, measure: bool = True) -> Plan:
     """The plan of a Poisson case; with ``measure`` its seconds are scaled by this machine's
     speed now (:func:`femkit.cost.machine_speed`, ~0.25 s of probing)."""
     from ..cost import machine_speed, msh_triangle_count
@@ -41,7 +119,12 @@ def plan_poisson_case(case: Case, *, measure: bool = True) -> Plan:
         plan = plan_poisson(triangles=triangles, **common)
         plan.assumptions.insert(0, f"{triangles:,} triangles in {spec['file']} (from {how})")
     else:
-        plan = plan_poisson(geometry=spec["geometry"], h=spec["h"], params=spec.get("params"), **common)
+        dim, area, length = geometry_domain(spec["geometry"], spec.get("params"))
+        if dim != 2:
+            return Plan("poisson", f"{case.name}: {spec['geometry']} h={spec['h']:g}", {}, [],
+                        assumptions=[f"no cost model for {dim}D meshes yet: the run is not costed"])
+        plan = plan_poisson(area=area, line_length=length, h=spec["h"], name=spec["geometry"],
+                            params=spec.get("params"), **common)
     plan.title = f"{case.name}: {plan.title}"
     if d.get("adaptive"):
         plan.assumptions.append("adaptive refinement: only the first level is costed; the "
@@ -49,62 +132,18 @@ def plan_poisson_case(case: Case, *, measure: bool = True) -> Plan:
     return plan
 
 
-def plan_scene_case(case: Case, *, measure: bool = True) -> Plan:
-    """The plan of a scene: the system is built (cheap) and, with ``measure``, the seconds per
-    step are timed on a first batch of steps (at most 20 steps or 1 s)."""
-    from ..cost import measure_step_seconds
-    from .scene.run import build_context, build_integrator, build_system, output_every
-
+def plan_scene_case(case, system, integrator, *, ctx=None, measure: bool = True) -> Plan:
+    """The plan of a scene from its system's size (``system.n``, ``n_springs``, ``dim``) and
+    time grid; with ``measure`` the seconds per step are timed on a first batch of steps (at
+    most 20 steps or 1 s, :func:`measure_step_seconds`) on ``system`` with ``ctx``."""
     d = case.data
-    system, _ = build_system(case)
-    integrator = build_integrator(case)
     per_step = None
     if measure:
-        per_step = measure_step_seconds(system, integrator, d["dt"], ctx=build_context(case))
+        per_step = measure_step_seconds(system, integrator, d["dt"], ctx=ctx)
     out = d["output"]
     outputs = tuple(k for k in ("vtu", "xdmf", "energy_csv", "png", "gif") if out[k])
-    plan = plan_scene(n_nodes=system.n, n_springs=system.n_springs, dim=system.dim, dt=d["dt"],
-                      t_end=d["t_end"], every=output_every(case), outputs=outputs,
+    return plan_scene(n_nodes=system.n, n_springs=system.n_springs, dim=system.dim, dt=d["dt"],
+                      t_end=d["t_end"], every=out.get("every"), interval=out.get("interval"),
+                      frames=out.get("frames"), outputs=outputs,
                       method=integrator.name, implicit=integrator.implicit, step_seconds=per_step,
                       name=case.name)
-    return plan
-
-
-def plan_case(case: Case, *, measure: bool = True) -> Plan:
-    """The plan of any case, through its problem type (``PROBLEMS[case.problem].plan``)."""
-    from .problems import get_problem
-
-    return get_problem(case.problem).plan(case, measure=measure)
-
-
-def check_case(case: Case, *, max_memory: float | None = None, force: bool = False,
-               echo=None) -> Plan:
-    """Plan ``case`` and refuse it when it exceeds a budget (before anything runs).
-
-    Limits: the file's ``limits:``, ``max_memory`` (bytes, ``--max-memory``) and the available
-    memory. Steps and memory are checked on the model alone (immediately, however large the
-    run); a time limit first measures: the machine's speed (Poisson) or a batch of steps (scenes). With ``force`` the
-    violations are printed as warnings on stderr and the run goes on (also past the
-    library's own memory checks: ``case.run_options["force"]``).
-
-    Raises
-    ------
-    BudgetExceededError
-        A limit is exceeded and ``force`` is false.
-    """
-    limits = case.run_options.get("limits") or Limits()
-    if max_memory is not None:
-        limits = limits.merged(Limits(memory=max_memory))
-    case.run_options["force"] = bool(force)
-    say = echo or (lambda line: print(line, file=sys.stderr))
-    untimed = Limits(limits.memory, None, limits.steps, limits.output, limits.check_available)
-    plan = plan_case(case, measure=False)
-    warnings = check_budget(plan, untimed, force=force, override=OVERRIDE)
-    if limits.time is not None:
-        plan = plan_case(case, measure=True)
-        warnings += check_budget(plan, Limits(time=limits.time, check_available=False),
-                                 force=force, override=OVERRIDE)
-    for w in warnings:
-        say(f"femkit: warning: {w.replace(f' (or {OVERRIDE} to run anyway)', '')} ({OVERRIDE} given)")
-    case.run_options["plan"] = plan  # long Poisson runs report each stage against it
-    return plan

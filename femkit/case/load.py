@@ -51,7 +51,7 @@ class Case:
     solver : SolverSpec or None
         The validated ``solver`` (``linear_solver`` in scenes): built once at load time.
     run_options : dict
-        How to run it (:mod:`femkit.case.cost`): ``limits`` (:class:`femkit.cost.Limits` from
+        How to run it (:mod:`femkit.case.budget`): ``limits`` (:class:`femkit.cost.Limits` from
         the ``limits:`` key, set at load time), ``force`` (skip every budget) and ``stop`` (a
         :class:`femkit.interrupt.StopFlag` the runners check between steps and iterations).
     """

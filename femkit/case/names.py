@@ -14,7 +14,6 @@ femkit.errors.UnknownNameError: solver.method: unknown solver 'bicgstab'; valid 
 
 from __future__ import annotations
 
-import inspect
 from pathlib import Path
 
 from ..errors import CaseFileError, InputError, UnknownNameError, with_prefix
@@ -48,16 +47,14 @@ def check_geometry_spec(spec: dict, where: str) -> None:
     """
     from ..mesh.geometries import GEOMETRIES
 
-    factory = lookup(GEOMETRIES, spec["geometry"], f"{where}.geometry")
+    entry = lookup(GEOMETRIES, spec["geometry"], f"{where}.geometry")
     params = spec.get("params") or {}
-    signature = inspect.signature(factory)
     try:
-        signature.bind(spec["h"], **params)
-    except TypeError:
-        valid = [p for p in signature.parameters if p != "h"]
+        entry.check_params(spec["h"], params)
+    except InputError:
         raise CaseFileError(
             f"{where}.params: {sorted(params)} do not fit geometry {spec['geometry']!r}; "
-            f"valid parameters: {', '.join(valid) or '(none)'}") from None
+            f"valid parameters: {', '.join(entry.parameters) or '(none)'}") from None
 
 
 def resolve_file(spec: dict, where: str, base: Path) -> None:

@@ -111,8 +111,10 @@ def _poisson_plan(case, **kwargs):
 
 def _scene_plan(case, **kwargs):
     from .cost import plan_scene_case
+    from .scene.run import build_context, build_integrator, build_system
 
-    return plan_scene_case(case, **kwargs)
+    return plan_scene_case(case, build_system(case)[0], build_integrator(case),
+                           ctx=build_context(case), **kwargs)
 
 
 register_problem("poisson", _poisson_schema, _poisson_prepare, _poisson_run, _poisson_plan)

@@ -23,8 +23,7 @@ from ..errors import BudgetExceededError, InputError
 from .memory import available_memory, format_bytes
 from .plan import Plan, format_seconds
 
-__all__ = ["Limits", "check_budget", "parse_bytes", "parse_seconds", "LIMIT_KEYS",
-           "check_mesh_fits"]
+__all__ = ["Limits", "check_budget", "parse_bytes", "parse_seconds", "LIMIT_KEYS"]
 
 #: Keys of a ``limits:`` mapping in case and scene files.
 LIMIT_KEYS = ("memory", "time", "steps", "output")
@@ -169,24 +168,3 @@ def check_budget(plan: Plan, limits: Limits | None = None, *, force: bool = Fals
         what, predicted, limit, _ = problems[0]
         raise BudgetExceededError(f"{plan.title}: {messages[0]}", what, predicted, limit, plan)
     return messages
-
-
-def check_mesh_fits(geometry: str | None = None, h: float | None = None, *, params: dict | None = None,
-                    triangles: float | None = None, refine: int = 0, override: str = "check_memory=False") -> None:
-    """Refuse a mesh generation or refinement whose predicted memory exceeds the available memory.
-
-    The safety net of :func:`femkit.mesh.generate` and :func:`femkit.mesh.refine` (before gmsh
-    or numpy start): only the mesh stages are planned (:func:`femkit.cost.plan_mesh`); a
-    geometry the cost model does not know (a user-registered one) is not checked.
-
-    Raises
-    ------
-    BudgetExceededError
-        The mesh alone would not fit in the available memory.
-    """
-    from .geometry import MEASURES
-    from .poisson import plan_mesh
-
-    if triangles is None and geometry not in MEASURES.names():
-        return
-    check_budget(plan_mesh(geometry, h, refine, params=params, triangles=triangles), override=override)

@@ -19,6 +19,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Callable
 
+from ..timing import format_seconds
 from .memory import format_bytes
 
 __all__ = ["Stage", "Plan", "format_seconds", "round_up", "round_down"]
@@ -136,24 +137,6 @@ def _count(v) -> str:
         v = float(v)
         return f"{v:,.0f}" if abs(v) < 1e7 else f"{v:.3g}"
     return str(v)
-
-
-def format_seconds(s: float) -> str:
-    """``0.42 -> '0.42 s'``, ``5400 -> '1.5 h'``, ``3e7 -> '347 d'``.
-
-    >>> format_seconds(0.0042), format_seconds(90), format_seconds(5400), format_seconds(3e7)
-    ('0.0042 s', '1.5 min', '1.5 h', '347 d')
-    """
-    s = float(s)
-    if s < 60:
-        return f"{s:.2g} s" if s < 10 else f"{s:.0f} s"
-    if s < 3600:
-        return f"{s / 60:.2g} min"
-    if s < 86400 * 2:
-        return f"{s / 3600:.2g} h"
-    if s < 86400 * 365 * 2:
-        return f"{s / 86400:.3g} d"
-    return f"{s / (86400 * 365):.3g} years"
 
 
 def round_up(x: float) -> str:

@@ -8,8 +8,9 @@
 * output: per frame ``frame_file_bytes_fixed`` plus ``..._per_node`` and ``..._per_spring``
   (``.vtu`` frames or XDMF), ``energy.csv`` per frame, a GIF of at most 60 frames (fitted on
   the bundled scenes: rope, soft disk, hanging cloth, Liu's cloth, within 17 %);
-* time: ``steps x`` the seconds of one step, measured on a first batch of steps
-  (:func:`measure_step_seconds`) when given, else the calibrated per-spring constant.
+* time: ``steps x`` the seconds of one step, measured on a first batch of steps by the caller
+  (``femkit.case.cost.measure_step_seconds``) when given, else the calibrated per-spring
+  constant.
 
 >>> p = plan_scene(n_nodes=100, n_springs=300, dim=3, dt=1e-9, t_end=2.0, frames=50)
 >>> p.steps, p.sizes["frames"]
@@ -19,13 +20,12 @@
 from __future__ import annotations
 
 import math
-import time
 
 from ..errors import InputError
 from .constants import load_constants
 from .plan import Plan, Stage, format_seconds, round_down, round_up
 
-__all__ = ["plan_scene", "measure_step_seconds", "record_every"]
+__all__ = ["plan_scene", "record_every"]
 
 _FLOAT = 8
 
@@ -125,24 +125,3 @@ def plan_scene(*, n_nodes: int, n_springs: int, dim: int, dt: float, t_end: floa
 
     plan.suggest = suggest
     return plan
-
-
-def measure_step_seconds(system, integrator, dt: float, *, ctx=None, batch: int = 20,
-                         max_seconds: float = 1.0, **integrator_options) -> float:
-    """Seconds per step of ``integrator`` on ``system``, timed on a first batch of steps.
-
-    One warm-up step first (imports, symbolic factorisations, caches of ``ctx``: paid once per
-    run, not per step), then up to ``batch`` steps (stopping early after ``max_seconds``) from
-    the system's initial state without stability checks.
-    """
-    from ..dynamics.integrators import StepContext
-    from ..dynamics.simulate import simulate
-
-    ctx = ctx if ctx is not None else StepContext()
-    quiet = dict(check_stability=False, energy_growth_limit=math.inf, **integrator_options)
-    simulate(system, integrator, dt, dt, ctx=ctx, **quiet)
-    budget_end = time.perf_counter() + float(max_seconds)
-    t0 = time.perf_counter()
-    traj = simulate(system, integrator, dt, batch * dt, ctx=ctx, record_every=batch,
-                    stop=lambda: time.perf_counter() > budget_end, **quiet)
-    return (time.perf_counter() - t0) / max(traj.steps, 1)

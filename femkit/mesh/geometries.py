@@ -3,11 +3,33 @@
 gmsh is imported inside the functions only, so ``import femkit.mesh`` stays cheap and a case
 that reads a ``.msh`` file never loads it.
 
-Every geometry is a factory registered in :data:`GEOMETRIES`; call it through
+Every geometry is one entry of :data:`GEOMETRIES`, a :class:`Geometry` record; call it through
 :func:`generate`::
 
     generate("l_shape", h=0.1)
     generate("annulus", h=0.05, r_inner=0.3, r_outer=1.0)
+
+Adding a geometry is one registration, in any module (nothing else lists geometries: case
+files, ``femkit solve``, its cost plan and budget checks all read this registry)::
+
+    def _strip_measure(length=4.0):                 # same parameters and defaults as build
+        return length * 1.0, 2.0 * (length + 1.0)   # (area, length of every mesh line)
+
+    @register_geometry("strip", measure=_strip_measure,
+                       boundary_tags=("boundary",), cell_tags=("domain",))
+    def strip(h, length=4.0):                       # build(h, **params) -> Mesh
+        return rectangle(h, 0.0, 0.0, length, 1.0)
+
+An entry holds:
+
+* ``build(h, **params) -> Mesh``: the mesh at target size ``h``;
+* ``measure(**params) -> (measure, line_measure)``: with the same parameter names and defaults
+  as ``build``; in 2D the area and the length of every mesh line (outer boundary, holes, and
+  interfaces between regions counted twice, since the elements on both sides follow them); in
+  3D the volume and the area of every mesh surface, counted the same way. The cost model
+  predicts the element count from these two numbers (:mod:`femkit.cost.poisson`);
+* ``dim``: 2 (triangles) or 3 (tetrahedra);
+* ``boundary_tags``, ``cell_tags``: the tag names the generated mesh carries.
 
 Tag conventions (names go to :attr:`Mesh.tag_names`):
 
@@ -27,8 +49,10 @@ between runs; triangles are counter-clockwise.
 from __future__ import annotations
 
 import contextlib
+import inspect
 import math
 import os
+from dataclasses import dataclass
 from typing import Callable, Iterator, Sequence
 
 import numpy as np
@@ -38,7 +62,84 @@ from ..registry import Registry
 from ..validation import mesh_size as _check_h
 from .mesh import Mesh
 
-GEOMETRIES: Registry[Callable[..., Mesh]] = Registry("geometry")
+__all__ = ["GEOMETRIES", "Geometry", "register_geometry", "generate", "geo_file"]
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """One entry of :data:`GEOMETRIES` (see the module docstring).
+
+    Attributes
+    ----------
+    name : the registered name
+    build : ``build(h, **params) -> Mesh``
+    measure : ``measure(**params) -> (measure, line_measure)``: area and mesh-line length (2D),
+        or volume and mesh-surface area (3D); same parameters and defaults as ``build``
+    dim : 2 or 3
+    boundary_tags, cell_tags : the tag names of a generated mesh
+    """
+
+    name: str
+    build: Callable[..., Mesh]
+    measure: Callable[..., tuple[float, float]]
+    dim: int = 2
+    boundary_tags: tuple[str, ...] = ()
+    cell_tags: tuple[str, ...] = ()
+
+    @property
+    def parameters(self) -> list[str]:
+        """Names of the geometry's parameters (those of ``build`` after ``h``)."""
+        return [n for n in inspect.signature(self.build).parameters if n != "h"]
+
+    def check_params(self, h, params: dict) -> None:
+        """Raise :class:`~femkit.errors.InputError` when ``params`` do not fit ``build``."""
+        try:
+            inspect.signature(self.build).bind(h, **params)
+        except TypeError as exc:
+            raise InputError(f"geometry {self.name!r}: {exc}; valid parameters: "
+                             f"{', '.join(self.parameters) or '(none)'}") from None
+
+    def measures(self, params: dict | None = None) -> tuple[float, float]:
+        """``(measure, line_measure)`` of the geometry with ``params`` (floats, measure > 0).
+
+        Raises
+        ------
+        InputError
+            Unknown parameters, or parameters giving no positive measure.
+        """
+        params = dict(params or {})
+        self.check_params(1.0, params)
+        try:
+            size, lines = self.measure(**params)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"geometry {self.name!r}: {exc}") from None
+        size, lines = float(size), float(lines)
+        if not (math.isfinite(size) and size > 0 and math.isfinite(lines) and lines >= 0):
+            what = "area" if self.dim == 2 else "volume"
+            raise InputError(f"geometry {self.name!r} with {params} has no positive {what}")
+        return size, lines
+
+
+#: ``name -> Geometry``: every geometry :func:`generate` (and a case file's ``mesh.geometry``)
+#: knows.
+GEOMETRIES: Registry[Geometry] = Registry("geometry")
+
+
+def register_geometry(name: str, *, measure: Callable[..., tuple[float, float]], dim: int = 2,
+                      boundary_tags: Sequence[str] = (), cell_tags: Sequence[str] = ()):
+    """Decorator registering ``build`` as geometry ``name`` (see the module docstring).
+
+    Returns ``build`` unchanged; a name registered twice raises ``ValueError``.
+    """
+    if dim not in (2, 3):
+        raise ValueError(f"geometry {name!r}: dim must be 2 or 3, got {dim!r}")
+
+    def decorator(build: Callable[..., Mesh]) -> Callable[..., Mesh]:
+        GEOMETRIES.register(name, Geometry(name, build, measure, dim, tuple(boundary_tags),
+                                           tuple(cell_tags)))
+        return build
+
+    return decorator
 
 #: gmsh element type numbers
 _GMSH_LINE, _GMSH_TRIANGLE = 1, 2
@@ -244,7 +345,16 @@ def _circle(geo, cx: float, cy: float, r: float, h: float) -> list[int]:
     return [geo.addCircleArc(p[i], c, p[(i + 1) % 4]) for i in range(4)]
 
 
-@GEOMETRIES.register("rectangle")
+def _rectangle_measure(x0: float = 0.0, y0: float = 0.0, x1: float = 1.0, y1: float = 1.0):
+    w, hgt = float(x1) - float(x0), float(y1) - float(y0)
+    return w * hgt, 2.0 * (w + hgt)
+
+
+_SIDES = ("left", "right", "bottom", "top", "boundary")
+
+
+@register_geometry("rectangle", measure=_rectangle_measure, boundary_tags=_SIDES,
+                   cell_tags=("domain",))
 def rectangle(h: float, x0: float = 0.0, y0: float = 0.0, x1: float = 1.0, y1: float = 1.0) -> Mesh:
     """Rectangle ``[x0, x1] x [y0, y1]``.
 
@@ -265,13 +375,15 @@ def rectangle(h: float, x0: float = 0.0, y0: float = 0.0, x1: float = 1.0, y1: f
         return _finish(gmsh, h)
 
 
-@GEOMETRIES.register("unit_square")
+@register_geometry("unit_square", measure=lambda: (1.0, 4.0), boundary_tags=_SIDES,
+                   cell_tags=("domain",))
 def unit_square(h: float) -> Mesh:
     """Unit square ``[0, 1]^2``; tags as :func:`rectangle` (left/right/bottom/top/boundary, domain)."""
     return rectangle(h, 0.0, 0.0, 1.0, 1.0)
 
 
-@GEOMETRIES.register("l_shape")
+@register_geometry("l_shape", measure=lambda: (3.0, 8.0),
+                   boundary_tags=("reentrant", "outer", "boundary"), cell_tags=("domain",))
 def l_shape(h: float) -> Mesh:
     """L-shaped domain ``(-1, 1)^2`` minus the quadrant ``[0, 1] x [-1, 0]``.
 
@@ -296,7 +408,13 @@ def l_shape(h: float) -> Mesh:
         return _finish(gmsh, h)
 
 
-@GEOMETRIES.register("disk")
+def _disk_measure(centre: Sequence[float] = (0.0, 0.0), radius: float = 1.0):
+    r = float(radius)
+    return math.pi * r * r, 2.0 * math.pi * r
+
+
+@register_geometry("disk", measure=_disk_measure, boundary_tags=("outer", "boundary"),
+                   cell_tags=("domain",))
 def disk(h: float, centre: Sequence[float] = (0.0, 0.0), radius: float = 1.0) -> Mesh:
     """Disk of ``radius`` about ``centre``.
 
@@ -316,7 +434,14 @@ def disk(h: float, centre: Sequence[float] = (0.0, 0.0), radius: float = 1.0) ->
         return _finish(gmsh, h)
 
 
-@GEOMETRIES.register("annulus")
+def _annulus_measure(r_inner: float = 0.5, r_outer: float = 1.0,
+                     centre: Sequence[float] = (0.0, 0.0)):
+    ri, ro = float(r_inner), float(r_outer)
+    return math.pi * (ro * ro - ri * ri), 2.0 * math.pi * (ro + ri)
+
+
+@register_geometry("annulus", measure=_annulus_measure,
+                   boundary_tags=("inner", "outer", "boundary"), cell_tags=("domain",))
 def annulus(h: float, r_inner: float = 0.5, r_outer: float = 1.0,
             centre: Sequence[float] = (0.0, 0.0)) -> Mesh:
     """Annulus ``r_inner < |x - centre| < r_outer``.
@@ -341,7 +466,13 @@ def annulus(h: float, r_inner: float = 0.5, r_outer: float = 1.0,
         return _finish(gmsh, h)
 
 
-@GEOMETRIES.register("checkerboard")
+def _checkerboard_measure(n: int = 4):
+    # 2 (n - 1) interior lines of length 1, counted twice
+    return 1.0, 4.0 + 2.0 * 2.0 * (int(n) - 1)
+
+
+@register_geometry("checkerboard", measure=_checkerboard_measure, boundary_tags=_SIDES,
+                   cell_tags=("high", "low"))
 def checkerboard(h: float, n: int = 4) -> Mesh:
     """Unit square split into ``n x n`` equal squares tagged alternately ``high`` and ``low``.
 
@@ -379,7 +510,15 @@ def checkerboard(h: float, n: int = 4) -> Mesh:
         return _finish(gmsh, h)
 
 
-@GEOMETRIES.register("square_with_inclusion")
+def _inclusion_measure(centre: Sequence[float] = (0.5, 0.5), radius: float = 0.25,
+                       shape: str = "disk"):
+    r = float(radius)
+    inner = 2.0 * math.pi * r if shape == "disk" else 8.0 * r
+    return 1.0, 4.0 + 2.0 * inner
+
+
+@register_geometry("square_with_inclusion", measure=_inclusion_measure, boundary_tags=_SIDES,
+                   cell_tags=("matrix", "inclusion"))
 def square_with_inclusion(h: float, centre: Sequence[float] = (0.5, 0.5), radius: float = 0.25,
                           shape: str = "disk") -> Mesh:
     """Unit square with a centred inclusion (a disk of ``radius`` or a square of half-side ``radius``).
@@ -446,7 +585,7 @@ def geo_file(path: str | os.PathLike, h: float | None = None) -> Mesh:
         return _mesh_from_gmsh(gmsh)
 
 
-def generate(geometry: str, h: float, *, check_memory: bool = True, **params) -> Mesh:
+def generate(geometry: str, h: float, **params) -> Mesh:
     """Generate a mesh of a named geometry from :data:`GEOMETRIES`.
 
     Parameters
@@ -455,8 +594,9 @@ def generate(geometry: str, h: float, *, check_memory: bool = True, **params) ->
         ``l_shape``, ``rectangle``, ``square_with_inclusion``, ``unit_square``)
     h : target (maximal) element size
     **params : geometry parameters (e.g. ``r_inner`` for ``annulus``)
-    check_memory : refuse, before gmsh starts, a mesh whose predicted memory exceeds the
-        available memory (:func:`femkit.cost.check_mesh_fits`)
+
+    Whether the mesh fits in memory is checked by the application before it calls this
+    (``femkit.case.cost.check_mesh_fits``); the library itself does not plan.
 
     Raises
     ------
@@ -464,21 +604,7 @@ def generate(geometry: str, h: float, *, check_memory: bool = True, **params) ->
         Unknown geometry (the message lists the valid ones).
     InputError
         Bad or unknown parameters.
-    BudgetExceededError
-        ``h`` so small that the mesh cannot fit in memory (the message says which ``h`` fits).
     """
-    factory = GEOMETRIES.get(geometry)
-    import inspect
-
-    sig = inspect.signature(factory)
-    try:
-        sig.bind(h, **params)
-    except TypeError as exc:
-        valid = [n for n in sig.parameters if n != "h"]
-        raise InputError(f"geometry {geometry!r}: {exc}; valid parameters: "
-                         f"{', '.join(valid) or '(none)'}") from None
-    if check_memory:
-        from ..cost.budget import check_mesh_fits
-
-        check_mesh_fits(geometry, _check_h(h), params=params)
-    return factory(h, **params)
+    entry = GEOMETRIES.get(geometry)
+    entry.check_params(h, params)
+    return entry.build(h, **params)

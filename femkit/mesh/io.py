@@ -23,6 +23,7 @@ import numpy as np
 
 from ..errors import MeshError
 from .mesh import Mesh
+from .vtk import write_cells
 
 _SIDECAR = ".tags.json"
 
@@ -229,8 +230,6 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = No
     ``line`` blocks and names to ``field_data`` (see the module notes), so :func:`read_mesh`
     gives back the same points, triangles and tags.
     """
-    import meshio
-
     p = os.fspath(path)
     ext = Path(p).suffix.lower()
     m, k = mesh.n_triangles, len(mesh.boundary_edges)
@@ -267,17 +266,16 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = No
             raise MeshError(f"msh_version must be '4.1' or '2.2', got {msh_version!r}")
         dims = _tag_dims(mesh)
         fdata = {name: np.array([int(t), dims[name]]) for name, t in mesh.tag_names.items()}
-        points = np.column_stack([mesh.points, np.zeros(mesh.n_points)])
-        out = meshio.Mesh(points, cells, point_data=pdata, cell_data=cdata, field_data=fdata)
         if ext == ".msh":
             if msh_version == "4.1":
                 raise MeshError("binary msh 4.1 is not supported; use binary=False or msh_version='2.2'")
             if pdata or cell_data:
                 raise MeshError("point/cell data are written to msh 4.1 (the default), .vtu or "
                                 ".xdmf, not to msh 2.2")
-            meshio.write(p, out, file_format="gmsh22", binary=binary)
+            write_cells(p, mesh.points, cells, cell_data=cdata, field_data=fdata,
+                        file_format="gmsh22", binary=binary)
         else:
-            meshio.write(p, out)
+            write_cells(p, mesh.points, cells, point_data=pdata, cell_data=cdata, field_data=fdata)
             if mesh.tag_names:
                 Path(_sidecar(p)).write_text(json.dumps(mesh.tag_names, sort_keys=True))
     except MeshError:

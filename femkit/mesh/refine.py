@@ -52,22 +52,18 @@ def refine_once(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
     return fine, edge_nodes
 
 
-def refine(mesh: Mesh, levels: int = 1, *, check_memory: bool = True) -> Mesh:
+def refine(mesh: Mesh, levels: int = 1) -> Mesh:
     """Uniform red refinement: each triangle into four by its edge midpoints, ``levels`` times.
 
     Nested: the coarse nodes are the first ``n`` nodes of the fine mesh (in the same order),
     then one new node per coarse edge in :func:`edges` order. Children ``4t .. 4t+3`` come
     from coarse triangle ``t`` and inherit its cell tag; each tagged boundary edge becomes two
-    edges (same direction) with its tag. Orientation is preserved. With ``check_memory`` a
-    refinement whose result cannot fit in the available memory raises
-    :class:`~femkit.errors.BudgetExceededError` before any work (:func:`femkit.cost.check_mesh_fits`).
+    edges (same direction) with its tag. Orientation is preserved. Whether the refined mesh
+    fits in memory is checked by the application before it calls this
+    (``femkit.case.cost.check_mesh_fits``).
     """
     if int(levels) != levels or levels < 0:
         raise ValueError(f"levels must be a non-negative integer, got {levels!r}")
-    if check_memory and levels:
-        from ..cost.budget import check_mesh_fits
-
-        check_mesh_fits(triangles=mesh.n_triangles, refine=int(levels))
     for _ in range(int(levels)):
         mesh, _ = refine_once(mesh)
     return mesh

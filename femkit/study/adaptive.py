@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..interrupt import active_flag
+from ..progress import progress
 from .fit import fit_rate
-from .progress import progress
 
 __all__ = ["run_adaptive_study", "build_adaptive_report", "adaptive_summary"]
 
@@ -40,7 +41,8 @@ def run_adaptive_study(study, progress_enabled=None) -> dict:
     solve_on(mesh0, None)                                   # warm-up: imports, AMG, caches
     records, fits, meshes, outcome = [], [], {}, []
     measured = "error" if grad is not None else "estimate"
-    for label, refinement, est in progress(_runs(d), desc="refinements", enabled=progress_enabled):
+    for label, refinement, est in progress(list(_runs(d)), desc="refinements", unit="run",
+                                             enabled=progress_enabled, stop=active_flag()):
         run = adaptive_solve(solve_on, mesh0, theta=d["theta"], target=d.get("target"),
                              max_dofs=d["max_dofs"], max_time=d.get("max_time"),
                              max_levels=d["max_levels"], estimator=est, refinement=refinement,

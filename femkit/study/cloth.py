@@ -98,14 +98,16 @@ def run_cloth_study(study, progress_enabled=None) -> dict:
     from ..case.specs import solver_spec
     from ..dynamics.work_precision import cloth_work_precision
     from .pareto import pareto_front
-    from .progress import progress
+    from ..interrupt import active_flag
+    from ..progress import progress
 
     d = study.data
     spec = solver_spec(d["linear_solver"], "linear_solver", default_method="cholesky")
     ref = {"tol": 1e-10, "trajectory": "newmark", "substeps": 16, "solve": "newton",
            **(d.get("reference") or {})}
     records, energy, references, notes = [], {}, [], []
-    for path in progress(d["scenes"], desc="cloth scenes", enabled=progress_enabled):
+    for path in progress(list(d["scenes"]), desc="cloth scenes", unit="run",
+                         enabled=progress_enabled, stop=active_flag()):
         case = _scene_case(study, path)
         system, _ = build_system(case)
         dt = float(d.get("dt") or _time_value(case, "dt"))

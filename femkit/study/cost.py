@@ -25,6 +25,7 @@ def _levels(study) -> list[tuple[float, int]]:
 
 def plan_poisson_study(study) -> Plan:
     """The plan of a ``poisson_convergence`` study."""
+    from ..case.cost import geometry_domain
     from ..cost import msh_triangle_count
     from .problem import study_problem
 
@@ -37,7 +38,9 @@ def plan_poisson_study(study) -> Plan:
         if "file" in spec:
             where = dict(triangles=msh_triangle_count(spec["file"])[0])
         else:
-            where = dict(geometry=spec["geometry"], h=h, params=spec.get("params"))
+            _, area, length = geometry_domain(spec["geometry"], spec.get("params"))
+            where = dict(area=area, line_length=length, h=h, name=spec["geometry"],
+                         params=spec.get("params"))
         where["refine"] = k + spec.get("refine", 0)
         seconds, level_peak = 0.0, 0.0
         for s in study.solvers:

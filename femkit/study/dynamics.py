@@ -22,8 +22,9 @@ import warnings
 import numpy as np
 
 from ..errors import InstabilityError
+from ..interrupt import active_flag
+from ..progress import progress
 from .fit import fit_asymptotic
-from .progress import progress
 from .timing import time_call
 
 
@@ -112,7 +113,8 @@ def run_dynamics_study(study, *, progress_enabled=None) -> dict:
             except InstabilityError:
                 pass
     jobs = [(i, dt) for i in integrators for dt in dts]
-    for (name, opts, label), dt in progress(jobs, total=len(jobs), desc=study.name, enabled=progress_enabled):
+    for (name, opts, label), dt in progress(jobs, total=len(jobs), desc=study.name, unit="run",
+                                                enabled=progress_enabled, stop=active_flag()):
         every = int(round(dt_big / dt))
         rec = {"integrator": label, "name": name, "dt": dt, "k": -np.log2(dt), "steps": int(round(t_end / dt))}
         try:

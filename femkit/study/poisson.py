@@ -15,8 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..interrupt import active_flag
+from ..progress import progress
 from .fit import fit_rate
-from .progress import progress
 from .timing import StageTimer, time_call
 
 
@@ -46,7 +47,10 @@ def _meshes(study, spec, timer_list):
         return meshes, lambda level: None
     count = lv["count"] if "max_level" not in lv else min(lv["count"], lv["max_level"] + 1)
     timed(0, lambda: spec.base_mesh(lv["h0"]))
+    from ..case.cost import check_mesh_fits
+
     for i in range(1, count):
+        check_mesh_fits(triangles=meshes[-1].n_triangles, refine=1)  # before numpy allocates
         timed(i, lambda: refine(meshes[-1], 1))
 
     prols: list = []  # built once, on the first request that reaches them
@@ -120,34 +124,16 @@ def _skfem_run(spec, mesh, rtol, repeats):
     """scikit-fem assembly + condense, pyamg SA + SciPy CG: (nodal u, iterations, relres, times, A)."""
     import pyamg
     import scipy.sparse.linalg as spla
-    import skfem
-    from skfem.helpers import dot, grad
+
+    from ..case.poisson import reference
 
     problem = spec.problem(mesh)
-    kappa = problem.kappa
     f = spec.case.functions["source"]
-
-    @skfem.BilinearForm
-    def a(u, v, w):
-        return w["kap"] * dot(grad(u), grad(v))
-
-    @skfem.LinearForm
-    def L(v, w):
-        return f(w.x[0], w.x[1]) * v
-
-    def assemble():
-        m = skfem.MeshTri(mesh.points.T.copy(), mesh.triangles.T.copy())
-        basis = skfem.Basis(m, skfem.ElementTriP1())
-        kap = np.repeat(kappa[:, None], basis.X.shape[1], axis=1)
-        return a.assemble(basis, kap=kap), L.assemble(basis)
-
-    ta = time_call(assemble, repeats=repeats, warmup=0)
+    ta = time_call(lambda: reference.assemble(mesh, problem.kappa, f), repeats=repeats, warmup=0)
     K, F = ta.value
     nodes, vals = problem.dirichlet_data()
-    x = np.zeros(mesh.n_points)
-    x[nodes] = vals
-    tb = time_call(lambda: skfem.condense(K, F, x=x, D=nodes), repeats=repeats, warmup=0)
-    A, b, xI, I = tb.value
+    tb = time_call(lambda: reference.condense(K, F, nodes, vals), repeats=repeats, warmup=0)
+    A, b, x, I = tb.value
 
     def run():
         it = [0]
@@ -196,7 +182,8 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
     records = []
     systems = {}  # (level, rule) -> system: fmg's lower levels (its coarse right-hand sides)
     jobs = [(lvl, rule) for lvl in range(len(meshes)) for rule in rules]
-    for lvl, rule in progress(jobs, total=len(jobs), desc=f"{study.name}", enabled=progress_enabled):
+    for lvl, rule in progress(jobs, total=len(jobs), desc=f"{study.name}", unit="run",
+                                 enabled=progress_enabled, stop=active_flag()):
         mesh = meshes[lvl]
         ta = time_call(lambda: _assemble(spec, mesh, rule), repeats=repeats, warmup=0)
         prob, K, F = ta.value

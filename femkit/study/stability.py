@@ -31,8 +31,9 @@ import warnings
 import numpy as np
 
 from ..errors import FemkitError, InstabilityError, SingularSystemError
+from ..interrupt import active_flag
 from ..mesh.structured import structured_mesh
-from .progress import progress
+from ..progress import progress
 
 # ----------------------------------------------------------------------------- meshes
 
@@ -402,7 +403,8 @@ def run_stability_study(study, *, progress_enabled=None) -> dict:
         warmed = warm_up(study.solvers, study.integrators)
         notes.append("Warm-up before timing (untimed, on an 8 x 8 Poisson system and a two-spring chain): "
                      + ", ".join(warmed) + "; no timed run includes imports, AMG module loading or compilation.")
-    for case in progress(cases, total=len(cases), desc=study.name, enabled=progress_enabled):
+    for case in progress(cases, total=len(cases), desc=study.name, unit="run",
+                         enabled=progress_enabled, stop=active_flag()):
         t = case["type"]
         if t == "poisson_neumann":
             rows += case_neumann(case, quick_n)

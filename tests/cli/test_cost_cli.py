@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from femkit.cost.probe import child_env
+from cost_probe import child_env
 
 ROOT = Path(__file__).parents[2]
 DIRICHLET = {"dirichlet": [{"tags": ["boundary"], "value": 0}]}

@@ -10,12 +10,12 @@ from femkit.errors import InputError
 
 
 def test_env_override_changes_the_plan(tmp_path, monkeypatch):
-    base = plan_poisson(geometry="unit_square", h=0.01)
+    base = plan_poisson(area=1.0, line_length=4.0, h=0.01)
     over = tmp_path / "cost.json"
     shipped = load_constants()["mesh"]["triangles_per_area_h2"]
     over.write_text(json.dumps({"mesh": {"triangles_per_area_h2": 2 * shipped}}))
     monkeypatch.setenv(ENV_VAR, str(over))
-    plan = plan_poisson(geometry="unit_square", h=0.01)
+    plan = plan_poisson(area=1.0, line_length=4.0, h=0.01)
     assert 1.8 < plan.sizes["triangles"] / base.sizes["triangles"] < 2.0
 
 
@@ -57,7 +57,7 @@ def test_every_solver_is_costed_or_says_it_is_not():
         pcs = [p for p in PRECONDITIONERS.names() if p != "amg"] if method == "pcg" else [None]
         for pc in pcs:
             key = solver_key(method, pc)
-            plan = plan_poisson(geometry="unit_square", h=0.1, refine=1, method=method,
+            plan = plan_poisson(area=1.0, line_length=4.0, h=0.1, refine=1, method=method,
                                 preconditioner=pc)
             if key in c["bytes"]["solve_per_triangle"]:
                 assert key == "direct" or key in c["iterations"], key

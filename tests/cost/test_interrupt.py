@@ -71,7 +71,7 @@ def test_signal_from_outside_stops_a_simulation_cleanly(tmp_path):
         "                    progress=bar, check_stability=False)\n"
         "print(json.dumps(traj.summary()), flush=True)\n"
         "sys.exit(exit_code(flag) if flag else 0)\n")
-    from femkit.cost.probe import child_env
+    from cost_probe import child_env
 
     proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, env=child_env())

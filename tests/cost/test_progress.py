@@ -57,3 +57,36 @@ def test_progress_iterator():
     out = io.StringIO()
     assert list(progress(range(20), desc="study", stream=out, mode="lines")) == list(range(20))
     assert out.getvalue().count("\n") == 10 and "(20/20 jobs)" in out.getvalue()
+
+
+def test_progress_stops_before_the_next_item_on_request():
+    """With ``stop=`` the item after a stop request is not started: Interrupted names it."""
+    import pytest
+
+    from femkit.interrupt import Interrupted, StopFlag
+
+    flag, seen = StopFlag(), []
+    with pytest.raises(Interrupted, match=r"by SIGTERM before run 3 of 5 \(2 done\)"):
+        for i in progress(range(5), unit="run", enabled=False, stop=flag):
+            seen.append(i)
+            if i == 1:
+                flag.request(15)
+    assert seen == [0, 1]
+
+
+def test_planned_stages_report_the_remaining_time_scaled_by_the_pace():
+    """Stages predicted 5 s + 15 s; the first takes 10 s (twice slower): ~30 s remain."""
+    clock = FakeClock()
+    out = io.StringIO()
+    bar = Progress.planned([("mesh", 5.0), ("refine", 1.0), ("solve", 15.0)], "case",
+                           stream=out, min_seconds=0, clock=clock)
+    clock.t = 12.0
+    bar.done("mesh", "refine")  # mesh includes refine: 6 s predicted, 12 s taken
+    clock.t = 40.0
+    bar.done("solve")
+    assert out.getvalue().splitlines() == ["case: mesh done, elapsed 12 s, remaining ~30 s",
+                                           "case: solve done, elapsed 40 s"]
+    quiet = io.StringIO()
+    short = Progress.planned([("mesh", 5.0)], "case", stream=quiet)  # below 30 s: silent
+    short.done("mesh")
+    assert quiet.getvalue() == ""

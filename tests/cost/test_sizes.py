@@ -4,6 +4,9 @@ import math
 
 import pytest
 
+from cost_probe import domain
+
+from femkit.case.cost import geometry_domain
 from femkit.cost import msh_triangle_count, plan_poisson, predict_triangles
 from femkit.errors import InputError, UnknownNameError
 from femkit.mesh import generate, read_mesh, refine
@@ -23,7 +26,8 @@ GEOMETRY_CASES = [
                               for g, h, p in GEOMETRY_CASES])
 def test_triangle_count_within_15_percent(geometry, h, params):
     mesh = generate(geometry, h, **params)
-    predicted = predict_triangles(geometry, h, params)
+    _, area, length = geometry_domain(geometry, params)
+    predicted = predict_triangles(area, length, h)
     assert abs(predicted / mesh.n_triangles - 1) < 0.15, (predicted, mesh.n_triangles)
 
 
@@ -34,7 +38,7 @@ def test_refined_counts_and_sizes(levels):
 
     base = generate("unit_square", 0.1)
     mesh = refine(base, levels)
-    plan = plan_poisson(geometry="unit_square", h=0.1, refine=levels)
+    plan = plan_poisson(**domain("unit_square"), h=0.1, refine=levels)
     assert plan.sizes["triangles"] / plan.sizes["triangles_generated"] == 4 ** levels
     assert abs(plan.sizes["triangles"] / mesh.n_triangles - 1) < 0.15
     assert abs(plan.sizes["points"] / mesh.n_points - 1) < 0.15
@@ -50,17 +54,24 @@ def test_mesh_file_count_from_header():
 @pytest.mark.parametrize("bad", [0, -1.0, math.nan, math.inf, "x"], ids=repr)
 def test_bad_h_is_an_input_error(bad):
     with pytest.raises(InputError, match="h must be"):
-        plan_poisson(geometry="unit_square", h=bad)
+        plan_poisson(area=1.0, line_length=4.0, h=bad)
 
 
 def test_unknown_geometry_lists_valid_ones():
     with pytest.raises(UnknownNameError, match="unit_square"):
-        predict_triangles("hexagon", 0.1)
+        geometry_domain("hexagon")
 
 
 def test_unknown_geometry_parameter():
-    with pytest.raises(InputError, match="annulus"):
-        predict_triangles("annulus", 0.1, {"radius": 2})
+    with pytest.raises(InputError, match="annulus.*valid parameters: r_inner, r_outer, centre"):
+        geometry_domain("annulus", {"radius": 2})
+
+
+@pytest.mark.parametrize("area, length", [(0.0, 4.0), (-1.0, 4.0), (math.nan, 4.0), (1.0, -1.0)],
+                         ids=["zero-area", "negative-area", "nan-area", "negative-length"])
+def test_bad_domain_numbers_are_input_errors(area, length):
+    with pytest.raises(InputError, match="positive area"):
+        predict_triangles(area, length, 0.1)
 
 
 def test_compiled_threshold_matches_assembly():

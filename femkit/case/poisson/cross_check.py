@@ -76,13 +76,11 @@ def cross_check(case: Case) -> list[CheckRow]:
         from ...errors import CaseFileError
 
         raise CaseFileError(f"femkit check handles 'poisson' cases, not {case.problem!r}")
-    import scipy.sparse as sp
     import scipy.sparse.linalg as spla
-    skfem = _require("skfem", "scikit-fem")
+    _require("skfem", "scikit-fem")
     _require("pyamg", "pyamg")
-    from skfem import Basis, BilinearForm, ElementTriP1, LinearForm, MeshTri, condense
-    from skfem.helpers import dot, grad
 
+    from . import reference
     from .run import build_mesh_levels, is_pure_neumann, multigrid_inputs, poisson_problem
 
     mesh, hierarchy = build_mesh_levels(case)
@@ -93,29 +91,13 @@ def cross_check(case: Case) -> list[CheckRow]:
     one_point = poisson_problem(case, mesh, load_rule="barycentric")  # skfem gets the same rule
     F_source = one_point.assemble_matrices()[1] - one_point.neumann_load
 
-    m = MeshTri(mesh.points.T.copy(), mesh.triangles.T.copy(), sort_t=False)
-    # skfem's intorder=1 picks a 3-point rule on triangles; pass the centroid rule itself
-    # (reference triangle area 1/2) so both codes use the same one-point quadrature.
-    basis = Basis(m, ElementTriP1(), quadrature=(np.array([[1 / 3], [1 / 3]]), np.array([0.5])))
-    nqp = basis.X.shape[1]
-
-    @BilinearForm
-    def stiffness(u, v, w):
-        return w.kappa * dot(grad(u), grad(v))
-
-    f = case.functions["source"]
-
-    @LinearForm
-    def load(v, w):
-        return f(w.x[0], w.x[1]) * v
-
-    K_sk = stiffness.assemble(basis, kappa=np.repeat(kappa[:, None], nqp, axis=1)).tocsr()
-    F_sk = load.assemble(basis)
+    # the centroid rule on both sides: the same one-point quadrature
+    K_sk, F_sk = reference.assemble(mesh, kappa, case.functions["source"], one_point=True)
     rows = [
         CheckRow("stiffness K vs scikit-fem", float(spla.norm(K - K_sk) / spla.norm(K_sk)),
                  MATRIX_TOL, f"{K.shape[0]}x{K.shape[1]}, nnz {K.nnz}"),
         CheckRow("load F (one-point) vs scikit-fem", _rel(F_source, F_sk), MATRIX_TOL,
-                 f"skfem centroid rule ({nqp} point)"),
+                 "skfem centroid rule (1 point)"),
     ]
 
     # Our solution with the case's solver.
@@ -148,9 +130,7 @@ def cross_check(case: Case) -> list[CheckRow]:
         u = at_mean_zero(u)
     else:
         nodes, values = problem.dirichlet_data()
-    x_d = np.zeros(mesh.n_points)
-    x_d[nodes] = values
-    u_sk = skfem.solve(*condense(sp.csr_matrix(K_sk), F_sk, x=x_d, D=nodes))
+    u_sk = reference.solve_direct(K_sk, F_sk, nodes, values)
     if pure:
         u_sk = at_mean_zero(u_sk)
     rows.append(CheckRow("solution vs scikit-fem" + (" (mean zero)" if pure else ""),

@@ -28,7 +28,7 @@ import numpy as np
 
 from ...errors import CaseFileError, ExpressionError, InputError
 from ...interrupt import Interrupted
-from ...progress import StageProgress
+from ...progress import Progress
 from ..expressions import compile_expression
 from ..load import Case
 from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
@@ -157,33 +157,33 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
     """:func:`build_mesh` and the :class:`~femkit.mesh.MeshHierarchy` of its refinement when the
     case's solver is geometric multigrid (``None`` otherwise): ``(mesh, hierarchy)``."""
     from ...mesh import MeshHierarchy, check_tags, generate, read_mesh, refine, validate
+    from ..cost import check_mesh_fits
 
     spec = case.data["mesh"]
     where = f"mesh.file {spec['file']}" if "file" in spec else f"mesh.geometry {spec['geometry']}"
-    check = not case.run_options.get("force", False)  # --force also passes the library's memory checks
+
+    force = case.run_options.get("force", False)  # --force also passes the memory guard
     try:
         if "file" in spec:
             mesh = read_mesh(spec["file"])
         else:
-            mesh = generate(spec["geometry"], spec["h"] if h is None else h, check_memory=check,
-                            **(spec.get("params") or {}))
+            hv, params = spec["h"] if h is None else h, spec.get("params") or {}
+            check_mesh_fits(geometry=spec["geometry"], h=hv, params=params, force=force)
+            mesh = generate(spec["geometry"], hv, **params)
         mesh = validate(mesh)
     except InputError as exc:
         raise with_prefix(exc, where) from None
     hierarchy = None
     k = spec.get("refine") or 0
-    if k and check:  # before numpy allocates the finer levels
-        from ...cost.budget import check_mesh_fits
-
-        check_mesh_fits(triangles=mesh.n_triangles, refine=k)
     if k:
+        check_mesh_fits(triangles=mesh.n_triangles, refine=k, force=force)  # before numpy allocates
         big = mesh.n_triangles * 4 ** k >= RENUMBER_MIN_TRIANGLES
         if big or case.solver.needs_hierarchy:
             levels = MeshHierarchy.from_refinement(mesh, k, renumber="rcm" if big else "none")
             mesh = levels.finest
             hierarchy = levels if case.solver.needs_hierarchy else None
         else:
-            mesh = refine(mesh, k, check_memory=False)
+            mesh = refine(mesh, k)
     bnd = case.data["boundary"]
     for kind in ("dirichlet", "neumann"):
         for i, bc in enumerate(bnd.get(kind, [])):
@@ -487,8 +487,8 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         target = output_location(output_dir or case.data["output"]["dir"])
     stop = case.run_options.get("stop")
     plan = case.run_options.get("plan")
-    report = StageProgress([(st.name, st.seconds) for st in plan.stages] if plan else [],
-                           case.name, quiet=quiet)
+    report = Progress.planned([(st.name, st.seconds) for st in plan.stages] if plan else [],
+                              case.name, quiet=quiet)
 
     def check_stop(where: str) -> None:  # a signal during a stage stops after it
         report.done(where, *(("refine",) if where == "mesh" else ()))  # mesh includes refine

@@ -18,13 +18,12 @@ from __future__ import annotations
 import os
 from pathlib import Path
 from typing import Sequence
-from xml.sax.saxutils import quoteattr
-
 import numpy as np
 
 from ...interrupt import active_flag
-from ...io.atomic import EARLIER_RUN, atomic_directory, atomic_write_text
+from ...io.atomic import EARLIER_RUN, atomic_directory
 from ...io.writers import write_csv, write_json
+from ...mesh.vtk import pad3, write_cells, write_collection
 from .plot import write_final_png, write_gif
 
 __all__ = ["write_scene_outputs", "write_frames_vtu", "write_frames_xdmf", "write_pvd",
@@ -38,55 +37,42 @@ RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "system", "inte
 
 
 
-def _pad3(a: np.ndarray) -> np.ndarray:
-    a = np.asarray(a, dtype=np.float64)
-    if a.shape[1] == 3:
-        return a
-    return np.concatenate([a, np.zeros((a.shape[0], 3 - a.shape[1]))], axis=1)
-
-
-def _frame_mesh(system, x, v, triangles):
-    import meshio
-
+def _frame_cells(system, triangles) -> list[tuple[str, np.ndarray]]:
     cells = [("line", np.asarray(system.springs, dtype=np.int64))]
-    i, j = system.springs[:, 0], system.springs[:, 1]
-    length = np.linalg.norm(x[j] - x[i], axis=1)
-    stretch = [length / system.rest - 1.0]
     if triangles is not None and len(triangles):
         cells.append(("triangle", np.asarray(triangles, dtype=np.int64)))
-        stretch.append(np.zeros(len(triangles)))
-    return meshio.Mesh(_pad3(x), cells,
-                       point_data={"velocity": _pad3(v),
-                                   "pinned": system.pinned.astype(np.int32)},
-                       cell_data={"stretch": stretch})
+    return cells
 
 
 def write_frames_vtu(directory: str | os.PathLike, system, traj, triangles=None,
                      subdir: str = "frames", stop=None) -> list[str]:
-    """One ``.vtu`` per recorded frame in ``directory/subdir``; returns their relative names.
+    """One ``.vtu`` per recorded frame in ``directory/subdir`` (femkit's one VTK writer,
+    :func:`femkit.mesh.vtk.write_cells`); returns their relative names.
 
     ``stop`` (a :class:`~femkit.interrupt.StopFlag`) is checked before each frame: once set,
     the frames written so far are returned (a Ctrl-C while frames are written is answered)."""
     d = Path(directory)
-    (d / subdir).mkdir(parents=True, exist_ok=True)
+    cells = _frame_cells(system, triangles)
+    i, j = system.springs[:, 0], system.springs[:, 1]
     names = []
     for k in range(len(traj.times)):
         if stop:
             break
+        x = traj.x[k]
+        stretch = [np.linalg.norm(x[j] - x[i], axis=1) / system.rest - 1.0]
+        if len(cells) > 1:
+            stretch.append(np.zeros(len(cells[1][1])))
         name = f"{subdir}/frame_{k:05d}.vtu"
-        _frame_mesh(system, traj.x[k], traj.v[k], triangles).write(d / name)
+        write_cells(d / name, x, cells, cell_data={"stretch": stretch},
+                    point_data={"velocity": pad3(traj.v[k]),
+                                "pinned": system.pinned.astype(np.int32)})
         names.append(name)
     return names
 
 
 def write_pvd(path: str | os.PathLike, times: Sequence[float], files: Sequence[str]) -> Path:
-    """A ParaView collection listing ``files`` at ``times``."""
-    rows = "\n".join(f'    <DataSet timestep="{float(t)!r}" group="" part="0" file={quoteattr(f)}/>'
-                     for t, f in zip(times, files))
-    text = ('<?xml version="1.0"?>\n'
-            '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
-            f'  <Collection>\n{rows}\n  </Collection>\n</VTKFile>\n')
-    return atomic_write_text(path, text)
+    """A ParaView collection listing ``files`` at ``times`` (:func:`femkit.mesh.vtk.write_collection`)."""
+    return write_collection(path, times, files)
 
 
 def write_frames_xdmf(path: str | os.PathLike, system, traj, triangles=None) -> Path:
@@ -97,8 +83,8 @@ def write_frames_xdmf(path: str | os.PathLike, system, traj, triangles=None) -> 
     """
     import meshio
 
-    m0 = _frame_mesh(system, traj.x[0], traj.v[0], triangles)
-    x0 = _pad3(traj.x[0])
+    cells = _frame_cells(system, triangles)
+    x0 = pad3(traj.x[0])
     path = Path(path).resolve()
     # meshio 5 opens the .h5 by its bare name, i.e. in the current directory: write from there
     # (os.chdir and back: contextlib.chdir needs Python 3.11)
@@ -106,11 +92,11 @@ def write_frames_xdmf(path: str | os.PathLike, system, traj, triangles=None) -> 
     os.chdir(path.parent)
     try:
         with meshio.xdmf.TimeSeriesWriter(str(path)) as w:
-            w.write_points_cells(m0.points, m0.cells)
+            w.write_points_cells(x0, cells)
             for k, t in enumerate(traj.times):
-                x = _pad3(traj.x[k])
+                x = pad3(traj.x[k])
                 w.write_data(float(t), point_data={"position": x, "displacement": x - x0,
-                                                   "velocity": _pad3(traj.v[k])})
+                                                   "velocity": pad3(traj.v[k])})
     finally:
         os.chdir(cwd)
     return path

@@ -296,12 +296,15 @@ def build_system(case: Case):
 
 
 def _scene_mesh(spec: dict):
+    from ..cost import check_mesh_fits
 
     where = f"system.file {spec['file']}" if "file" in spec else f"system.geometry {spec['geometry']}"
     try:
         if "file" in spec:
             return validate(read_mesh(spec["file"]))
-        return validate(generate(spec["geometry"], spec["h"], **(spec.get("params") or {})))
+        params = spec.get("params") or {}
+        check_mesh_fits(geometry=spec["geometry"], h=spec["h"], params=params)
+        return validate(generate(spec["geometry"], spec["h"], **params))
     except InputError as exc:
         raise with_prefix(exc, where) from None
 

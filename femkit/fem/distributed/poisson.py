@@ -16,8 +16,6 @@ the exact solution on own elements and reduce them, gather the solution to rank 
 
 from __future__ import annotations
 
-import time
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -27,6 +25,7 @@ from ...solvers.petsc.backend import ksp_solve
 from ...solvers.petsc.env import require_petsc
 from ...solvers.petsc.failure import collective, from_root
 from ...solvers.result import SolveResult
+from ...timing import StageTimer
 from ..norms import error_norms
 from ..poisson import mean_shift_parts
 from .assembly import (DistributedSystem, assemble_poisson, gather_nodal, nodal_solution,
@@ -106,13 +105,8 @@ def solve_poisson(problem, *, method: str = "pcg", preconditioner: str | None = 
     comm = comm or PETSc.COMM_WORLD
     mpi = comm.tompi4py()
     rank, size = comm.getRank(), comm.getSize()
-    times: dict[str, float] = {}
-
-    @contextmanager
-    def timer(stage):
-        t0 = time.perf_counter()
-        yield
-        times[stage] = times.get(stage, 0.0) + time.perf_counter() - t0
+    timer = StageTimer()
+    times = timer.times
 
     mesh = problem.mesh
     with timer("boundary_data"):

@@ -4,13 +4,12 @@
 Rank ``r`` writes ``NAME_p{r}.vtu``: its own elements, the nodes they use (with ``u`` fetched
 from the ranks owning them), cell data ``tag``, ``rank`` and any per-element arrays given; rank 0
 writes ``NAME.pvtu`` listing the pieces with the array declarations read back from its own piece
-(so the index always matches what meshio wrote). ParaView opens the ``.pvtu`` as one dataset.
+(so the index always matches what was written). Pieces and index are written by femkit's one
+VTK writer (:mod:`femkit.mesh.vtk`). ParaView opens the ``.pvtu`` as one dataset.
 """
 
 from __future__ import annotations
 
-import os
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +24,7 @@ def write_pvtu(directory, name: str, mesh, u_vec, layout, comm,
     ``cell_data``: ``{name: (m,) array over the whole mesh}``; each rank writes its elements'.
     """
     from ...mesh import Mesh, write_mesh
+    from ...mesh.vtk import write_parallel_index
 
     mpi = comm.tompi4py()
     directory = Path(directory)
@@ -44,36 +44,6 @@ def write_pvtu(directory, name: str, mesh, u_vec, layout, comm,
     mpi.Barrier()
     index = directory / f"{name}.pvtu"
     if rank == 0:
-        _write_index(index, piece, [f"{name}_p{r}.vtu" for r in range(size)])
+        write_parallel_index(index, piece, [f"{name}_p{r}.vtu" for r in range(size)])
     mpi.Barrier()
     return index
-
-
-def _declarations(piece: Path) -> dict[str, list[dict]]:
-    """``{"PointData": [...], "CellData": [...], "Points": [...]}``: the DataArray attributes
-    (type, Name, NumberOfComponents) of a ``.vtu`` piece."""
-    root = ET.parse(piece).getroot()
-    grid = root.find("UnstructuredGrid/Piece")
-    out = {}
-    for section in ("PointData", "CellData", "Points"):
-        node = grid.find(section)
-        arrays = [] if node is None else node.findall("DataArray")
-        out[section] = [{k: a.attrib[k] for k in ("type", "Name", "NumberOfComponents")
-                         if k in a.attrib} for a in arrays]
-    return out
-
-
-def _write_index(path: Path, piece0: Path, pieces: list[str]) -> None:
-    decl = _declarations(piece0)
-    vtk = ET.Element("VTKFile", type="PUnstructuredGrid", version="1.0", byte_order="LittleEndian")
-    grid = ET.SubElement(vtk, "PUnstructuredGrid", GhostLevel="0")
-    for section, tag in (("PointData", "PPointData"), ("CellData", "PCellData"),
-                         ("Points", "PPoints")):
-        block = ET.SubElement(grid, tag)
-        for attrs in decl[section]:
-            ET.SubElement(block, "PDataArray", **attrs)
-    for p in pieces:
-        ET.SubElement(grid, "Piece", Source=p)
-    tmp = path.with_suffix(".pvtu.tmp")
-    ET.ElementTree(vtk).write(tmp, xml_declaration=True, encoding="utf-8")
-    os.replace(tmp, path)

@@ -1,5 +1,9 @@
 """Measure the cost of the Poisson pipeline stage by stage (what the cost model is calibrated on).
 
+Used by ``calibrate_cost.py`` and ``bench_cost_model.py`` (run as scripts from this folder)
+and by the model-against-measurement tests; it runs femkit's library, which the cost model
+itself (:mod:`femkit.cost`, pure functions of numbers) never does.
+
 :func:`measure_poisson` runs mesh generation, refinement, assembly, Dirichlet elimination,
 the solve, error norms and output writing with the library functions the case runner uses, and
 records per stage the wall time and the peak resident memory above the resident memory at
@@ -21,9 +25,18 @@ import time
 
 import numpy as np
 
-from .memory import current_rss, peak_rss, reset_peak_rss
+from femkit.cost.memory import current_rss, peak_rss, reset_peak_rss
 
-__all__ = ["measure_poisson", "measure_poisson_subprocess", "preload", "child_env"]
+__all__ = ["measure_poisson", "measure_poisson_subprocess", "preload", "child_env", "domain"]
+
+
+def domain(geometry: str, params: dict | None = None) -> dict:
+    """The numbers :func:`femkit.cost.plan_poisson` takes for a registered geometry:
+    ``{area, line_length, name, params}`` (the measure declared with the geometry)."""
+    from femkit.case.cost import geometry_domain
+
+    _, area, length = geometry_domain(geometry, params)
+    return dict(area=area, line_length=length, name=geometry, params=params or None)
 
 
 def preload() -> None:
@@ -138,9 +151,9 @@ def _png(path: str, mesh, u) -> None:
 def child_env() -> dict:
     """Environment of a measuring child process: BLAS on one thread, and this femkit first on
     the path (the child imports the same femkit as the parent, installed or not)."""
-    here = os.path.abspath(__file__)  # <root>/femkit/cost/probe.py
-    root = os.path.dirname(os.path.dirname(os.path.dirname(here)))
-    path = os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH", "")) if p)
+    here = os.path.abspath(os.path.dirname(__file__))  # <root>/benchmarks
+    root = os.path.dirname(here)
+    path = os.pathsep.join(p for p in (root, here, os.environ.get("PYTHONPATH", "")) if p)
     return dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
                 MPLBACKEND="Agg", PYTHONPATH=path)
 
@@ -148,7 +161,7 @@ def child_env() -> dict:
 def measure_poisson_subprocess(timeout: float = 600.0, **kwargs) -> dict:
     """:func:`measure_poisson` in a fresh Python process (BLAS pinned to one thread)."""
     env = child_env()
-    code = ("import json, sys; from femkit.cost.probe import measure_poisson; "
+    code = ("import json, sys; from cost_probe import measure_poisson; "
             "print(json.dumps(measure_poisson(**json.loads(sys.argv[1]))))")
     out = subprocess.run([sys.executable, "-c", code, json.dumps(kwargs)], capture_output=True,
                          text=True, env=env, timeout=timeout, check=False)
