@@ -1,7 +1,7 @@
 """The cost of a case or scene file before it runs: its plan, the budget check, the stop flag.
 
 :func:`plan_case` translates a loaded case into a :class:`femkit.cost.Plan` through its
-problem type (``PROBLEMS[...].plan``); :func:`check_case` checks it against the case's
+kind (``KINDS[...].plan``); :func:`check_case` checks it against the case's
 ``limits:``, the command line's ``--max-memory`` and the available memory, refusing with
 :class:`~femkit.errors.BudgetExceededError` (exit code 2, one line) unless forced. Run options
 travel in ``case.run_options``: ``limits`` (:class:`femkit.cost.Limits`, from the file), ``force``
@@ -71,10 +71,17 @@ def plan_scene_case(case: Case, *, measure: bool = True) -> Plan:
 
 
 def plan_case(case: Case, *, measure: bool = True) -> Plan:
-    """The plan of any case, through its problem type (``PROBLEMS[case.problem].plan``)."""
-    from .problems import get_problem
+    """The plan of any case, through its kind (``KINDS[case.problem].plan``)."""
+    from .kinds import KINDS
 
-    return get_problem(case.problem).plan(case, measure=measure)
+    kind = KINDS.get(case.problem, "problem")
+    if kind.plan is None:  # a kind without a cost model runs unchecked, and the plan says so
+        from ..cost import load_constants
+
+        return Plan("case", f"{case.name}: {case.problem}", {}, [],
+                    load_constants()["bytes"]["baseline"],
+                    assumptions=[f"no cost model for problem {case.problem!r}: the run is unchecked"])
+    return kind.plan(case, measure=measure)
 
 
 def check_case(case: Case, *, max_memory: float | None = None, force: bool = False,

@@ -83,7 +83,7 @@ def cross_check(case: Case) -> list[CheckRow]:
     from skfem import Basis, BilinearForm, ElementTriP1, LinearForm, MeshTri, condense
     from skfem.helpers import dot, grad
 
-    from .run import build_mesh_levels, is_pure_neumann, multigrid_inputs, poisson_problem
+    from .problem import build_mesh_levels, is_pure_neumann, multigrid_inputs, poisson_problem
 
     mesh, hierarchy = build_mesh_levels(case)
     problem = poisson_problem(case, mesh)

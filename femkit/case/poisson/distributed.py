@@ -54,7 +54,7 @@ def _run(case, comm, output_dir, quiet, write, echo):
     from ...mesh import quality
     from ...solvers.petsc.failure import collective, from_root
     from ...timing import StageTimer
-    from .run import CaseResult, _nullspace_facts, build_mesh, exact_gradient, poisson_problem
+    from .problem import CaseResult, build_mesh, exact_gradient, nullspace_facts, poisson_problem
 
     mpi = comm.tompi4py()
     rank, size = comm.getRank(), comm.getSize()
@@ -109,7 +109,7 @@ def _run(case, comm, output_dir, quiet, write, echo):
         indicators = est.indicators
     elif rank == 0:
         parallel["not_computed"] = ["error_estimate (needs the gathered solution)"]
-    nullspace = _nullspace_facts(system)
+    nullspace = nullspace_facts(system)
     n_fixed = len(system.fixed)
     result = CaseResult(case=case, mesh=mesh, u=sol.u, kappa=problem.kappa, solve=res,
                         errors=sol.errors, timings=stage.times, quality=q,

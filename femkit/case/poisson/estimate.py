@@ -39,7 +39,7 @@ def estimate_facts(case, problem, u: np.ndarray, grad_exact=None, est=None):
 def solve_adaptive(case, mesh, *, echo=None):
     """Run the case's ``adaptive:`` loop from ``mesh``; an :class:`~femkit.fem.adaptive.AdaptiveResult`."""
     from ...fem.adaptive import adaptive_solve, problem_solver
-    from .run import exact_gradient, poisson_problem
+    from .problem import exact_gradient, poisson_problem
 
     a = case.data["adaptive"]
     solve_on = problem_solver(lambda m: poisson_problem(case, m), case.solver.solve, case.solver.method)

@@ -132,26 +132,26 @@ def write_energy_csv(path: str | os.PathLike, traj) -> Path:
 
 def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
     """Write every requested output of ``result`` (a SceneResult) into ``directory`` atomically."""
-    opts = result.case.data["output"]
+    opts = result.case.spec.output
     traj, system, tri = result.trajectory, result.system, result.triangles
     final = Path(directory).resolve()
     result.output_dir = final
     files: list[str] = []
     with atomic_directory(final, EARLIER_RUN) as tmp:
-        if opts["vtu"]:
+        if opts.vtu:
             frames = write_frames_vtu(tmp, system, traj, tri)
             write_pvd(tmp / "scene.pvd", traj.times, frames)
             files += ["scene.pvd", *frames]
-        if opts["xdmf"]:
+        if opts.xdmf:
             write_frames_xdmf(tmp / "scene.xdmf", system, traj, tri)
             files += ["scene.xdmf", "scene.h5"]
-        if opts["energy_csv"]:
+        if opts.energy_csv:
             write_energy_csv(tmp / "energy.csv", traj)
             files.append("energy.csv")
-        if opts["png"]:
+        if opts.png:
             write_final_png(tmp / "final.png", system, traj, result.case.name, triangles=tri)
             files.append("final.png")
-        if opts["gif"]:
+        if opts.gif:
             write_gif(tmp / "animation.gif", system, traj, result.case.name, triangles=tri)
             files.append("animation.gif")
         files.append("result.json")
