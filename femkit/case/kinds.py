@@ -9,8 +9,8 @@ registers itself from its own module (``femkit/case/<folder>/kind.py``: ``poisso
 ``femkit study``, the cost check and the report dispatch through :data:`KINDS` alone.
 
 Discovery is lazy: nothing is imported until a kind is first looked up, so ``femkit --help`` and
-a bad-input exit stay fast. The first look-up imports the built-in kind modules and then the
-plugins (:mod:`femkit.case.plugins`): modules of the ``femkit.plugins`` entry-point group of
+a bad-input exit stay fast. The first look-up of a family imports its built-in kind modules (a
+case look-up never imports the study kinds), and the first look-up of any kind the plugins (:mod:`femkit.case.plugins`): modules of the ``femkit.plugins`` entry-point group of
 installed packages, and the modules named in the ``FEMKIT_PLUGINS`` environment variable.
 
 Adding a kind is one module::
@@ -111,7 +111,7 @@ class KindRegistry:
 
     def __init__(self):
         self._items: dict[str, Kind] = {}
-        self._discovered = False
+        self._discovered: set[str] = set()
 
     def register(self, kind: Kind) -> Kind:
         if kind.name in self._items:
@@ -120,30 +120,35 @@ class KindRegistry:
         return kind
 
     def remove(self, name: str) -> Kind:
-        self._discover()
+        self._discover(None)
         kind = self._items.pop(name, None)
         if kind is None:
             raise UnknownNameError("kind", str(name), self._items)
         return kind
 
-    def _discover(self) -> None:
-        if self._discovered:
-            return
-        self._discovered = True
-        case = importlib.import_module(CASE_PACKAGE)
-        for info in sorted(pkgutil.iter_modules(case.__path__), key=lambda i: i.name):
-            if info.ispkg and importlib.util.find_spec(f"{CASE_PACKAGE}.{info.name}.kind"):
-                importlib.import_module(f"{CASE_PACKAGE}.{info.name}.kind")
-        study = importlib.import_module(STUDY_PACKAGE)
-        for info in sorted(pkgutil.iter_modules(study.__path__), key=lambda i: i.name):
-            if not info.name.startswith("_"):
-                importlib.import_module(f"{STUDY_PACKAGE}.{info.name}")
+    def _discover(self, key: str | None) -> None:
+        """Import the built-in kinds of family ``key`` (both for None), then the plugins; each
+        family once (a case look-up never imports the study kinds)."""
+        for family in (FAMILIES if key is None else (key,)):
+            if family in self._discovered:
+                continue
+            self._discovered.add(family)
+            if family == "problem":
+                case = importlib.import_module(CASE_PACKAGE)
+                for info in sorted(pkgutil.iter_modules(case.__path__), key=lambda i: i.name):
+                    if info.ispkg and importlib.util.find_spec(f"{CASE_PACKAGE}.{info.name}.kind"):
+                        importlib.import_module(f"{CASE_PACKAGE}.{info.name}.kind")
+            else:
+                study = importlib.import_module(STUDY_PACKAGE)
+                for info in sorted(pkgutil.iter_modules(study.__path__), key=lambda i: i.name):
+                    if not info.name.startswith("_"):
+                        importlib.import_module(f"{STUDY_PACKAGE}.{info.name}")
         from .plugins import load_plugins
 
         load_plugins()
 
     def _of(self, key: str | None) -> dict[str, Kind]:
-        self._discover()
+        self._discover(key)
         return {n: k for n, k in self._items.items() if key is None or k.key == key}
 
     def get(self, name: Any, key: str | None = None) -> Kind:
