@@ -90,7 +90,7 @@ def check_cloth_study(study) -> None:
             raise CaseFileError(f"scenes[{i}]: scene file not found: {path}")
         study.files.append(path)
         case = _scene_case(study, p)
-        if case.data.get("problem") != "mass_spring" or case.data["system"].get("type") != "cloth":
+        if case.problem != "mass_spring" or case.spec.system["type"] != "cloth":
             raise CaseFileError(f"scenes[{i}]: {path.name} is not a cloth scene (system.type: cloth)")
     try:
         expand_methods(_methods(study.data["methods"]))

@@ -139,7 +139,7 @@ def cross_check(case: Case) -> list[CheckRow]:
         )
 
         w = node_weights(mesh)
-        F_sk = check_compatibility(F_sk, weights=w, rtol=case.data["boundary"]["compatibility_rtol"])[0]
+        F_sk = check_compatibility(F_sk, weights=w, rtol=case.spec.boundary.compatibility_rtol)[0]
         nodes, values = np.array([0]), np.array([0.0])
 
         def at_mean_zero(v):

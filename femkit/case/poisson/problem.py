@@ -43,20 +43,20 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
     case's solver is geometric multigrid (``None`` otherwise): ``(mesh, hierarchy)``."""
     from ...mesh import MeshHierarchy, check_tags, generate, read_mesh, refine, validate
 
-    spec = case.data["mesh"]
-    where = f"mesh.file {spec['file']}" if "file" in spec else f"mesh.geometry {spec['geometry']}"
+    spec = case.spec.mesh
+    where = f"mesh.file {spec.file}" if spec.file is not None else f"mesh.geometry {spec.geometry}"
     check = not case.run_options.get("force", False)  # --force also passes the library's memory checks
     try:
-        if "file" in spec:
-            mesh = read_mesh(spec["file"])
+        if spec.file is not None:
+            mesh = read_mesh(spec.file)
         else:
-            mesh = generate(spec["geometry"], spec["h"] if h is None else h, check_memory=check,
-                            **(spec.get("params") or {}))
+            mesh = generate(spec.geometry, spec.h if h is None else h, check_memory=check,
+                            **spec.params)
         mesh = validate(mesh)
     except InputError as exc:
         raise with_prefix(exc, where) from None
     hierarchy = None
-    k = spec.get("refine") or 0
+    k = spec.refine
     if k and check:  # before numpy allocates the finer levels
         from ...cost.budget import check_mesh_fits
 
@@ -69,16 +69,16 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
             hierarchy = levels if case.solver.needs_hierarchy else None
         else:
             mesh = refine(mesh, k, check_memory=False)
-    bnd = case.data["boundary"]
+    bnd = case.spec.boundary
     for kind in ("dirichlet", "neumann"):
-        for i, bc in enumerate(bnd.get(kind, [])):
+        for i, bc in enumerate(getattr(bnd, kind)):
             tags = [t for t in bc["tags"] if not _is_whole_boundary(mesh, t)]
             if tags:
                 try:
                     check_tags(mesh, tags, kind="boundary")
                 except InputError as exc:
                     raise with_prefix(exc, f"boundary.{kind}[{i}].tags") from None
-    coef = case.data["coefficient"]
+    coef = case.spec.coefficient
     if isinstance(coef, dict):
         try:
             check_tags(mesh, list(coef["regions"]), kind="cell")
@@ -125,7 +125,7 @@ def element_kappa(case: Case, mesh) -> np.ndarray:
     """Per-triangle coefficient values (constant, expression at barycentres, or region table)."""
     from ...fem.coefficients import element_coefficient
 
-    coef = case.data["coefficient"]
+    coef = case.spec.coefficient
     if isinstance(coef, dict):
         from ...mesh import check_tags
 
@@ -166,10 +166,9 @@ def poisson_problem(case: Case, mesh, *, load_rule: str | None = None):
     """
     from ...fem import PoissonProblem
 
-    d = case.data
-    bnd = d["boundary"]
+    bnd = case.spec.boundary
     dirichlet = []
-    for i, bc in enumerate(bnd.get("dirichlet", [])):
+    for i, bc in enumerate(bnd.dirichlet):
         g = case.functions[f"boundary.dirichlet[{i}].value"]
         named = [t for t in bc["tags"] if not _is_whole_boundary(mesh, t)]
         if len(named) < len(bc["tags"]):
@@ -177,22 +176,22 @@ def poisson_problem(case: Case, mesh, *, load_rule: str | None = None):
         if named:
             dirichlet.append((named, g))
     neumann = [(_tags(mesh, bc["tags"]), case.functions[f"boundary.neumann[{i}].flux"])
-               for i, bc in enumerate(bnd.get("neumann", []))]
+               for i, bc in enumerate(bnd.neumann)]
     extra = {}
     if not dirichlet:
-        extra = dict(nullspace=bnd["nullspace"], compatibility_rtol=bnd["compatibility_rtol"])
-        if bnd["nullspace"] == "pin" and "exact.u" in case.functions:
+        extra = dict(nullspace=bnd.nullspace, compatibility_rtol=bnd.compatibility_rtol)
+        if bnd.nullspace == "pin" and "exact.u" in case.functions:
             x0, y0 = mesh.points[0]
             u0 = case.functions["exact.u"](np.array([x0]), np.array([y0]))
             extra["pin_value"] = float(np.asarray(u0).ravel()[0])
     return PoissonProblem(mesh, element_kappa(case, mesh), case.functions["source"],
                           dirichlet=dirichlet, neumann=neumann,
-                          load_rule=load_rule or d["quadrature"]["load"], **extra)
+                          load_rule=load_rule or case.spec.load_rule, **extra)
 
 
 def is_pure_neumann(case: Case) -> bool:
     """True when the case has no Dirichlet condition (``u`` fixed only up to a constant)."""
-    return not case.data["boundary"].get("dirichlet")
+    return case.spec.boundary.pure_neumann
 
 
 def exact_gradient(case: Case):
@@ -250,15 +249,14 @@ class CaseResult:
         """The content of ``result.json`` (keys documented in docs/case-files.md)."""
         from ..._version import __version__
 
-        spec = self.case.data["mesh"]
+        spec = self.case.spec.mesh
         mesh_info = {k: self.quality.get(k) for k in (
             "n_points", "n_triangles", "h_max", "h_min", "h_mean", "min_angle",
             "max_aspect_ratio", "area")}
         mesh_info["n_points"] = self.mesh.n_points
         mesh_info["n_triangles"] = self.mesh.n_triangles
-        mesh_info["source"] = (spec["file"] if "file" in spec else
-                               f"geometry {spec['geometry']} h={spec['h']}")
-        mesh_info["refine"] = spec.get("refine", 0)
+        mesh_info["source"] = spec.source()
+        mesh_info["refine"] = spec.refine
         return {
             "case": self.case.name,
             "problem": self.case.problem,

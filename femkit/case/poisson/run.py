@@ -28,8 +28,10 @@ from ...errors import CaseFileError, ExpressionError, InputError
 from ...interrupt import Interrupted
 from ...progress import StageProgress
 from ..expressions import compile_expression
+from ..frozen import freeze
 from ..load import Case
 from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
+from .spec import BoundarySpec, MeshSpec, PoissonOutputSpec, PoissonSpec
 from .problem import (CaseResult, build_mesh, build_mesh_levels, compute_errors, element_kappa,
                       exact_gradient, is_pure_neumann, multigrid_inputs, multigrid_overrides,
                       nullspace_facts, poisson_problem)
@@ -121,6 +123,16 @@ def prepare_poisson(case: Case) -> None:
 
     out = d["output"]
     out["dir"] = str((base / out.get("dir", os.path.join("runs", case.name))).resolve())
+    bnd = d["boundary"]
+    case.spec = PoissonSpec(
+        mesh=MeshSpec.from_mapping(freeze(mesh)), coefficient=freeze(coef),
+        boundary=BoundarySpec(tuple(freeze(list(bnd.get("dirichlet") or ()))),
+                              tuple(freeze(list(bnd.get("neumann") or ()))), bnd.get("nullspace"),
+                              bnd.get("compatibility_rtol")),
+        load_rule=d["quadrature"]["load"], estimator=d["estimator"],
+        adaptive=freeze(d["adaptive"]) if d.get("adaptive") else None, solver=case.solver,
+        output=PoissonOutputSpec(out["dir"], bool(out["vtu"]), bool(out["xdmf"]),
+                                 bool(out["plot"]), out.get("gather_limit")))
 
 
 def _prepare_nullspace(bnd: dict) -> None:
@@ -168,7 +180,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     if write:  # a bad output location is bad input: refuse it before any work is done
         from .output import output_location
 
-        target = output_location(output_dir or case.data["output"]["dir"])
+        target = output_location(output_dir or case.spec.output.dir)
     stop = case.run_options.get("stop")
     plan = case.run_options.get("plan")
     report = StageProgress([(st.name, st.seconds) for st in plan.stages] if plan else [],
@@ -184,7 +196,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     check_stop("mesh")
     grad = exact_gradient(case)
     run = est = None
-    if case.data.get("adaptive"):
+    if case.spec.adaptive:
         from .estimate import solve_adaptive
 
         with stage("adaptive"):
