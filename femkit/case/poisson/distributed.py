@@ -76,7 +76,7 @@ def _run(case, comm, output_dir, quiet, write, echo):
                 else GATHER_LIMIT)
     gather = mesh.n_points <= limit
     sol = solve_poisson(problem, method=spec.method,
-                        preconditioner=spec.preconditioner if spec.method == "pcg" else None,
+                        preconditioner=spec.preconditioner,  # checked by the spec and the backend
                         rtol=spec.rtol, atol=spec.atol, maxiter=spec.maxiter,
                         petsc_options=spec.petsc_options, omega=spec.options.get("omega", 1.0),
                         exact=case.functions.get("exact.u"), grad_exact=exact_gradient(case),
