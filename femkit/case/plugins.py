@@ -11,7 +11,8 @@ femkit imports plugins once, at the first look-up of a file kind (every ``load_c
 * the ``FEMKIT_PLUGINS`` environment variable: module names separated by commas (modules on
   ``sys.path``/``PYTHONPATH``), for scripts and experiments without packaging.
 
-A plugin that cannot be imported is an :class:`~femkit.errors.InputError` naming it (exit 2).
+A plugin that cannot be imported, or fails while importing (e.g. registers a name twice), is an
+:class:`~femkit.errors.InputError` naming it (exit 2).
 """
 
 from __future__ import annotations
@@ -56,5 +57,8 @@ def load_plugins() -> list[str]:
             importlib.import_module(module)
         except ImportError as exc:
             raise InputError(f"plugin {module!r} from {where} cannot be imported: {exc}") from None
+        except Exception as exc:  # a plugin's own error (e.g. a name registered twice)
+            raise InputError(f"plugin {module!r} from {where} failed while importing: "
+                             f"{type(exc).__name__}: {exc}") from None
         done.append(module)
     return done

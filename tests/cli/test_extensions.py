@@ -247,3 +247,12 @@ def test_a_plugin_that_cannot_be_imported_is_bad_input(tmp_path):
                        env=env, capture_output=True, text=True, timeout=120)
     assert p.returncode == 2
     assert "plugin 'no_such_femkit_plugin' from FEMKIT_PLUGINS cannot be imported" in p.stderr
+
+
+def test_a_plugin_registering_a_taken_name_is_bad_input(tmp_path):
+    case = str(ROOT / "cases" / "poisson_unit_square.yaml")
+    p = _femkit(tmp_path, "twice", PROBLEM.replace('Kind("rod"', 'Kind("poisson"'), "solve", case,
+                "--dry-run")
+    assert p.returncode == 2 and "Traceback" not in p.stderr
+    assert ("plugin 'twice' from FEMKIT_PLUGINS failed while importing: ValueError: problem "
+            "'poisson' registered twice") in p.stderr
