@@ -1,15 +1,16 @@
 """Case files: schema validation, safe expressions, loading and running.
 
 ``load_case(path, **overrides) -> Case``; ``Case.run(output_dir=None, quiet=True, write=True)``.
-Problem types (``poisson``, later ``mass_spring``) are dispatched through
-:data:`femkit.case.problems.PROBLEMS`.
+Kinds of file (``problem: poisson``, ``problem: mass_spring``, and the study kinds) are
+dispatched through the one registry :data:`femkit.case.kinds.KINDS`; a new kind is one module
+calling :func:`femkit.case.kinds.register_kind`.
 """
 
 from .load import Case, apply_overrides, case_from_dict, load_case
-from .problems import PROBLEMS, ProblemType, register_problem
+from .kinds import KINDS, Kind, register_kind
 
-__all__ = ["Case", "load_case", "case_from_dict", "apply_overrides", "PROBLEMS", "ProblemType",
-           "register_problem", "compile_expression"]
+__all__ = ["Case", "load_case", "case_from_dict", "apply_overrides", "KINDS", "Kind",
+           "register_kind", "compile_expression"]
 
 
 def __getattr__(name):  # compile_expression pulls numpy: import it on first use only

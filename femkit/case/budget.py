@@ -1,7 +1,7 @@
 """The budget check of a case or scene file before it runs (``femkit solve``, ``--dry-run``).
 
 :func:`plan_case` translates a loaded case into a :class:`femkit.cost.Plan` through its
-problem type (``PROBLEMS[...].plan``); :func:`check_case` checks it against the case's
+kind (``KINDS[...].plan``); :func:`check_case` checks it against the case's
 ``limits:``, the command line's ``--max-memory`` and the available memory, refusing with
 :class:`~femkit.errors.BudgetExceededError` (exit code 2, one line) unless forced.
 
@@ -24,10 +24,17 @@ __all__ = ["plan_case", "check_case"]
 
 
 def plan_case(case, *, measure: bool = True) -> Plan:
-    """The plan of any case, through its problem type (``PROBLEMS[case.problem].plan``)."""
-    from .problems import get_problem
+    """The plan of any case, through its kind (``KINDS[case.problem].plan``)."""
+    from .kinds import KINDS
 
-    return get_problem(case.problem).plan(case, measure=measure)
+    kind = KINDS.get(case.problem, "problem")
+    if kind.plan is None:  # a kind without a cost model runs unchecked, and the plan says so
+        from ..cost import load_constants
+
+        return Plan("case", f"{case.name}: {case.problem}", {}, [],
+                    load_constants()["bytes"]["baseline"],
+                    assumptions=[f"no cost model for problem {case.problem!r}: the run is unchecked"])
+    return kind.plan(case, measure=measure)
 
 
 def check_case(case, *, max_memory: float | None = None, force: bool = False,

@@ -12,7 +12,7 @@ the checks, so no library layer plans anything:
 * :func:`measure_step_seconds` times a scene's first batch of steps (what ``plan_scene`` is
   given as ``step_seconds``);
 * :func:`plan_poisson_case` and :func:`plan_scene_case` are the plans of the two problem
-  types (``PROBLEMS[...].plan``); :mod:`femkit.case.budget` checks a case's plan against its
+  kinds (``KINDS[...].plan``); :mod:`femkit.case.budget` checks a case's plan against its
   limits before it runs.
 
 Nothing here imports another module of ``femkit.case``: the runners import this module (the

@@ -23,7 +23,8 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import CaseFileError, UnknownNameError
-from .problems import get_problem
+from .frozen import freeze
+from .kinds import KINDS
 from .schema import fill_defaults, validate_against
 
 __all__ = ["Case", "load_case", "case_from_dict", "read_yaml", "apply_overrides"]
@@ -36,9 +37,10 @@ class Case:
     Attributes
     ----------
     data : dict
-        The validated case, defaults filled, relative paths resolved against ``base_dir``.
+        The validated case, defaults filled, relative paths resolved against ``base_dir``;
+        read-only once loaded (:func:`femkit.case.frozen.freeze`).
     problem : str
-        The ``problem`` key (dispatch key of :data:`femkit.case.problems.PROBLEMS`).
+        The ``problem`` key (dispatch key of :data:`femkit.case.kinds.KINDS`).
     name : str
         ``name`` key, else the file stem.
     base_dir : Path
@@ -50,6 +52,9 @@ class Case:
         each with ``.source`` holding its text. Replace an entry to swap a piece.
     solver : SolverSpec or None
         The validated ``solver`` (``linear_solver`` in scenes): built once at load time.
+    spec : object or None
+        The kind's typed, frozen run spec built at load time (scenes:
+        :class:`femkit.case.scene.spec.SceneSpec`); the runners read it, not ``data``.
     run_options : dict
         How to run it (:mod:`femkit.case.budget`): ``limits`` (:class:`femkit.cost.Limits` from
         the ``limits:`` key, set at load time), ``force`` (skip every budget) and ``stop`` (a
@@ -64,6 +69,7 @@ class Case:
     functions: dict = field(default_factory=dict)
     solver: Any = None
     run_options: dict = field(default_factory=dict)
+    spec: Any = None
 
     def run(self, output_dir: str | os.PathLike | None = None, quiet: bool = True,
             write: bool = True, echo=None):
@@ -77,7 +83,7 @@ class Case:
         write : when False, nothing is written to disk.
         echo : callable used for printing (default :func:`print`).
         """
-        run = get_problem(self.problem).get_run()
+        run = KINDS.get(self.problem, "problem").run
         return run(self, output_dir=output_dir, quiet=quiet, write=write, echo=echo)
 
 
@@ -177,17 +183,18 @@ def case_from_dict(data: Mapping, base_dir: str | os.PathLike = ".", *, name: st
         raise CaseFileError("(top level): missing required key 'problem' "
                             "(e.g. 'problem: poisson')")
     try:
-        ptype = get_problem(data["problem"])
+        kind = KINDS.get(data["problem"], "problem")
     except UnknownNameError as exc:
         raise CaseFileError(f"problem: {exc}") from None
-    schema = ptype.get_schema()
+    schema = kind.get_schema()
     validate_against(data, schema)
     full = fill_defaults(data, schema)
     base = Path(base_dir).resolve()
     case_name = full.get("name") or name or "case"
     case = Case(data=full, problem=str(full["problem"]), name=case_name, base_dir=base,
                 path=Path(path).resolve() if path is not None else None)
-    ptype.get_prepare()(case)
+    kind.prepare(case)
+    case.data = freeze(case.data)  # from here on the data is read, never edited
     return case
 
 

@@ -31,7 +31,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("study", help="study YAML file (kind: poisson_convergence | dynamics_work_precision | stability)")
+    p.add_argument("study", help="study YAML file (kind: poisson_convergence, dynamics_work_precision, "
+                   "stability, adaptive, cloth_work_precision, or a plugin's kind)")
     p.add_argument("-o", "--output", help="report directory (default: the file's output: key, "
                    "else femkit-out/<name> beside the study file)")
     p.add_argument("--quick", action="store_true", help="apply the file's quick: block (small sizes)")
@@ -90,9 +91,10 @@ def cli_main(args) -> int:
                   "kept as it was", file=sys.stderr)
             return 128 + int(exc.flag.signum or 2)
         print(f"{study.kind} '{study.name}': {len(result.records)} runs in {result.elapsed:.1f} s")
-        from .kinds import STUDY_KINDS
+        from ..case.kinds import KINDS
 
-        for line in STUDY_KINDS.get(study.kind).summary(result):
+        summary = KINDS.get(study.kind, "kind").summary
+        for line in (summary(result) if summary else ()):
             print(f"  {line}")
         for line in result.notes:
             print(f"  note: {line}")

@@ -18,16 +18,24 @@ import numpy as np
 
 from ..case.specs import SOLVER_SCHEMA
 from ..errors import CaseFileError, InputError
-from .kinds import StudyKind
 
-__all__ = ["CLOTH_SCHEMA", "CLOTH_KIND", "run_cloth_study"]
+__all__ = ["cloth_schema", "check_cloth_study", "run_cloth_study", "build_cloth_report",
+           "cloth_summary", "family_styles"]
 
 _POS = {"type": "number", "exclusiveMinimum": 0}
 _ITS = {"type": "array", "minItems": 1, "items": {"type": "integer", "minimum": 1}}
 
-#: The kind's own keys (``kind``, ``title``, ``description``, ``output``, ``repeats`` and
-#: ``warmup`` are common to every study kind).
-CLOTH_SCHEMA = {
+def cloth_schema() -> dict:
+    """The kind's own keys (``kind``, ``title``, ``description``, ``output``, ``repeats`` and
+    ``warmup`` are common to every study kind); the family enum is the keys of
+    :data:`femkit.dynamics.work_precision.FAMILIES`."""
+    from ..dynamics.work_precision import FAMILIES
+
+    return _schema(sorted(FAMILIES))
+
+
+def _schema(families: list) -> dict:
+    return {
     "scenes": {"type": "array", "minItems": 1, "items": {"type": "string"},
                "description": "cloth scene files (relative to the study file)"},
     "system_overrides": {"type": "object", "description": "merged into every scene's system block"},
@@ -36,7 +44,7 @@ CLOTH_SCHEMA = {
     "linear_solver": {**SOLVER_SCHEMA, "default": {"method": "cholesky"}},
     "methods": {"type": "array", "minItems": 1, "items": {
         "type": "object", "additionalProperties": False, "required": ["family"],
-        "properties": {"family": {"enum": ["fast_mass_spring", "chebyshev", "baraff_witkin", "newton"]},
+        "properties": {"family": {"enum": families},
                        "iterations": _ITS, "options": {"type": "object"},
                        "linear_solver": {**SOLVER_SCHEMA, "description":
                                          "this family's linear solver (default: the study's)"}}},
@@ -49,10 +57,21 @@ CLOTH_SCHEMA = {
         "solve": {"enum": ["newton", "local_global"], "default": "newton"},
         "trajectory": {"enum": ["newmark", "rk4"], "default": "newmark"},
         "substeps": {"type": "integer", "minimum": 2, "default": 16}}},
-}
+    }
 
-FAMILY_STYLE = {"fast_mass_spring": ("tab:blue", "o"), "chebyshev": ("tab:green", "s"),
-                "baraff_witkin": ("tab:red", "D"), "newton": ("tab:purple", "^")}
+
+_COLOURS = ("tab:blue", "tab:green", "tab:red", "tab:purple", "tab:orange", "tab:brown",
+            "tab:pink", "tab:olive", "tab:cyan", "tab:gray")
+_MARKERS = ("o", "s", "D", "^", "v", "P", "X", "*", "<", ">")
+
+
+def family_styles() -> dict:
+    """family -> (colour, marker), in the order of :data:`~femkit.dynamics.work_precision.FAMILIES`
+    (a family added there gets the next style)."""
+    from ..dynamics.work_precision import FAMILIES
+
+    return {fam: (_COLOURS[i % len(_COLOURS)], _MARKERS[i % len(_MARKERS)])
+            for i, fam in enumerate(FAMILIES)}
 
 
 def _scene_case(study, path):
@@ -62,7 +81,7 @@ def _scene_case(study, path):
     return load_case(study.resolve(path), **overrides)
 
 
-def _check(study) -> None:
+def check_cloth_study(study) -> None:
     from ..dynamics.work_precision import expand_methods
 
     for i, p in enumerate(study.data["scenes"]):
@@ -71,7 +90,7 @@ def _check(study) -> None:
             raise CaseFileError(f"scenes[{i}]: scene file not found: {path}")
         study.files.append(path)
         case = _scene_case(study, p)
-        if case.data.get("problem") != "mass_spring" or case.data["system"].get("type") != "cloth":
+        if case.problem != "mass_spring" or case.spec.system["type"] != "cloth":
             raise CaseFileError(f"scenes[{i}]: {path.name} is not a cloth scene (system.type: cloth)")
     try:
         expand_methods(_methods(study.data["methods"]))
@@ -94,7 +113,7 @@ def _methods(methods: list) -> list:
 
 def run_cloth_study(study, progress_enabled=None) -> dict:
     """The sweep: one record per (scene, method setting), energies and references per scene."""
-    from ..case.scene.run import _time_value, build_system
+    from ..case.scene.run import build_system
     from ..case.specs import solver_spec
     from ..dynamics.work_precision import cloth_work_precision
     from .pareto import pareto_front
@@ -103,14 +122,13 @@ def run_cloth_study(study, progress_enabled=None) -> dict:
 
     d = study.data
     spec = solver_spec(d["linear_solver"], "linear_solver", default_method="cholesky")
-    ref = {"tol": 1e-10, "trajectory": "newmark", "substeps": 16, "solve": "newton",
-           **(d.get("reference") or {})}
+    ref = d["reference"]  # every key filled from the schema's defaults
     records, energy, references, notes = [], {}, [], []
     for path in progress(list(d["scenes"]), desc="cloth scenes", unit="run",
                          enabled=progress_enabled, stop=active_flag()):
         case = _scene_case(study, path)
         system, _ = build_system(case)
-        dt = float(d.get("dt") or _time_value(case, "dt"))
+        dt = float(d.get("dt") or case.spec.dt)
         name = case.name
         out = cloth_work_precision(system, dt, int(d["frames"]), _methods(d["methods"]), solver=spec,
                                    reference_tol=ref["tol"], trajectory_reference=ref["trajectory"],
@@ -159,7 +177,7 @@ def _figure(path, title: str, recs: list, energy: dict) -> None:
             ft, fe = np.array(front).T
             ax.step(ft, fe, where="post", color="gold", linewidth=8, alpha=0.5, zorder=0,
                     label="Pareto front")
-        for fam, (color, marker) in FAMILY_STYLE.items():
+        for fam, (color, marker) in family_styles().items():
             rows = [r for r in recs if r["family"] == fam and not r["failed"]]
             if rows:
                 ax.plot([r["time_per_frame"] for r in rows], [r[key] for r in rows], color=color,
@@ -181,7 +199,7 @@ def _figure(path, title: str, recs: list, energy: dict) -> None:
     ax.plot(t, np.asarray(energy["trajectory"]) - e0, color="black", linewidth=2, label="small-dt reference")
     ax.plot(t, np.asarray(energy["implicit_euler"]) - e0, color="0.5", linestyle="--",
             label="implicit Euler (solved tightly)")
-    for fam, (color, marker) in FAMILY_STYLE.items():
+    for fam, (color, marker) in family_styles().items():
         rows = [r for r in recs if r["family"] == fam and not r["failed"]]
         if rows:  # the cheapest and the most accurate setting of each family
             for r, ls in ((rows[0], ":"), (rows[-1], "-")) if len(rows) > 1 else ((rows[0], "-"),):
@@ -218,7 +236,7 @@ def build_cloth_report(report, study, result, data, stage) -> None:
         report.table(cols, [[r[c] for c in cols] for r in rows])
 
 
-def _summary(result) -> list[str]:
+def cloth_summary(result) -> list[str]:
     lines = []
     for scene in dict.fromkeys(r["scene"] for r in result.records):
         rows = [r for r in result.records if r["scene"] == scene]
@@ -226,10 +244,3 @@ def _summary(result) -> list[str]:
             front = [r["label"] for r in sorted(rows, key=lambda r: r["time_per_frame"]) if r[key]]
             lines.append(f"{scene}: Pareto front ({what} error): {', '.join(front)}")
     return lines
-
-
-def _run(study, progress_enabled=None) -> dict:
-    return run_cloth_study(study, progress_enabled=progress_enabled)
-
-
-CLOTH_KIND = StudyKind(CLOTH_SCHEMA, _check, _run, build_cloth_report, _summary)

@@ -3,7 +3,7 @@
 A convergence study's plan has one stage per mesh level: every solver and quadrature rule,
 ``repeats`` times, on that level's mesh (:func:`femkit.cost.plan_poisson` per run); the
 peak memory is the largest run's plus the meshes of every level (the sweep keeps them all).
-Other study kinds have no cost model yet: their plan counts the runs only, and says so.
+It is that kind's ``plan``; other study kinds have no cost model yet: their plan says so.
 """
 
 from __future__ import annotations
@@ -67,9 +67,13 @@ def plan_poisson_study(study) -> Plan:
 
 
 def plan_study(study) -> Plan:
-    """The plan of any study: :func:`plan_poisson_study`, else a count of the runs."""
-    if study.kind == "poisson_convergence":
-        return plan_poisson_study(study)
+    """The plan of any study, through its kind (``KINDS[study.kind].plan``); a kind without a
+    cost model gets a plan that says so."""
+    from ..case.kinds import KINDS
+
+    kind = KINDS.get(study.kind, "kind")
+    if kind.plan is not None:
+        return kind.plan(study)
     from ..cost import load_constants
 
     return Plan("study", f"{study.name}: {study.kind}", {}, [],

@@ -21,11 +21,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+from ..case.frozen import freeze
+from ..case.kinds import KINDS
 from ..errors import CaseFileError
-from .kinds import STUDY_KINDS
 from .schema import schema_for
 
-__all__ = ["Study", "load_study", "study_from_dict", "STUDY_KINDS"]
+__all__ = ["Study", "load_study", "study_from_dict"]
 
 
 @dataclass
@@ -94,11 +95,12 @@ def study_from_dict(data: Mapping, base_dir: str | os.PathLike = ".", *, name: s
     if not isinstance(data, Mapping):
         raise CaseFileError(f"a study file must be a mapping of keys, got {type(data).__name__}")
     kind = data.get("kind")
+    valid = KINDS.names("kind")
     if kind is None:
         raise CaseFileError("(top level): missing required key 'kind'; valid kinds: "
-                            + ", ".join(STUDY_KINDS.names()))
-    if kind not in STUDY_KINDS:
-        raise CaseFileError(f"kind: unknown study kind {kind!r}; valid kinds: {', '.join(STUDY_KINDS.names())}")
+                            + ", ".join(valid))
+    if not isinstance(kind, str) or kind not in valid:
+        raise CaseFileError(f"kind: unknown study kind {kind!r}; valid kinds: {', '.join(valid)}")
     schema = schema_for(kind)
     validate_against(dict(data), schema)
     merged = dict(data)
@@ -112,6 +114,7 @@ def study_from_dict(data: Mapping, base_dir: str | os.PathLike = ".", *, name: s
     if study.path is not None:
         study.files.append(study.path)
     _check_kind(study)
+    study.data = freeze(study.data)  # from here on the data is read, never edited
     return study
 
 
@@ -124,7 +127,7 @@ def _check_kind(study: Study) -> None:
     study.solvers = [solver_spec(s, f"solvers[{i}]") for i, s in enumerate(d.get("solvers") or ())]
     study.integrators = [IntegratorSpec.from_mapping(s, f"integrators[{i}]")
                          for i, s in enumerate(d.get("integrators") or ())]
-    STUDY_KINDS.get(study.kind).check(study)
+    KINDS.get(study.kind, "kind").prepare(study)
 
 
 def load_study(path: str | os.PathLike, *, quick: bool = False, **overrides: Any) -> Study:

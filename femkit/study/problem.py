@@ -22,7 +22,7 @@ class StudyProblem:
 
     @property
     def has_neumann(self) -> bool:
-        return bool(self.case.data["boundary"].get("neumann"))
+        return bool(self.case.spec.boundary.neumann)
 
     @property
     def pure_neumann(self) -> bool:

@@ -115,14 +115,14 @@ def build_dynamics_report(report, study, result, data, stage) -> None:
     rows = [{"method": r["integrator"], "h_omega": r["h_omega"], "stable": r["stable"],
              "bound": None} for r in recs if r.get("h_omega")]
     if rows:
-        from .stability import NEVER_STABLE
+        from .stability import oscillator_bound
 
         bounds, never = {}, []
         for spec in study.integrators:
-            name, lab = spec.method, spec.label
+            lab = spec.label
             # the scenes are undamped: methods whose region misses the imaginary axis have no limit
-            bounds[lab] = None if name in NEVER_STABLE else spec.build().stability_bound
-            if name in NEVER_STABLE:
+            bounds[lab] = oscillator_bound(spec.build())
+            if bounds[lab] is None:
                 never.append(lab)
         for r in rows:
             r["bound"] = bounds.get(r["method"])

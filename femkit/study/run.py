@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..case.kinds import KINDS
 from .cache import fingerprint
-from .kinds import STUDY_KINDS
 from .report import Report, staged_output, write_csv, write_json
 
 __all__ = ["StudyResult", "run_study"]
@@ -94,7 +94,7 @@ def run_study(study, output_dir=None, *, progress: bool | None = None, write: bo
 
         check_output_dir(output_dir if output_dir is not None else study.default_output(),
                          EARLIER_REPORT)
-    kind = STUDY_KINDS.get(study.kind)
+    kind = KINDS.get(study.kind, "kind")
     data = kind.run(study, progress_enabled=progress)
     result = StudyResult(kind=study.kind, name=study.name, records=data["records"], fits=data.get("fits", []),
                          tables=data.get("tables", {}), notes=data.get("notes", []),

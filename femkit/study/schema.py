@@ -51,7 +51,7 @@ POISSON = {
         "max_level": {"type": "integer", "minimum": 1},
     }),
     "solvers": {"type": "array", "items": SOLVER, "minItems": 1,
-                "default": [{"method": "pcg", "preconditioner": "amg"}]},
+                "default": [{"method": "pcg", "preconditioner": "amg"}]},  # rtol: the one default
     "quadrature": {"type": "array", "items": {"type": "string"}, "minItems": 1, "default": ["barycentric"]},
     "error_order": {**POSINT, "default": 5},
     "reference": {"enum": ["none", "scikit-fem"], "default": "none"},
@@ -97,36 +97,6 @@ DYNAMICS = {
     "energy_growth_limit": {**POS, "default": 10.0},
 }
 
-STRESS_CASE = _obj({
-    "name": {"type": "string"},
-    "type": {"enum": ["poisson_contrast", "poisson_anisotropic", "poisson_scaled", "poisson_degenerate",
-                      "poisson_fine", "poisson_neumann", "cg_residual_drift", "jacobi_divergence",
-                      "dynamics_stiffness"]},
-    "values": {"type": "array", "minItems": 1, "items": {"type": "number"},
-               "description": "the swept parameter: contrast, aspect ratio, scale, degeneracy, ..."},
-    "n": {"type": "integer", "minimum": 2},
-    "dofs": POSINT,
-    "mass_ratio": {"type": "array", "items": POS},
-    "dt_factors": {"type": "array", "items": POS},
-    "t_end": POS,
-    "maxiter": POSINT,
-    "description": {"type": "string"},
-}, required=["type"])
-
-STABILITY = {
-    "cases": {"type": "array", "minItems": 1,
-              "items": {"oneOf": [{"type": "string"}, STRESS_CASE],
-                        "x-message": "must be a stress case file path or an inline stress case"}},
-    "solvers": {"type": "array", "items": SOLVER, "minItems": 1,
-                "default": [{"method": "pcg", "preconditioner": "amg_sa", "rtol": COMPARISON_RTOL},
-                            {"method": "pcg", "preconditioner": "amg_rs", "rtol": COMPARISON_RTOL},
-                            {"method": "pcg", "preconditioner": "jacobi", "rtol": COMPARISON_RTOL},
-                            {"method": "cg", "rtol": COMPARISON_RTOL}]},
-    "integrators": {"type": "array", "items": INTEGRATOR, "minItems": 1,
-                    "default": ["explicit_euler", "symplectic_euler", "verlet", "rk4"]},
-    "case_overrides": {"type": "object", "description": "per case name: keys merged over that case"},
-}
-
 def _partial(node: dict) -> None:
     """A ``quick:`` value may give part of an object: no defaults, no required keys (lists stay whole)."""
     node.pop("default", None)
@@ -137,14 +107,12 @@ def _partial(node: dict) -> None:
 
 def schema_for(kind: str) -> dict:
     """The full schema of a study of ``kind`` (with its ``quick:`` block)."""
-    from .kinds import STUDY_KINDS
+    from ..case.kinds import KINDS
 
-    props = {**copy.deepcopy(COMMON), **copy.deepcopy(STUDY_KINDS.get(kind).schema)}
+    props = {**copy.deepcopy(COMMON), **copy.deepcopy(KINDS.get(kind, "kind").get_schema())}
     quick = _obj({k: copy.deepcopy(v) for k, v in props.items() if k != "kind"})
     for v in quick["properties"].values():
         _partial(v)
     props["quick"] = quick
     return _obj(props, required=["kind"])
 
-
-STRESS_CASE_SCHEMA = STRESS_CASE

@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import time
 import warnings
+from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -34,6 +36,9 @@ from ..errors import FemkitError, InstabilityError, SingularSystemError
 from ..interrupt import active_flag
 from ..mesh.structured import structured_mesh
 from ..progress import progress
+from ..registry import Registry
+from ..solvers.defaults import COMPARISON_RTOL
+from .schema import INTEGRATOR, POS, POSINT, SOLVER, _obj
 
 # ----------------------------------------------------------------------------- meshes
 
@@ -243,9 +248,13 @@ def case_jacobi(case):
 
 # ----------------------------------------------------------------------------- dynamics
 
-#: Explicit methods whose stability region misses the imaginary axis: unstable on an undamped
-#: oscillator at every step size (energy grows as (1 + h^2 w^2)^n for explicit Euler).
-NEVER_STABLE = ("explicit_euler", "heun", "midpoint")
+def oscillator_bound(integrator) -> float | None:
+    """The largest ``h * omega`` for which ``integrator`` keeps the undamped oscillator bounded,
+    None for a method that declares ``oscillator_stable = False`` (its stability region misses
+    the imaginary axis: the energy grows at every step size, as ``(1 + h^2 w^2)^n`` for
+    explicit Euler)."""
+    return integrator.stability_bound if getattr(integrator, "oscillator_stable", True) else None
+
 #: A run "survived" when the largest total energy of its last third of steps is at most this
 #: multiple of the largest of its first third: bounded oscillation (a symplectic method near its
 #: limit swings the energy by 1 / (1 - (h w / 2)^2)) passes, exponential growth does not.
@@ -301,7 +310,7 @@ def case_dynamics(case, integrators):
                     rows.append({"case": case["name"], "type": "dynamics_stiffness", "value": f"k={k:g}, m2/m1={ratio:g}",
                                  "k": float(k), "mass_ratio": float(ratio), "method": label, "dt": dt,
                                  "dt_factor": fac, "omega_max": w, "h_omega": dt * w,
-                                 "bound": 0.0 if spec.method in NEVER_STABLE else integ.stability_bound,
+                                 "bound": oscillator_bound(integ) or 0.0,
                                  "survived": ok, "outcome": outcome, "energy_growth": drift, "time": time.perf_counter() - t0})
     return rows
 
@@ -327,7 +336,8 @@ def boundaries(rows) -> list[dict]:
 def load_cases(study) -> list[dict]:
     from ..case.load import read_yaml
     from ..case.schema import fill_defaults, validate_against
-    from .schema import STRESS_CASE_SCHEMA
+
+    STRESS_CASE_SCHEMA = stress_case_schema()
 
     cases = []
     overrides = study.data.get("case_overrides") or {}
@@ -343,7 +353,7 @@ def load_cases(study) -> list[dict]:
         data = {**data, **(overrides.get(data["name"]) or {})}
         validate_against(data, STRESS_CASE_SCHEMA, f"cases[{i}]")
         data = fill_defaults(data, STRESS_CASE_SCHEMA)
-        data.setdefault("values", _DEFAULT_VALUES[data["type"]])
+        data.setdefault("values", list(STRESS_CASES.get(data["type"]).values))
         cases.append(data)
     unknown = sorted(set(overrides) - {c["name"] for c in cases})
     if unknown:  # a typo here would silently run that case at full size
@@ -352,14 +362,6 @@ def load_cases(study) -> list[dict]:
         raise CaseFileError(f"case_overrides.{unknown[0]}: no such case; case names: "
                             + ", ".join(c["name"] for c in cases))
     return cases
-
-
-_DEFAULT_VALUES = {
-    "poisson_contrast": [1.0, 1e2, 1e4, 1e6, 1e8], "poisson_anisotropic": [1.0, 10.0, 100.0, 1000.0],
-    "poisson_scaled": [1e-6, 1.0, 1e6], "poisson_degenerate": [1e-2, 1e-4, 1e-6], "poisson_fine": [1e6],
-    "poisson_neumann": [0], "cg_residual_drift": [1e4, 1e8, 1e12], "jacobi_divergence": [0.05, 0.5, 0.9],
-    "dynamics_stiffness": [1e2, 1e5, 1e9],
-}
 
 
 def warm_up(solvers, integrators) -> list[str]:
@@ -405,19 +407,78 @@ def run_stability_study(study, *, progress_enabled=None) -> dict:
                      + ", ".join(warmed) + "; no timed run includes imports, AMG module loading or compilation.")
     for case in progress(cases, total=len(cases), desc=study.name, unit="run",
                          enabled=progress_enabled, stop=active_flag()):
-        t = case["type"]
-        if t == "poisson_neumann":
-            rows += case_neumann(case, quick_n)
-        elif t.startswith("poisson_"):
-            rows += case_poisson(case, study.solvers, quick_n)
-        elif t == "cg_residual_drift":
-            rows += case_cg_drift(case)
-        elif t == "jacobi_divergence":
-            rows += case_jacobi(case)
-        else:
-            rows += case_dynamics(case, study.integrators)
+        rows += STRESS_CASES.get(case["type"]).run(case, study, quick_n)
     tables = {}
     b = boundaries(rows)
     if b:
         tables["stability_boundaries"] = b
     return {"records": rows, "tables": tables, "notes": notes}
+
+
+# ----------------------------------------------------------------------------- stress-case types
+
+@dataclass(frozen=True)
+class StressCase:
+    """One stress-case ``type``: ``run(case, study, quick_n) -> rows`` and the default ``values``
+    of its swept parameter."""
+
+    run: Callable
+    values: tuple
+
+
+#: stress-case type -> :class:`StressCase`; the ``type`` enum of the schema is its names.
+STRESS_CASES: Registry = Registry("stress case type")
+
+
+def _poisson(case, study, quick_n):
+    return case_poisson(case, study.solvers, quick_n)
+
+
+for _name, _values in (("poisson_contrast", (1.0, 1e2, 1e4, 1e6, 1e8)),
+                       ("poisson_anisotropic", (1.0, 10.0, 100.0, 1000.0)),
+                       ("poisson_scaled", (1e-6, 1.0, 1e6)),
+                       ("poisson_degenerate", (1e-2, 1e-4, 1e-6)),
+                       ("poisson_fine", (1e6,))):
+    STRESS_CASES.register(_name, StressCase(_poisson, _values))
+STRESS_CASES.register("poisson_neumann", StressCase(
+    lambda case, study, quick_n: case_neumann(case, quick_n), (0,)))
+STRESS_CASES.register("cg_residual_drift", StressCase(
+    lambda case, study, quick_n: case_cg_drift(case), (1e4, 1e8, 1e12)))
+STRESS_CASES.register("jacobi_divergence", StressCase(
+    lambda case, study, quick_n: case_jacobi(case), (0.05, 0.5, 0.9)))
+STRESS_CASES.register("dynamics_stiffness", StressCase(
+    lambda case, study, quick_n: case_dynamics(case, study.integrators), (1e2, 1e5, 1e9)))
+
+
+def stress_case_schema() -> dict:
+    """The schema of one stress case; its ``type`` enum is :data:`STRESS_CASES`."""
+    return _obj({
+        "name": {"type": "string"},
+        "type": {"enum": STRESS_CASES.names()},
+        "values": {"type": "array", "minItems": 1, "items": {"type": "number"},
+                   "description": "the swept parameter: contrast, aspect ratio, scale, degeneracy, ..."},
+        "n": {"type": "integer", "minimum": 2},
+        "dofs": POSINT,
+        "mass_ratio": {"type": "array", "items": POS},
+        "dt_factors": {"type": "array", "items": POS},
+        "t_end": POS,
+        "maxiter": POSINT,
+        "description": {"type": "string"},
+    }, required=["type"])
+
+
+def stability_schema() -> dict:
+    """The ``stability`` kind's own keys."""
+    return {
+        "cases": {"type": "array", "minItems": 1,
+                  "items": {"oneOf": [{"type": "string"}, stress_case_schema()],
+                            "x-message": "must be a stress case file path or an inline stress case"}},
+        "solvers": {"type": "array", "items": SOLVER, "minItems": 1,
+                    "default": [{"method": "pcg", "preconditioner": "amg_sa", "rtol": COMPARISON_RTOL},
+                                {"method": "pcg", "preconditioner": "amg_rs", "rtol": COMPARISON_RTOL},
+                                {"method": "pcg", "preconditioner": "jacobi", "rtol": COMPARISON_RTOL},
+                                {"method": "cg", "rtol": COMPARISON_RTOL}]},
+        "integrators": {"type": "array", "items": INTEGRATOR, "minItems": 1,
+                        "default": ["explicit_euler", "symplectic_euler", "verlet", "rk4"]},
+        "case_overrides": {"type": "object", "description": "per case name: keys merged over that case"},
+    }

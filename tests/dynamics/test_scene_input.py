@@ -193,7 +193,7 @@ def test_time_expressions_and_velocity_field(tmp_path):
     case = load_case(write(tmp_path, ROPE), dt="1/1000", t_end="5*dt0",
                      constants={"dt0": 0.001},
                      system={"velocity": ["0", "-2*x"]})
-    assert case.data["dt"] == pytest.approx(1e-3) and case.data["t_end"] == pytest.approx(5e-3)
+    assert case.spec.dt == pytest.approx(1e-3) and case.spec.t_end == pytest.approx(5e-3)
     system, _ = build_system(case)
     expected = np.stack([np.zeros(6), -2 * system.x0[:, 0]], 1)
     expected[0] = 0.0                          # the pinned first node does not move

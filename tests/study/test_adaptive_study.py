@@ -9,7 +9,7 @@ import pytest
 
 from femkit.errors import CaseFileError, InputError
 from femkit.study import load_study
-from femkit.study.kinds import STUDY_KINDS
+from femkit.case.kinds import KINDS
 
 ROOT = Path(__file__).parents[2]
 
@@ -21,7 +21,7 @@ def lshape(tmp_path_factory):
 
 
 def test_kind_is_registered():
-    assert "adaptive" in STUDY_KINDS
+    assert "adaptive" in KINDS.names("kind")
 
 
 def test_rates_uniform_one_third_adaptive_one_half(lshape):

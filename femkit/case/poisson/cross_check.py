@@ -81,7 +81,7 @@ def cross_check(case: Case) -> list[CheckRow]:
     _require("pyamg", "pyamg")
 
     from . import reference
-    from .run import build_mesh_levels, is_pure_neumann, multigrid_inputs, poisson_problem
+    from .problem import build_mesh_levels, is_pure_neumann, multigrid_inputs, poisson_problem
 
     mesh, hierarchy = build_mesh_levels(case)
     problem = poisson_problem(case, mesh)
@@ -121,7 +121,7 @@ def cross_check(case: Case) -> list[CheckRow]:
         )
 
         w = node_weights(mesh)
-        F_sk = check_compatibility(F_sk, weights=w, rtol=case.data["boundary"]["compatibility_rtol"])[0]
+        F_sk = check_compatibility(F_sk, weights=w, rtol=case.spec.boundary.compatibility_rtol)[0]
         nodes, values = np.array([0]), np.array([0.0])
 
         def at_mean_zero(v):

@@ -54,11 +54,11 @@ def _run(case, comm, output_dir, quiet, write, echo):
     from ...mesh import quality
     from ...solvers.petsc.failure import collective, from_root
     from ...timing import StageTimer
-    from .run import CaseResult, _nullspace_facts, build_mesh, exact_gradient, poisson_problem
+    from .problem import CaseResult, build_mesh, exact_gradient, nullspace_facts, poisson_problem
 
     mpi = comm.tompi4py()
     rank, size = comm.getRank(), comm.getSize()
-    if case.data.get("adaptive"):  # the same check on every rank: all exit 2, rank 0 says it
+    if case.spec.adaptive:  # the same check on every rank: all exit 2, rank 0 says it
         raise InputError("adaptive: adaptive refinement runs on the femkit backend only; remove "
                          "adaptive or use solver.backend: femkit")
     stage = StageTimer()
@@ -66,16 +66,17 @@ def _run(case, comm, output_dir, quiet, write, echo):
     if write:
         from .output import output_location
 
-        target = from_root(mpi, output_location, output_dir or case.data["output"]["dir"])
+        target = from_root(mpi, output_location, output_dir or case.spec.output.dir)
     with stage("mesh"):
         mesh = broadcast_mesh(lambda: build_mesh(case), comm)
         q = from_root(mpi, quality, mesh)
     problem = collective(mpi, poisson_problem, case, mesh)
     spec = case.solver
-    limit = int(case.data["output"].get("gather_limit", GATHER_LIMIT))
+    limit = int(case.spec.output.gather_limit if case.spec.output.gather_limit is not None
+                else GATHER_LIMIT)
     gather = mesh.n_points <= limit
     sol = solve_poisson(problem, method=spec.method,
-                        preconditioner=spec.preconditioner if spec.method == "pcg" else None,
+                        preconditioner=spec.preconditioner,  # checked by the spec and the backend
                         rtol=spec.rtol, atol=spec.atol, maxiter=spec.maxiter,
                         petsc_options=spec.petsc_options, omega=spec.options.get("omega", 1.0),
                         exact=case.functions.get("exact.u"), grad_exact=exact_gradient(case),
@@ -109,7 +110,7 @@ def _run(case, comm, output_dir, quiet, write, echo):
         indicators = est.indicators
     elif rank == 0:
         parallel["not_computed"] = ["error_estimate (needs the gathered solution)"]
-    nullspace = _nullspace_facts(system)
+    nullspace = nullspace_facts(system)
     n_fixed = len(system.fixed)
     result = CaseResult(case=case, mesh=mesh, u=sol.u, kappa=problem.kappa, solve=res,
                         errors=sol.errors, timings=stage.times, quality=q,
@@ -145,7 +146,7 @@ def _write(result, target, sol, mesh, problem, comm, gather: bool) -> None:
     from .output import write_outputs
 
     mpi = comm.tompi4py()
-    wants_pieces = not gather and result.case.data["output"]["vtu"]
+    wants_pieces = not gather and result.case.spec.output.vtu
 
     def pieces(tmp):
         mpi.bcast(str(tmp), root=0)

@@ -26,7 +26,7 @@ def estimate_facts(case, problem, u: np.ndarray, grad_exact=None, est=None):
     from ...fem.norms import energy_error
 
     if est is None:
-        est = estimate(problem, u, case.data["estimator"])
+        est = estimate(problem, u, case.spec.estimator)
     facts = {"estimator": est.estimator, "energy": est.energy, "per_region": est.per_region(problem.mesh)}
     eff = None
     if grad_exact is not None:
@@ -39,13 +39,13 @@ def estimate_facts(case, problem, u: np.ndarray, grad_exact=None, est=None):
 def solve_adaptive(case, mesh, *, echo=None):
     """Run the case's ``adaptive:`` loop from ``mesh``; an :class:`~femkit.fem.adaptive.AdaptiveResult`."""
     from ...fem.adaptive import adaptive_solve, problem_solver
-    from .run import exact_gradient, poisson_problem
+    from .problem import exact_gradient, poisson_problem
 
-    a = case.data["adaptive"]
+    a = case.spec.adaptive
     solve_on = problem_solver(lambda m: poisson_problem(case, m), case.solver.solve, case.solver.method)
     return adaptive_solve(solve_on, mesh, theta=a["theta"], target=a.get("target"),
                           max_dofs=a.get("max_dofs"), max_time=a.get("max_time"),
-                          max_levels=a["max_levels"], estimator=case.data["estimator"],
+                          max_levels=a["max_levels"], estimator=case.spec.estimator,
                           grad_exact=exact_gradient(case))
 
 

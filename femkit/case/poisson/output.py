@@ -113,21 +113,21 @@ def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None) ->
     from ...io.atomic import EARLIER_RUN, atomic_directory
     from ...io.writers import write_json
 
-    opts = result.case.data["output"]
+    opts = result.case.spec.output
     final = output_location(directory)
     result.output_dir = final
     t0 = time.perf_counter()
     with atomic_directory(final, EARLIER_RUN) as tmp:
-        if opts["vtu"] and write_pieces is not None:
+        if opts.vtu and write_pieces is not None:
             write_pieces(tmp)
-        elif opts["vtu"]:
+        elif opts.vtu:
             write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa)
         if result.u is None:
             result.parallel["not_written"] = [f"solution.{e}" for e, k in
-                                              (("xdmf", "xdmf"), ("png", "plot")) if opts[k]]
-        elif opts["xdmf"]:
+                                              (("xdmf", "xdmf"), ("png", "plot")) if getattr(opts, k)]
+        elif opts.xdmf:
             write_solution(tmp / "solution.xdmf", result.mesh, result.u, result.kappa)
-        if opts["plot"] and result.u is not None:
+        if opts.plot and result.u is not None:
             title = (f"{result.case.name}: {result.mesh.n_triangles} triangles, "
                      f"h_max = {result.quality.get('h_max', float('nan')):.3g}")
             est = result.error_estimate or {}

@@ -20,8 +20,6 @@ atomically (see :func:`femkit.io.atomic.atomic_directory`).
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
@@ -30,8 +28,13 @@ from ...errors import CaseFileError, ExpressionError, InputError
 from ...interrupt import Interrupted
 from ...progress import Progress
 from ..expressions import compile_expression
+from ..frozen import freeze
 from ..load import Case
 from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
+from .spec import BoundarySpec, MeshSpec, PoissonOutputSpec, PoissonSpec
+from .problem import (CaseResult, build_mesh, build_mesh_levels, compute_errors, element_kappa,
+                      exact_gradient, is_pure_neumann, multigrid_inputs, multigrid_overrides,
+                      nullspace_facts, poisson_problem)
 
 __all__ = ["prepare_poisson", "run_poisson", "build_mesh", "build_mesh_levels",
            "multigrid_inputs", "multigrid_overrides", "element_kappa", "poisson_problem", "compute_errors", "CaseResult"]
@@ -120,6 +123,16 @@ def prepare_poisson(case: Case) -> None:
 
     out = d["output"]
     out["dir"] = str((base / out.get("dir", os.path.join("runs", case.name))).resolve())
+    bnd = d["boundary"]
+    case.spec = PoissonSpec(
+        mesh=MeshSpec.from_mapping(freeze(mesh)), coefficient=freeze(coef),
+        boundary=BoundarySpec(tuple(freeze(list(bnd.get("dirichlet") or ()))),
+                              tuple(freeze(list(bnd.get("neumann") or ()))), bnd.get("nullspace"),
+                              bnd.get("compatibility_rtol")),
+        load_rule=d["quadrature"]["load"], estimator=d["estimator"],
+        adaptive=freeze(d["adaptive"]) if d.get("adaptive") else None, solver=case.solver,
+        output=PoissonOutputSpec(out["dir"], bool(out["vtu"]), bool(out["xdmf"]),
+                                 bool(out["plot"]), out.get("gather_limit")))
 
 
 def _prepare_nullspace(bnd: dict) -> None:
@@ -134,323 +147,6 @@ def _prepare_nullspace(bnd: dict) -> None:
         return
     bnd.setdefault("nullspace", "mean_zero")
     bnd.setdefault("compatibility_rtol", COMPATIBILITY_RTOL)
-
-
-# ----------------------------------------------------------------------------- stages
-
-#: Refined meshes with at least this many triangles are renumbered for memory locality
-#: (reverse Cuthill-McKee on the coarse mesh, midpoints next to their edges: see
-#: :class:`femkit.mesh.MeshHierarchy`); at 3.7M triangles assembly is 1.6-3x and an fmg solve
-#: 2-3x faster, at 0.9M it makes no difference (docs/benchmarks.md).
-RENUMBER_MIN_TRIANGLES = 2_000_000
-
-
-def build_mesh(case: Case, *, h: float | None = None):
-    """Generate or read the mesh, refine, validate, and check every tag the case names.
-
-    ``h`` replaces ``mesh.h`` of a generated mesh (studies sweep it); a mesh file ignores it.
-    """
-    return build_mesh_levels(case, h=h)[0]
-
-
-def build_mesh_levels(case: Case, *, h: float | None = None):
-    """:func:`build_mesh` and the :class:`~femkit.mesh.MeshHierarchy` of its refinement when the
-    case's solver is geometric multigrid (``None`` otherwise): ``(mesh, hierarchy)``."""
-    from ...mesh import MeshHierarchy, check_tags, generate, read_mesh, refine, validate
-    from ..cost import check_mesh_fits
-
-    spec = case.data["mesh"]
-    where = f"mesh.file {spec['file']}" if "file" in spec else f"mesh.geometry {spec['geometry']}"
-
-    force = case.run_options.get("force", False)  # --force also passes the memory guard
-    try:
-        if "file" in spec:
-            mesh = read_mesh(spec["file"])
-        else:
-            hv, params = spec["h"] if h is None else h, spec.get("params") or {}
-            check_mesh_fits(geometry=spec["geometry"], h=hv, params=params, force=force)
-            mesh = generate(spec["geometry"], hv, **params)
-        mesh = validate(mesh)
-    except InputError as exc:
-        raise with_prefix(exc, where) from None
-    hierarchy = None
-    k = spec.get("refine") or 0
-    if k:
-        check_mesh_fits(triangles=mesh.n_triangles, refine=k, force=force)  # before numpy allocates
-        big = mesh.n_triangles * 4 ** k >= RENUMBER_MIN_TRIANGLES
-        if big or case.solver.needs_hierarchy:
-            levels = MeshHierarchy.from_refinement(mesh, k, renumber="rcm" if big else "none")
-            mesh = levels.finest
-            hierarchy = levels if case.solver.needs_hierarchy else None
-        else:
-            mesh = refine(mesh, k)
-    bnd = case.data["boundary"]
-    for kind in ("dirichlet", "neumann"):
-        for i, bc in enumerate(bnd.get(kind, [])):
-            tags = [t for t in bc["tags"] if not _is_whole_boundary(mesh, t)]
-            if tags:
-                try:
-                    check_tags(mesh, tags, kind="boundary")
-                except InputError as exc:
-                    raise with_prefix(exc, f"boundary.{kind}[{i}].tags") from None
-    coef = case.data["coefficient"]
-    if isinstance(coef, dict):
-        try:
-            check_tags(mesh, list(coef["regions"]), kind="cell")
-        except InputError as exc:
-            raise with_prefix(exc, "coefficient.regions") from None
-    return mesh, hierarchy
-
-
-def multigrid_inputs(case: Case, hierarchy, system) -> dict:
-    """What geometric multigrid needs at solve time, as :meth:`SolverSpec.solve` overrides:
-    the hierarchy and the free nodes; for ``fmg`` with Dirichlet conditions also the reduced
-    systems of the coarser meshes (their own right-hand sides and Dirichlet values, see
-    :func:`femkit.solvers.fmg.fmg`). Empty for every other solver."""
-    spec = case.solver
-    if not spec.needs_hierarchy:
-        return {}
-    levels = None
-    if spec.method == "fmg" and not is_pure_neumann(case):
-        levels = [poisson_problem(case, m).assemble(spec.method) for m in hierarchy.meshes[:-1]]
-    return multigrid_overrides(spec, hierarchy, system.free, levels)
-
-
-def multigrid_overrides(spec, hierarchy, free, levels=None) -> dict:
-    """The :meth:`SolverSpec.solve` overrides of geometric multigrid: ``{"options": ...}`` for
-    ``method: fmg`` (with the coarser levels' own systems ``levels`` when given),
-    ``{"preconditioner_options": ...}`` for ``preconditioner: gmg``, ``{}`` otherwise. The one
-    place the case pipeline and the studies turn a hierarchy into solver arguments."""
-    if not spec.needs_hierarchy:
-        return {}
-    mg = {"hierarchy": hierarchy, "free": free}
-    if spec.method != "fmg":
-        return {"preconditioner_options": mg}
-    if levels is not None:
-        mg["levels"] = list(levels)
-    return {"options": mg}
-
-
-def _is_whole_boundary(mesh, tag) -> bool:
-    """``boundary`` names the whole (topological) boundary of a mesh without such a group."""
-    return tag == "boundary" and "boundary" not in mesh.tag_names
-
-
-def element_kappa(case: Case, mesh) -> np.ndarray:
-    """Per-triangle coefficient values (constant, expression at barycentres, or region table)."""
-    from ...fem.coefficients import element_coefficient
-
-    coef = case.data["coefficient"]
-    if isinstance(coef, dict):
-        from ...mesh import check_tags
-
-        values = np.full(mesh.n_triangles, float(coef.get("default", np.nan)))
-        for name, value in coef["regions"].items():
-            (tag,) = check_tags(mesh, [name], kind="cell")
-            values[mesh.cell_tags == tag] = float(value)
-        missing = np.flatnonzero(np.isnan(values))
-        if missing.size:
-            tags = sorted(set(mesh.cell_tags[missing].tolist()))
-            raise CaseFileError(
-                f"coefficient.regions: {missing.size} triangles (cell tags {tags}) are in no "
-                f"listed region; add them or give coefficient.default")
-        return values
-    kappa = case.functions.get("coefficient", coef)
-    try:
-        return element_coefficient(mesh, kappa, name="coefficient")
-    except ExpressionError:
-        raise
-    except InputError as exc:
-        raise with_prefix(exc, "coefficient") from None
-
-
-def _tags(mesh, tags: list):
-    """Boundary-condition tags for the library: ``None`` (the whole boundary, found
-    topologically) when the list names the whole boundary of a mesh without such a group."""
-    named = [t for t in tags if not _is_whole_boundary(mesh, t)]
-    return named if len(named) == len(tags) else None
-
-
-def poisson_problem(case: Case, mesh, *, load_rule: str | None = None):
-    """The case on ``mesh`` as a :class:`femkit.fem.PoissonProblem` (the one translation).
-
-    Dirichlet entries naming the whole boundary together with other tags cover both (a later
-    entry wins on shared nodes); a Neumann entry naming the whole boundary takes each boundary
-    edge once. Pure Neumann with ``nullspace: pin`` pins node 0 to the exact solution's value
-    there when ``exact`` is given, else to 0.
-    """
-    from ...fem import PoissonProblem
-
-    d = case.data
-    bnd = d["boundary"]
-    dirichlet = []
-    for i, bc in enumerate(bnd.get("dirichlet", [])):
-        g = case.functions[f"boundary.dirichlet[{i}].value"]
-        named = [t for t in bc["tags"] if not _is_whole_boundary(mesh, t)]
-        if len(named) < len(bc["tags"]):
-            dirichlet.append((None, g))
-        if named:
-            dirichlet.append((named, g))
-    neumann = [(_tags(mesh, bc["tags"]), case.functions[f"boundary.neumann[{i}].flux"])
-               for i, bc in enumerate(bnd.get("neumann", []))]
-    extra = {}
-    if not dirichlet:
-        extra = dict(nullspace=bnd["nullspace"], compatibility_rtol=bnd["compatibility_rtol"])
-        if bnd["nullspace"] == "pin" and "exact.u" in case.functions:
-            x0, y0 = mesh.points[0]
-            u0 = case.functions["exact.u"](np.array([x0]), np.array([y0]))
-            extra["pin_value"] = float(np.asarray(u0).ravel()[0])
-    return PoissonProblem(mesh, element_kappa(case, mesh), case.functions["source"],
-                          dirichlet=dirichlet, neumann=neumann,
-                          load_rule=load_rule or d["quadrature"]["load"], **extra)
-
-
-def is_pure_neumann(case: Case) -> bool:
-    """True when the case has no Dirichlet condition (``u`` fixed only up to a constant)."""
-    return not case.data["boundary"].get("dirichlet")
-
-
-def exact_gradient(case: Case):
-    """``grad u`` of ``exact`` as one callable ``(x, y) -> (gx, gy)``, or None."""
-    if "exact.grad[0]" not in case.functions:
-        return None
-    gx, gy = case.functions["exact.grad[0]"], case.functions["exact.grad[1]"]
-
-    def grad(x, y):
-        return gx(x, y), gy(x, y)
-
-    return grad
-
-
-def compute_errors(case: Case, problem, u: np.ndarray, *, order: int = 5) -> dict | None:
-    """Error norms against ``exact`` (None when the case gives no exact solution); pure
-    Neumann: modulo the constant (:meth:`femkit.fem.PoissonProblem.errors`)."""
-    if "exact.u" not in case.functions:
-        return None
-    return problem.errors(u, case.functions["exact.u"], exact_gradient(case), order=order)
-
-
-# ----------------------------------------------------------------------------- result
-
-@dataclass
-class CaseResult:
-    """Everything a Poisson run produced (arrays in memory, facts in :meth:`to_dict`)."""
-
-    case: Case
-    mesh: Any
-    u: np.ndarray
-    kappa: np.ndarray
-    solve: Any
-    errors: dict | None
-    timings: dict
-    quality: dict
-    dofs: int
-    n_dirichlet: int
-    nnz: int
-    output_dir: Path | None = None
-    files: list = field(default_factory=list)
-    nullspace: dict | None = None
-    error_estimate: dict | None = None
-    effectivity: float | None = None
-    indicators: np.ndarray | None = None
-    adaptive: dict | None = None
-    parallel: dict | None = None
-    interrupted: str | None = None
-
-    @property
-    def converged(self) -> bool:
-        return bool(self.solve.converged)
-
-    def to_dict(self) -> dict:
-        """The content of ``result.json`` (keys documented in docs/case-files.md)."""
-        from ..._version import __version__
-
-        spec = self.case.data["mesh"]
-        mesh_info = {k: self.quality.get(k) for k in (
-            "n_points", "n_triangles", "h_max", "h_min", "h_mean", "min_angle",
-            "max_aspect_ratio", "area")}
-        mesh_info["n_points"] = self.mesh.n_points
-        mesh_info["n_triangles"] = self.mesh.n_triangles
-        mesh_info["source"] = (spec["file"] if "file" in spec else
-                               f"geometry {spec['geometry']} h={spec['h']}")
-        mesh_info["refine"] = spec.get("refine", 0)
-        return {
-            "case": self.case.name,
-            "problem": self.case.problem,
-            "case_file": str(self.case.path) if self.case.path else None,
-            "femkit_version": __version__,
-            "mesh": mesh_info,
-            "dofs": self.dofs,
-            "n_dirichlet": self.n_dirichlet,
-            "nullspace": self.nullspace,
-            "nnz": self.nnz,
-            "solver": self.solve.summary(),
-            "converged": self.converged,
-            "interrupted": self.interrupted is not None,
-            "errors": self.errors,
-            "error_estimate": self.error_estimate,
-            "effectivity": self.effectivity,
-            "adaptive": self.adaptive,
-            "timings": dict(self.timings),
-            "expressions": {k: f.source for k, f in self.case.functions.items()},
-            "files": list(self.files),
-            "backend": self.case.solver.backend,
-            "parallel": self.parallel,
-        }
-
-    def summary_lines(self) -> list[str]:
-        """Short human summary (what ``femkit solve`` prints)."""
-        s = self.solve
-        q = self.quality
-        lines = [
-            f"case      {self.case.name} (problem {self.case.problem})",
-            f"mesh      {self.mesh.n_points} points, {self.mesh.n_triangles} triangles, "
-            f"h_max {q.get('h_max', float('nan')):.3g}, min angle {q.get('min_angle', float('nan')):.1f} deg",
-            f"system    {self.dofs} dofs ({self.n_dirichlet} Dirichlet nodes eliminated), nnz {self.nnz}",
-        ]
-        if self.nullspace is not None:
-            ns = self.nullspace
-            lines[-1] = (f"system    {self.dofs} dofs, pure Neumann: constant fixed by {ns['mode']} "
-                         f"({ns['how']}), nnz {self.nnz}")
-            lines.append(f"data      int f dx {ns['source_integral']:.4e} + int h ds "
-                         f"{ns['flux_integral']:.4e}: relative imbalance "
-                         f"{ns['relative_imbalance']:.2e} (<= {ns['rtol']:g}) removed")
-        pc = f" + {s.preconditioner}" if s.preconditioner not in ("none", "", None) else ""
-        status = "converged" if s.converged else f"NOT converged ({s.reason})"
-        mg = getattr(s, "info", None) or {}
-        if mg.get("stopped_by") == "discretisation-error estimate":
-            # fmg stops on the error, not on the residual: a residual tolerance beside a
-            # relative residual of 1e-3 would read as a contradiction
-            lines.append(f"solver    {s.method}{pc}: {status} to the discretisation error "
-                         f"(algebraic error {mg['algebraic_error_estimate']:.2e} <= "
-                         f"{mg['fraction']:g} x estimated discretisation error "
-                         f"{mg['discretisation_error_estimate']:.2e}, energy norm), "
-                         f"{s.iterations} V-cycles on the finest level; true residual "
-                         f"{s.true_residual:.3e} (relative {s.relative_residual:.3e}: not the "
-                         f"criterion)")
-        else:
-            lines.append(f"solver    {s.method}{pc}: {status}, {s.iterations} iterations, "
-                         f"true residual {s.true_residual:.3e} (relative {s.relative_residual:.3e}, "
-                         f"tolerance {s.tolerance:.3e})")
-        if self.errors is not None:
-            lines.append("errors    " + ", ".join(f"{k} {v:.4e}" for k, v in self.errors.items()
-                                                  if v is not None))
-        if self.error_estimate is not None:
-            e = self.error_estimate
-            eff = f", effectivity {self.effectivity:.3f}" if self.effectivity is not None else ""
-            lines.append(f"estimate  energy-norm error ~ {e['energy']:.4e} ({e['estimator']} "
-                         f"estimator{eff})")
-        if self.adaptive is not None:
-            a = self.adaptive
-            met = ("target met" if a["target_met"] else
-                   f"target NOT met: stopped by {a['stop_reason']}" if a.get("target") is not None
-                   else f"stopped by {a['stop_reason']}")
-            lines.append(f"adaptive  {len(a['levels'])} levels, theta {a['theta']:g}, "
-                         f"{a['levels'][0]['dofs']} -> {a['levels'][-1]['dofs']} dofs; {met}")
-        lines.append("time      " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timings.items()))
-        if self.output_dir is not None:
-            lines.append(f"output    {self.output_dir} ({', '.join(self.files)})")
-        return lines
 
 
 # ----------------------------------------------------------------------------- run
@@ -484,7 +180,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     if write:  # a bad output location is bad input: refuse it before any work is done
         from .output import output_location
 
-        target = output_location(output_dir or case.data["output"]["dir"])
+        target = output_location(output_dir or case.spec.output.dir)
     stop = case.run_options.get("stop")
     plan = case.run_options.get("plan")
     report = Progress.planned([(st.name, st.seconds) for st in plan.stages] if plan else [],
@@ -500,7 +196,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     check_stop("mesh")
     grad = exact_gradient(case)
     run = est = None
-    if case.data.get("adaptive"):
+    if case.spec.adaptive:
         from .estimate import solve_adaptive
 
         with stage("adaptive"):
@@ -533,7 +229,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     result = CaseResult(case=case, mesh=mesh, u=u, kappa=problem.kappa, solve=res, errors=errors,
                         timings=stage.times, quality=q, dofs=int(system.A.shape[0]),
                         n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
-                        nnz=int(system.A.nnz), nullspace=_nullspace_facts(system),
+                        nnz=int(system.A.nnz), nullspace=nullspace_facts(system),
                         error_estimate=estimate, effectivity=effectivity, indicators=est.indicators,
                         adaptive=adaptive_facts(run) if run is not None else None,
                         interrupted=stop.name if res.reason == "interrupted" else None)
@@ -570,14 +266,3 @@ def _solve(case: Case, system, stop, **mg):
                            tolerance=max(s.rtol * bn, s.atol), method=s.method,
                            preconditioner=s.preconditioner)
 
-
-def _nullspace_facts(system) -> dict | None:
-    """result.json's ``nullspace``: mode, how the constant was fixed, the compatibility check."""
-    mode = getattr(system, "mode", None)
-    if mode is None:
-        return None
-    if getattr(system, "bordered", False):
-        how = "bordered matrix [[K, w], [w^T, 0]], LU"
-    else:
-        how = f"node {int(system.fixed[0])} pinned" + (", shifted to mean zero" if mode == "mean_zero" else "")
-    return {"mode": mode, "how": how, **system.compatibility}

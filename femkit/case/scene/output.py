@@ -124,7 +124,7 @@ def write_energy_csv(path: str | os.PathLike, traj) -> Path:
 
 def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
     """Write every requested output of ``result`` (a SceneResult) into ``directory`` atomically."""
-    opts = result.case.data["output"]
+    opts = result.case.spec.output
     traj, system, tri = result.trajectory, result.system, result.triangles
     final = Path(directory).resolve()
     result.output_dir = final
@@ -133,23 +133,23 @@ def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
     if stop:  # the simulation itself was stopped: write every frame it recorded
         stop = None
     with atomic_directory(final, EARLIER_RUN) as tmp:
-        if opts["vtu"]:
+        if opts.vtu:
             frames = write_frames_vtu(tmp, system, traj, tri, stop=stop)
             write_pvd(tmp / "scene.pvd", traj.times[:len(frames)], frames)
             files += ["scene.pvd", *frames]
             if stop:  # stopped while writing frames: keep those, skip the pictures
                 result.output_stop = stop.name
                 result.frames_written = len(frames)
-        if opts["xdmf"] and not stop:
+        if opts.xdmf and not stop:
             write_frames_xdmf(tmp / "scene.xdmf", system, traj, tri)
             files += ["scene.xdmf", "scene.h5"]
-        if opts["energy_csv"]:
+        if opts.energy_csv:
             write_energy_csv(tmp / "energy.csv", traj)
             files.append("energy.csv")
-        if opts["png"] and not stop:
+        if opts.png and not stop:
             write_final_png(tmp / "final.png", system, traj, result.case.name, triangles=tri)
             files.append("final.png")
-        if opts["gif"] and not stop:
+        if opts.gif and not stop:
             write_gif(tmp / "animation.gif", system, traj, result.case.name, triangles=tri)
             files.append("animation.gif")
         files.append("result.json")

@@ -1,6 +1,6 @@
 """Run a ``problem: mass_spring`` scene end to end: system, forces, integrator, outputs.
 
-``femkit solve SCENE.yaml`` dispatches here through :data:`femkit.case.problems.PROBLEMS`:
+``femkit solve SCENE.yaml`` dispatches here through :data:`femkit.case.kinds.KINDS`:
 :func:`prepare_scene` checks everything at load time (integrator, linear solver and
 preconditioner names against their registries, integrator options, mesh geometry and file,
 expressions, output cadence), so bad input fails before anything is computed or written;
@@ -36,15 +36,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..._version import __version__
-from ...dynamics import topology
-from ...dynamics.forces import (
-    Gravity,
-    GroundContact,
-    RayleighDamping,
-    SphereContact,
-    ViscousDamping,
-)
-from ...dynamics.integrators import StepContext, get_integrator
+from ...dynamics.integrators import StepContext
 from ...dynamics.integrators.base import check_matrix_free
 from ...dynamics.simulate import StabilityWarning, simulate
 from ...dynamics.stability import estimate_omega_max
@@ -57,17 +49,18 @@ from ...errors import (
     with_prefix,
 )
 from ...io.atomic import EARLIER_RUN, check_output_dir
-from ...mesh import generate, grid_triangles, read_mesh, validate
 from ...progress import Progress
-from ...registry import Registry
 from ...solvers.defaults import DEFAULT_METHOD
-from ...solvers.spec import SolverSpec
 from ...timing import StageTimer
 from ..expressions import compile_expression
+from ..frozen import freeze
 from ..load import Case
 from ..names import check_geometry_spec, resolve_file
 from ..specs import IntegratorSpec, limits_spec, solver_spec
+from .forces import FORCES
 from .output import write_scene_outputs
+from .spec import OutputSpec, SceneSpec, StabilitySpec, record_every
+from .systems import SYSTEMS
 
 __all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "build_context",
            "output_every", "n_steps", "SceneResult", "state_checksum", "FORCES", "SYSTEMS"]
@@ -76,7 +69,7 @@ __all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "bu
 # ----------------------------------------------------------------------------- prepare
 
 def _time_value(case: Case, key: str) -> float:
-    """``dt``/``t_end``: a number, or a constant expression such as ``"1/60"``."""
+    """``dt``/``t_end`` of the file: a number, or a constant expression such as ``"1/60"``."""
     value = case.data[key]
     if isinstance(value, str):
         try:
@@ -87,7 +80,6 @@ def _time_value(case: Case, key: str) -> float:
     value = float(value)
     if not (math.isfinite(value) and value > 0.0):
         raise CaseFileError(f"{key}: must be a positive finite number, got {value!r}")
-    case.data[key] = value
     return value
 
 
@@ -104,12 +96,13 @@ def _normalise_forces(spec) -> list[dict]:
 
 
 def prepare_scene(case: Case) -> None:
-    """Check a validated scene against the registries and resolve it (load time, nothing runs).
+    """Check a validated scene against the registries and build its :class:`SceneSpec`
+    (``case.spec``; load time, nothing runs).
 
-    Normalises ``integrator`` to ``{method, options}`` and ``forces`` to a list of
+    Normalises ``integrator`` to an :class:`IntegratorSpec` and ``forces`` to a list of
     ``{type, ...}``, evaluates ``dt``/``t_end`` expressions, compiles ``system.velocity``
-    expressions into ``case.functions``, fills the linear solver's preconditioner, makes
-    ``system.file`` and ``output.dir`` absolute, and checks the output cadence.
+    expressions into ``case.functions``, builds the linear solver spec (``case.solver``), makes
+    ``system.file`` and ``output.dir`` absolute, and computes the output cadence once.
 
     Raises
     ------
@@ -131,12 +124,10 @@ def prepare_scene(case: Case) -> None:
         raise
     except InputError as exc:
         raise CaseFileError(str(exc)) from None
-    d["integrator"] = {"method": integ.method, "options": dict(integ.options)}
 
     # linear solver
     case.solver = ls_spec = solver_spec(d["linear_solver"], "linear_solver",
                                         default_method=DEFAULT_METHOD["mass_spring"])
-    d["linear_solver"] = ls_spec.to_dict()
     case.run_options["limits"] = limits_spec(d.get("limits"))
     if integ.options.get("matrix_free"):  # caught at load time, before anything runs
         try:
@@ -147,22 +138,24 @@ def prepare_scene(case: Case) -> None:
     # times
     dt = _time_value(case, "dt")
     t_end = _time_value(case, "t_end")
-    if round(t_end / dt) < 1:
+    steps = int(round(t_end / dt))
+    if steps < 1:
         raise CaseFileError(f"t_end: {t_end:g} is shorter than one step dt = {dt:g}")
 
     # system
-    system = d["system"]
+    system = dict(d["system"])
     if system["type"] == "mesh":
         _prepare_mesh(system, case.base_dir)
-    if "damping" in system and any(f["type"] == "dashpot" for f in _normalise_forces(d["forces"])):
+    forces = _normalise_forces(d["forces"])
+    damping_forces = [n for n in FORCES.names() if FORCES.get(n).spring_damping]
+    if "damping" in system and any(f["type"] in damping_forces for f in forces):
         raise CaseFileError("system.damping: give the dashpot coefficient either as "
                             "system.damping or as a 'dashpot' force, not both")
-    d["forces"] = _normalise_forces(d["forces"])
-    kinds = [f["type"] for f in d["forces"]]
-    for kind in ("gravity", "dashpot", "viscous", "rayleigh", "ground"):
-        if kinds.count(kind) > 1:
+    kinds = [f["type"] for f in forces]
+    for kind in FORCES.names():
+        if kinds.count(kind) > 1 and not FORCES.get(kind).repeatable:
             raise CaseFileError(f"forces: {kind!r} is declared {kinds.count(kind)} times "
-                                "(only 'sphere' may repeat)")
+                                f"(only {_repeatable()} may repeat)")
     for i, comp in enumerate(system.get("velocity") or []):
         key = f"system.velocity[{i}]"
         try:
@@ -174,7 +167,25 @@ def prepare_scene(case: Case) -> None:
     out = d["output"]
     if "every" in out and "interval" in out:
         raise CaseFileError("output: give 'every' (steps) or 'interval' (seconds), not both")
-    out["dir"] = str((case.base_dir / out.get("dir", os.path.join("runs", case.name))).resolve())
+    directory = str((case.base_dir / out.get("dir", os.path.join("runs", case.name))).resolve())
+    # the file's data, normalised once (what result.json echoes and cost models read);
+    # frozen by the loader right after this
+    d.update(integrator={"method": integ.method, "options": dict(integ.options)},
+             linear_solver=ls_spec.to_dict(), dt=dt, t_end=t_end, system=system, forces=forces)
+    out["dir"] = directory
+    st = d["stability"]
+    case.spec = SceneSpec(
+        system=freeze(system), forces=tuple(freeze(f) for f in forces), integrator=integ, solver=ls_spec, dt=dt,
+        t_end=t_end, steps=steps,
+        output=OutputSpec(directory, record_every(steps, dt, out), bool(out["vtu"]),
+                          bool(out["xdmf"]), bool(out["energy_csv"]), bool(out["png"]),
+                          bool(out["gif"])),
+        stability=StabilitySpec(bool(st["check"]), float(st["energy_growth_limit"]),
+                                int(st["check_every"])))
+
+
+def _repeatable() -> str:
+    return ", ".join(repr(n) for n in FORCES.names() if FORCES.get(n).repeatable) or "none"
 
 
 def _prepare_mesh(system: dict, base: Path) -> None:
@@ -186,80 +197,16 @@ def _prepare_mesh(system: dict, base: Path) -> None:
 
 # ----------------------------------------------------------------------------- build
 
-#: force type -> builder ``(params) -> force object`` (``dashpot`` is a spring coefficient,
-#: handled by :func:`_forces`)
-FORCES: Registry = Registry("force")
-
-
-@FORCES.register("gravity")
-def _gravity(f: dict):
-    g = f.get("g", 9.81)
-    return Gravity(g, axis=int(f.get("axis", -1))) if np.ndim(g) == 0 else Gravity(list(g))
-
-
-@FORCES.register("viscous")
-def _viscous(f: dict):
-    return ViscousDamping(f["gamma"], per_mass=bool(f.get("per_mass", False)))
-
-
-@FORCES.register("rayleigh")
-def _rayleigh(f: dict):
-    return RayleighDamping(f.get("alpha", 0.0), f.get("beta", 0.0))
-
-
-@FORCES.register("ground")
-def _ground(f: dict):
-    return GroundContact(f["stiffness"], f.get("height", 0.0), f.get("normal"))
-
-
-@FORCES.register("sphere")
-def _sphere(f: dict):
-    return SphereContact(f["centre"], f["radius"], f["stiffness"])
-
-
 def _forces(case: Case) -> tuple[list, float | None]:
     """Force objects for the declared forces, and the dashpot coefficient (None: no dashpot)."""
     objs, dashpot = [], None
-    for f in case.data["forces"]:
-        if f["type"] == "dashpot":
-            dashpot = float(f["c"])
-        else:  # the schema admits only registered types
-            objs.append(FORCES.get(f["type"])(f))
+    for f in case.spec.forces:
+        ftype = FORCES.get(f["type"])  # the schema admits only registered types
+        if ftype.spring_damping:
+            dashpot = float(f[ftype.spring_damping])
+        else:
+            objs.append(ftype.build(f))
     return objs, dashpot
-
-
-#: system type -> builder ``(params, origin, forces/damping keywords) -> (system, triangles)``;
-#: ``params`` is the ``system`` mapping without ``type``, ``velocity``, ``damping``, ``origin``.
-SYSTEMS: Registry = Registry("system type")
-
-
-@SYSTEMS.register("rope")
-def _rope(s: dict, origin, kw: dict):
-    return topology.rope(s.pop("n"), s.pop("length"), origin=origin, **s, **kw), None
-
-
-@SYSTEMS.register("cloth")
-def _cloth(s: dict, origin, kw: dict):
-    nx, ny = s.pop("nx"), s.pop("ny")
-    system = topology.cloth_grid(nx, ny, s.pop("width"), s.pop("height"), origin=origin, **s, **kw)
-    return system, grid_triangles(nx, ny)
-
-
-@SYSTEMS.register("mesh")
-def _mesh(s: dict, origin, kw: dict):
-    mesh = _scene_mesh(s)
-    for key in ("geometry", "h", "params", "file"):
-        s.pop(key, None)
-    system = topology.mesh_springs(mesh, **s, **kw)
-    if origin is not None:
-        system.x0 = system.x0 + np.asarray(origin, float).reshape(1, system.dim)
-    return system, np.asarray(mesh.triangles, dtype=np.int64)
-
-
-@SYSTEMS.register("single_spring")
-def _single_spring(s: dict, origin, kw: dict):
-    return topology.single_spring(s.pop("k"), s.pop("m"), s.pop("rest", 1.0), gravity=None,
-                                  **s, **kw), None
 
 
 def build_system(case: Case):
@@ -268,13 +215,13 @@ def build_system(case: Case):
     Only the declared forces are attached; the dashpot is present only when declared
     (``system.damping`` or a ``dashpot`` force).
     """
-    s = dict(case.data["system"])
+    s = dict(case.spec.system)
     kind = s.pop("type")
     s.pop("velocity", None)
     forces, dashpot = _forces(case)
     damping = s.pop("damping", dashpot if dashpot is not None else 0.0)
     origin = s.pop("origin", None)
-    builder = SYSTEMS.get(kind)  # the schema admits only registered types
+    builder = SYSTEMS.get(kind).build  # the schema admits only registered types
     try:
         system, triangles = builder(s, origin, dict(forces=forces, damping=damping))
     except CaseFileError:
@@ -282,7 +229,7 @@ def build_system(case: Case):
     except InputError as exc:
         raise with_prefix(exc, "system") from None
     vel = [case.functions[f"system.velocity[{i}]"]
-           for i in range(len(case.data["system"].get("velocity") or []))]
+           for i in range(len(case.spec.system.get("velocity") or []))]
     if vel:
         if len(vel) != system.dim:
             raise CaseFileError(f"system.velocity: needs {system.dim} components for a "
@@ -295,45 +242,25 @@ def build_system(case: Case):
     return system, triangles
 
 
-def _scene_mesh(spec: dict):
-    from ..cost import check_mesh_fits
-
-    where = f"system.file {spec['file']}" if "file" in spec else f"system.geometry {spec['geometry']}"
-    try:
-        if "file" in spec:
-            return validate(read_mesh(spec["file"]))
-        params = spec.get("params") or {}
-        check_mesh_fits(geometry=spec["geometry"], h=spec["h"], params=params)
-        return validate(generate(spec["geometry"], spec["h"], **params))
-    except InputError as exc:
-        raise with_prefix(exc, where) from None
-
-
 def build_integrator(case: Case):
     """The integrator object named by ``integrator.method`` with its ``options``."""
-    spec = case.data["integrator"]
-    return get_integrator(spec["method"], **spec["options"])
+    return case.spec.integrator.build()
 
 
 def build_context(case: Case):
     """A :class:`~femkit.dynamics.integrators.StepContext` holding the ``linear_solver`` spec."""
-    return StepContext(SolverSpec(**case.data["linear_solver"]))
+    return StepContext(case.spec.solver)
 
 
 def n_steps(case: Case) -> int:
     """Number of steps ``round(t_end / dt)``."""
-    return int(round(case.data["t_end"] / case.data["dt"]))
+    return case.spec.steps
 
 
 def output_every(case: Case) -> int:
     """Output cadence in steps: ``every``, else ``round(interval / dt)``, else enough steps
     for about ``frames`` frames (``ceil(steps / frames)``)."""
-    out = case.data["output"]
-    if "every" in out:
-        return int(out["every"])
-    if "interval" in out:
-        return max(1, int(round(out["interval"] / case.data["dt"])))
-    return max(1, math.ceil(n_steps(case) / int(out["frames"])))
+    return case.spec.output.every
 
 
 def state_checksum(x: np.ndarray) -> str:
@@ -352,7 +279,7 @@ def state_checksum(x: np.ndarray) -> str:
 
 def _declared(case: Case, system) -> list[str]:
     """Declared force types, with ``dashpot`` when the springs carry a damping coefficient."""
-    kinds = [f["type"] for f in case.data["forces"]]
+    kinds = [f["type"] for f in case.spec.forces]
     if "dashpot" not in kinds and np.any(np.asarray(system.damping) != 0):
         kinds.append("dashpot")
     return kinds
@@ -401,7 +328,7 @@ class SceneResult:
 
     def stability(self) -> dict:
         tr = self.trajectory
-        dt = float(self.case.data["dt"])
+        dt = self.case.spec.dt
         om = tr.omega_max if tr.omega_max is not None else self.omega_max
         exceeds = tr.dt_exceeds_critical
         if exceeds is None and self.integrator.implicit:
@@ -411,7 +338,7 @@ class SceneResult:
                "omega_max": om, "dt_crit": tr.dt_crit,
                "h_omega_max": None if om is None else dt * om,
                "stability_bound": self.integrator.describe()["stability_bound"],
-               "energy_growth_limit": self.case.data["stability"]["energy_growth_limit"]}
+               "energy_growth_limit": self.case.spec.stability.energy_growth_limit}
         e = self.instability
         if e is not None:
             out.update(method=e.method, step=int(e.step), time=float(e.time),
@@ -432,21 +359,21 @@ class SceneResult:
             "problem": self.case.problem,
             "case_file": str(self.case.path) if self.case.path else None,
             "femkit_version": __version__,
-            "system": {"type": self.case.data["system"]["type"], "particles": int(s.n),
+            "system": {"type": self.case.spec.system["type"], "particles": int(s.n),
                        "springs": int(s.n_springs), "dim": int(s.dim), "dofs": int(s.ndof),
                        "pinned": int(np.count_nonzero(s.pinned)),
                        "triangles": 0 if self.triangles is None else int(len(self.triangles)),
                        "forces": _declared(self.case, s)},
             "integrator": {k: desc[k] for k in ("name", "order", "implicit", "symplectic",
                                                 "stability_bound", "options")},
-            "linear_solver": {**self.case.data["linear_solver"],
+            "linear_solver": {**self.case.spec.solver.to_dict(),
                               "used": bool(desc["implicit"]),
                               "factorizations": int(stats.get("factorizations", 0)),
                               "linear_solves": int(stats.get("linear_solves", 0)),
                               "iterations": int(stats.get("linear_iterations", 0)),
                               "stats": stats},
-            "dt": float(self.case.data["dt"]),
-            "t_end": float(self.case.data["t_end"]),
+            "dt": self.case.spec.dt,
+            "t_end": self.case.spec.t_end,
             "steps": int(tr.steps),
             "steps_planned": n_steps(self.case),
             "interrupted": self.interrupted is not None,
@@ -535,7 +462,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
         step are still written, marked ``"verdict": "unstable"``.
     """
     if write:  # refuse a bad output location before any work (never replaces user files)
-        check_output_dir(output_dir or case.data["output"]["dir"], EARLIER_RUN)
+        check_output_dir(output_dir or case.spec.output.dir, EARLIER_RUN)
     out = echo or print
     timer = StageTimer()
     t0 = time.perf_counter()
@@ -544,7 +471,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
         integrator = build_integrator(case)
         ctx = build_context(case)
         every = output_every(case)
-    st = case.data["stability"]
+    st = case.spec.stability
     stop = case.run_options.get("stop")
     # a tqdm bar on a terminal, else one line per 10 % or per minute on stderr (logs, batch jobs)
     progress = Progress(n_steps(case), f"scene {case.name}", unit="step", quiet=quiet)
@@ -554,9 +481,9 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     with timer("simulate"), warnings.catch_warnings(record=True) as wlist:
         warnings.simplefilter("always", StabilityWarning)
         try:
-            traj = simulate(system, integrator, case.data["dt"], case.data["t_end"], ctx=ctx,
-                            record_every=every, energy_growth_limit=st["energy_growth_limit"],
-                            check_stability=st["check"], check_every=st["check_every"],
+            traj = simulate(system, integrator, case.spec.dt, case.spec.t_end, ctx=ctx,
+                            record_every=every, energy_growth_limit=st.energy_growth_limit,
+                            check_stability=st.check, check_every=st.check_every,
                             progress=progress, stop=stop)
         except InstabilityError as exc:
             instability = exc
@@ -568,7 +495,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
     omega = None
-    if st["check"] and traj.omega_max is None and system.n_springs:
+    if st.check and traj.omega_max is None and system.n_springs:
         omega = float(estimate_omega_max(system, iters=200))
     result = SceneResult(case=case, system=system, integrator=integrator, trajectory=traj,
                          triangles=triangles, instability=instability, every=every,
@@ -579,7 +506,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
             print(f"femkit: warning: {w}", file=sys.stderr)
     if write:
         with timer("output"):
-            write_scene_outputs(result, output_dir or case.data["output"]["dir"])
+            write_scene_outputs(result, output_dir or case.spec.output.dir)
         # wall_time stays "build + simulate" as result.json and docs/scenes.md say; the output
         # stage has its own entry in the timings
     if instability is not None:

@@ -3,7 +3,9 @@
 Every object is closed (``additionalProperties: false``), so a misspelled key is an error
 with the valid keys listed. The ``system`` mapping is checked per ``type`` (``rope``,
 ``cloth``, ``mesh``, ``single_spring``) with ``if``/``then`` branches, so the error for a
-wrong key names the keys of *that* builder. Names of integrators, linear solvers,
+wrong key names the keys of *that* builder. The ``system.type`` and force ``type`` enums and
+their branches are derived from the registries :data:`femkit.case.scene.systems.SYSTEMS` and
+:data:`femkit.case.scene.forces.FORCES` each time the schema is built (:func:`scene_schema`). Names of integrators, linear solvers,
 preconditioners and mesh geometries are not enumerated here: they are checked against the
 live registries at load time (:func:`femkit.case.scene.run.prepare_scene`).
 
@@ -12,122 +14,81 @@ Every property named here appears in docs/scenes.md (a test checks it).
 
 from __future__ import annotations
 
-from ..specs import INTEGRATOR_SCHEMA, SOLVER_SCHEMA, LIMITS_SCHEMA
+from ..specs import INTEGRATOR_SCHEMA, LIMITS_SCHEMA, SOLVER_SCHEMA
+from .forces import FORCES
+from .fragments import POS
+from .systems import SYSTEMS
 
-_POS = {"type": "number", "exclusiveMinimum": 0}
-_NONNEG = {"type": "number", "minimum": 0}
-_COUNT2 = {"type": "integer", "minimum": 2}
-_VEC = {"type": "array", "minItems": 2, "maxItems": 3, "items": {"type": "number"}}
-_DIM = {"enum": [2, 3]}
-_NODES = {"type": "array", "items": {"type": "integer", "minimum": 0}}
-_DAMPING = _NONNEG
+__all__ = ["scene_schema", "force_types", "system_types"]
+
 #: A time: a positive number or a constant expression such as "1/60".
-_TIME = {"anyOf": [_POS, {"type": "string", "minLength": 1}],
-         "x-message": "expected a positive number or a constant expression such as '1/60'"}  # dashpot coefficient along every spring
-
-#: Initial velocity: a constant vector, or one expression string of ``x, y, z`` per component.
-_VELOCITY = {
-    "type": "array", "minItems": 2, "maxItems": 3,
-    "items": {"anyOf": [{"type": "number"}, {"type": "string", "minLength": 1}],
-              "x-message": "expected a number or an expression string of x, y, z"},
-}
+_TIME = {"anyOf": [POS, {"type": "string", "minLength": 1}],
+         "x-message": "expected a positive number or a constant expression such as '1/60'"}
 
 
-def _pinned(named: list[str]) -> dict:
-    return {"anyOf": [{"enum": named}, _NODES],
-            "x-message": f"expected one of {', '.join(named)} or a list of node indices"}
+def system_types() -> dict:
+    """system type -> schema of its mapping, from :data:`~femkit.case.scene.systems.SYSTEMS`."""
+    return {name: SYSTEMS.get(name).schema for name in SYSTEMS.names()}
 
 
-def _closed(props: dict, required: list[str]) -> dict:
-    return {"type": "object", "additionalProperties": False, "required": required,
-            "properties": props}
+def force_types() -> dict:
+    """force type -> schema of its mapping (``type`` included), from
+    :data:`~femkit.case.scene.forces.FORCES`."""
+    out = {}
+    for name in FORCES.names():
+        schema = FORCES.get(name).schema
+        out[name] = {**schema, "properties": {"type": {"const": name}, **schema["properties"]}}
+    return out
 
 
-_COMMON = {"type": {"type": "string"}, "damping": _DAMPING, "velocity": _VELOCITY}
+def _system() -> dict:
+    types = system_types()
+    return {
+        "type": "object",
+        "required": ["type"],
+        "properties": {"type": {"enum": sorted(types)}},
+        "allOf": [{"if": {"properties": {"type": {"const": name}}, "required": ["type"]},
+                   "then": schema} for name, schema in types.items()],
+    }
 
-ROPE = _closed({
-    **_COMMON,
-    "origin": _VEC, "n": _COUNT2, "length": _POS, "k": _POS, "mass": _POS, "total_mass": _POS, "dim": _DIM,
-    "pinned": _pinned(["first", "last", "both", "none"]),
-}, ["type", "n", "length", "k"])
 
-CLOTH = _closed({
-    **_COMMON,
-    "origin": _VEC, "nx": _COUNT2, "ny": _COUNT2, "width": _POS, "height": _POS,
-    "k_structural": _POS, "k_shear": _NONNEG, "k_bending": _NONNEG,
-    "mass": _POS, "total_mass": _POS, "plane": {"enum": ["xz", "xy"]}, "dim": _DIM,
-    "pinned": _pinned(["top_corners", "corners", "top_edge", "none"]),
-}, ["type", "nx", "ny", "width", "height", "k_structural"])
+def _forces() -> dict:
+    types = force_types()
+    item = {
+        "type": "object",
+        "required": ["type"],
+        "properties": {"type": {"enum": sorted(types)}},
+        "allOf": [{"if": {"properties": {"type": {"const": name}}, "required": ["type"]},
+                   "then": {**schema, "required": ["type", *schema["required"]]}}
+                  for name, schema in types.items()],
+    }
 
-MESH = {
-    **_closed({
-        **_COMMON,
-        "origin": _VEC, "geometry": {"type": "string", "minLength": 1}, "h": _POS, "params": {"type": "object"},
-        "file": {"type": "string", "minLength": 1},
-        "k": _POS, "density": _POS, "thickness": _POS, "dim": _DIM,
-        "pinned": {"anyOf": [{"type": "string", "minLength": 1}, _NODES],
-                   "x-message": "expected a boundary tag name or a list of node indices"},
-    }, ["type", "k"]),
-    "oneOf": [{"required": ["geometry", "h"]}, {"required": ["file"]}],
-    "x-message": "give either 'geometry' with 'h' (generated mesh) or 'file' (read mesh), not both",
-}
+    def mapping_value(name: str, schema: dict) -> dict:
+        short = FORCES.get(name).shorthand
+        if short is None:
+            return schema
+        return {"anyOf": [*short["schema"]["anyOf"], schema],
+                "x-message": "expected a magnitude, a vector or a mapping"}
 
-SINGLE_SPRING = _closed({
-    **_COMMON,
-    "k": _POS, "m": _POS, "rest": _POS, "dim": _DIM,
-}, ["type", "k", "m"])
+    return {
+        "anyOf": [
+            {"type": "array", "items": item},
+            {"type": "object", "additionalProperties": False,
+             "properties": {name: mapping_value(name, s) for name, s in types.items()}},
+        ],
+        "default": [],
+        "x-message": "expected a list of {type: ..., ...} or a mapping force name -> parameters",
+    }
 
-#: system type -> schema of its mapping
-SYSTEM_TYPES = {"rope": ROPE, "cloth": CLOTH, "mesh": MESH, "single_spring": SINGLE_SPRING}
 
-_SYSTEM = {
-    "type": "object",
-    "required": ["type"],
-    "properties": {"type": {"enum": sorted(SYSTEM_TYPES)}},
-    "allOf": [{"if": {"properties": {"type": {"const": name}}, "required": ["type"]},
-               "then": schema} for name, schema in SYSTEM_TYPES.items()],
-}
+def scene_schema() -> dict:
+    """The whole scene schema, its force and system branches derived from the registries now
+    (so a force or system type registered later is accepted)."""
+    return {**_SCENE, "properties": {**_SCENE["properties"], "system": _system(),
+                                     "forces": _forces()}}
 
-GRAVITY = _closed({"type": {"const": "gravity"},
-                   "g": {"anyOf": [_NONNEG, _VEC],
-                         "x-message": "expected a magnitude >= 0 or a vector"},
-                   "axis": {"type": "integer"}}, [])
-DASHPOT = _closed({"type": {"const": "dashpot"}, "c": _NONNEG}, ["c"])
-VISCOUS = _closed({"type": {"const": "viscous"}, "gamma": _NONNEG,
-                   "per_mass": {"type": "boolean"}}, ["gamma"])
-RAYLEIGH = _closed({"type": {"const": "rayleigh"}, "alpha": _NONNEG, "beta": _NONNEG}, [])
-GROUND = _closed({"type": {"const": "ground"}, "height": {"type": "number"},
-                  "stiffness": _POS, "normal": _VEC}, ["stiffness"])
-SPHERE = _closed({"type": {"const": "sphere"}, "centre": _VEC, "radius": _POS,
-                  "stiffness": _POS}, ["centre", "radius", "stiffness"])
 
-#: force type -> schema of its mapping
-FORCE_TYPES = {"gravity": GRAVITY, "dashpot": DASHPOT, "viscous": VISCOUS,
-               "rayleigh": RAYLEIGH, "ground": GROUND, "sphere": SPHERE}
-
-_FORCE_ITEM = {
-    "type": "object",
-    "required": ["type"],
-    "properties": {"type": {"enum": sorted(FORCE_TYPES)}},
-    "allOf": [{"if": {"properties": {"type": {"const": name}}, "required": ["type"]},
-               "then": {**schema, "required": ["type", *schema["required"]]}}
-              for name, schema in FORCE_TYPES.items()],
-}
-
-_FORCES = {
-    "anyOf": [
-        {"type": "array", "items": _FORCE_ITEM},
-        {"type": "object", "additionalProperties": False,
-         "properties": {name: ({"anyOf": [_NONNEG, _VEC, s],
-                                "x-message": "expected a magnitude, a vector or a mapping"}
-                               if name == "gravity" else s)
-                        for name, s in FORCE_TYPES.items()}},
-    ],
-    "default": [],
-    "x-message": "expected a list of {type: ..., ...} or a mapping force name -> parameters",
-}
-
-SCENE_SCHEMA: dict = {
+_SCENE: dict = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "title": "femkit mass-spring scene",
     "type": "object",
@@ -140,8 +101,6 @@ SCENE_SCHEMA: dict = {
         "constants": {"type": "object",
                       "propertyNames": {"pattern": "^[A-Za-z_][A-Za-z0-9_]*$"},
                       "additionalProperties": {"type": "number"}, "default": {}},
-        "system": _SYSTEM,
-        "forces": _FORCES,
         "integrator": INTEGRATOR_SCHEMA,
         "linear_solver": {**SOLVER_SCHEMA, "default": {}},
         "limits": LIMITS_SCHEMA,
@@ -161,7 +120,7 @@ SCENE_SCHEMA: dict = {
             "properties": {
                 "dir": {"type": "string", "minLength": 1},
                 "every": {"type": "integer", "minimum": 1},
-                "interval": _POS,
+                "interval": POS,
                 "frames": {"type": "integer", "minimum": 1, "default": 100},
                 "vtu": {"type": "boolean", "default": True},
                 "xdmf": {"type": "boolean", "default": False},
@@ -172,3 +131,13 @@ SCENE_SCHEMA: dict = {
         },
     },
 }
+
+
+def __getattr__(name):  # the schema as of now, under its earlier names
+    if name == "SCENE_SCHEMA":
+        return scene_schema()
+    if name == "FORCE_TYPES":
+        return force_types()
+    if name == "SYSTEM_TYPES":
+        return system_types()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

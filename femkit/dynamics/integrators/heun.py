@@ -17,4 +17,7 @@ from .runge_kutta import ButcherTableau, ExplicitRungeKutta
 class Heun(ExplicitRungeKutta):
     order = 2
     stability_bound = 2.0
+    #: its stability region misses the imaginary axis: unstable on the undamped oscillator at
+    #: every step size (``stability_bound`` is the real interval, for the critical-step warning)
+    oscillator_stable = False
     tableau = ButcherTableau(((0.0, 0.0), (1.0, 0.0)), (0.5, 0.5), (0.0, 1.0))

@@ -1,0 +1,41 @@
+"""``problem: mass_spring``: a mass-spring scene file, registered as a :class:`~femkit.case.kinds.Kind`.
+
+Schema :func:`femkit.case.scene.schema.scene_schema` (its force and system enums come from
+:data:`~femkit.case.scene.forces.FORCES` and :data:`~femkit.case.scene.systems.SYSTEMS`);
+load-time checks :func:`femkit.case.scene.run.prepare_scene`; the run
+:func:`femkit.case.scene.run.run_scene`; the cost plan :func:`femkit.case.cost.plan_scene_case`.
+The dynamics modules are imported on first use only.
+"""
+
+from __future__ import annotations
+
+from ..kinds import Kind, register_kind
+
+
+def _schema() -> dict:
+    from .schema import scene_schema
+
+    return scene_schema()
+
+
+def _prepare(case) -> None:
+    from .run import prepare_scene
+
+    prepare_scene(case)
+
+
+def _run(case, **kwargs):
+    from .run import run_scene
+
+    return run_scene(case, **kwargs)
+
+
+def _plan(case, **kwargs):
+    from ..cost import plan_scene_case
+    from .run import build_context, build_integrator, build_system
+
+    return plan_scene_case(case, build_system(case)[0], build_integrator(case),
+                           ctx=build_context(case), **kwargs)
+
+
+KIND = register_kind(Kind("mass_spring", "problem", _schema, _prepare, _run, _plan))

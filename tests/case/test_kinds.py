@@ -1,0 +1,84 @@
+"""The one registry of file kinds: every problem and study kind resolves to a schema and callables,
+unknown names list the valid ones of their family, a registered kind is dispatched."""
+
+import pytest
+
+from femkit.case.kinds import KINDS, Kind, register_kind
+from femkit.case.load import Case, case_from_dict
+from femkit.errors import CaseFileError, UnknownNameError
+
+PROBLEMS = KINDS.names("problem")
+STUDIES = KINDS.names("kind")
+
+
+def test_builtin_kinds_are_discovered():
+    assert {"poisson", "mass_spring"} <= set(PROBLEMS)
+    assert {"poisson_convergence", "dynamics_work_precision", "stability", "adaptive",
+            "cloth_work_precision"} <= set(STUDIES)
+
+
+@pytest.mark.parametrize("name", PROBLEMS, ids=PROBLEMS)
+def test_problem_entries_resolve(name):
+    k = KINDS.get(name, "problem")
+    schema = k.get_schema()
+    assert schema["type"] == "object" and schema["additionalProperties"] is False
+    assert "problem" in schema["properties"]
+    assert callable(k.prepare) and callable(k.run) and callable(k.plan)
+
+
+@pytest.mark.parametrize("name", STUDIES, ids=STUDIES)
+def test_study_entries_resolve(name):
+    from femkit.study.schema import schema_for
+
+    k = KINDS.get(name, "kind")
+    assert callable(k.prepare) and callable(k.run) and callable(k.report) and callable(k.summary)
+    full = schema_for(name)
+    assert full["additionalProperties"] is False and "quick" in full["properties"]
+
+
+def test_unknown_problem_lists_the_valid_ones_of_its_family():
+    with pytest.raises(UnknownNameError, match="valid problems: mass_spring, poisson$"):
+        KINDS.get("heat", "problem")
+    with pytest.raises(UnknownNameError, match="unknown study kind 'poisson'"):
+        KINDS.get("poisson", "kind")  # a problem is not a study kind
+    with pytest.raises(CaseFileError, match="missing required key 'problem'"):
+        case_from_dict({"mesh": {}})
+    with pytest.raises(CaseFileError, match="problem: unknown problem 'stability'"):
+        case_from_dict({"problem": "stability"})
+
+
+def test_kind_key_is_checked():
+    with pytest.raises(ValueError, match="Kind.key must be one of problem, kind"):
+        Kind("x", "case", {}, print, print)
+
+
+def test_a_registered_problem_kind_is_dispatched_and_its_data_is_read_only(tmp_path):
+    seen = {}
+    schema = {"type": "object", "additionalProperties": False,
+              "properties": {"problem": {"const": "toy"}, "n": {"type": "integer", "default": 3}}}
+
+    def prepare(case: Case):
+        seen["prepared"] = case.data["n"]
+        case.spec = ("toy", case.data["n"])
+
+    def run(case, output_dir=None, quiet=False, write=True, echo=None):
+        return ("ran", case.spec, write)
+
+    register_kind(Kind("toy", "problem", schema, prepare, run))
+    try:
+        case = case_from_dict({"problem": "toy"}, tmp_path)
+        assert seen == {"prepared": 3}
+        assert case.run(write=False) == ("ran", ("toy", 3), False)
+        with pytest.raises(TypeError, match="read-only"):
+            case.data["n"] = 4
+        with pytest.raises(CaseFileError, match="m: unknown key"):
+            case_from_dict({"problem": "toy", "m": 1}, tmp_path)
+        with pytest.raises(ValueError, match="twice"):
+            register_kind(Kind("toy", "problem", schema, prepare, run))
+        from femkit.case.budget import plan_case
+
+        plan = plan_case(case)  # no cost model: a plan that says so, nothing refused
+        assert plan.stages == [] and "no cost model for problem 'toy'" in plan.assumptions[0]
+    finally:
+        KINDS.remove("toy")
+    assert "toy" not in KINDS
