@@ -3,7 +3,7 @@
 ``ElasticBody(points, cells, material)`` precomputes the rest data once
 (:func:`~femkit.solids.kinematics.rest_shape`) and, on the first Hessian, the CSR pattern
 (:class:`~femkit.solids.pattern.BlockPattern`); each evaluation is one compiled pass per material
-group (:mod:`femkit.solids.kernels.element`). Positions are node-major ``(n, d)`` arrays, the flat
+group (:mod:`femkit.solids.compiled`). Positions are node-major ``(n, d)`` arrays, the flat
 dof index ``i*d + a`` as in :mod:`femkit.dynamics`.
 
 >>> import numpy as np
@@ -34,7 +34,7 @@ def point_tangent(material: Material, F, *, project: bool = False):
     F = np.ascontiguousarray(F, dtype=float)
     d = F.shape[0]
     P, lam, Q = np.zeros((d, d)), np.zeros(d * d), np.zeros((d * d, d, d))
-    from .kernels.element import point
+    from .compiled import point
 
     psi = point(material.code, F, material.params(), 2, P, lam, Q)
     if project:
@@ -142,7 +142,7 @@ class ElasticBody:
         None, negative (m,) or None)``; ``level`` 0, 1 or 2 as in the kernel. ``negative[e]``
         bounds the negative part of element ``e``'s unprojected Hessian (see
         :meth:`negative_bound`)."""
-        from .kernels.element import element_pass
+        from .compiled import element_pass
 
         x = self._state(x)
         m = self.rest.n_cells

@@ -2,13 +2,13 @@
 
 A hyperelastic isotropic material is fully described by its energy density as a function of the
 principal stretches ``W(s_1, .., s_d)`` (Xu, Sin, Zhu & Barbic 2015); forces and Hessians then
-follow from the SVD derivative (:mod:`femkit.solids.kernels.principal`) with only ``dW/ds`` and
+follow from the SVD derivative (:mod:`femkit.solids.compiled`) with only ``dW/ds`` and
 ``d^2W/ds^2``. So a material here *is* that function and its constants:
 
 * :class:`StretchMaterial` subclasses name a numba-compiled
   ``energy(s, params, grad, hess) -> W`` (``params`` = :meth:`Material.params`) by its number
-  ``code`` in :func:`femkit.solids.materials.stretch.stretch_energy` (:mod:`.stretch`, compiled
-  code imported only when evaluated); a material designed by its
+  ``code`` in :func:`femkit.solids.compiled.stretch_energy` (:mod:`femkit.solids.compiled`,
+  imported only when evaluated); a material designed by its
   energy (written by a user, derivatives generated symbolically) is one more such function, the
   element kernels are shared.
 * The linear (small-strain) material is not a function of the stretches (not rotation
@@ -116,21 +116,21 @@ class Material:
         return np.array([self.mu, self.lam])
 
     #: number of the material's point function in the compiled element pass
-    #: (:func:`femkit.solids.kernels.element.point`)
+    #: (:func:`femkit.solids.compiled.point`)
     code: ClassVar[int] = -1
 
 
 @dataclass(frozen=True)
 class StretchMaterial(Material):
     """A material given by its energy of the principal stretches (number ``code`` of
-    :func:`femkit.solids.materials.stretch.stretch_energy`)."""
+    :func:`femkit.solids.compiled.stretch_energy`)."""
 
 
     def stretch_derivatives(self, s) -> tuple[float, np.ndarray, np.ndarray]:
         """``(W, dW/ds, d^2W/ds^2)`` at one set of stretches ``s`` (``d`` values)."""
         s = np.ascontiguousarray(s, dtype=float)
         g, H = np.zeros(len(s)), np.zeros((len(s), len(s)))
-        from .stretch import stretch_energy
+        from ..compiled import stretch_energy
 
         W = stretch_energy(self.code, s, self.params(), g, H)
         return float(W), g, H
