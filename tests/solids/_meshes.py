@@ -52,3 +52,17 @@ def random_rotation(rng, d: int) -> np.ndarray:
 
 def mesh_by_dim(dim: int):
     return tri_rect(3, 2) if dim == 2 else tet_box(2, 1, 1)
+
+
+def facets_on(points, cells, axis: int, value: float, tol: float = 1e-12):
+    """Boundary facets (edges in 2D, triangles in 3D) of ``cells`` lying on the plane
+    ``points[:, axis] == value``."""
+    d = points.shape[1]
+    nv = d + 1
+    faces = np.concatenate([np.delete(cells, k, axis=1) for k in range(nv)])
+    on = np.all(np.abs(points[faces, axis] - value) <= tol, axis=1)
+    return faces[on]
+
+
+def nodes_on(points, axis: int, value: float, tol: float = 1e-12):
+    return np.flatnonzero(np.abs(points[:, axis] - value) <= tol)

@@ -45,8 +45,8 @@ def _finite(value, name: str) -> float:
 def lame_from_young(E: float, nu: float) -> tuple[float, float]:
     """``(mu, lam)`` of Young's modulus ``E > 0`` and Poisson ratio ``-1 < nu < 1/2``.
 
-    >>> lame_from_young(2.6, 0.3)
-    (1.0, 1.5000000000000004)
+    >>> [round(v, 12) for v in lame_from_young(2.6, 0.3)]
+    [1.0, 1.5]
     """
     E, nu = _finite(E, "Young's modulus E"), _finite(nu, "Poisson ratio nu")
     if E <= 0.0:
