@@ -98,6 +98,13 @@ class ElasticBody:
         self.groups = groups
         self._pattern = None
 
+    @classmethod
+    def from_mesh(cls, mesh, material) -> "ElasticBody":
+        """The body of a :class:`femkit.mesh.Mesh` (triangles: plane strain; tetrahedra);
+        ``material`` one :class:`Material` or ``{region name or tag: Material}``."""
+        return cls(mesh.points, mesh.cells, material, cell_tags=mesh.cell_tags,
+                   tag_names=mesh.tag_names)
+
     # ------------------------------------------------------------------ data
     @property
     def materials(self) -> list[Material]:

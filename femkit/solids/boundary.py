@@ -22,7 +22,8 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["Dirichlet", "traction_forces", "body_forces", "facet_measures"]
+__all__ = ["Dirichlet", "traction_forces", "body_forces", "facet_measures", "tagged_facets",
+           "tagged_nodes"]
 
 
 class Dirichlet:
@@ -145,3 +146,20 @@ def body_forces(body, force_density: Callable | np.ndarray) -> np.ndarray:
     for a in range(d):
         out[:, a] = np.bincount(cells.ravel(), weights=np.repeat(w[:, a], d + 1), minlength=body.n)
     return out
+
+
+def tagged_facets(mesh, tags) -> np.ndarray:
+    """Boundary facets of ``mesh`` (a :class:`femkit.mesh.Mesh`) carrying any of ``tags``
+    (names or numbers). An unknown name raises :class:`~femkit.errors.MeshError` listing the
+    known groups; tags that select no facet raise :class:`InputError`."""
+    names = [tags] if isinstance(tags, (str, int, np.integer)) else list(tags)
+    ids = [mesh.tag(t) for t in names]
+    sel = np.isin(mesh.boundary_tags, ids)
+    if not sel.any():
+        raise InputError(f"no boundary facets tagged {', '.join(map(str, names))}")
+    return mesh.boundary_facets[sel]
+
+
+def tagged_nodes(mesh, tags) -> np.ndarray:
+    """The nodes of :func:`tagged_facets` (sorted, unique)."""
+    return np.unique(tagged_facets(mesh, tags))
