@@ -7,9 +7,11 @@ values) by Newton iterations on the free dofs: ``H_ff dx = -r_f`` with the eleme
 PSD-projected Hessian (Teran et al. 2005; ``project=True`` by default, so ``dx`` is a descent
 direction), then Armijo backtracking on the total potential (Nocedal & Wright, Numerical
 Optimization, section 3.1), as :mod:`femkit.dynamics.integrators.newton` does for implicit
-Euler; the Armijo test allows the round-off level of the potential (``64 eps (|E| + |f.x|)``),
-without which Newton stalls where energy differences drown in rounding while the residual is
-still ~1e-8 relative. Converged when ``|r_f| <= rtol max(|f_k|, |r_0|)`` (``r_0``: residual at the start of
+Euler; the Armijo test allows the round-off level of the potential
+(``64 eps (|E| + |f.x| + sum (mu + |lam|) vol)``, the last term the size of the terms an energy
+density sums before they cancel near rest), and when even that finds no decrease, a full step
+that lowers the residual norm is taken: without these Newton stalls where energy differences
+drown in rounding while the residual is still ~1e-8 relative. Converged when ``|r_f| <= rtol max(|f_k|, |r_0|)`` (``r_0``: residual at the start of
 the load step) or the step ``|dx|_inf <= xtol L`` (``L`` the bounding-box diagonal).
 
 Failure -- a line search that finds no decrease, the iteration limit, an energy that is not
@@ -122,6 +124,8 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
     length = float(np.linalg.norm(np.ptp(body.rest_positions, axis=0)))
     x = X.copy() if x0 is None else np.array(x0, dtype=float).reshape(-1)
     records: list[LoadStepRecord] = []
+    # the size of the terms an energy density sums before they cancel near rest: (mu + lam) vol
+    stored = float(sum((m.mu + abs(m.lam)) * body.rest.volumes[e].sum() for e, m in body.groups))
 
     def potential(xf, f):
         """Total potential and its round-off level (energies near equilibrium stop changing
@@ -131,7 +135,7 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
         except SolverError:
             return np.inf, 0.0
         work = float(f @ xf)
-        return e - work, 64 * np.finfo(float).eps * (abs(e) + abs(work))
+        return e - work, 64 * np.finfo(float).eps * (abs(e) + abs(work) + stored)
 
     for k in range(1, load_steps + 1):
         lf = k / load_steps
@@ -172,11 +176,16 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
                         break
                     t *= shrink
                 else:
-                    raise EquilibriumError(
-                        f"static Newton: line search found no decrease in load step {k}/{load_steps} "
-                        f"(iteration {it + 1}, residual {res:.3e}; residuals "
-                        f"{', '.join(f'{v:.2e}' for v in rec.residuals[-6:])})",
-                        _result(body, x_start, records), k, x_start.reshape(body.n, body.dim))
+                    # energy differences below rounding: accept a full step that lowers |r|
+                    g_try = body.evaluate(x + dx, 1)[1].reshape(-1) - f
+                    t = 1.0
+                    p_try, noise_try = potential(x + dx, f)
+                    if not np.linalg.norm(g_try[free]) < (1.0 - armijo) * res:
+                        raise EquilibriumError(
+                            f"static Newton: line search found no decrease in load step "
+                            f"{k}/{load_steps} (iteration {it + 1}, residual {res:.3e}; residuals "
+                            f"{', '.join(f'{v:.2e}' for v in rec.residuals[-6:])})",
+                            _result(body, x_start, records), k, x_start.reshape(body.n, body.dim))
             else:  # not a descent direction (projection off): the full Newton step
                 p_try, noise_try = potential(x + dx, f)
             if not np.isfinite(p_try):
@@ -186,7 +195,7 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
             rec.step_lengths.append(t)
             x = x + t * dx
             pot, noise = p_try, noise_try
-            step = t * float(np.abs(dx).max(initial=0.0))
+            step = float(np.abs(dx).max(initial=0.0))      # the Newton step, not t * dx
         if not rec.converged:
             raise EquilibriumError(
                 f"static Newton: no convergence in {max_iterations} iterations in load step "

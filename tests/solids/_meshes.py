@@ -2,37 +2,15 @@
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 
-from femkit.mesh.structured import grid_triangles
+from femkit.mesh.structured import grid_triangles, structured_box
 
 
 def tet_box(nx: int, ny: int, nz: int, lengths=(1.0, 1.0, 1.0)):
-    """Points and positively oriented tetrahedra of a box: every hexahedron into the 6
-    tetrahedra around its main diagonal (Kuhn's subdivision, conforming across cells)."""
-    xs, ys, zs = (np.linspace(0.0, L, k + 1) for L, k in zip(lengths, (nx, ny, nz)))
-    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
-    pts = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
-
-    def node(i, j, k):
-        return (i * (ny + 1) + j) * (nz + 1) + k
-
-    i, j, k = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij"))
-    tets = []
-    for perm in itertools.permutations(range(3)):
-        corner = np.zeros((len(i), 3), dtype=np.int64)
-        verts = [node(i, j, k)]
-        for axis in perm:
-            corner[:, axis] += 1
-            verts.append(node(i + corner[:, 0], j + corner[:, 1], k + corner[:, 2]))
-        tets.append(np.column_stack(verts))
-    tets = np.concatenate(tets)
-    e = pts[tets[:, 1:]] - pts[tets[:, :1]]
-    flip = np.linalg.det(e) < 0
-    tets[flip, 1], tets[flip, 2] = tets[flip, 2].copy(), tets[flip, 1].copy()
-    return pts, tets
+    """Points and positively oriented tetrahedra of femkit's structured box (Kuhn's cut)."""
+    mesh = structured_box(nx, ny, nz, lengths)
+    return mesh.points, mesh.cells
 
 
 def tri_rect(nx: int, ny: int, width: float = 1.0, height: float = 1.0, diagonal: str = "alternating"):
