@@ -36,7 +36,8 @@ def point_tangent(material: Material, F, *, project: bool = False):
     P, lam, Q = np.zeros((d, d)), np.zeros(d * d), np.zeros((d * d, d, d))
     from .compiled import point
 
-    psi = point(material.code, F, material.params(), 2, P, lam, Q)
+    psi = point(material.code, F, material.params(), 2, P, lam, Q, np.zeros((6, d, d)),
+                np.zeros((2, d)))
     if project:
         lam = np.maximum(lam, 0.0)
     q = Q.reshape(d * d, d * d)

@@ -104,21 +104,107 @@ def det_small(A):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def signed_svd(F):  # pragma: no cover - compiled
-    """``U, s, V`` with ``F = U diag(s) V^T``, ``det U = det V = 1``; ``s`` by decreasing
-    magnitude, the last one negative when ``det F < 0``."""
+def sym_eig(A, V):  # pragma: no cover - compiled
+    """Eigen-decomposition of a small symmetric ``A`` by cyclic Jacobi rotations, in place:
+    on return ``diag(A)`` holds the eigenvalues and the columns of ``V`` (a rotation) the
+    eigenvectors (Golub & Van Loan, Matrix Computations, section 8.5). Converges quadratically;
+    a 3x3 needs ~4 sweeps. No allocation."""
+    d = A.shape[0]
+    for a in range(d):
+        for b in range(d):
+            V[a, b] = 1.0 if a == b else 0.0
+    for _ in range(30):
+        off = 0.0
+        scale = 0.0
+        for p in range(d):
+            scale += A[p, p] * A[p, p]
+            for q in range(p + 1, d):
+                off += A[p, q] * A[p, q]
+        if off <= 1e-34 * scale or off == 0.0:
+            break
+        for p in range(d - 1):
+            for q in range(p + 1, d):
+                apq = A[p, q]
+                if apq == 0.0:
+                    continue
+                theta = (A[q, q] - A[p, p]) / (2.0 * apq)
+                t = 1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0))
+                if theta < 0.0:
+                    t = -t
+                c = 1.0 / math.sqrt(t * t + 1.0)
+                sn = t * c
+                for k in range(d):                       # A <- A J
+                    akp, akq = A[k, p], A[k, q]
+                    A[k, p] = c * akp - sn * akq
+                    A[k, q] = sn * akp + c * akq
+                for k in range(d):                       # A <- J^T A
+                    apk, aqk = A[p, k], A[q, k]
+                    A[p, k] = c * apk - sn * aqk
+                    A[q, k] = sn * apk + c * aqk
+                for k in range(d):                       # V <- V J
+                    vkp, vkq = V[k, p], V[k, q]
+                    V[k, p] = c * vkp - sn * vkq
+                    V[k, q] = sn * vkp + c * vkq
+                A[p, q] = 0.0
+                A[q, p] = 0.0
+
+
+@numba.njit(cache=True)
+def signed_svd(F, U, s, V, A):  # pragma: no cover - compiled
+    """``F = U diag(s) V^T`` with ``det U = det V = 1`` into ``U, s, V`` (``A`` scratch); ``s``
+    by decreasing magnitude, the last one negative when ``det F < 0``.
+
+    McAdams, Selle, Tamstorf, Teran & Sifakis (2011): ``V`` from the Jacobi eigenvectors of
+    ``F^T F`` (sorted, made a rotation), then a Givens QR of ``F V = U R``: ``U`` is a product of
+    rotations and ``diag(R)`` the signed stretches, accurate even for nearly collapsed elements
+    (where ``sqrt`` of the eigenvalues of ``F^T F`` would not be). No allocation, no LAPACK."""
     d = F.shape[0]
-    U, s, Vt = np.linalg.svd(F)
-    V = np.ascontiguousarray(Vt.T)
-    if det_small(U) < 0.0:
-        for a in range(d):
-            U[a, d - 1] = -U[a, d - 1]
-        s[d - 1] = -s[d - 1]
+    for a in range(d):
+        for b in range(d):
+            acc = 0.0
+            for k in range(d):
+                acc += F[k, a] * F[k, b]
+            A[a, b] = acc
+    sym_eig(A, V)
+    for i in range(d):                                   # sort by decreasing eigenvalue
+        best = i
+        for j in range(i + 1, d):
+            if A[j, j] > A[best, best]:
+                best = j
+        if best != i:
+            A[i, i], A[best, best] = A[best, best], A[i, i]
+            for k in range(d):
+                V[k, i], V[k, best] = V[k, best], V[k, i]
     if det_small(V) < 0.0:
-        for a in range(d):
-            V[a, d - 1] = -V[a, d - 1]
-        s[d - 1] = -s[d - 1]
-    return U, s, V
+        for k in range(d):
+            V[k, d - 1] = -V[k, d - 1]
+    for a in range(d):                                   # A <- F V, then QR by Givens
+        for b in range(d):
+            acc = 0.0
+            for k in range(d):
+                acc += F[a, k] * V[k, b]
+            A[a, b] = acc
+    for a in range(d):                                   # U^T accumulated in U
+        for b in range(d):
+            U[a, b] = 1.0 if a == b else 0.0
+    for col in range(d - 1):
+        for row in range(col + 1, d):
+            x, y = A[col, col], A[row, col]
+            r = math.sqrt(x * x + y * y)
+            if r == 0.0:
+                continue
+            c, sn = x / r, y / r
+            for k in range(d):
+                ai, aj = A[col, k], A[row, k]
+                A[col, k] = c * ai + sn * aj
+                A[row, k] = -sn * ai + c * aj
+                ui, uj = U[col, k], U[row, k]
+                U[col, k] = c * ui + sn * uj
+                U[row, k] = -sn * ui + c * uj
+    for a in range(d):
+        s[a] = A[a, a]
+        for b in range(a + 1, d):
+            U[a, b], U[b, a] = U[b, a], U[a, b]
 
 
 # ---------------------------------------------------------------- stretch energies
@@ -203,7 +289,7 @@ def stretch_energy(code, s, params, grad, hess):  # pragma: no cover - compiled
 
 # ---------------------------------------------------------------- linear material
 @numba.njit(cache=True)
-def linear_point(F, params, level, P, lam, Q):  # pragma: no cover - compiled
+def linear_point(F, params, level, P, lam, Q, work, vec):  # pragma: no cover - compiled
     mu, la = params[0], params[1]
     d = F.shape[0]
     tr = 0.0
@@ -218,17 +304,17 @@ def linear_point(F, params, level, P, lam, Q):  # pragma: no cover - compiled
                 P[a, b] = 2.0 * mu * eps + (la * tr if a == b else 0.0)
     if level < 2:
         return psi
-    H = np.empty((d, d))
+    H, E = work[4], work[5]
     for i in range(d):
         for j in range(d):
             H[i, j] = la + (2.0 * mu if i == j else 0.0)
-    w, E = np.linalg.eigh(H)
+    sym_eig(H, E)
     for k in range(d * d):
         for a in range(d):
             for b in range(d):
                 Q[k, a, b] = 0.0
     for k in range(d):
-        lam[k] = w[k]
+        lam[k] = H[k, k]
         for i in range(d):
             Q[k, i, i] = E[i, k]
     r2 = 1.0 / math.sqrt(2.0)
@@ -252,17 +338,22 @@ _R2 = 1.0 / math.sqrt(2.0)
 
 
 @numba.njit(cache=True)
-def stretch_point(code, F, params, level, P, lam, Q):  # pragma: no cover - compiled
+def stretch_point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no cover - compiled
     """The point function of the stretch energy number ``code``
     (:func:`femkit.solids.compiled.stretch_energy`).
 
     ``level`` 0 energy only, 1 also the stress ``P`` (``d x d``), 2 also the ``d^2`` eigenpairs of
     ``dP/dF`` (``lam``, ``Q[k]`` the unit ``d x d`` mode in F-space). Returns ``psi``.
+    ``work`` ``(6, d, d)`` and ``vec`` ``(2, d)`` are scratch (no allocation per element).
     """
     d = F.shape[0]
-    U, s, V = signed_svd(F)
-    g = np.zeros(d)
-    H = np.zeros((d, d))
+    U, V, A, H, E = work[0], work[1], work[2], work[3], work[4]
+    s, g = vec[0], vec[1]
+    signed_svd(F, U, s, V, A)
+    for i in range(d):
+        g[i] = 0.0
+        for j in range(d):
+            H[i, j] = 0.0
     psi = stretch_energy(code, s, params, g, H)
     if level < 1:
         return psi
@@ -274,9 +365,12 @@ def stretch_point(code, F, params, level, P, lam, Q):  # pragma: no cover - comp
             P[a, b] = acc
     if level < 2:
         return psi
-    w, E = np.linalg.eigh(H)
+    for i in range(d):
+        for j in range(d):
+            A[i, j] = H[i, j]
+    sym_eig(A, E)                      # eigenpairs of the stretch Hessian (H kept for the limits)
     for k in range(d):
-        lam[k] = w[k]
+        lam[k] = A[k, k]
         for a in range(d):
             for b in range(d):
                 acc = 0.0
@@ -303,11 +397,11 @@ def stretch_point(code, F, params, level, P, lam, Q):  # pragma: no cover - comp
 
 # ---------------------------------------------------------------- element pass
 @numba.njit(cache=True)
-def point(code, F, params, level, P, lam, Q):  # pragma: no cover - compiled
+def point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no cover - compiled
     """Point function of material number ``code``: 0 linear, else the stretch energy ``code``."""
     if code == 0:
-        return linear_point(F, params, level, P, lam, Q)
-    return stretch_point(code, F, params, level, P, lam, Q)
+        return linear_point(F, params, level, P, lam, Q, work, vec)
+    return stretch_point(code, F, params, level, P, lam, Q, work, vec)
 
 
 @numba.njit(cache=True)
@@ -328,6 +422,8 @@ def element_pass(code, x, cells, grads, vol, elems, params, level, project,
     lam = np.zeros(dd)
     Q = np.zeros((dd, d, d))
     w = np.empty((dd, nv * d))
+    work = np.zeros((6, d, d))
+    vec = np.zeros((2, d))
     base = np.empty((nv * nv, d), dtype=np.int64)
     for t in range(elems.shape[0]):
         e = elems[t]
@@ -337,7 +433,7 @@ def element_pass(code, x, cells, grads, vol, elems, params, level, project,
                 for n in range(nv):
                     acc += x[cells[e, n], a] * grads[e, n, b]
                 F[a, b] = acc
-        psi = point(code, F, params, level, P, lam, Q)
+        psi = point(code, F, params, level, P, lam, Q, work, vec)
         v = vol[e]
         energy[e] = v * psi
         if level < 1:
@@ -379,9 +475,12 @@ def element_pass(code, x, cells, grads, vol, elems, params, level, project,
                     base[n * nv + m, a] = dd * r0 + a * d * width + off * d
         for i in range(nv * d):
             n, a = i // d, i % d
-            for j in range(nv * d):
+            for j in range(i, nv * d):
                 m, c = j // d, j % d
                 acc = 0.0
                 for k in range(dd):
                     acc += lam[k] * w[k, i] * w[k, j]
-                data[base[n * nv + m, a] + c] += v * acc
+                acc *= v
+                data[base[n * nv + m, a] + c] += acc
+                if j != i:
+                    data[base[m * nv + n, c] + a] += acc
