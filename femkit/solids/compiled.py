@@ -120,7 +120,7 @@ def sym_eig(A, V):  # pragma: no cover - compiled
             scale += A[p, p] * A[p, p]
             for q in range(p + 1, d):
                 off += A[p, q] * A[p, q]
-        if off <= 1e-34 * scale or off == 0.0:
+        if off <= 1e-30 * scale:
             break
         for p in range(d - 1):
             for q in range(p + 1, d):
