@@ -133,6 +133,10 @@ class ElasticBody:
         w = np.repeat(self.density() * self.rest.volumes / (self.dim + 1), self.dim + 1)
         return np.bincount(self.rest.cells.ravel(), weights=w, minlength=self.n)
 
+    def inverted(self, x) -> np.ndarray:
+        """Ids of the elements with ``det F <= 0`` at ``x`` (inverted or flat)."""
+        return np.flatnonzero(np.linalg.det(self.deformation_gradients(x)) <= 0.0)
+
     def deformation_gradients(self, x) -> np.ndarray:
         return deformation_gradients(self._state(x), self.rest)
 
