@@ -8,10 +8,14 @@ evaluation only.
 """
 
 from .body import ElasticBody, point_tangent
+from .boundary import Dirichlet, body_forces, tagged_facets, tagged_nodes, traction_forces
 from .kinematics import RestShape, deformation_gradients, invertible_svd, rest_shape
 from .materials import (MATERIALS, Corotational, LinearElastic, Material, StableNeoHookean,
                         StretchMaterial, StVenantKirchhoff, lame_from_young, material)
+from .static import LoadStepRecord, StaticResult, solve_static
 
 __all__ = ["ElasticBody", "point_tangent", "RestShape", "rest_shape", "deformation_gradients",
            "invertible_svd", "MATERIALS", "Material", "StretchMaterial", "LinearElastic",
-           "Corotational", "StVenantKirchhoff", "StableNeoHookean", "lame_from_young", "material"]
+           "Corotational", "StVenantKirchhoff", "StableNeoHookean", "lame_from_young", "material",
+           "Dirichlet", "traction_forces", "body_forces", "tagged_facets", "tagged_nodes",
+           "solve_static", "StaticResult", "LoadStepRecord"]
