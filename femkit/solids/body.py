@@ -149,11 +149,12 @@ class ElasticBody:
         return np.ascontiguousarray(x)
 
     # ------------------------------------------------------------------ evaluation
-    def evaluate(self, x, level: int = 2, *, project: bool = False):
+    def evaluate(self, x, level: int = 2, *, project: bool = False, stress: np.ndarray | None = None):
         """One compiled pass: ``(element_energies (m,), gradient (n, d) or None, hessian CSR or
         None, negative (m,) or None)``; ``level`` 0, 1 or 2 as in the kernel. ``negative[e]``
         bounds the negative part of element ``e``'s unprojected Hessian (see
-        :meth:`negative_bound`)."""
+        :meth:`negative_bound`). ``stress``: an ``(m, d, d)`` array to receive the first
+        Piola-Kirchhoff stress per element (``level >= 1``)."""
         from .compiled import element_pass
 
         x = self._state(x)
@@ -167,9 +168,10 @@ class ElasticBody:
         else:
             data, slots, indptr = np.zeros(0), np.zeros((0, 0), np.int64), np.zeros(1, np.int64)
         r = self.rest
+        P = np.zeros((0, self.dim, self.dim)) if stress is None else stress
         for elems, mat in self.groups:
             element_pass(mat.code, x, r.cells, r.gradients, r.volumes, elems, mat.params(), int(level),
-                   bool(project), slots, indptr, energy, grad, data, neg)
+                   bool(project), slots, indptr, energy, grad, data, neg, P)
         if not np.all(np.isfinite(energy)):
             bad = np.flatnonzero(~np.isfinite(energy))
             from ..errors import SolverError
@@ -189,6 +191,32 @@ class ElasticBody:
     def hessian(self, x, *, project: bool = False) -> sp.csr_matrix:
         """``d^2E/dx^2`` (CSR ``nd x nd``); element-wise PSD-projected when ``project``."""
         return self.evaluate(x, 2, project=project)[2]
+
+    def stresses(self, x) -> np.ndarray:
+        """First Piola-Kirchhoff stress ``P = dpsi/dF`` per element, ``(m, d, d)``."""
+        P = np.zeros((self.rest.n_cells, self.dim, self.dim))
+        self.evaluate(x, 1, stress=P)
+        return P
+
+    def element_fields(self, x) -> dict:
+        """Per-element output fields at ``x``: ``principal_stretches`` ``(m, d)`` (signed, the
+        invertible SVD), ``J`` ``(m,)`` (``det F``), ``cauchy`` ``(m, d, d)``
+        (``sigma = P F^T / J``) and ``von_mises`` ``(m,)`` of the in-plane (2D) or full (3D)
+        Cauchy stress, ``sqrt(3/2 |dev sigma|^2)`` (in 2D the plane-strain ``sigma_zz`` is left
+        out). Elements with ``J <= 0`` get NaN in ``cauchy`` and ``von_mises`` (their Cauchy
+        stress is undefined); :meth:`inverted` names them."""
+        from .kinematics import invertible_svd
+
+        F = self.deformation_gradients(x)
+        _, s, _ = invertible_svd(F)
+        P = self.stresses(x)
+        J = np.linalg.det(F)
+        ok = J > 0.0
+        sigma = np.full_like(P, np.nan)
+        sigma[ok] = np.einsum("mab,mcb->mac", P[ok], F[ok]) / J[ok, None, None]
+        dev = sigma - np.einsum("maa->m", sigma)[:, None, None] / self.dim * np.eye(self.dim)
+        vm = np.sqrt(1.5 * np.einsum("mab,mab->m", dev, dev))
+        return {"principal_stretches": s, "J": J, "cauchy": sigma, "von_mises": vm}
 
     def negative_bound(self, x) -> np.ndarray:
         """Per-node ``e_i >= 0`` with ``z^T H(x) z >= -sum_i e_i |z_i|^2``: each element's

@@ -406,13 +406,15 @@ def point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no cover - c
 
 @numba.njit(cache=True)
 def element_pass(code, x, cells, grads, vol, elems, params, level, project,
-                 node_slots, node_indptr, energy, grad, data, neg):  # pragma: no cover - compiled
+                 node_slots, node_indptr, energy, grad, data, neg, stress):  # pragma: no cover - compiled
     """The element pass of material number ``code`` (:func:`point`).
 
     Loops over ``elems``; ``level`` 0 writes ``energy[e]``, 1 also adds
     the gradient into ``grad`` ``(n, d)``, 2 also adds the Hessian values into ``data`` and the sum
     of the negative eigenvalues of ``vol dP/dF`` times ``|g|_F^2`` into ``neg[e]`` (a bound on the
-    element Hessian's negative part, before projection).
+    element Hessian's negative part, before projection). With a non-empty ``stress``
+    ``(m, d, d)`` and ``level >= 1`` the first Piola-Kirchhoff stress of each element is written
+    there too.
     """
     d = x.shape[1]
     nv = d + 1
@@ -438,6 +440,10 @@ def element_pass(code, x, cells, grads, vol, elems, params, level, project,
         energy[e] = v * psi
         if level < 1:
             continue
+        if stress.shape[0] > 0:
+            for a in range(d):
+                for b in range(d):
+                    stress[e, a, b] = P[a, b]
         for n in range(nv):
             node = cells[e, n]
             for a in range(d):

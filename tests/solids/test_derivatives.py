@@ -155,3 +155,15 @@ def test_projected_mesh_hessian_is_psd_and_bounds_hold(name, rng):
     # the per-node bound of the negative part: H + diag(e) is PSD
     e = np.repeat(body.negative_bound(x), 3)
     assert np.linalg.eigvalsh(H + np.diag(e)).min() >= -1e-10 * scale
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_element_stresses_are_the_point_stresses(name, rng):
+    X, cells = mesh_by_dim(3)
+    mat = _mat(name)
+    body = ElasticBody(X, cells, mat)
+    x = X + 0.2 * rng.standard_normal(X.shape)
+    P = body.stresses(x)
+    F = body.deformation_gradients(x)
+    for e in range(len(cells)):
+        np.testing.assert_allclose(P[e], point_tangent(mat, F[e])[1], atol=1e-12 * np.abs(P).max())

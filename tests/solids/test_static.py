@@ -49,6 +49,12 @@ def test_rollers_give_the_uniaxial_stress_state(nu):
     res = solve_static(body, bc)
     expected = X * np.array([eps, -nu * eps, -nu * eps])
     assert np.abs(res.u - expected).max() <= 1e-10 * eps
+    # output fields: stretches 1 + eps, 1 - nu eps (twice); von Mises of uniaxial stress = E eps
+    fields = body.element_fields(res.x)
+    np.testing.assert_allclose(fields["principal_stretches"],
+                               np.tile(sorted([1 + eps, 1 - nu * eps, 1 - nu * eps], reverse=True),
+                                       (len(cells), 1)), atol=1e-12)
+    np.testing.assert_allclose(fields["von_mises"], 1.0 * eps, rtol=1e-5)
 
 
 def _skfem_cantilever(X, cells, mu, lam, q, length):
