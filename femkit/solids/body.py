@@ -20,7 +20,7 @@ from typing import Mapping
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import InputError
+from ..errors import InputError, SolverError
 from .kinematics import RestShape, deformation_gradients, rest_shape
 from .materials.base import Material
 
@@ -170,12 +170,10 @@ class ElasticBody:
         r = self.rest
         P = np.zeros((0, self.dim, self.dim)) if stress is None else stress
         for elems, mat in self.groups:
-            element_pass(mat.code, x, r.cells, r.gradients, r.volumes, elems, mat.params(), int(level),
-                   bool(project), slots, indptr, energy, grad, data, neg, P)
+            element_pass(mat.code, x, r.cells, r.gradients, r.volumes, elems, mat.params(),
+                         int(level), bool(project), slots, indptr, energy, grad, data, neg, P)
         if not np.all(np.isfinite(energy)):
             bad = np.flatnonzero(~np.isfinite(energy))
-            from ..errors import SolverError
-
             raise SolverError(f"elastic energy not finite on {len(bad)} elements, first {int(bad[0])}")
         return (energy, grad if level >= 1 else None,
                 self.pattern.matrix(data) if level >= 2 else None, neg if level >= 2 else None)
