@@ -102,3 +102,18 @@ def test_neumann_faces_integrate_linear_data_exactly(mesh):
 def test_two_argument_expression_on_a_3d_mesh_is_refused(mesh):
     with pytest.raises(InputError, match=r"f\(x, y, z\): the function takes \(x, y\).*3D"):
         assemble_load(mesh, lambda x, y: x + y)
+
+
+def test_gmsh_msh_volume_equals_scikit_fem(tmp_path):
+    """The acceptance check on a .msh volume: the Fichera corner, written and read back."""
+    pytest.importorskip("gmsh")
+    from femkit.mesh import generate, read_mesh, write_mesh
+
+    write_mesh(tmp_path / "fichera.msh", generate("l_shape_3d", 0.4))
+    m = read_mesh(tmp_path / "fichera.msh")
+    basis = _basis(m, intorder=1)
+    ones = basis.with_element(skfem.ElementTetP0()).interpolate(np.ones(m.n_cells))
+    assert _rel(assemble_stiffness(m), _laplace.assemble(basis, kappa=ones)) < 1e-12
+    f = lambda x, y, z: 1.0 + x * y - z  # noqa: E731
+    ref = skfem.LinearForm(lambda v, w: f(*w.x) * v).assemble(basis)
+    assert _rel(assemble_load(m, f), ref) < 1e-12
