@@ -15,7 +15,8 @@ import numpy as np
 
 from .mesh import Mesh
 
-__all__ = ["LOCAL_FACES", "local_faces", "faces", "boundary_faces_topological", "unique_rows"]
+__all__ = ["LOCAL_FACES", "local_faces", "faces", "boundary_faces_topological", "unique_rows",
+           "face_ids"]
 
 #: Local face ``k`` of a tetrahedron is opposite its vertex ``k``, ordered so that its normal
 #: ``(b - a) x (c - a)`` points out of a positively oriented tetrahedron.
@@ -70,3 +71,21 @@ def boundary_faces_topological(mesh: Mesh) -> np.ndarray:
     _, tet_faces = faces(mesh)
     counts = np.bincount(tet_faces.ravel(), minlength=int(tet_faces.max(initial=-1)) + 1)
     return loc[counts[tet_faces.ravel()] == 1]
+
+
+def face_ids(face_nodes: np.ndarray, triples: np.ndarray) -> np.ndarray:
+    """Index in ``face_nodes`` (from :func:`faces`) of each node triple (k, 3), in any order.
+
+    Raises :class:`~femkit.errors.MeshError` when a triple is not a face of any tetrahedron.
+    """
+    from ..errors import MeshError
+
+    triples = np.sort(np.asarray(triples, dtype=np.int64).reshape(-1, 3), axis=1)
+    uniq, inverse = unique_rows(np.concatenate([face_nodes, triples]))
+    if len(uniq) != len(face_nodes):
+        known = np.zeros(len(uniq), bool)
+        known[inverse[:len(face_nodes)]] = True
+        bad = np.flatnonzero(~known[inverse[len(face_nodes):]])
+        raise MeshError(f"{len(bad)} boundary face(s) are not faces of any tetrahedron "
+                        f"(face ids {', '.join(map(str, bad[:10]))})")
+    return inverse[len(face_nodes):]

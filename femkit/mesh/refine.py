@@ -4,7 +4,8 @@ Tetrahedra follow Bey (1995, "Tetrahedral grid refinement", Computing 55): four 
 children and an inner octahedron cut into four along one of its three diagonals. femkit cuts
 along the *shortest* diagonal of each octahedron (the choice that keeps the children's shape
 regular, Bey 1995 section 3; Zhang 1995), so the minimum dihedral angle stays bounded under
-repeated refinement (docs/methods.md states the numbers after five levels).
+repeated refinement (docs/methods.md states the numbers after five levels). On a structured
+Kuhn box (:func:`femkit.mesh.structured_box`) this gives the structured box of half the size.
 
 >>> import numpy as np
 >>> from femkit.mesh import Mesh
@@ -79,7 +80,13 @@ def _refine_tetrahedra(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
     points = np.vstack([mesh.points, mesh.points[edge_nodes].mean(axis=1)])
     local = np.concatenate([mesh.cells, n + cell_edges], axis=1)          # (m, 10)
     d = points[local[:, _DIAGONALS[:, 0]]] - points[local[:, _DIAGONALS[:, 1]]]
-    choice = np.argmin(np.einsum("mkd,mkd->mk", d, d), axis=1)             # shortest diagonal
+    len2 = np.einsum("mkd,mkd->mk", d, d)
+    # the shortest diagonal; ties (a Kuhn tetrahedron has two) go to the one closest to the
+    # direction (1, 1, 1), so a structured Kuhn box refines into the structured box of half
+    # the size (Bey's congruent children) whatever the vertex order
+    tied = len2 <= len2.min(axis=1, keepdims=True) * (1.0 + 1e-10)
+    align = np.abs(d.sum(axis=2)) / np.sqrt(len2)
+    choice = np.argmax(np.where(tied, align, -1.0), axis=1)
     inner = _INNER[choice]                                                 # (m, 4, 4)
     rows = np.arange(len(local))[:, None, None]
     children = np.concatenate([local[:, _CORNERS], local[rows, inner]], axis=1)
