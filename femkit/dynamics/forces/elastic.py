@@ -51,7 +51,9 @@ class ElasticForce(Force):
 
     def _eval(self, x, level: int, project: bool = False):
         kept = self._kept
-        if kept is not None and kept[1] >= level and kept[2] == project and np.array_equal(kept[0], x):
+        # energy and gradient do not depend on the projection, only the Hessian does
+        if kept is not None and kept[1] >= level and (level < 2 or kept[2] == project) \
+                and np.array_equal(kept[0], x):
             return kept[3]
         out = self.body.evaluate(x, level, project=project)
         self._kept = (np.array(x, copy=True), level, project, out)
