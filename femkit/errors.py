@@ -18,13 +18,16 @@ Hierarchy::
     │   ├── AdaptivityError        bad adaptive-refinement setting (theta, target, budgets)
     │   ├── BudgetExceededError    predicted memory / time / steps / output above a limit
     │   │                          (before the run; ``force`` overrides)
-    │   └── BackendUnavailableError  a solver backend (PETSc: petsc4py, mpi4py) cannot be
+    │   ├── BackendUnavailableError  a solver backend (PETSc: petsc4py, mpi4py) cannot be
     │                              imported; the message names scripts/install-petsc.sh
+    │   └── MaterialError          bad material parameters (E <= 0, nu outside (-1, 1/2), density <= 0)
     ├── SolverError                a linear solver could not do what was asked
     │   ├── NotSPDError            input to CG-type method is not symmetric positive definite
-    │   └── SingularSystemError    singular system (e.g. pure Neumann, inconsistent rhs)
-    │       └── PureNeumannError   pure-Neumann data violating int f + int h = 0, or
-    │                              nullspace: error (also an InputError: exit code 2)
+    │   ├── SingularSystemError    singular system (e.g. pure Neumann, inconsistent rhs)
+    │   │   └── PureNeumannError   pure-Neumann data violating int f + int h = 0, or
+    │   │                          nullspace: error (also an InputError: exit code 2)
+    │   └── EquilibriumError       quasi-static Newton failed (line search exhausted, iteration
+    │                              limit); carries the convergence record so far
     ├── InstabilityError           a time integrator blew up (method, step, time, energy ratio, dt_crit)
     └── RankFailureError           another MPI rank of a distributed run failed (its rank and message)
 
@@ -98,6 +101,12 @@ class DegenerateMeshError(MeshError):
         super().__init__(message)
 
 
+class MaterialError(InputError):
+    """Invalid material parameters (Young's modulus <= 0, Poisson ratio outside (-1, 1/2),
+    Lame moduli that make the material unstable at rest, density <= 0); the message names the
+    parameter and its value."""
+
+
 class BackendUnavailableError(InputError):
     """A solver backend cannot be used here (e.g. ``backend="petsc"`` without petsc4py):
     the one-line message says what is missing and how to install it."""
@@ -161,6 +170,20 @@ class PureNeumannError(SingularSystemError, InputError):
     Both a :class:`SingularSystemError` (what it is) and an :class:`InputError` (whose
     fault it is: the data), so ``femkit solve`` exits with code 2 and writes nothing.
     """
+
+
+class EquilibriumError(SolverError):
+    """A quasi-static Newton solve failed (line search exhausted or iteration limit reached).
+
+    ``record`` is the convergence record so far (load steps done, iterations, residual
+    history), ``load_step`` the failing load step and ``x`` the last accepted configuration.
+    """
+
+    def __init__(self, message: str, record=None, load_step: int = -1, x=None):
+        self.record = record
+        self.load_step = load_step
+        self.x = x
+        super().__init__(message)
 
 
 class InstabilityError(FemkitError):

@@ -1,9 +1,10 @@
 """The layering of femkit, checked from the source: library layers never reach the application.
 
-Layers: ``mesh -> fem -> solvers <- dynamics`` know nothing of files; ``case`` (case and scene
-files), ``study`` and ``cli`` sit on top. ``cost/`` is a base of pure functions of numbers
-below the application: it imports only the shared leaves, and the library never imports it
-(the application plans and guards). Every import is read from the AST of every module,
+Layers: ``mesh -> fem -> solvers <- dynamics`` (and ``solids``, elastic bodies, beside dynamics,
+which never imports it: the elastic force takes a body object) know nothing of files; ``case``
+(case and scene files), ``study`` and ``cli`` sit on top. ``cost/`` is a base of pure functions
+of numbers below the application: it imports only the shared leaves, and the library never
+imports it (the application plans and guards). Every import is read from the AST of every module,
 imports inside functions (lazy ones) included, and no string names an application module for
 importlib to load. Import cycles: ``tests/test_no_import_cycles.py``.
 """
@@ -17,7 +18,7 @@ from pathlib import Path
 import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "femkit"
-LIBRARY = ("mesh", "fem", "solvers", "dynamics")
+LIBRARY = ("mesh", "fem", "solvers", "dynamics", "solids")
 APPLICATION = ("case", "study", "cli")
 #: What the library must never import: the application and the cost model (planned above it).
 ABOVE_THE_LIBRARY = APPLICATION + ("cost",)
@@ -107,10 +108,11 @@ def test_library_layers_do_not_write_femkit_files(layer):
     assert not {k: v for k, v in bad.items() if v}
 
 
-@pytest.mark.parametrize("layer, below", [("mesh", ("fem", "solvers", "dynamics")),
-                                          ("solvers", ("mesh", "fem", "dynamics")),
-                                          ("fem", ("dynamics",))],
-                         ids=["mesh", "solvers", "fem"])
+@pytest.mark.parametrize("layer, below", [("mesh", ("fem", "solvers", "dynamics", "solids")),
+                                          ("solvers", ("mesh", "fem", "dynamics", "solids")),
+                                          ("fem", ("dynamics", "solids")),
+                                          ("solids", ("dynamics",))],
+                         ids=["mesh", "solvers", "fem", "solids"])
 def test_lower_layers_do_not_import_higher_library_layers(layer, below):
     bad = {str(p.relative_to(PKG)): _forbidden(_imported(p), below) for p in _modules(layer)}
     assert not {k: v for k, v in bad.items() if v}

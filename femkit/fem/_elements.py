@@ -1,4 +1,4 @@
-"""Shared helpers of the assembly routines: element subsets and triangle geometry."""
+"""Shared helpers of the assembly routines: element subsets and triangle / tetrahedron geometry."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ def select_elements(mesh, elements) -> np.ndarray | None:
     """
     if elements is None:
         return None
-    m = mesh.n_triangles
+    m = mesh.n_cells
     sel = np.asarray(elements)
     if sel.dtype == bool:
         if sel.shape != (m,):
@@ -27,7 +27,8 @@ def select_elements(mesh, elements) -> np.ndarray | None:
         raise InputError(f"elements must be an integer index array or a boolean mask, got dtype {sel.dtype}")
     sel = sel.ravel().astype(np.intp, copy=False)
     if sel.min() < -m or sel.max() >= m:
-        raise InputError(f"element indices out of range for a mesh of {m} triangles")
+        raise InputError(f"element indices out of range for a mesh of {m} "
+                         f"{'triangles' if getattr(mesh, 'dim', 2) == 2 else 'tetrahedra'}")
     return np.where(sel < 0, sel + m, sel)
 
 
@@ -50,16 +51,52 @@ def triangle_geometry(mesh, idx: np.ndarray | None):
     return e, area, signed, tri
 
 
-def check_areas(area: np.ndarray, idx: np.ndarray | None) -> None:
-    """Raise :class:`DegenerateMeshError` naming zero-area (or non-finite) triangles."""
+def check_areas(area: np.ndarray, idx: np.ndarray | None, dim: int = 2) -> None:
+    """Raise :class:`DegenerateMeshError` naming zero-area (or non-finite) triangles, or
+    zero-volume tetrahedra with ``dim=3``."""
     bad = ~(area > 0) | ~np.isfinite(area)
     if bad.any():
         local = np.flatnonzero(bad)
         ids = local if idx is None else idx[local]
-        raise DegenerateMeshError(
-            f"{len(ids)} triangle(s) with zero or non-finite area, first ids: {ids[:10].tolist()}",
-            element_ids=ids.tolist(),
-        )
+        what = "triangle(s) with zero or non-finite area" if dim == 2 else \
+            "tetrahedron(s) with zero or non-finite volume"
+        raise DegenerateMeshError(f"{len(ids)} {what}, first ids: {ids[:10].tolist()}",
+                                  element_ids=ids.tolist())
+
+
+def tetrahedron_geometry(mesh, idx: np.ndarray | None):
+    """Barycentric gradients and volumes of the selected tetrahedra.
+
+    Returns ``(grads, volume, signed, tets)``: ``grads`` (m, 4, 3) with ``grads[:, a]`` the
+    constant gradient of the P1 basis function of vertex ``a``. With ``a, b, c`` the edges
+    from vertex 0 and ``D = a . (b x c) = 6 V_signed``, the rows of the inverse Jacobian are
+    ``(b x c, c x a, a x b) / D`` and ``grad N_0 = -(grad N_1 + grad N_2 + grad N_3)``.
+    Raises :class:`DegenerateMeshError` naming zero-volume tetrahedra.
+    """
+    tets = mesh.cells if idx is None else mesh.cells[idx]
+    p = mesh.points
+    p0 = p[tets[:, 0]]
+    a, b, c = p[tets[:, 1]] - p0, p[tets[:, 2]] - p0, p[tets[:, 3]] - p0
+    rows = np.stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)], axis=1)   # (m, 3, 3)
+    det = np.einsum("md,md->m", a, rows[:, 0])
+    volume = np.abs(det) / 6.0
+    check_areas(volume, idx, dim=3)
+    grads = np.empty((len(tets), 4, 3))
+    grads[:, 1:] = rows / det[:, None, None]
+    grads[:, 0] = -grads[:, 1:].sum(axis=1)
+    return grads, volume, det / 6.0, tets
+
+
+def simplex_gradients(mesh, idx: np.ndarray | None):
+    """``(grads (m, d+1, d), volume (m,), cells)`` of triangles or tetrahedra: the constant
+    gradients of the P1 basis functions and the element areas / volumes."""
+    if mesh.dim == 3:
+        grads, volume, _, cells = tetrahedron_geometry(mesh, idx)
+        return grads, volume, cells
+    e, area, signed, tri = triangle_geometry(mesh, idx)
+    inv = 1.0 / (2.0 * signed)
+    grads = np.stack([-e[:, :, 1] * inv[:, None], e[:, :, 0] * inv[:, None]], axis=2)
+    return grads, area, tri
 
 
 def p1_gradients(e: np.ndarray, signed: np.ndarray, ue: np.ndarray) -> np.ndarray:

@@ -14,10 +14,12 @@ import numpy as np
 def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  # pragma: no cover - compiled
     """Node-wise P1 pattern: row i = sorted unique vertices of the elements around node i.
 
-    ``indices`` is a buffer of at least ``n + 6 m`` entries (each element adds at most three
-    edges, two entries each); ``slots`` (m, 9) is filled.  With ``with_data`` the stiffness
-    (coefficient ``kappa``) is summed in the same element-order pass that writes the slots.
-    Returns ``(indptr, nnz, data, number of bad areas)`` (``data`` empty without ``with_data``).
+    ``tri`` has ``w`` columns (3: triangles, 4: tetrahedra). ``indices`` is a buffer of at
+    least ``n + w (w - 1) m`` entries (each element adds at most ``w (w - 1) / 2`` edges, two
+    entries each); ``slots`` (m, w * w) is filled. With ``with_data`` (triangles only) the
+    stiffness (coefficient ``kappa``) is summed in the same element-order pass that writes
+    the slots. Returns ``(indptr, nnz, data, number of bad areas)`` (``data`` empty without
+    ``with_data``).
 
     Node numbers of a mesh are far apart within an element, so node-wise passes over
     ``tri`` would read it at random.  Instead the element's vertices are copied into the
@@ -26,30 +28,29 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
     the slots are gathered back in element order.
     """
     m = tri.shape[0]
+    w = tri.shape[1]
     # 1. node -> incidences, by counting sort; each incidence carries the element's vertices.
     start = np.zeros(n + 1, np.int64)
     for e in range(m):
-        for a in range(3):
+        for a in range(w):
             start[tri[e, a] + 1] += 1
     for i in range(n):
         start[i + 1] += start[i]
-    verts = np.empty((3 * m, 3), slots.dtype)  # incidence k: the three vertices of its element
-    where = np.empty(3 * m, slots.dtype)  # 3 e + a -> incidence k
+    verts = np.empty((w * m, w), slots.dtype)  # incidence k: the w vertices of its element
+    where = np.empty(w * m, slots.dtype)  # w e + a -> incidence k
     for e in range(m):
-        v0, v1, v2 = tri[e, 0], tri[e, 1], tri[e, 2]
-        for a in range(3):
+        for a in range(w):
             i = tri[e, a]
             k = start[i]
             start[i] = k + 1
-            verts[k, 0] = v0
-            verts[k, 1] = v1
-            verts[k, 2] = v2
-            where[3 * e + a] = k
+            for b in range(w):
+                verts[k, b] = tri[e, b]
+            where[w * e + a] = k
     for i in range(n, 0, -1):  # start[i] now holds the old start[i + 1]: shift back
         start[i] = start[i - 1]
     start[0] = 0
-    # 2. per row: unique neighbours (stamp array), insertion sort (rows are short, ~7), then
-    #    each incidence's vertices replaced by the CSR positions of (i, vertex).
+    # 2. per row: unique neighbours (stamp array), insertion sort (rows are short, ~7 in 2D,
+    #    ~15 in 3D), then each incidence's vertices replaced by the CSR positions of (i, vertex).
     indptr = np.zeros(n + 1, np.int64)
     stamp = np.full(n, -1, np.int64)
     pos = np.empty(n, slots.dtype)
@@ -57,7 +58,7 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
     for i in range(n):
         s = nnz
         for k in range(start[i], start[i + 1]):
-            for b in range(3):
+            for b in range(w):
                 j = verts[k, b]
                 if stamp[j] != i:
                     stamp[j] = i
@@ -70,7 +71,7 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
         for q in range(s, nnz):
             pos[indices[q]] = q
         for k in range(start[i], start[i + 1]):
-            for b in range(3):
+            for b in range(w):
                 verts[k, b] = pos[verts[k, b]]
         indptr[i + 1] = nnz
     # 3. slots in element order: entry (e, a, b) is position b of incidence (e, a); with
@@ -78,10 +79,10 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
     data = np.zeros(nnz if with_data else 0)
     bad = 0
     for e in range(m):
-        for a in range(3):
-            k = where[3 * e + a]
-            for b in range(3):
-                slots[e, 3 * a + b] = verts[k, b]
+        for a in range(w):
+            k = where[w * e + a]
+            for b in range(w):
+                slots[e, w * a + b] = verts[k, b]
         if with_data:
             _, _, _, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(tri, points, e)
             if not (area > 0.0 and area < np.inf):
@@ -93,22 +94,22 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
 
 
 def pattern_kernel(tri: np.ndarray, n: int, points: np.ndarray | None = None, kappa=None):
-    """CSR ``indptr``, ``indices``, the (m, 9) slot map of the P1 pattern (compiled) and, when
-    ``points`` and ``kappa`` (a float or one value per element) are given, the CSR data of the
-    stiffness summed in the same pass (None if some triangle is degenerate; else None too
-    when not asked).
+    """CSR ``indptr``, ``indices``, the (m, w * w) slot map of the P1 pattern (compiled; ``w``
+    = 3 for triangles, 4 for tetrahedra) and, for triangles when ``points`` and ``kappa`` (a
+    float or one value per element) are given, the CSR data of the stiffness summed in the
+    same pass (None if some triangle is degenerate; else None too when not asked).
 
     ``indices`` and ``slots`` are int32 when the entry count allows it (half the memory
     traffic of int64), else int64.
     """
     tri = np.ascontiguousarray(tri, dtype=np.int64)
     n = int(n)
-    m = tri.shape[0]
-    bound = n + 6 * m
+    m, w = tri.shape
+    bound = n + w * (w - 1) * m
     dtype = np.int32 if bound < np.iinfo(np.int32).max else np.int64
     indices = np.empty(bound, dtype)
-    slots = np.empty((m, 9), dtype)
-    with_data = points is not None and kappa is not None
+    slots = np.empty((m, w * w), dtype)
+    with_data = points is not None and kappa is not None and w == 3
     pts = np.ascontiguousarray(points, dtype=np.float64) if with_data else np.zeros((0, 2))
     kap, scalar = _values(kappa if with_data else 1.0)
     indptr, nnz, data, bad = _pattern(tri, n, indices, slots, pts, kap, scalar, with_data)
@@ -161,12 +162,13 @@ def _stiffness(tri, points, idx, use_idx, kappa, scalar_kappa, slots, nnz):  # p
 
 
 def stiffness_kernel(mesh, idx, kappa, pattern):
-    """CSR data of the stiffness of elements ``idx`` (None: all), or None if some triangle is
-    degenerate (the caller's numpy path then raises with the ids).
+    """CSR data of the stiffness of elements ``idx`` (None: all; triangles or tetrahedra), or
+    None if some element is degenerate (the caller's numpy path then raises with the ids).
 
     ``kappa`` is a float (the same for every element) or one value per selected element.
     """
-    data, bad = _stiffness(mesh.triangles, mesh.points, *_selection(idx), *_values(kappa), pattern.slots, pattern.nnz)
+    kernel = _stiffness_tet if mesh.dim == 3 else _stiffness
+    data, bad = kernel(mesh.cells, mesh.points, *_selection(idx), *_values(kappa), pattern.slots, pattern.nnz)
     return None if bad else data
 
 
@@ -191,9 +193,72 @@ def _load_barycentric(tri, points, idx, use_idx, fvals, scalar_f, n):  # pragma:
 
 def load_kernel(mesh, idx, fvals):
     """Barycentric-rule load vector of elements ``idx`` (None: all) with ``fvals`` a float or
-    one value of ``f`` per selected element's centroid; None if some triangle is degenerate."""
-    out, bad = _load_barycentric(mesh.triangles, mesh.points, *_selection(idx), *_values(fvals), mesh.n_points)
+    one value of ``f`` per selected element's centroid; None if some element is degenerate."""
+    kernel = _load_tet if mesh.dim == 3 else _load_barycentric
+    out, bad = kernel(mesh.cells, mesh.points, *_selection(idx), *_values(fvals), mesh.n_points)
     return None if bad else out
+
+
+@numba.njit(cache=True)
+def _tetrahedron(tets, points, e):  # pragma: no cover - compiled
+    """Vertex ids, the three rows ``b x c, c x a, a x b`` (9 numbers) and ``D = 6 V_signed``."""
+    i0, i1, i2, i3 = tets[e, 0], tets[e, 1], tets[e, 2], tets[e, 3]
+    ax, ay, az = points[i1, 0] - points[i0, 0], points[i1, 1] - points[i0, 1], points[i1, 2] - points[i0, 2]
+    bx, by, bz = points[i2, 0] - points[i0, 0], points[i2, 1] - points[i0, 1], points[i2, 2] - points[i0, 2]
+    cx, cy, cz = points[i3, 0] - points[i0, 0], points[i3, 1] - points[i0, 1], points[i3, 2] - points[i0, 2]
+    g = np.empty((4, 3))
+    g[1, 0], g[1, 1], g[1, 2] = by * cz - bz * cy, bz * cx - bx * cz, bx * cy - by * cx
+    g[2, 0], g[2, 1], g[2, 2] = cy * az - cz * ay, cz * ax - cx * az, cx * ay - cy * ax
+    g[3, 0], g[3, 1], g[3, 2] = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+    for d in range(3):
+        g[0, d] = -(g[1, d] + g[2, d] + g[3, d])
+    det = ax * g[1, 0] + ay * g[1, 1] + az * g[1, 2]
+    return i0, i1, i2, i3, g, det
+
+
+@numba.njit(cache=True)
+def _stiffness_tet(tets, points, idx, use_idx, kappa, scalar_kappa, slots, nnz):  # pragma: no cover - compiled
+    """Fused tetrahedron stiffness ``kappa (g_a . g_b) / (6 |D|)`` + scatter into CSR data
+    (``g_a = D grad N_a``); returns (data, number of bad volumes)."""
+    data = np.zeros(nnz)
+    count = idx.shape[0] if use_idx else tets.shape[0]
+    bad = 0
+    for k in range(count):
+        e = idx[k] if use_idx else k
+        _, _, _, _, g, det = _tetrahedron(tets, points, e)
+        vol6 = abs(det)
+        if not (vol6 > 0.0 and vol6 < np.inf):
+            bad += 1
+            continue
+        s = (kappa[0] if scalar_kappa else kappa[k]) / (6.0 * vol6)
+        for a in range(4):
+            for b in range(a, 4):
+                v = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
+                data[slots[e, 4 * a + b]] += v
+                if b != a:
+                    data[slots[e, 4 * b + a]] += v
+    return data, bad
+
+
+@numba.njit(cache=True)
+def _load_tet(tets, points, idx, use_idx, fvals, scalar_f, n):  # pragma: no cover - compiled
+    """One-point load ``F_j += |T| f(c) / 4``; returns (F, number of bad volumes)."""
+    out = np.zeros(n)
+    count = idx.shape[0] if use_idx else tets.shape[0]
+    bad = 0
+    for k in range(count):
+        e = idx[k] if use_idx else k
+        i0, i1, i2, i3, _, det = _tetrahedron(tets, points, e)
+        vol = abs(det) / 6.0
+        if not (vol > 0.0 and vol < np.inf):
+            bad += 1
+            continue
+        w = vol * ((fvals[0] if scalar_f else fvals[k]) / 4.0)
+        out[i0] += w
+        out[i1] += w
+        out[i2] += w
+        out[i3] += w
+    return out, bad
 
 
 def _selection(idx):
@@ -217,3 +282,10 @@ def warm_up() -> None:
     _, nnz, _, _ = _pattern(tri, 4, ind, slots, pts, np.ones(1), True, True)
     _stiffness(tri, pts, np.zeros(1, np.int64), False, np.ones(1), True, slots, nnz)
     _load_barycentric(tri, pts, np.zeros(1, np.int64), False, np.ones(1), True, 4)
+    tet = np.array([[0, 1, 2, 3]], dtype=np.int64)
+    p3 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    ind3 = np.empty(4 + 12, np.int32)
+    slots3 = np.empty((1, 16), np.int32)
+    _, nnz3, _, _ = _pattern(tet, 4, ind3, slots3, p3, np.ones(1), True, False)
+    _stiffness_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, slots3, nnz3)
+    _load_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, 4)

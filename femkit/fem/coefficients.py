@@ -1,7 +1,7 @@
 """Coefficient and source data: scalars, per-element arrays, per-region tables, callables.
 
-Callables take coordinate arrays ``(x, y)`` and return an array of the same shape (a scalar
-is broadcast).
+Callables take coordinate arrays ``(x, y)`` (``(x, y, z)`` on tetrahedra) and return an array
+of the same shape (a scalar is broadcast).
 
 >>> import numpy as np
 >>> from femkit.mesh import Mesh
@@ -25,19 +25,39 @@ from ._elements import select_elements
 Coefficient = Union[float, np.ndarray, Mapping, Callable]
 
 
-def evaluate_callable(func: Callable, x: np.ndarray, y: np.ndarray, *, name: str = "function") -> np.ndarray:
-    """Call ``func(x, y)`` and broadcast the result to ``x.shape`` as float64.
+def evaluate_callable(func: Callable, x: np.ndarray, *coords: np.ndarray,
+                      name: str = "function") -> np.ndarray:
+    """Call ``func(x, y)`` (``func(x, y, z)`` given three coordinate arrays) and broadcast the
+    result to ``x.shape`` as float64.
 
     Raises :class:`InputError` if the result cannot be broadcast.
     """
-    val = func(x, y)
+    args = "x, y" if len(coords) < 2 else "x, y, z"
+    _check_arity(func, 1 + len(coords), f"{name}({args})")
+    val = func(x, *coords)
     try:
         out = np.broadcast_to(np.asarray(val, dtype=np.float64), x.shape)
     except (ValueError, TypeError) as exc:
         raise InputError(
-            f"{name}(x, y) must return a number or an array of shape {x.shape}: {exc}"
+            f"{name}({args}) must return a number or an array of shape {x.shape}: {exc}"
         ) from None
     return out
+
+
+def _check_arity(func: Callable, n: int, what: str) -> None:
+    """InputError when ``func`` cannot take ``n`` positional arguments (a 2D expression on a
+    3D mesh, or the reverse), said before it is called."""
+    import inspect
+
+    try:
+        sig = inspect.signature(func)
+    except (TypeError, ValueError):       # builtins without a signature: let the call decide
+        return
+    try:
+        sig.bind(*range(n))
+    except TypeError:
+        raise InputError(f"{what}: the function takes ({', '.join(sig.parameters)}), but this "
+                         f"mesh is {n}D and passes {n} coordinates") from None
 
 
 def element_coefficient(mesh, kappa: Coefficient, elements=None, *, name: str = "kappa",
@@ -49,8 +69,8 @@ def element_coefficient(mesh, kappa: Coefficient, elements=None, *, name: str = 
     mesh : Mesh
     kappa : float, (m,) array, dict or callable
         A constant; one value per element of the whole mesh; a table ``{cell tag or group
-        name: value}`` covering every cell tag in use; or ``kappa(x, y)`` evaluated at the
-        barycentres.
+        name: value}`` covering every cell tag in use; or ``kappa(x, y)`` (``kappa(x, y, z)``
+        on tetrahedra) evaluated at the barycentres.
     elements : index array or boolean mask, optional
         Return the values of these elements only.
     name : str
@@ -69,12 +89,12 @@ def element_coefficient(mesh, kappa: Coefficient, elements=None, *, name: str = 
         a region table that misses a cell tag, or an array of the wrong length.
     """
     idx = select_elements(mesh, elements)
-    m = mesh.n_triangles
+    m = mesh.n_cells
     count = m if idx is None else len(idx)
     if callable(kappa):
-        tri = mesh.triangles if idx is None else mesh.triangles[idx]
+        tri = mesh.cells if idx is None else mesh.cells[idx]
         c = mesh.points[tri].mean(axis=1)
-        vals = evaluate_callable(kappa, c[:, 0], c[:, 1], name=name)
+        vals = evaluate_callable(kappa, *c.T, name=name)
         vals = np.array(vals, dtype=np.float64)
     elif isinstance(kappa, Mapping):
         vals = _region_values(mesh, kappa, idx, name)

@@ -65,11 +65,12 @@ class DirichletSystem:
 
 
 def dirichlet_values(mesh, nodes, g: Values) -> np.ndarray:
-    """Values of ``g`` (scalar, per-node array, or callable ``g(x, y)``) at ``nodes``."""
+    """Values of ``g`` (scalar, per-node array, or callable ``g(x, y)``; ``g(x, y, z)`` in 3D)
+    at ``nodes``."""
     nodes = np.asarray(nodes, dtype=np.int64).ravel()
     if callable(g):
         pts = mesh.points[nodes]
-        vals = np.array(evaluate_callable(g, pts[:, 0], pts[:, 1], name="g"))
+        vals = np.array(evaluate_callable(g, *pts.T, name="g"))
     else:
         vals = np.asarray(g, dtype=np.float64)
         if vals.ndim == 0:

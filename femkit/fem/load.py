@@ -33,9 +33,11 @@ def assemble_load(mesh, f: Source, *, rule: str = "barycentric", elements=None,
     Parameters
     ----------
     mesh : Mesh
-    f : float or callable f(x, y)
+    f : float or callable f(x, y) (f(x, y, z) on tetrahedra)
     rule : str
-        Quadrature rule name: ``barycentric`` (default, one point), ``gauss3``, ``gauss6``, ``gauss7``.
+        Quadrature rule name: ``barycentric`` (default, one point: ``F_j += |T| f(c) / (d + 1)``),
+        on triangles ``gauss3``, ``gauss6``, ``gauss7``; on tetrahedra ``gauss4``, ``stroud8``,
+        ``stroud27``, ``stroud64`` (:mod:`femkit.fem.quadrature`).
     elements : index array or boolean mask, optional
         Integrate over these elements only (global-size result).
     backend : {"auto", "numpy", "numba"}
@@ -48,11 +50,11 @@ def assemble_load(mesh, f: Source, *, rule: str = "barycentric", elements=None,
     -------
     ndarray, shape (n,)
     """
-    quad = get_rule(rule)
+    quad = get_rule(rule, dim=mesh.dim)
     idx = select_elements(mesh, elements)
     if backend not in ("auto", "numpy", "numba"):
         raise InputError(f"unknown assembly backend {backend!r}; valid: auto, numba, numpy")
-    count = mesh.n_triangles if idx is None else len(idx)
+    count = mesh.n_cells if idx is None else len(idx)
     if backend == "auto":
         backend = "numba" if count >= NUMBA_THRESHOLD else "numpy"
     if backend == "numba" and quad.points.shape[0] == 1 and np.all(quad.points == quad.points[0, 0]):
@@ -60,24 +62,25 @@ def assemble_load(mesh, f: Source, *, rule: str = "barycentric", elements=None,
         out = _load_numba(mesh, f, quad, idx)
         if out is not None:
             return out
-    tri = mesh.triangles if idx is None else mesh.triangles[idx]
+    tri = mesh.cells if idx is None else mesh.cells[idx]
     area = _areas(mesh, tri)
-    check_areas(area, idx)
+    check_areas(area, idx, mesh.dim)
     if callable(f):
         fq = _source_values(mesh, f, quad, tri, idx)
         # local[e, a] = |T_e| sum_q w_q f(x_q) lambda_a(x_q)
         local = (fq * quad.weights) @ quad.points
         local *= area[:, None]
         return np.bincount(tri.ravel(), weights=local.ravel(), minlength=mesh.n_points)
-    w = area * (_scalar(f) / 3.0)  # the same share for the three vertices
+    k = mesh.dim + 1
+    w = area * (_scalar(f) / float(k))  # the same share for every vertex
     n = mesh.n_points
-    return sum(np.bincount(tri[:, a], weights=w, minlength=n) for a in range(3))
+    return sum(np.bincount(tri[:, a], weights=w, minlength=n) for a in range(k))
 
 
 def _source_values(mesh, f, quad, tri, idx) -> np.ndarray:
     """``f`` at the rule's physical points, (k, q); raises naming elements where it is not finite."""
-    x, y = quad.physical_points(mesh, tri)  # (m, q)
-    fq = evaluate_callable(f, x, y, name="f")
+    coords = quad.physical_points(mesh, tri)  # d arrays (m, q)
+    fq = evaluate_callable(f, *coords, name="f")
     if not np.isfinite(fq).all():
         bad = np.flatnonzero(~np.isfinite(fq).all(axis=1))
         ids = bad if idx is None else idx[bad]
@@ -91,7 +94,7 @@ def _load_numba(mesh, f, quad, idx):
     from ._kernels import load_kernel
 
     if callable(f):
-        tri = mesh.triangles if idx is None else mesh.triangles[idx]
+        tri = mesh.cells if idx is None else mesh.cells[idx]
         fvals = _source_values(mesh, f, quad, tri, idx)[:, 0]
     else:
         fvals = _scalar(f)
@@ -99,6 +102,10 @@ def _load_numba(mesh, f, quad, idx):
 
 
 def _areas(mesh, tri):
+    if tri.shape[1] == 4:
+        from ..mesh.mesh import signed_volumes
+
+        return np.abs(signed_volumes(mesh.points, tri))
     px, py = mesh.points[:, 0].copy(), mesh.points[:, 1].copy()
     x = [np.take(px, tri[:, a]) for a in range(3)]
     y = [np.take(py, tri[:, a]) for a in range(3)]
@@ -109,7 +116,7 @@ def _scalar(f) -> float:
     try:
         val = float(f)
     except (TypeError, ValueError):
-        raise InputError(f"source f must be a number or a callable f(x, y), got {f!r}") from None
+        raise InputError(f"source f must be a number or a callable f(x, y[, z]), got {f!r}") from None
     if not np.isfinite(val):
         raise InputError(f"source f must be finite, got {val}")
     return val

@@ -19,7 +19,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import InputError
-from ._elements import p1_gradients, select_elements, triangle_geometry
+from ._elements import p1_gradients, select_elements, simplex_gradients, triangle_geometry
 from .coefficients import evaluate_callable
 from .quadrature import rule_for_degree
 
@@ -33,8 +33,8 @@ def error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | Non
     mesh : Mesh
     u : ndarray, shape (n,)
         Nodal values.
-    exact : callable exact(x, y)
-    grad_exact : callable returning ``(du/dx, du/dy)``, optional
+    exact : callable exact(x, y) (exact(x, y, z) on tetrahedra)
+    grad_exact : callable returning ``(du/dx, du/dy)`` (``(du/dx, du/dy, du/dz)``), optional
         Without it ``H1_semi`` is ``None``.
     order : int
         Polynomial degree the quadrature must integrate exactly (a rule of at least this degree).
@@ -57,19 +57,21 @@ def error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | Non
     u = np.asarray(u, dtype=np.float64)
     if u.shape != (mesh.n_points,):
         raise InputError(f"u must have one value per node, shape ({mesh.n_points},), got {u.shape}")
-    rule = rule_for_degree(order)
+    rule = rule_for_degree(order, mesh.dim)
     root = (lambda v: v) if squared else np.sqrt
-    e, area, signed, tri = triangle_geometry(mesh, select_elements(mesh, elements))
-    ue = u[tri]  # (m, 3)
-    x, y = rule.physical_points(mesh, tri)
-    diff = ue @ rule.points.T - evaluate_callable(exact, x, y, name="exact")
+    idx = select_elements(mesh, elements)
+    geometry = triangle_geometry(mesh, idx) if mesh.dim == 2 else simplex_gradients(mesh, idx)
+    area, tri = geometry[1], geometry[-1]
+    ue = u[tri]  # (m, d + 1)
+    xy = rule.physical_points(mesh, tri)
+    diff = ue @ rule.points.T - evaluate_callable(exact, *xy, name="exact")
     l2 = float(root(np.sum(area * ((diff * diff) @ rule.weights))))
     nodes = slice(None) if elements is None else np.unique(tri)
     pts = mesh.points[nodes]
-    nodal = u[nodes] - evaluate_callable(exact, pts[:, 0], pts[:, 1], name="exact")
+    nodal = u[nodes] - evaluate_callable(exact, *pts.T, name="exact")
     out = {"L2": l2, "H1_semi": None, "max_nodal": float(np.max(np.abs(nodal))) if nodal.size else 0.0}
     if grad_exact is not None:
-        sq = _gradient_error_sq(mesh, u, grad_exact, rule, (e, area, signed, tri), (x, y))
+        sq = _gradient_error_sq(mesh, u, grad_exact, rule, geometry, xy)
         out["H1_semi"] = float(root(np.sum(sq)))
     for k, v in out.items():
         if v is not None and not np.isfinite(v):
@@ -79,6 +81,8 @@ def error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | Non
 
 def _gradient_error_sq(mesh, u, grad_exact, rule, geometry=None, xy=None) -> np.ndarray:
     """Per element ``int_T |grad u - grad u_h|^2`` by the quadrature ``rule``."""
+    if mesh.dim == 3:
+        return _gradient_error_sq_3d(mesh, u, grad_exact, rule, geometry, xy)
     e, area, signed, tri = triangle_geometry(mesh, None) if geometry is None else geometry
     x, y = rule.physical_points(mesh, tri) if xy is None else xy
     g_h = p1_gradients(e, signed, u[tri])
@@ -90,6 +94,19 @@ def _gradient_error_sq(mesh, u, grad_exact, rule, geometry=None, xy=None) -> np.
         raise InputError(f"grad_exact(x, y) must return (du/dx, du/dy): {exc}") from None
     dx, dy = g_h[:, 0, None] - gxe, g_h[:, 1, None] - gye
     return area * ((dx * dx + dy * dy) @ rule.weights)
+
+
+def _gradient_error_sq_3d(mesh, u, grad_exact, rule, geometry, xyz) -> np.ndarray:
+    grads, volume, tets = simplex_gradients(mesh, None) if geometry is None else geometry
+    xyz = rule.physical_points(mesh, tets) if xyz is None else xyz
+    g_h = np.einsum("ma,mad->md", u[tets], grads)
+    g = grad_exact(*xyz)
+    try:
+        ge = [np.broadcast_to(np.asarray(g[d], dtype=np.float64), xyz[0].shape) for d in range(3)]
+    except (TypeError, IndexError, ValueError) as exc:
+        raise InputError(f"grad_exact(x, y, z) must return (du/dx, du/dy, du/dz): {exc}") from None
+    sq = sum((g_h[:, d, None] - ge[d]) ** 2 for d in range(3))
+    return volume * (sq @ rule.weights)
 
 
 def energy_error(mesh, u: np.ndarray, grad_exact: Callable, kappa=1.0, *, order: int = 5,
@@ -112,7 +129,8 @@ def energy_error(mesh, u: np.ndarray, grad_exact: Callable, kappa=1.0, *, order:
     u = np.asarray(u, dtype=np.float64)
     if u.shape != (mesh.n_points,):
         raise InputError(f"u must have one value per node, shape ({mesh.n_points},), got {u.shape}")
-    sq = element_coefficient(mesh, kappa) * _gradient_error_sq(mesh, u, grad_exact, rule_for_degree(order))
+    sq = element_coefficient(mesh, kappa) * _gradient_error_sq(mesh, u, grad_exact,
+                                                               rule_for_degree(order, mesh.dim))
     if not np.isfinite(sq).all():
         raise InputError("energy error is not finite (exact gradient or u not finite)")
     return np.sqrt(sq) if per_element else float(np.sqrt(sq.sum()))

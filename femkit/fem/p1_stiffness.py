@@ -3,6 +3,9 @@
 With ``e_a`` the edge of triangle T opposite vertex ``a``, ``grad N_a = rot(e_a) / (2 A)``,
 so the local matrix is ``kappa_e (e_a . e_b) / (4 |T_e|)``: computed for all elements at once
 as an (m, 3, 3) array and summed into CSR through a cached :class:`SparsityPattern`.
+On tetrahedra ``grad N_a = g_a / D`` with ``g_1 = b x c``, ``g_2 = c x a``, ``g_3 = a x b``
+(``a, b, c`` the edges from vertex 0, ``D = 6 V``) and ``g_0 = -(g_1 + g_2 + g_3)``, so the
+local matrix is ``kappa_e (g_a . g_b) / (6 |D|)``, (m, 4, 4).
 
 >>> import numpy as np
 >>> from femkit.mesh import Mesh
@@ -16,19 +19,24 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ._elements import check_areas, select_elements
+from ._elements import check_areas, select_elements, tetrahedron_geometry
 from .coefficients import Coefficient, element_coefficient
 from ..errors import InputError
 from .sparsity import NUMBA_THRESHOLD, SparsityPattern
 
 
 def local_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None) -> np.ndarray:
-    """Local P1 stiffness matrices of the selected elements, shape (k, 3, 3).
+    """Local P1 stiffness matrices of the selected elements, shape (k, 3, 3) (triangles) or
+    (k, 4, 4) (tetrahedra).
 
     Raises :class:`~femkit.errors.InputError` for a non-positive or non-finite ``kappa`` and
-    :class:`~femkit.errors.DegenerateMeshError` for zero-area triangles.
+    :class:`~femkit.errors.DegenerateMeshError` for zero-area triangles / zero-volume tetrahedra.
     """
     idx = select_elements(mesh, elements)
+    if mesh.dim == 3:
+        grads, volume, _, _ = tetrahedron_geometry(mesh, idx)
+        scale = element_coefficient(mesh, kappa, idx) * volume
+        return np.einsum("mad,mbd->mab", grads, grads) * scale[:, None, None]
     ex, ey, area = edge_components(mesh, idx)
     scale = element_coefficient(mesh, kappa, idx) / (4.0 * area)
     local = np.empty((len(area), 3, 3))
@@ -72,7 +80,7 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
     Parameters
     ----------
     mesh : Mesh
-    kappa : float, (m,) array, dict {cell tag or name: value} or callable kappa(x, y)
+    kappa : float, (m,) array, dict {cell tag or name: value} or callable kappa(x, y[, z])
         Diffusion coefficient, constant per element (callables are evaluated at barycentres).
     elements : index array or boolean mask, optional
         Assemble only these elements (a partition); the result keeps the global shape, so the
@@ -80,7 +88,7 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
     pattern : SparsityPattern, optional
         A pattern built for this mesh; by default the mesh's cached pattern is used.
     backend : {"auto", "numpy", "numba"}
-        ``numpy``: (m, 3, 3) local matrices + ``np.bincount``; ``numba``: one fused compiled
+        ``numpy``: (m, w, w) local matrices + ``np.bincount``; ``numba``: one fused compiled
         loop (imported lazily, cached on disk); ``auto``: numba from
         :data:`~femkit.fem.sparsity.NUMBA_THRESHOLD` selected elements on.  A first numba
         assembly of the whole mesh without a cached pattern builds the pattern and sums the
@@ -95,12 +103,12 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
     if backend not in ("auto", "numpy", "numba"):
         raise InputError(f"unknown assembly backend {backend!r}; valid: auto, numba, numpy")
     idx = select_elements(mesh, elements)
-    count = mesh.n_triangles if idx is None else len(idx)
+    count = mesh.n_cells if idx is None else len(idx)
     if backend == "auto":
         backend = "numba" if count >= NUMBA_THRESHOLD else "numpy"
     if pattern is None:
         pattern = SparsityPattern.cached(mesh)
-        if pattern is None and backend == "numba" and idx is None:
+        if pattern is None and backend == "numba" and idx is None and mesh.dim == 2:
             # first assembly on a large mesh: pattern, slots and stiffness in one pass
             pattern, data = SparsityPattern.with_stiffness(mesh, _kernel_coefficient(mesh, kappa, None))
             if data is not None:

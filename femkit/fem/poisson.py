@@ -52,7 +52,7 @@ import numpy as np
 from ..errors import InputError, PureNeumannError, SingularSystemError  # noqa: F401 (re-exported)
 from ..mesh.edges import boundary_nodes
 from ..timing import StageTimer
-from ._elements import select_elements, triangle_geometry
+from ._elements import select_elements, simplex_gradients, triangle_geometry
 from .coefficients import Coefficient, evaluate_callable
 from .dirichlet import DirichletSystem, apply_dirichlet, dirichlet_values
 from .load import assemble_load
@@ -69,12 +69,16 @@ COMPATIBILITY_RTOL = 1e-3
 
 
 def node_weights(mesh, *, elements=None) -> np.ndarray:
-    """``w_i = int N_i dx`` (one third of the area of each triangle around node i); ``sum w = |Omega|``.
+    """``w_i = int N_i dx`` (a third of the area of each triangle, a quarter of the volume of each
+    tetrahedron around node i); ``sum w = |Omega|``.
 
     >>> from femkit.mesh import Mesh
     >>> node_weights(Mesh(np.array([[0., 0.], [3., 0.], [0., 2.]]), np.array([[0, 1, 2]]))).tolist()
     [1.0, 1.0, 1.0]
     """
+    if mesh.dim == 3:
+        _, vol, tets = simplex_gradients(mesh, select_elements(mesh, elements))
+        return np.bincount(tets.ravel(), weights=np.repeat(vol / 4.0, 4), minlength=mesh.n_points)
     _, area, _, tri = triangle_geometry(mesh, select_elements(mesh, elements))
     return np.bincount(tri.ravel(), weights=np.repeat(area / 3.0, 3), minlength=mesh.n_points)
 
@@ -238,11 +242,15 @@ def mean_shift_parts(mesh, u: np.ndarray, exact: Callable, *, order: int = 5,
     selected elements' nodes)."""
     from .quadrature import rule_for_degree
 
-    rule = rule_for_degree(order)
-    _, area, _, tri = triangle_geometry(mesh, select_elements(mesh, elements))
-    x, y = rule.physical_points(mesh, tri)
-    exact_integral = float(area @ (evaluate_callable(exact, x, y, name="exact") @ rule.weights))
-    uh_integral = float((area / 3.0) @ np.asarray(u, dtype=np.float64)[tri].sum(axis=1))
+    rule = rule_for_degree(order, mesh.dim)
+    idx = select_elements(mesh, elements)
+    if mesh.dim == 3:
+        _, area, tri = simplex_gradients(mesh, idx)
+    else:
+        _, area, _, tri = triangle_geometry(mesh, idx)
+    xy = rule.physical_points(mesh, tri)
+    exact_integral = float(area @ (evaluate_callable(exact, *xy, name="exact") @ rule.weights))
+    uh_integral = float((area / (mesh.dim + 1.0)) @ np.asarray(u, dtype=np.float64)[tri].sum(axis=1))
     return uh_integral, exact_integral, float(area.sum())
 
 
@@ -259,15 +267,18 @@ class PoissonProblem:
     Parameters
     ----------
     mesh : Mesh
+        Triangles or tetrahedra; on tetrahedra every callable takes ``(x, y, z)``.
     kappa : float, (m,) array, {cell tag or name: value} or callable kappa(x, y)
     f : float or callable f(x, y)
     dirichlet : sequence of (tags or None, g)
-        ``u = g`` on boundary edges with those tags (``None``: the whole boundary, found
-        topologically); ``g`` a number, callable g(x, y). Later entries win on shared nodes.
+        ``u = g`` on boundary facets (edges, faces) with those tags (``None``: the whole
+        boundary, found topologically); ``g`` a number, callable g(x, y). Later entries win on
+        shared nodes.
     neumann : sequence of (tags, h)
-        Outward flux ``kappa du/dn = h`` on those boundary edges.
+        Outward flux ``kappa du/dn = h`` on those boundary facets.
     load_rule : str
-        Quadrature rule of the load (``barycentric`` default; ``gauss3``, ``gauss6``, ``gauss7``).
+        Quadrature rule of the load (``barycentric`` default; triangles ``gauss3``, ``gauss6``,
+        ``gauss7``; tetrahedra ``gauss4``, ``stroud8``, ``stroud27``, ``stroud64``).
     nullspace : {"mean_zero", "pin", "error"}, optional
         Only without Dirichlet data (pure Neumann, ``dirichlet=[]``): how the constant is
         fixed (default ``mean_zero``; see the module docstring). Giving it together with

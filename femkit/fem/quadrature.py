@@ -1,12 +1,19 @@
-"""Quadrature rules on triangles, by name.
+"""Quadrature rules on triangles and tetrahedra, by name.
 
 A rule is barycentric points ``(q, 3)`` and weights ``(q,)`` summing to 1 (multiply by the
 triangle area).  Registry :data:`QUADRATURE`: ``barycentric`` (1 point, degree 1), ``gauss3``
 (3 interior points, degree 2), ``gauss6`` (Dunavant, degree 4), ``gauss7`` (Dunavant, degree 5).
 
+Tetrahedra have their own registry :data:`TET_QUADRATURE` (``get_rule(name, dim=3)``):
+``barycentric`` (1 point, degree 1), ``gauss4`` (4 points, degree 2; Keast 1986) and the
+conical-product (Stroud 1971, collapsed Gauss-Jacobi) rules ``stroud8`` (degree 3),
+``stroud27`` (degree 5) and ``stroud64`` (degree 7).
+
 >>> rule = get_rule("gauss6")
 >>> rule.degree, rule.points.shape, round(float(rule.weights.sum()), 15)
 (4, (6, 3), 1.0)
+>>> get_rule("stroud27", dim=3).points.shape
+(27, 4)
 """
 
 from __future__ import annotations
@@ -21,21 +28,25 @@ from ..registry import Registry
 
 @dataclass(frozen=True)
 class TriangleRule:
-    """A quadrature rule: barycentric ``points`` (q, 3), ``weights`` (q,) summing to 1, exact ``degree``."""
+    """A quadrature rule: barycentric ``points`` (q, d + 1), ``weights`` (q,) summing to 1,
+    exact ``degree`` (``d = 2`` triangles, ``d = 3`` tetrahedra)."""
 
     name: str
     points: np.ndarray
     weights: np.ndarray
     degree: int
 
-    def physical_points(self, mesh, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Coordinates ``(x, y)`` of the points on each triangle, each shape (m, q)."""
-        p = mesh.points[tri]  # (m, 3, 2)
+    def physical_points(self, mesh, tri: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Coordinates ``(x, y)`` (``(x, y, z)`` on tetrahedra) of the points on each cell,
+        each shape (m, q)."""
+        p = mesh.points[tri]  # (m, d + 1, d)
         xy = np.einsum("qa,mad->dmq", self.points, p)
-        return xy[0], xy[1]
+        return tuple(xy)
 
 
 QUADRATURE: Registry[TriangleRule] = Registry("quadrature rule")
+TET_QUADRATURE: Registry[TriangleRule] = Registry("tetrahedron quadrature rule")
+_REGISTRIES = {2: QUADRATURE, 3: TET_QUADRATURE}
 
 
 def _orbit3(a: float) -> list[tuple[float, float, float]]:
@@ -46,7 +57,28 @@ def _orbit3(a: float) -> list[tuple[float, float, float]]:
 def _rule(name, pts, wts, degree):
     pts = np.asarray(pts, dtype=np.float64)
     wts = np.asarray(wts, dtype=np.float64)
-    QUADRATURE.register(name, TriangleRule(name, pts, wts / wts.sum(), degree))
+    _REGISTRIES[pts.shape[1] - 1].register(name, TriangleRule(name, pts, wts / wts.sum(), degree))
+
+
+def conical_product_points(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Stroud's conical-product rule on the tetrahedron with ``n^3`` points, exact to degree
+    ``2 n - 1``: Gauss-Jacobi points in the collapsed coordinates ``x = u``,
+    ``y = v (1 - u)``, ``z = w (1 - u)(1 - v)`` (weights ``(1 - u)^2`` and ``(1 - v)`` taken
+    into the Jacobi weights). Returns barycentric points (n^3, 4) and weights summing to 1.
+    """
+    from scipy.special import roots_jacobi
+
+    tu, wu = roots_jacobi(n, 2.0, 0.0)
+    tv, wv = roots_jacobi(n, 1.0, 0.0)
+    tw, ww = roots_jacobi(n, 0.0, 0.0)
+    u, v, w = (0.5 * (1.0 + t) for t in (tu, tv, tw))
+    U, V, W = np.meshgrid(u, v, w, indexing="ij")
+    weights = np.einsum("i,j,k->ijk", wu, wv, ww).ravel()
+    x = U.ravel()
+    y = (V * (1.0 - U)).ravel()
+    z = (W * (1.0 - U) * (1.0 - V)).ravel()
+    pts = np.column_stack([1.0 - x - y - z, x, y, z])
+    return pts, weights / weights.sum()
 
 
 _rule("barycentric", [(1 / 3, 1 / 3, 1 / 3)], [1.0], 1)
@@ -59,20 +91,32 @@ _rule("gauss7", [(1 / 3, 1 / 3, 1 / 3)] + _orbit3(0.470142064105115) + _orbit3(0
       [0.225] + [0.132394152788506] * 3 + [0.125939180544827] * 3, 5)
 
 
-def get_rule(name: str) -> TriangleRule:
-    """The rule registered as ``name``; :class:`~femkit.errors.UnknownNameError` otherwise."""
-    return QUADRATURE.get(name)
+# tetrahedra: the centroid; Keast (1986) degree 2; conical products of degree 3, 5 and 7
+_rule("barycentric", [(0.25, 0.25, 0.25, 0.25)], [1.0], 1)
+_A4, _B4 = 0.1381966011250105, 0.5854101966249685
+_rule("gauss4", [(_B4, _A4, _A4, _A4), (_A4, _B4, _A4, _A4), (_A4, _A4, _B4, _A4),
+                 (_A4, _A4, _A4, _B4)], [0.25] * 4, 2)
+for _n, _deg in ((2, 3), (3, 5), (4, 7)):
+    _rule(f"stroud{_n ** 3}", *conical_product_points(_n), _deg)
 
 
-def rule_for_degree(degree: int) -> TriangleRule:
-    """The cheapest registered rule exact for polynomials of total degree ``degree``.
+def get_rule(name: str, dim: int = 2) -> TriangleRule:
+    """The rule registered as ``name`` for triangles (``dim=2``) or tetrahedra (``dim=3``);
+    :class:`~femkit.errors.UnknownNameError` (listing the valid names) otherwise."""
+    return _REGISTRIES[dim].get(name)
+
+
+def rule_for_degree(degree: int, dim: int = 2) -> TriangleRule:
+    """The cheapest registered rule exact for polynomials of total degree ``degree`` on
+    triangles (``dim=2``) or tetrahedra (``dim=3``).
 
     Raises
     ------
     InputError
         No registered rule is exact for that degree (the highest available is named).
     """
-    rules = sorted((QUADRATURE.get(n) for n in QUADRATURE), key=lambda r: (len(r.weights), r.degree))
+    reg = _REGISTRIES[dim]
+    rules = sorted((reg.get(n) for n in reg), key=lambda r: (len(r.weights), r.degree))
     for r in rules:
         if r.degree >= degree:
             return r

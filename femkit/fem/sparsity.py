@@ -1,8 +1,9 @@
 """The CSR sparsity pattern of P1 assembly, computed once per mesh and reused.
 
 A :class:`SparsityPattern` holds ``indptr`` and ``indices`` of the global matrix and
-``slots`` (m, 9): the position in CSR ``data`` of each local entry ``(e, a, b)`` (row
-``triangles[e, a]``, column ``triangles[e, b]``, flattened as ``3 a + b``).  Assembling a
+``slots`` (m, w * w): the position in CSR ``data`` of each local entry ``(e, a, b)`` (row
+``cells[e, a]``, column ``cells[e, b]``, flattened as ``w a + b``; ``w`` = 3 for triangles,
+4 for tetrahedra).  Assembling a
 new set of local matrices on the same mesh is then one ``np.bincount``.
 
 >>> import numpy as np
@@ -43,9 +44,9 @@ class SparsityPattern:
         Matrix size (number of mesh points).
     indptr, indices : ndarray
         CSR structure with sorted column indices (int32 when it fits).
-    slots : ndarray, shape (m, 9)
-        ``slots[e, 3 a + b]`` is the index into CSR ``data`` of entry
-        ``(triangles[e, a], triangles[e, b])`` (int32 from the compiled builder when the
+    slots : ndarray, shape (m, w * w)
+        ``slots[e, w a + b]`` is the index into CSR ``data`` of entry
+        ``(cells[e, a], cells[e, b])`` (int32 from the compiled builder when the
         entry count fits, else int64).
     """
 
@@ -71,9 +72,9 @@ class SparsityPattern:
         backend : {"auto", "numpy", "numba"}
             ``numpy``: ``np.unique`` over the 9 m (row, col) keys; ``numba``: a compiled
             O(m) counting-sort kernel (imported lazily, cached on disk);
-            ``auto``: numba for meshes of at least :data:`NUMBA_THRESHOLD` triangles.
+            ``auto``: numba for meshes of at least :data:`NUMBA_THRESHOLD` cells.
         """
-        tri = mesh.triangles
+        tri = mesh.cells
         n = mesh.n_points
         if backend == "auto":
             backend = "numba" if len(tri) >= NUMBA_THRESHOLD else "numpy"
@@ -123,10 +124,11 @@ class SparsityPattern:
 
     def check(self, mesh) -> None:
         """Raise :class:`InputError` if this pattern does not belong to ``mesh``'s size."""
-        if self.n != mesh.n_points or self.n_elements != mesh.n_triangles:
+        width = int(round(np.sqrt(self.slots.shape[1]))) if self.slots.ndim == 2 else 3
+        if self.n != mesh.n_points or self.n_elements != mesh.n_cells or width != mesh.dim + 1:
             raise InputError(
-                f"sparsity pattern is for {self.n} nodes / {self.n_elements} triangles, "
-                f"mesh has {mesh.n_points} / {mesh.n_triangles}"
+                f"sparsity pattern is for {self.n} nodes / {self.n_elements} cells of "
+                f"{width} nodes, mesh has {mesh.n_points} / {mesh.n_cells} of {mesh.dim + 1}"
             )
 
     def assemble(self, local: np.ndarray, elements=None) -> sp.csr_matrix:
@@ -134,7 +136,7 @@ class SparsityPattern:
 
         Parameters
         ----------
-        local : ndarray, shape (k, 3, 3) or (k, 9)
+        local : ndarray, shape (k, w, w) or (k, w * w)
             Local matrices of the selected elements (all ``m`` when ``elements`` is None).
         elements : index array or boolean mask, optional
             Which elements ``local`` belongs to; the result still has the global shape and
@@ -142,7 +144,7 @@ class SparsityPattern:
         """
         idx = None if elements is None else _normalise(self, elements)
         slots = self.slots if idx is None else self.slots[idx]
-        local = np.asarray(local, dtype=np.float64).reshape(len(slots), 9)
+        local = np.asarray(local, dtype=np.float64).reshape(len(slots), self.slots.shape[1])
         return self.matrix(np.bincount(slots.ravel(), weights=local.ravel(), minlength=self.nnz))
 
     def matrix(self, data: np.ndarray) -> sp.csr_matrix:
@@ -154,20 +156,20 @@ class SparsityPattern:
 
 
 def _normalise(pattern: SparsityPattern, elements):
-    class _Shape:  # select_elements only needs n_triangles
-        n_triangles = pattern.n_elements
+    class _Shape:  # select_elements only needs n_cells
+        n_cells = pattern.n_elements
 
     return select_elements(_Shape, elements)
 
 
 def _pattern_numpy(tri: np.ndarray, n: int):
-    m = len(tri)
-    rows = np.repeat(tri, 3, axis=1).ravel()  # (e, a, b) -> tri[e, a]
-    cols = np.tile(tri, (1, 3)).ravel()  # (e, a, b) -> tri[e, b]
+    m, w = tri.shape
+    rows = np.repeat(tri, w, axis=1).ravel()  # (e, a, b) -> tri[e, a]
+    cols = np.tile(tri, (1, w)).ravel()  # (e, a, b) -> tri[e, b]
     keys = rows * np.int64(n) + cols
     uniq, inv = np.unique(keys, return_inverse=True)
     indices = uniq % n
     counts = np.bincount(uniq // n, minlength=n)
     indptr = np.zeros(n + 1, dtype=np.int64)
     np.cumsum(counts, out=indptr[1:])
-    return indptr, indices, inv.reshape(m, 9).astype(np.intp, copy=False)
+    return indptr, indices, inv.reshape(m, w * w).astype(np.intp, copy=False)

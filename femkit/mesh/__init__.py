@@ -1,4 +1,4 @@
-"""Meshes: the record, gmsh generation, meshio I/O, validation, uniform and adaptive
+"""Meshes (triangles in 2D, tetrahedra in 3D): the record, gmsh generation, meshio I/O, validation, uniform and adaptive
 (newest-vertex bisection) refinement, nested hierarchies, renumbering, quality.
 
 Importing this package is cheap: gmsh and meshio are imported inside the functions that need
@@ -7,14 +7,16 @@ them (generation and file I/O).
 
 from .bisect import Bisection, bisect, label_longest_edge
 from .edges import boundary_edges_topological, boundary_nodes, edges
+from .faces import boundary_faces_topological, faces
 from .geometries import GEOMETRIES, generate, geo_file
+from . import geometries3d  # noqa: F401  (registers the solid geometries in GEOMETRIES)
 from .hierarchy import MeshHierarchy
 from .io import read_mesh, write_mesh
 from .mesh import Mesh
 from .quality import quality
 from .refine import refine, refine_once
 from .renumber import permute_nodes, rcm_permutation, renumber
-from .structured import grid_triangles, structured_mesh
+from .structured import grid_triangles, structured_box, structured_mesh
 from .validate import check_tags, orient_ccw, remove_unreferenced, validate
 
 __all__ = [
@@ -22,5 +24,5 @@ __all__ = [
     "check_tags", "remove_unreferenced", "orient_ccw", "refine", "quality", "boundary_nodes",
     "boundary_edges_topological", "edges", "structured_mesh", "grid_triangles",
     "bisect", "label_longest_edge", "Bisection", "refine_once", "MeshHierarchy", "renumber",
-    "rcm_permutation", "permute_nodes",
+    "rcm_permutation", "permute_nodes", "structured_box", "faces", "boundary_faces_topological",
 ]

@@ -1,4 +1,4 @@
-"""Edges of a triangle mesh and its boundary (by tags, or topologically).
+"""Edges of a triangle or tetrahedral mesh, and the boundary of a mesh (by tags, or topologically).
 
 >>> import numpy as np
 >>> from femkit.mesh import Mesh
@@ -19,9 +19,16 @@ from .mesh import Mesh
 __all__ = ["edges", "boundary_edges_topological", "boundary_nodes", "edge_ids", "boundary_edge_ids"]
 
 
-def _local_edges(tri: np.ndarray) -> np.ndarray:
-    """(m, 3, 2) local edges; edge k is opposite vertex k: (v1, v2), (v2, v0), (v0, v1)."""
-    return tri[:, [[1, 2], [2, 0], [0, 1]]]
+#: Local edges of a triangle (edge k opposite vertex k) and of a tetrahedron (Bey's order:
+#: 01, 02, 03, 12, 13, 23).
+LOCAL_EDGES = {3: np.array([[1, 2], [2, 0], [0, 1]]),
+               4: np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])}
+
+
+def _local_edges(cells: np.ndarray) -> np.ndarray:
+    """(m, k, 2) local edges: triangles (v1, v2), (v2, v0), (v0, v1); tetrahedra
+    :data:`LOCAL_EDGES`."""
+    return cells[:, LOCAL_EDGES[cells.shape[1]]]
 
 
 def edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
@@ -31,15 +38,17 @@ def edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     -------
     edge_nodes : (E, 2) int64
         Node pairs, each sorted ascending, rows sorted lexicographically.
-    tri_edges : (m, 3) int64
-        ``tri_edges[t, k]`` is the edge of triangle ``t`` opposite its local vertex ``k``.
+    cell_edges : (m, 3) or (m, 6) int64
+        ``cell_edges[t, k]`` is the edge of triangle ``t`` opposite its local vertex ``k``, or
+        the local edge ``k`` of a tetrahedron (:data:`LOCAL_EDGES`).
     """
     n = max(mesh.n_points, 1)
-    loc = _local_edges(mesh.triangles).reshape(-1, 2)
+    k = 3 if mesh.dim == 2 else 6
+    loc = _local_edges(mesh.cells).reshape(-1, 2)
     lo, hi = loc.min(axis=1), loc.max(axis=1)
     keys, inverse = np.unique(lo * n + hi, return_inverse=True)
     edge_nodes = np.stack([keys // n, keys % n], axis=1)
-    return edge_nodes, inverse.reshape(-1, 3).astype(np.int64)
+    return edge_nodes, inverse.reshape(-1, k).astype(np.int64)
 
 
 def boundary_edges_topological(mesh: Mesh) -> np.ndarray:
@@ -55,19 +64,23 @@ def boundary_edges_topological(mesh: Mesh) -> np.ndarray:
 
 
 def boundary_nodes(mesh: Mesh, tags: Iterable | str | int | None = None) -> np.ndarray:
-    """Sorted node ids on boundary edges carrying any of ``tags``.
+    """Sorted node ids on boundary facets (edges in 2D, faces in 3D) carrying any of ``tags``.
 
-    ``tags=None`` finds the whole boundary topologically (edges of exactly one triangle).
+    ``tags=None`` finds the whole boundary topologically (facets of exactly one cell).
     Names and numbers are checked with :func:`femkit.mesh.validate.check_tags` (a missing tag
     raises :class:`~femkit.errors.MeshError` listing the available ones).
     """
     if tags is None:
+        if mesh.dim == 3:
+            from .faces import boundary_faces_topological
+
+            return np.unique(boundary_faces_topological(mesh))
         return np.unique(boundary_edges_topological(mesh))
     from .validate import check_tags
 
     nums = check_tags(mesh, tags, kind="boundary")
     sel = np.isin(mesh.boundary_tags, nums)
-    return np.unique(mesh.boundary_edges[sel])
+    return np.unique(mesh.boundary_facets[sel])
 
 
 def edge_ids(mesh: Mesh, edge_nodes: np.ndarray, pairs: np.ndarray) -> np.ndarray:

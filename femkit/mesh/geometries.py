@@ -142,7 +142,7 @@ def register_geometry(name: str, *, measure: Callable[..., tuple[float, float]],
     return decorator
 
 #: gmsh element type numbers
-_GMSH_LINE, _GMSH_TRIANGLE = 1, 2
+_GMSH_LINE, _GMSH_TRIANGLE, _GMSH_TETRA = 1, 2, 4
 
 
 def _positive(name: str, value) -> float:
@@ -184,6 +184,8 @@ def _gmsh_session(name: str) -> Iterator[object]:
         gmsh.option.setNumber("General.Verbosity", 0)
         gmsh.option.setNumber("General.NumThreads", 1)
         gmsh.option.setNumber("Mesh.MaxNumThreads2D", 1)
+        gmsh.option.setNumber("Mesh.MaxNumThreads3D", 1)
+        gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay
         gmsh.option.setNumber("Mesh.RandomSeed", 1)
         gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay
         gmsh.option.setNumber("Mesh.ElementOrder", 1)
@@ -225,75 +227,79 @@ def _set_size(gmsh, h: float) -> None:
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
 
 
-def _mesh_from_gmsh(gmsh) -> Mesh:
-    """Turn the current gmsh model (already meshed in 2D) into a :class:`Mesh`.
+def _mesh_from_gmsh(gmsh, dim: int = 2) -> Mesh:
+    """Turn the current gmsh model (already meshed in ``dim`` = 2 or 3) into a :class:`Mesh`.
 
-    Triangles: when the model has 2D physical groups, only triangles of surfaces in a physical
-    group are kept (gmsh's own rule when saving), each tagged with its group (the first group
-    when a surface is in several); otherwise all triangles, tag 0. Nodes not used by any kept
-    triangle are dropped (e.g. circle centres); node order follows gmsh's node tags.
+    Cells (triangles in 2D, tetrahedra in 3D): when the model has physical groups of that
+    dimension, only cells of entities in a physical group are kept (gmsh's own rule when
+    saving), each tagged with its group (the first group when an entity is in several);
+    otherwise all cells, tag 0. Facets (edges, triangles) of the physical groups of dimension
+    ``dim - 1`` become the tagged boundary. Nodes not used by any kept cell are dropped (e.g.
+    circle centres); node order follows gmsh's node tags.
     """
     model = gmsh.model
+    cell_code, facet_code = (_GMSH_TRIANGLE, _GMSH_LINE) if dim == 2 else (_GMSH_TETRA, _GMSH_TRIANGLE)
+    width = dim + 1
     node_tags, coords, _ = model.mesh.getNodes(-1, -1, includeBoundary=True,
                                                returnParametricCoord=False)
     node_tags = np.asarray(node_tags, dtype=np.int64)
     xyz = np.asarray(coords, dtype=np.float64).reshape(-1, 3)
 
+    def blocks_of(entity_dim: int, ent: int, code: int, w: int):
+        types, _, enodes = model.mesh.getElements(entity_dim, ent)
+        return [np.asarray(nodes, np.int64).reshape(-1, w) for t, nodes in zip(types, enodes)
+                if t == code]
+
     tri_blocks, tag_blocks = [], []
     names: dict[str, int] = {}
-    groups2 = model.getPhysicalGroups(2)
-    if groups2:
+    groups = model.getPhysicalGroups(dim)
+    if groups:
         seen_entities: set[int] = set()
-        for dim, ptag in groups2:
-            name = model.getPhysicalName(dim, ptag)
+        for gdim, ptag in groups:
+            name = model.getPhysicalName(gdim, ptag)
             if name:
                 names[name] = int(ptag)
-            for ent in model.getEntitiesForPhysicalGroup(dim, ptag):
+            for ent in model.getEntitiesForPhysicalGroup(gdim, ptag):
                 if int(ent) in seen_entities:
                     continue
                 seen_entities.add(int(ent))
-                types, _, enodes = model.mesh.getElements(2, int(ent))
-                for t, nodes in zip(types, enodes):
-                    if t == _GMSH_TRIANGLE:
-                        tri_blocks.append(np.asarray(nodes, np.int64).reshape(-1, 3))
-                        tag_blocks.append(np.full(len(tri_blocks[-1]), ptag, np.int32))
+                for b in blocks_of(dim, int(ent), cell_code, width):
+                    tri_blocks.append(b)
+                    tag_blocks.append(np.full(len(b), ptag, np.int32))
     else:
-        for _, ent in model.getEntities(2):
-            types, _, enodes = model.mesh.getElements(2, ent)
-            for t, nodes in zip(types, enodes):
-                if t == _GMSH_TRIANGLE:
-                    tri_blocks.append(np.asarray(nodes, np.int64).reshape(-1, 3))
-                    tag_blocks.append(np.zeros(len(tri_blocks[-1]), np.int32))
+        for _, ent in model.getEntities(dim):
+            for b in blocks_of(dim, ent, cell_code, width):
+                tri_blocks.append(b)
+                tag_blocks.append(np.zeros(len(b), np.int32))
     if not tri_blocks:
         found = sorted({gmsh.model.mesh.getElementProperties(int(t))[0]
-                        for t in model.mesh.getElementTypes(2)})
-        raise MeshError("gmsh produced no linear triangles"
-                        + (f" (found 2D element types: {', '.join(found)})" if found else ""))
+                        for t in model.mesh.getElementTypes(dim)})
+        what = "linear triangles" if dim == 2 else "linear tetrahedra"
+        raise MeshError(f"gmsh produced no {what}"
+                        + (f" (found {dim}D element types: {', '.join(found)})" if found else ""))
     tri_gmsh = np.concatenate(tri_blocks)
     cell_tags = np.concatenate(tag_blocks)
 
     edge_blocks, etag_blocks = [], []
-    for dim, ptag in model.getPhysicalGroups(1):
-        name = model.getPhysicalName(dim, ptag)
+    for gdim, ptag in model.getPhysicalGroups(dim - 1):
+        name = model.getPhysicalName(gdim, ptag)
         if name:
             names[name] = int(ptag)
-        for ent in model.getEntitiesForPhysicalGroup(dim, ptag):
-            types, _, enodes = model.mesh.getElements(1, int(ent))
-            for t, nodes in zip(types, enodes):
-                if t == _GMSH_LINE:
-                    edge_blocks.append(np.asarray(nodes, np.int64).reshape(-1, 2))
-                    etag_blocks.append(np.full(len(edge_blocks[-1]), ptag, np.int32))
-    edges_gmsh = np.concatenate(edge_blocks) if edge_blocks else np.zeros((0, 2), np.int64)
+        for ent in model.getEntitiesForPhysicalGroup(gdim, ptag):
+            for b in blocks_of(dim - 1, int(ent), facet_code, dim):
+                edge_blocks.append(b)
+                etag_blocks.append(np.full(len(b), ptag, np.int32))
+    edges_gmsh = np.concatenate(edge_blocks) if edge_blocks else np.zeros((0, dim), np.int64)
     edge_tags = np.concatenate(etag_blocks) if etag_blocks else np.zeros(0, np.int32)
 
-    # compact numbering: keep nodes used by triangles, in gmsh tag order
+    # compact numbering: keep nodes used by cells, in gmsh tag order
     order = np.argsort(node_tags, kind="stable")
     sorted_tags = node_tags[order]
     used = np.unique(tri_gmsh)
     pos = np.searchsorted(sorted_tags, used)
     if np.any(pos >= len(sorted_tags)) or np.any(sorted_tags[np.minimum(pos, len(sorted_tags) - 1)] != used):
-        raise MeshError("gmsh returned triangles referring to unknown nodes")
-    points = xyz[order[pos], :2]
+        raise MeshError("gmsh returned cells referring to unknown nodes")
+    points = xyz[order[pos], :dim]
 
     def renumber(arr: np.ndarray) -> np.ndarray:
         idx = np.searchsorted(used, arr)
@@ -306,8 +312,8 @@ def _mesh_from_gmsh(gmsh) -> Mesh:
     keep = eok.all(axis=1) if len(e) else np.zeros(0, bool)
     from .validate import orient_ccw
 
-    return orient_ccw(Mesh(points=points, triangles=tri, cell_tags=cell_tags,
-                           boundary_edges=e[keep], boundary_tags=edge_tags[keep],
+    return orient_ccw(Mesh(points=points, cells=tri, cell_tags=cell_tags,
+                           boundary_facets=e[keep], boundary_tags=edge_tags[keep],
                            tag_names=names))
 
 
@@ -553,7 +559,8 @@ def square_with_inclusion(h: float, centre: Sequence[float] = (0.5, 0.5), radius
 
 
 def geo_file(path: str | os.PathLike, h: float | None = None) -> Mesh:
-    """Mesh a user ``.geo`` file in 2D with gmsh (physical groups become tags).
+    """Mesh a user ``.geo`` file with gmsh (physical groups become tags): in 3D when it defines
+    volumes (tetrahedra; physical surfaces become the tagged faces), else in 2D.
 
     Parameters
     ----------
@@ -579,10 +586,26 @@ def geo_file(path: str | os.PathLike, h: float | None = None) -> Mesh:
             if hv is not None:
                 gmsh.option.setNumber("Mesh.MeshSizeMax", hv)
             gmsh.option.setNumber("Mesh.ElementOrder", 1)
-            _generate(gmsh, 2)
+            dim = 3 if gmsh.model.getEntities(3) else 2
+            _generate(gmsh, dim)
         except Exception as exc:  # gmsh raises bare Exception with its last error
             raise MeshError(f"gmsh could not mesh {p}: {exc}") from None
-        return _mesh_from_gmsh(gmsh)
+        if dim == 3:
+            _refuse_unassigned_volumes(gmsh, p)
+        return _mesh_from_gmsh(gmsh, dim)
+
+
+def _refuse_unassigned_volumes(gmsh, path: str) -> None:
+    """A .geo with physical volumes that leave a volume out would lose its tetrahedra
+    silently (gmsh's saving rule): refuse it in one line."""
+    groups = gmsh.model.getPhysicalGroups(3)
+    if not groups:
+        return
+    grouped = {int(e) for _, t in groups for e in gmsh.model.getEntitiesForPhysicalGroup(3, t)}
+    loose = sorted(int(t) for _, t in gmsh.model.getEntities(3) if int(t) not in grouped)
+    if loose:
+        raise MeshError(f"{path}: volume(s) {', '.join(map(str, loose))} belong to no physical "
+                        "volume; add them to a Physical Volume (gmsh would drop their tetrahedra)")
 
 
 def generate(geometry: str, h: float, **params) -> Mesh:
@@ -608,3 +631,4 @@ def generate(geometry: str, h: float, **params) -> Mesh:
     entry = GEOMETRIES.get(geometry)
     entry.check_params(h, params)
     return entry.build(h, **params)
+

@@ -40,13 +40,16 @@ def _block_tags(mesh_io, i: int, n: int) -> np.ndarray:
 
 
 def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
-    """Read a triangle mesh; physical tags and names become ``cell_tags``/``boundary_tags``/``tag_names``.
+    """Read a triangle or tetrahedral mesh; physical tags and names become
+    ``cell_tags``/``boundary_tags``/``tag_names``.
+
+    A file with ``tetra`` cells is a 3D mesh: its triangles become the tagged boundary faces.
 
     Parameters
     ----------
     path : mesh file; the format is taken from the extension (``.msh`` v2 or v4, ``.vtu``,
         ``.xdmf`` and anything else meshio reads)
-    compact : drop nodes used by no triangle (e.g. geometry points such as circle centres that
+    compact : drop nodes used by no cell (e.g. geometry points such as circle centres that
         gmsh writes) and renumber, keeping the order of the rest
 
     Triangles are made counter-clockwise; a 3D point array whose z is zero is reduced to 2D.
@@ -55,7 +58,9 @@ def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
     ------
     MeshError
         Missing file (the path is named), a file meshio cannot read, no (linear) triangles
-        (the cell types found are named), mixed triangle/other 2D cells, or non-planar points.
+        (the cell types found are named), mixed triangle/other 2D cells, or non-planar points
+        without tetrahedra; for tetrahedra: other 3D cells, triangles that are not faces of
+        the tetrahedra (mixed dimensions), tetrahedra outside every physical volume.
     """
     p = os.fspath(path)
     if not os.path.isfile(p):
@@ -72,46 +77,53 @@ def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
         raise MeshError(unreadable_message(p)) from None
 
     types = [c.type for c in mio.cells]
-    tri_blocks, tri_tags, line_blocks, line_tags = [], [], [], []
+    dim = 3 if "tetra" in types else 2
+    cell_type, facet_type = _CELL_TYPE[dim]
+    cell_blocks, cell_tags, facet_blocks, facet_tags = [], [], [], []
     for i, block in enumerate(mio.cells):
         data = np.asarray(block.data, dtype=np.int64)
-        if block.type == "triangle":
-            tri_blocks.append(data)
-            tri_tags.append(_block_tags(mio, i, len(data)))
-        elif block.type == "line":
+        if block.type == cell_type:
+            cell_blocks.append(data)
+            cell_tags.append(_block_tags(mio, i, len(data)))
+        elif block.type == facet_type:
             tags = _block_tags(mio, i, len(data))
-            line_blocks.append(data)
-            line_tags.append(tags)
+            facet_blocks.append(data)
+            facet_tags.append(tags)
             # msh 4.1: an entity in several physical groups -> meshio keeps only the first in
-            # gmsh:physical but records every membership in cell_sets; repeat those edges
-            for name, (t, dim) in _groups(mio).items():
+            # gmsh:physical but records every membership in cell_sets; repeat those facets
+            for name, (t, gdim) in _groups(mio).items():
                 idx = (mio.cell_sets.get(name) or [None] * (i + 1))[i]
-                if dim != 1 or idx is None or len(idx) == 0:
+                if gdim != dim - 1 or idx is None or len(idx) == 0:
                     continue
                 idx = np.asarray(idx, dtype=np.int64)
                 extra = idx[tags[idx] != t]
                 if len(extra):
-                    line_blocks.append(data[extra])
-                    line_tags.append(np.full(len(extra), t, np.int32))
-    if not tri_blocks:
-        found = ", ".join(sorted(set(types))) or "no cells at all"
-        raise MeshError(f"{p} holds no linear triangles (found cell types: {found}); "
-                        "femkit needs a P1 triangle mesh")
-    other2d = sorted(set(types) - {"triangle", "line", "vertex"})
-    if other2d:
-        raise MeshError(f"{p} mixes triangles with other cells ({', '.join(other2d)}); "
-                        "femkit needs a pure linear-triangle mesh")
-
+                    facet_blocks.append(data[extra])
+                    facet_tags.append(np.full(len(extra), t, np.int32))
     pts = np.asarray(mio.points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] not in (2, 3):
         raise MeshError(f"{p}: points have shape {pts.shape}, expected (n, 2) or (n, 3)")
-    if pts.shape[1] == 3:
+    if not cell_blocks:
+        found = ", ".join(sorted(set(types))) or "no cells at all"
+        raise MeshError(f"{p} holds no linear triangles (found cell types: {found}); "
+                        "femkit needs a P1 triangle mesh")
+    allowed = {"triangle", "line", "vertex"} | ({"tetra"} if dim == 3 else set())
+    other = sorted(set(types) - allowed)
+    if other:
+        what = "tetrahedra" if dim == 3 else "triangles"
+        raise MeshError(f"{p} mixes {what} with other cells ({', '.join(other)}); "
+                        f"femkit needs a pure linear-{'tetrahedron' if dim == 3 else 'triangle'} mesh")
+    if dim == 2 and pts.shape[1] == 3:
         z = pts[:, 2]
         scale = max(float(np.abs(pts[:, :2]).max(initial=0.0)), 1.0)
         if np.abs(z).max(initial=0.0) > 1e-12 * scale:
             raise MeshError(f"{p}: points are not in the plane z = 0 "
-                            f"(|z| up to {np.abs(z).max():.3g}); femkit meshes are 2D")
+                            f"(|z| up to {np.abs(z).max():.3g}) and the file holds no tetrahedra: "
+                            "a surface, not a volume (gmsh saves only elements of physical groups:"
+                            " a volume with no physical group is left out)")
         pts = pts[:, :2]
+    if dim == 3 and pts.shape[1] != 3:
+        raise MeshError(f"{p}: tetrahedra need 3D points, got shape {pts.shape}")
 
     names: dict[str, int] = {}
     for name, val in (mio.field_data or {}).items():
@@ -120,19 +132,47 @@ def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
             names[str(name)] = int(arr[0])
     names.update(_read_extra_names(mio, p))
 
-    tri = np.concatenate(tri_blocks)
-    be = np.concatenate(line_blocks) if line_blocks else np.zeros((0, 2), np.int64)
-    bt = np.concatenate(line_tags) if line_tags else np.zeros(0, np.int32)
+    cells = np.concatenate(cell_blocks)
+    ct = np.concatenate(cell_tags)
+    be = np.concatenate(facet_blocks) if facet_blocks else np.zeros((0, dim), np.int64)
+    bt = np.concatenate(facet_tags) if facet_tags else np.zeros(0, np.int32)
     n = len(pts)
-    if tri.min(initial=0) < 0 or tri.max(initial=0) >= n:
-        raise MeshError(f"{p}: triangles refer to nodes outside 0..{n - 1}")
+    if cells.min(initial=0) < 0 or cells.max(initial=0) >= n:
+        raise MeshError(f"{p}: {'triangles' if dim == 2 else 'tetrahedra'} refer to nodes "
+                        f"outside 0..{n - 1}")
+    if dim == 3:
+        _check_volume_file(p, cells, ct, be, names, _groups(mio))
     from .validate import orient_ccw, remove_unreferenced
 
-    mesh = Mesh(points=pts, triangles=tri, cell_tags=np.concatenate(tri_tags),
-                boundary_edges=be, boundary_tags=bt, tag_names=names)
+    mesh = Mesh(points=pts, cells=cells, cell_tags=ct,
+                boundary_facets=be, boundary_tags=bt, tag_names=names)
     if compact:
         mesh = remove_unreferenced(mesh)
     return orient_ccw(mesh)
+
+
+def _check_volume_file(p: str, tets, tet_tags, tri, names, groups) -> None:
+    """Refuse, in one line, a tetrahedral file whose triangles are not faces of its
+    tetrahedra (a 2D domain beside the 3D one: mixed dimensions) or whose physical groups
+    leave some tetrahedra out (a volume with no physical group)."""
+    from .faces import LOCAL_FACES, unique_rows
+
+    if len(tri):
+        faces = np.sort(tets[:, LOCAL_FACES].reshape(-1, 3), axis=1)
+        uniq, _ = unique_rows(faces)
+        both, inv = unique_rows(np.concatenate([uniq, np.sort(tri, axis=1)]))
+        known = np.zeros(len(both), bool)
+        known[inv[:len(uniq)]] = True
+        loose = int((~known[inv[len(uniq):]]).sum())
+        if loose:
+            raise MeshError(f"{p} mixes dimensions: {loose} triangle(s) are not faces of its "
+                            f"{len(tets)} tetrahedra (a 2D domain beside the volume?); femkit "
+                            "needs one volume with its boundary faces")
+    has_volume_groups = any(d == 3 for _, d in groups.values())
+    untagged = int((tet_tags == 0).sum())
+    if has_volume_groups and untagged:
+        raise MeshError(f"{p}: {untagged} of {len(tets)} tetrahedra belong to no physical "
+                        "volume; add them to a Physical Volume (or remove the other groups)")
 
 
 #: What each extension must hold, for the messages of unreadable files.
@@ -209,7 +249,18 @@ def _read_extra_names(mio, path: str) -> dict[str, int]:
 
 def _tag_dims(mesh: Mesh) -> dict[str, int]:
     cells = set(np.unique(mesh.cell_tags).tolist())
-    return {name: (2 if int(t) in cells else 1) for name, t in mesh.tag_names.items()}
+    d = mesh.dim
+    return {name: (d if int(t) in cells else d - 1) for name, t in mesh.tag_names.items()}
+
+
+#: meshio cell type of the cells and of the boundary facets, per dimension
+_CELL_TYPE = {2: ("triangle", "line"), 3: ("tetra", "triangle")}
+#: gmsh element type numbers of the cells and of the facets, per dimension
+_GMSH_TYPE = {2: (2, 1), 3: (4, 2)}
+
+
+def _points3(mesh: Mesh) -> np.ndarray:
+    return mesh.points if mesh.dim == 3 else np.column_stack([mesh.points, np.zeros(mesh.n_points)])
 
 
 def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = None,
@@ -223,20 +274,22 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = No
         ``binary``; mesh and tags only, no data)),
         ``.vtu``, ``.xdmf`` or any other meshio format
     point_data : ``{name: (n,) or (n, k) array}``
-    cell_data : ``{name: (m,) or (m, k) array}`` on the triangles (tagged boundary edges get
+    cell_data : ``{name: (m,) or (m, k) array}`` on the cells (tagged boundary facets get
         zeros in the written file)
 
     Physical tags go to ``gmsh:physical`` / ``gmsh:geometrical`` on the ``triangle`` and
-    ``line`` blocks and names to ``field_data`` (see the module notes), so :func:`read_mesh`
-    gives back the same points, triangles and tags.
+    ``line`` blocks (``tetra`` and ``triangle`` for a tetrahedral mesh) and names to
+    ``field_data`` (see the module notes), so :func:`read_mesh` gives back the same points,
+    cells and tags.
     """
     p = os.fspath(path)
     ext = Path(p).suffix.lower()
-    m, k = mesh.n_triangles, len(mesh.boundary_edges)
-    cells = [("triangle", mesh.triangles)]
+    m, k = mesh.n_cells, len(mesh.boundary_facets)
+    cell_type, facet_type = _CELL_TYPE[mesh.dim]
+    cells = [(cell_type, mesh.cells)]
     with_lines = k > 0
     if with_lines:
-        cells.append(("line", mesh.boundary_edges))
+        cells.append((facet_type, mesh.boundary_facets))
 
     def per_block(tri_vals, line_vals):
         return [tri_vals, line_vals] if with_lines else [tri_vals]
@@ -248,7 +301,8 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = No
     for name, arr in (cell_data or {}).items():
         a = np.asarray(arr)
         if a.shape[0] != m:
-            raise MeshError(f"cell_data {name!r} has {a.shape[0]} rows, mesh has {m} triangles")
+            raise MeshError(f"cell_data {name!r} has {a.shape[0]} rows, mesh has {m} "
+                            f"{'triangles' if mesh.dim == 2 else 'tetrahedra'}")
         cdata[name] = per_block(a, np.zeros((k,) + a.shape[1:], a.dtype))
     pdata = {}
     for name, arr in (point_data or {}).items():
@@ -291,13 +345,16 @@ def _fmt_rows(arr: np.ndarray, fmt: str) -> str:
 
 
 def _write_msh41(path: str, mesh: Mesh, point_data: dict, cell_data: dict) -> None:
-    """ASCII gmsh 4.1 writer: one surface entity per cell tag, one curve entity per edge tag.
+    """ASCII gmsh 4.1 writer: one surface entity per cell tag, one curve entity per edge tag
+    (in 3D: one volume entity per cell tag, one surface entity per face tag).
 
-    An edge carrying several tags is written once per tag (in each tag's curve entity), so
-    gmsh and meshio read the same repeated edges back. Nodes are tagged 1..n in mesh order,
-    triangles 1..m in mesh order, then the edges.
+    A facet carrying several tags is written once per tag (in each tag's entity), so gmsh and
+    meshio read the same repeated facets back. Nodes are tagged 1..n in mesh order, cells
+    1..m in mesh order, then the facets.
     """
-    pts3 = np.column_stack([mesh.points, np.zeros(mesh.n_points)])
+    pts3 = _points3(mesh)
+    d = mesh.dim
+    cell_code, facet_code = _GMSH_TYPE[d]
     dims = _tag_dims(mesh)
     cell_vals = np.unique(mesh.cell_tags)
     edge_vals = np.unique(mesh.boundary_tags)
@@ -309,7 +366,9 @@ def _write_msh41(path: str, mesh: Mesh, point_data: dict, cell_data: dict) -> No
         for name, t in sorted(mesh.tag_names.items(), key=lambda kv: (dims[kv[0]], kv[1])):
             out.append(f'{dims[name]} {int(t)} "{name}"\n')
         out.append("$EndPhysicalNames\n")
-    out.append(f"$Entities\n0 {len(edge_vals)} {len(cell_vals)} 0\n")
+    counts = [0, 0, 0, 0]
+    counts[d - 1], counts[d] = len(edge_vals), len(cell_vals)
+    out.append(f"$Entities\n{' '.join(map(str, counts))}\n")
     for i, t in enumerate(edge_vals, start=1):
         phys = f"1 {int(t)}" if t != 0 else "0"
         out.append(f"{i} {box} {phys} 0\n")
@@ -318,30 +377,30 @@ def _write_msh41(path: str, mesh: Mesh, point_data: dict, cell_data: dict) -> No
         out.append(f"{i} {box} {phys} 0\n")
     out.append("$EndEntities\n")
     n = mesh.n_points
-    out.append(f"$Nodes\n1 {n} 1 {n}\n2 1 0 {n}\n")
+    out.append(f"$Nodes\n1 {n} 1 {n}\n{d} 1 0 {n}\n")
     out.append("\n".join(map(str, range(1, n + 1))) + "\n")
     out.append(_fmt_rows(pts3, "%.17g"))
     out.append("$EndNodes\n")
-    m, k = mesh.n_triangles, len(mesh.boundary_edges)
+    m, k = mesh.n_cells, len(mesh.boundary_facets)
     out.append(f"$Elements\n{len(cell_vals) + len(edge_vals)} {m + k} 1 {m + k}\n")
     ids = np.arange(1, m + 1)
     for i, t in enumerate(cell_vals, start=1):
         sel = np.flatnonzero(mesh.cell_tags == t)
-        out.append(f"2 {i} 2 {len(sel)}\n")
-        out.append(_fmt_rows(np.column_stack([ids[sel], mesh.triangles[sel] + 1]), "%d"))
+        out.append(f"{d} {i} {cell_code} {len(sel)}\n")
+        out.append(_fmt_rows(np.column_stack([ids[sel], mesh.cells[sel] + 1]), "%d"))
     eids = np.arange(m + 1, m + k + 1)
     for i, t in enumerate(edge_vals, start=1):
         sel = np.flatnonzero(mesh.boundary_tags == t)
-        out.append(f"1 {i} 1 {len(sel)}\n")
-        out.append(_fmt_rows(np.column_stack([eids[sel], mesh.boundary_edges[sel] + 1]), "%d"))
+        out.append(f"{d - 1} {i} {facet_code} {len(sel)}\n")
+        out.append(_fmt_rows(np.column_stack([eids[sel], mesh.boundary_facets[sel] + 1]), "%d"))
     out.append("$EndElements\n")
     out.append(_data_sections(mesh, point_data, cell_data))
     Path(path).write_text("".join(out))
 
 
 def _data_sections(mesh: Mesh, point_data: dict, cell_data: dict) -> str:
-    """ASCII ``$NodeData`` / ``$ElementData`` blocks (elements numbered triangles first, then edges)."""
-    n, m, k = mesh.n_points, mesh.n_triangles, len(mesh.boundary_edges)
+    """ASCII ``$NodeData`` / ``$ElementData`` blocks (elements numbered cells first, then facets)."""
+    n, m, k = mesh.n_points, mesh.n_cells, len(mesh.boundary_facets)
     out = []
     for name, a in point_data.items():
         a2 = np.asarray(a, dtype=np.float64).reshape(n, -1)

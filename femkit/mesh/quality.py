@@ -1,4 +1,4 @@
-"""Size and shape metrics of a triangle mesh.
+"""Size and shape metrics of a triangle or tetrahedral mesh.
 
 >>> import numpy as np
 >>> from femkit.mesh import Mesh
@@ -28,8 +28,71 @@ def side_lengths_and_angles(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return lens, np.degrees(np.arccos(cosang))
 
 
+def dihedral_angles(p: np.ndarray) -> np.ndarray:
+    """Dihedral angles (degrees) of tetrahedra given by their corners ``p`` (m, 4, 3), (m, 6).
+
+    Column order: at edges 23, 13, 12, 03, 02, 01 (the angle between the two faces through an
+    edge, from their outward normals: ``pi - angle(n_a, n_b)``).
+    """
+    from itertools import combinations
+
+    from .faces import LOCAL_FACES
+
+    normals = []
+    for f in LOCAL_FACES:
+        v = np.cross(p[:, f[1]] - p[:, f[0]], p[:, f[2]] - p[:, f[0]])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            normals.append(v / np.linalg.norm(v, axis=1)[:, None])
+    cos = [np.einsum("md,md->m", normals[a], normals[b]) for a, b in combinations(range(4), 2)]
+    return 180.0 - np.degrees(np.arccos(np.clip(np.stack(cos, axis=1), -1.0, 1.0)))
+
+
+def radius_ratios(p: np.ndarray) -> np.ndarray:
+    """``3 r_in / R_circ`` of tetrahedra with corners ``p`` (m, 4, 3): 1 for a regular one, 0
+    for a flat one."""
+    a, b, c = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]
+    vol6 = np.abs(np.einsum("md,md->m", a, np.cross(b, c)))
+    sq = lambda v: np.einsum("md,md->m", v, v)[:, None]  # noqa: E731
+    num = np.linalg.norm(sq(a) * np.cross(b, c) + sq(b) * np.cross(c, a) + sq(c) * np.cross(a, b), axis=1)
+    from .faces import LOCAL_FACES
+
+    face_area = sum(0.5 * np.linalg.norm(np.cross(p[:, f[1]] - p[:, f[0]], p[:, f[2]] - p[:, f[0]]), axis=1)
+                    for f in LOCAL_FACES)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r_in = 0.5 * vol6 / face_area          # 3 V / S
+        r_circ = num / (2.0 * vol6)            # |...| / (12 V)
+        return np.where(vol6 > 0, 3.0 * r_in / r_circ, 0.0)
+
+
+def _quality_3d(mesh: Mesh) -> dict:
+    from .edges import edges
+
+    p = mesh.points[mesh.cells]
+    edge_nodes, _ = edges(mesh)
+    lens = np.linalg.norm(mesh.points[edge_nodes[:, 1]] - mesh.points[edge_nodes[:, 0]], axis=1)
+    ang = dihedral_angles(p)
+    rr = radius_ratios(p)
+    return {
+        "n_points": mesh.n_points,
+        "n_tetrahedra": mesh.n_cells,
+        "h_max": float(lens.max()),
+        "h_min": float(lens.min()),
+        "h_mean": float(lens.mean()),
+        "min_dihedral": float(np.nanmin(ang)),
+        "max_dihedral": float(np.nanmax(ang)),
+        "min_radius_ratio": float(rr.min()),
+        "mean_radius_ratio": float(rr.mean()),
+        "volume": float(mesh.volumes().sum()),
+    }
+
+
 def quality(mesh: Mesh) -> dict:
     """Mesh size and shape numbers.
+
+    On a tetrahedral mesh: ``n_points``, ``n_tetrahedra``, ``h_max``/``h_min``/``h_mean`` (over
+    unique edges), ``min_dihedral``/``max_dihedral`` (degrees), ``min_radius_ratio`` /
+    ``mean_radius_ratio`` (``3 r_in / R_circ``, 1 for a regular tetrahedron) and ``volume``.
+    On a triangle mesh:
 
     Returns
     -------
@@ -41,6 +104,8 @@ def quality(mesh: Mesh) -> dict:
         equilateral triangle, infinite for a degenerate one;
         ``area`` (total area).
     """
+    if mesh.dim == 3:
+        return _quality_3d(mesh)
     from .edges import edges
 
     lens, ang = side_lengths_and_angles(mesh.points[mesh.triangles])

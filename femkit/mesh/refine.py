@@ -1,4 +1,11 @@
-"""Uniform red refinement (every triangle into four; nested meshes).
+"""Uniform red refinement: every triangle into four, every tetrahedron into eight (nested meshes).
+
+Tetrahedra follow Bey (1995, "Tetrahedral grid refinement", Computing 55): four corner
+children and an inner octahedron cut into four along one of its three diagonals. femkit cuts
+along the *shortest* diagonal of each octahedron (the choice that keeps the children's shape
+regular, Bey 1995 section 3; Zhang 1995), so the minimum dihedral angle stays bounded under
+repeated refinement (docs/methods.md states the numbers after five levels). On a structured
+Kuhn box (:func:`femkit.mesh.structured_box`) this gives the structured box of half the size.
 
 >>> import numpy as np
 >>> from femkit.mesh import Mesh
@@ -12,8 +19,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from .edges import boundary_edge_ids, edges
+from .edges import boundary_edge_ids, edge_ids, edges
 from .mesh import Mesh
+
+# Local vertices of a tetrahedron during refinement: v0..v3, then the midpoints of its edges in
+# :data:`~femkit.mesh.edges.LOCAL_EDGES` order, m01 m02 m03 m12 m13 m23 (ids 4..9).
+_CORNERS = np.array([[0, 4, 5, 6], [4, 1, 7, 8], [5, 7, 2, 9], [6, 8, 9, 3]])
+#: The inner octahedron cut along diagonal m01-m23, m02-m13 or m03-m12: the four tetrahedra
+#: around the diagonal (its ends, then consecutive vertices of the equator).
+_INNER = np.array([
+    [[4, 9, 5, 6], [4, 9, 6, 8], [4, 9, 8, 7], [4, 9, 7, 5]],     # m01-m23; equator m02 m03 m13 m12
+    [[5, 8, 4, 6], [5, 8, 6, 9], [5, 8, 9, 7], [5, 8, 7, 4]],     # m02-m13; equator m01 m03 m23 m12
+    [[6, 7, 4, 5], [6, 7, 5, 9], [6, 7, 9, 8], [6, 7, 8, 4]],     # m03-m12; equator m01 m02 m23 m13
+])
+_DIAGONALS = np.array([[4, 9], [5, 8], [6, 7]])
 
 
 def refine_once(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
@@ -23,6 +42,8 @@ def refine_once(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
     ``edge_nodes[e]`` (:func:`edges` order), so a nested prolongation needs no second edge search
     (:class:`femkit.mesh.hierarchy.MeshHierarchy`).
     """
+    if mesh.dim == 3:
+        return _refine_tetrahedra(mesh)
     n = mesh.n_points
     edge_nodes, tri_edges = edges(mesh)
     mid = mesh.points[edge_nodes].mean(axis=1)
@@ -52,8 +73,49 @@ def refine_once(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
     return fine, edge_nodes
 
 
+def _refine_tetrahedra(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
+    """Bey's red refinement of every tetrahedron (shortest inner diagonal), as :func:`refine_once`."""
+    n = mesh.n_points
+    edge_nodes, cell_edges = edges(mesh)
+    points = np.vstack([mesh.points, mesh.points[edge_nodes].mean(axis=1)])
+    local = np.concatenate([mesh.cells, n + cell_edges], axis=1)          # (m, 10)
+    d = points[local[:, _DIAGONALS[:, 0]]] - points[local[:, _DIAGONALS[:, 1]]]
+    len2 = np.einsum("mkd,mkd->mk", d, d)
+    # the shortest diagonal; ties (a Kuhn tetrahedron has two) go to the one closest to the
+    # direction (1, 1, 1), so a structured Kuhn box refines into the structured box of half
+    # the size (Bey's congruent children) whatever the vertex order
+    tied = len2 <= len2.min(axis=1, keepdims=True) * (1.0 + 1e-10)
+    align = np.abs(d.sum(axis=2)) / np.sqrt(len2)
+    choice = np.argmax(np.where(tied, align, -1.0), axis=1)
+    inner = _INNER[choice]                                                 # (m, 4, 4)
+    rows = np.arange(len(local))[:, None, None]
+    children = np.concatenate([local[:, _CORNERS], local[rows, inner]], axis=1)
+    children = children.reshape(-1, 4)
+    from .mesh import signed_volumes
+
+    neg = signed_volumes(points, children) < 0
+    children[neg, 2], children[neg, 3] = children[neg, 3], children[neg, 2].copy()
+    cell_tags = np.repeat(mesh.cell_tags, 8)
+
+    bf = mesh.boundary_facets
+    if len(bf):
+        mab, mbc, mca = (n + edge_ids(mesh, edge_nodes, bf[:, [i, j]])
+                         for i, j in ((0, 1), (1, 2), (2, 0)))
+        a, b, c = bf[:, 0], bf[:, 1], bf[:, 2]
+        new_bf = np.stack([np.stack([a, mab, mca], 1), np.stack([mab, b, mbc], 1),
+                           np.stack([mca, mbc, c], 1), np.stack([mab, mbc, mca], 1)],
+                          axis=1).reshape(-1, 3)
+        new_bt = np.repeat(mesh.boundary_tags, 4)
+    else:
+        new_bf, new_bt = bf, mesh.boundary_tags
+    fine = Mesh(points, children, cell_tags=cell_tags, boundary_facets=new_bf,
+                boundary_tags=new_bt, tag_names=mesh.tag_names)
+    return fine, edge_nodes
+
+
 def refine(mesh: Mesh, levels: int = 1) -> Mesh:
-    """Uniform red refinement: each triangle into four by its edge midpoints, ``levels`` times.
+    """Uniform red refinement: each triangle into four by its edge midpoints (each tetrahedron
+    into eight, Bey 1995), ``levels`` times.
 
     Nested: the coarse nodes are the first ``n`` nodes of the fine mesh (in the same order),
     then one new node per coarse edge in :func:`edges` order. Children ``4t .. 4t+3`` come

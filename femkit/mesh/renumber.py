@@ -25,10 +25,11 @@ from .mesh import Mesh
 
 
 def node_graph(mesh: Mesh) -> sp.csr_matrix:
-    """The symmetric node adjacency (nodes sharing a triangle), as a CSR pattern."""
-    t = mesh.triangles
-    rows = np.repeat(t, 3, axis=1).ravel()
-    cols = np.tile(t, (1, 3)).ravel()
+    """The symmetric node adjacency (nodes sharing a cell), as a CSR pattern."""
+    t = mesh.cells
+    k = t.shape[1]
+    rows = np.repeat(t, k, axis=1).ravel()
+    cols = np.tile(t, (1, k)).ravel()
     n = mesh.n_points
     g = sp.csr_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(n, n))
     g.sum_duplicates()
@@ -48,7 +49,7 @@ def rcm_permutation(mesh: Mesh) -> np.ndarray:
 def permute_nodes(mesh: Mesh, perm: np.ndarray, *, sort_elements: bool = True) -> Mesh:
     """The same mesh with node ``j`` the old node ``perm[j]``.
 
-    Triangles, boundary edges and their tags follow; with ``sort_elements`` the triangles are
+    Cells, boundary facets and their tags follow; with ``sort_elements`` the cells are
     also ordered by their smallest new node id (stable), so consecutive elements scatter into
     nearby rows during assembly. Orientation and tags are unchanged.
 
@@ -63,13 +64,13 @@ def permute_nodes(mesh: Mesh, perm: np.ndarray, *, sort_elements: bool = True) -
         raise MeshError(f"perm must be a permutation of 0..{n - 1} (got shape {perm.shape})")
     inv = np.empty(n, dtype=np.int64)
     inv[perm] = np.arange(n)
-    tri = inv[mesh.triangles]
+    tri = inv[mesh.cells]
     cell_tags = mesh.cell_tags
     if sort_elements:
         order = np.argsort(tri.min(axis=1), kind="stable")
         tri, cell_tags = tri[order], cell_tags[order]
-    return Mesh(points=mesh.points[perm], triangles=tri, cell_tags=cell_tags,
-                boundary_edges=inv[mesh.boundary_edges], boundary_tags=mesh.boundary_tags,
+    return Mesh(points=mesh.points[perm], cells=tri, cell_tags=cell_tags,
+                boundary_facets=inv[mesh.boundary_facets], boundary_tags=mesh.boundary_tags,
                 tag_names=mesh.tag_names)
 
 

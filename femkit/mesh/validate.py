@@ -28,47 +28,56 @@ def _ids(ids: np.ndarray) -> str:
 
 
 def _replace(mesh: Mesh, **changes) -> Mesh:
-    kw = dict(points=mesh.points, triangles=mesh.triangles, cell_tags=mesh.cell_tags,
-              boundary_edges=mesh.boundary_edges, boundary_tags=mesh.boundary_tags,
+    kw = dict(points=mesh.points, cells=mesh.cells, cell_tags=mesh.cell_tags,
+              boundary_facets=mesh.boundary_facets, boundary_tags=mesh.boundary_tags,
               tag_names=mesh.tag_names)
     kw.update(changes)
     return Mesh(**kw)
 
 
 def orient_ccw(mesh: Mesh) -> Mesh:
-    """Return the mesh with every triangle counter-clockwise (swaps two vertices of CW ones).
+    """Return the mesh with every cell positively oriented: triangles counter-clockwise,
+    tetrahedra with ``det[x1 - x0, x2 - x0, x3 - x0] > 0`` (swaps the last two vertices of
+    negative ones).
 
-    The input is returned unchanged when it is already counter-clockwise.
+    The input is returned unchanged when it is already oriented.
     """
-    cw = mesh.signed_areas() < 0
+    cw = mesh.signed_volumes() < 0
     if not cw.any():
         return mesh
-    tri = mesh.triangles.copy()
-    tri[cw, 1], tri[cw, 2] = mesh.triangles[cw, 2], mesh.triangles[cw, 1]
-    return _replace(mesh, triangles=tri)
+    cells = mesh.cells.copy()
+    a, b = mesh.dim - 1, mesh.dim
+    cells[cw, a], cells[cw, b] = mesh.cells[cw, b], mesh.cells[cw, a]
+    return _replace(mesh, cells=cells)
+
+
+#: The dimension-neutral name of :func:`orient_ccw`.
+orient = orient_ccw
 
 
 def remove_unreferenced(mesh: Mesh) -> Mesh:
-    """Drop nodes no triangle uses and renumber (order kept); edges on dropped nodes go too."""
+    """Drop nodes no cell uses and renumber (order kept); facets on dropped nodes go too."""
     used = np.zeros(mesh.n_points, bool)
-    used[mesh.triangles.ravel()] = True
+    used[mesh.cells.ravel()] = True
     if used.all():
         return mesh
     new = np.full(mesh.n_points, -1, np.int64)
     new[used] = np.arange(int(used.sum()))
-    be = new[mesh.boundary_edges] if len(mesh.boundary_edges) else mesh.boundary_edges
+    be = new[mesh.boundary_facets] if len(mesh.boundary_facets) else mesh.boundary_facets
     keep = (be >= 0).all(axis=1) if len(be) else np.zeros(0, bool)
-    return _replace(mesh, points=mesh.points[used], triangles=new[mesh.triangles],
-                    boundary_edges=be[keep], boundary_tags=mesh.boundary_tags[keep])
+    return _replace(mesh, points=mesh.points[used], cells=new[mesh.cells],
+                    boundary_facets=be[keep], boundary_tags=mesh.boundary_tags[keep])
 
 
 def validate(mesh: Mesh, *, rel_area_tol: float = 1e-12, dup_tol: float = 1e-12) -> Mesh:
-    """Check a mesh; return it counter-clockwise or raise naming the problem.
+    """Check a mesh (triangles or tetrahedra); return it positively oriented or raise naming
+    the problem.
 
-    Checks, in order: at least one triangle; finite coordinates; indices in range (triangles
-    and boundary edges); triangles repeating a vertex; zero/near-zero area triangles
-    (``area <= rel_area_tol * longest_edge**2``, a scale-free test); unreferenced nodes;
-    duplicate nodes (closer than ``dup_tol`` times the bounding-box diagonal).
+    Checks, in order: at least one cell; finite coordinates; indices in range (cells and
+    boundary facets); cells repeating a vertex; zero/near-zero area or volume cells
+    (``area <= rel_area_tol * longest_edge**2``, ``volume <= rel_area_tol *
+    longest_edge**3``, scale-free tests); unreferenced nodes; duplicate nodes (closer than
+    ``dup_tol`` times the bounding-box diagonal).
 
     Raises
     ------
@@ -78,41 +87,47 @@ def validate(mesh: Mesh, *, rel_area_tol: float = 1e-12, dup_tol: float = 1e-12)
     MeshError
         Everything else (the message says how many and which).
     """
-    n, m = mesh.n_points, mesh.n_triangles
+    n, m = mesh.n_points, mesh.n_cells
+    cell, facet, d = mesh.cell_name, f"boundary {mesh.facet_name}", mesh.dim
     if m == 0:
-        raise MeshError("mesh has no triangles")
+        raise MeshError(f"mesh has no {'triangles' if d == 2 else 'tetrahedra'}")
     if not np.isfinite(mesh.points).all():
         bad = np.flatnonzero(~np.isfinite(mesh.points).all(axis=1))
         raise MeshError(f"{len(bad)} node(s) with non-finite coordinates: node ids {_ids(bad)}")
-    tri = mesh.triangles
+    tri = mesh.cells
     out = np.flatnonzero(((tri < 0) | (tri >= n)).any(axis=1))
     if len(out):
-        raise MeshError(f"{len(out)} triangle(s) refer to nodes outside 0..{n - 1}: "
+        raise MeshError(f"{len(out)} {cell}(s) refer to nodes outside 0..{n - 1}: "
                         f"element ids {_ids(out)}")
-    be = mesh.boundary_edges
+    be = mesh.boundary_facets
     if len(be):
         eout = np.flatnonzero(((be < 0) | (be >= n)).any(axis=1))
         if len(eout):
-            raise MeshError(f"{len(eout)} boundary edge(s) refer to nodes outside 0..{n - 1}: "
-                            f"edge ids {_ids(eout)}")
-    rep = np.flatnonzero((tri[:, 0] == tri[:, 1]) | (tri[:, 1] == tri[:, 2]) | (tri[:, 0] == tri[:, 2]))
+            raise MeshError(f"{len(eout)} {facet}(s) refer to nodes outside 0..{n - 1}: "
+                            f"{mesh.facet_name} ids {_ids(eout)}")
+    srt = np.sort(tri, axis=1)
+    rep = np.flatnonzero((srt[:, 1:] == srt[:, :-1]).any(axis=1))
     if len(rep):
-        raise DegenerateMeshError(f"{len(rep)} triangle(s) repeat a vertex: element ids {_ids(rep)}",
+        raise DegenerateMeshError(f"{len(rep)} {cell}(s) repeat a vertex: element ids {_ids(rep)}",
                                   element_ids=rep)
+    from .edges import LOCAL_EDGES
+
     p = mesh.points[tri]
-    e = p[:, [1, 2, 0]] - p[:, [2, 0, 1]]
+    le = LOCAL_EDGES[d + 1]
+    e = p[:, le[:, 1]] - p[:, le[:, 0]]
     lmax2 = np.einsum("ijk,ijk->ij", e, e).max(axis=1)
-    area = np.abs(mesh.signed_areas())
-    degen = np.flatnonzero(area <= rel_area_tol * lmax2)
+    size = np.abs(mesh.signed_volumes())
+    what = "area" if d == 2 else "volume"
+    degen = np.flatnonzero(size <= rel_area_tol * lmax2 ** (d / 2))
     if len(degen):
         raise DegenerateMeshError(
-            f"{len(degen)} degenerate triangle(s) (area <= {rel_area_tol:g} x longest edge^2): "
+            f"{len(degen)} degenerate {cell}(s) ({what} <= {rel_area_tol:g} x longest edge^{d}): "
             f"element ids {_ids(degen)}", element_ids=degen)
     used = np.zeros(n, bool)
     used[tri.ravel()] = True
     if not used.all():
         un = np.flatnonzero(~used)
-        raise MeshError(f"{len(un)} unreferenced node(s) (used by no triangle): node ids {_ids(un)}; "
+        raise MeshError(f"{len(un)} unreferenced node(s) (used by no {cell}): node ids {_ids(un)}; "
                         "femkit.mesh.validate.remove_unreferenced(mesh) drops them")
     dup = _duplicate_pairs(mesh.points, dup_tol)
     if len(dup):
@@ -172,7 +187,7 @@ def check_tags(mesh: Mesh, tags: Iterable | str | int, *, kind: str = "boundary"
             raise MeshError(f"mesh has no {kind} tag {t!r}; available {kind} tags: {avail_txt}")
         if num not in present_set:
             raise MeshError(f"{kind} tag {t!r} (number {num}) is carried by no "
-                            f"{'edge' if kind == 'boundary' else 'cell'} of the mesh; "
+                            f"{mesh.facet_name if kind == 'boundary' else 'cell'} of the mesh; "
                             f"available {kind} tags: {avail_txt}")
         out.append(num)
     return out

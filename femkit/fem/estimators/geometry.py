@@ -1,4 +1,5 @@
-"""Per-element quantities both estimators need: gradients, fluxes, edges and their roles."""
+"""Per-element quantities both estimators need: gradients, fluxes, edges (faces in 3D) and their
+roles."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._elements import p1_gradients, triangle_geometry
+from .._elements import p1_gradients, simplex_gradients, triangle_geometry
 from ..coefficients import element_coefficient
 
 
@@ -18,6 +19,10 @@ class ElementFields:
     ``area`` (m,), ``grad`` (m, 2) = grad u_h, ``kappa`` (m,) barycentre values,
     ``edge_nodes`` (E, 2) and ``tri_edges`` (m, 3) from :func:`femkit.mesh.edges`,
     ``edge_count`` (E,) how many triangles share each edge (1 = boundary, 2 = interior).
+
+    On tetrahedra the facets are faces: ``e`` holds the barycentric gradients (m, 4, 3),
+    ``area`` the volumes, ``grad`` (m, 3), ``edge_nodes`` (F, 3) / ``tri_edges`` (m, 4) the
+    faces of :func:`femkit.mesh.faces.faces` (local face k opposite vertex k).
     """
 
     e: np.ndarray
@@ -39,9 +44,17 @@ def element_fields(mesh, u: np.ndarray, kappa) -> ElementFields:
         raise InputError(f"u must have one value per node, shape ({mesh.n_points},), got {u.shape}")
     if not np.isfinite(u).all():
         raise InputError("u has non-finite values: no error estimate for it")
+    kap = element_coefficient(mesh, kappa)
+    if mesh.dim == 3:
+        from ...mesh.faces import faces
+
+        grads, volume, tets = simplex_gradients(mesh, None)
+        face_nodes, tf = faces(mesh)
+        count = np.bincount(tf.ravel(), minlength=len(face_nodes))
+        grad = np.einsum("ma,mad->md", u[tets], grads)
+        return ElementFields(grads, volume, grad, kap, face_nodes, tf, count)
     e, area, signed, tri = triangle_geometry(mesh, None)
     grad = p1_gradients(e, signed, u[tri])
-    kap = element_coefficient(mesh, kappa)
     edge_nodes, te = edges(mesh)
     count = np.bincount(te.ravel(), minlength=len(edge_nodes))
     return ElementFields(e, area, grad, kap, edge_nodes, te, count)

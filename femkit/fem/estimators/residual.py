@@ -68,7 +68,8 @@ def residual_estimator(mesh, u: np.ndarray, *, kappa=1.0, f=0.0, neumann: Sequen
     mesh : Mesh
     u : (n,) nodal values of the discrete solution.
     kappa : coefficient as in :func:`~femkit.fem.coefficients.element_coefficient`.
-    f : float or callable f(x, y), the source.
+    f : float or callable f(x, y) (f(x, y, z) on tetrahedra; faces replace edges there,
+        :mod:`.residual_faces`), the source.
     neumann : sequence of (tags, h): outward flux data ``kappa du/dn = h`` as given to the problem.
     dirichlet_nodes : node ids where ``u`` was prescribed (a boundary edge with both ends among
         them is a Dirichlet edge); ``None``: no Dirichlet edge (every boundary edge is Neumann).
@@ -84,6 +85,11 @@ def residual_estimator(mesh, u: np.ndarray, *, kappa=1.0, f=0.0, neumann: Sequen
     from ..neumann import tagged_edges
 
     fl = element_fields(mesh, u, kappa)
+    if mesh.dim == 3:
+        from .residual_faces import residual_terms_3d
+
+        parts = residual_terms_3d(mesh, fl, f, neumann, dirichlet_nodes, c_volume, c_jump)
+        return ErrorEstimate("residual", np.sqrt(sum(parts.values())), parts)
     e, te, count = fl.e, fl.tri_edges, fl.edge_count
     lens = np.hypot(e[..., 0], e[..., 1])                  # (m, 3)
     h_T = lens.max(axis=1)

@@ -1,0 +1,103 @@
+"""An elastic finite-element body as a force of femkit's dynamics system.
+
+:class:`ElasticForce` wraps a :class:`femkit.solids.ElasticBody`: force ``-dE/dx``, energy
+``E(x)`` (reported in the system's ``"spring"`` bucket, the elastic potential of a scene),
+stiffness ``K = d^2E/dx^2`` (element-wise PSD-projected for the integrators' ``fix="clamp"``,
+Teran et al. 2005) and, for ``fix="regularize"``, the per-node bound of the negative part of
+``K`` (:meth:`~femkit.solids.ElasticBody.negative_bound`). So every registered integrator runs an
+elastic solid unchanged, with the system's pinning, gravity, damping and contact.
+
+:func:`elastic_system` builds that system: lumped masses from the density
+(:meth:`~femkit.solids.ElasticBody.lumped_masses`), no springs.
+
+The last evaluation is kept (positions and result), because an implicit step asks for the
+force, the energy and the stiffness at the same positions.
+"""
+
+from __future__ import annotations
+
+from typing import Iterable
+
+import numpy as np
+
+from .base import Force
+
+__all__ = ["ElasticForce", "elastic_system"]
+
+
+class ElasticForce(Force):
+    """The elastic force of a finite-element body (see module docstring).
+
+    Parameters
+    ----------
+    body : femkit.solids.ElasticBody
+        Its nodes are the system's particles, in the same order.
+    """
+
+    kind = "spring"
+
+    def __init__(self, body):
+        self.body = body
+        self._kept = None
+
+    def bind(self, system) -> None:
+        from ...errors import InputError
+
+        super().bind(system)
+        if (system.n, system.dim) != (self.body.n, self.body.dim):
+            raise InputError(f"elastic body has {self.body.n} nodes in {self.body.dim}D, the "
+                             f"system {system.n} in {system.dim}D")
+        self._kept = None
+
+    def _eval(self, x, level: int, project: bool = False):
+        kept = self._kept
+        # energy and gradient do not depend on the projection, only the Hessian does
+        if kept is not None and kept[1] >= level and (level < 2 or kept[2] == project) \
+                and np.array_equal(kept[0], x):
+            return kept[3]
+        out = self.body.evaluate(x, level, project=project)
+        self._kept = (np.array(x, copy=True), level, project, out)
+        return out
+
+    def add_force(self, x, v, t, out) -> None:
+        out -= self._eval(x, 1)[1]
+
+    def energy(self, x) -> float:
+        return float(self._eval(x, 0)[0].sum())
+
+    def stiffness(self, x, fix=None):
+        return self._eval(x, 2, fix == "clamp")[2]
+
+    def stiffness_product(self, x, d, fix=None):
+        K = self.stiffness(x, fix)
+        return (K @ np.asarray(d, dtype=float).reshape(-1)).reshape(self.body.n, self.body.dim)
+
+    def negative_bound(self, x):
+        return self.body.negative_bound(x)
+
+    def __repr__(self) -> str:
+        mats = ", ".join(m.name for m in self.body.materials)
+        return f"ElasticForce({self.body.rest.n_cells} elements, {mats})"
+
+
+def elastic_system(body, *, x0=None, v0=None, pinned=None, forces: Iterable[Force] = ()):
+    """A :class:`~femkit.dynamics.system.MassSpringSystem` whose only internal force is the
+    elastic ``body`` (no springs), lumped masses from its density, plus the declared ``forces``
+    (gravity, damping, contact) and ``pinned`` nodes; starts at rest positions unless ``x0``.
+
+    >>> from femkit.solids import ElasticBody, StableNeoHookean
+    >>> body = ElasticBody([[0., 0.], [1., 0.], [0., 1.]], [[0, 1, 2]], StableNeoHookean(1., 1.))
+    >>> s = elastic_system(body, pinned=[0])
+    >>> s.force(s.x0, s.v0).tolist()
+    [[0.0, 0.0], [0.0, 0.0], [0.0, 0.0]]
+    """
+    from ..system import MassSpringSystem
+
+    x = body.rest_positions if x0 is None else np.asarray(x0, dtype=float)
+    if x.shape != body.rest_positions.shape:
+        from ...errors import InputError
+
+        raise InputError(f"x0 must have the body's shape {body.rest_positions.shape} "
+                         f"({body.n} nodes), got {x.shape}")
+    return MassSpringSystem(x, body.lumped_masses(), np.zeros((0, 2), dtype=np.int64), 0.0,
+                            v0=v0, pinned=pinned, forces=[ElasticForce(body), *forces])

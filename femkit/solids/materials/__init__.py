@@ -1,0 +1,8 @@
+"""Materials as energies of the principal stretches (see :mod:`.base`)."""
+
+from .base import Material, StretchMaterial, lame_from_young
+from .registry import (MATERIALS, Corotational, LinearElastic, StableNeoHookean, StVenantKirchhoff,
+                       material)
+
+__all__ = ["Material", "StretchMaterial", "lame_from_young", "MATERIALS", "LinearElastic",
+           "Corotational", "StVenantKirchhoff", "StableNeoHookean", "material"]

@@ -1,0 +1,136 @@
+"""What a material is: a small frozen record of its constants plus one compiled energy function.
+
+A hyperelastic isotropic material is fully described by its energy density as a function of the
+principal stretches ``W(s_1, .., s_d)`` (Xu, Sin, Zhu & Barbic 2015); forces and Hessians then
+follow from the SVD derivative (:mod:`femkit.solids.compiled`) with only ``dW/ds`` and
+``d^2W/ds^2``. So a material here *is* that function and its constants:
+
+* :class:`StretchMaterial` subclasses name a numba-compiled
+  ``energy(s, params, grad, hess) -> W`` (``params`` = :meth:`Material.params`) by its number
+  ``code`` in :func:`femkit.solids.compiled.stretch_energy` (:mod:`femkit.solids.compiled`,
+  imported only when evaluated); a material designed by its
+  energy (written by a user, derivatives generated symbolically) is one more such function, the
+  element kernels are shared.
+* The linear (small-strain) material is not a function of the stretches (not rotation
+  invariant); it brings its own point function of ``F`` (:mod:`.linear`).
+
+Constants are the Lame moduli ``mu``, ``lam`` of the material *linearised at rest*: at ``F = I``
+every material's Hessian is the linear-elasticity tensor with these moduli. Plane strain in 2D:
+the same formulas with ``d = 2`` stretches (the third is 1).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from ...errors import MaterialError
+
+__all__ = ["Material", "StretchMaterial", "lame_from_young"]
+
+
+def _finite(value, name: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise MaterialError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise MaterialError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def lame_from_young(E: float, nu: float) -> tuple[float, float]:
+    """``(mu, lam)`` of Young's modulus ``E > 0`` and Poisson ratio ``-1 < nu < 1/2``.
+
+    >>> [round(v, 12) for v in lame_from_young(2.6, 0.3)]
+    [1.0, 1.5]
+    """
+    E, nu = _finite(E, "Young's modulus E"), _finite(nu, "Poisson ratio nu")
+    if E <= 0.0:
+        raise MaterialError(f"Young's modulus E must be > 0, got {E:g}")
+    if not -1.0 < nu < 0.5:
+        raise MaterialError(f"Poisson ratio nu must lie in (-1, 0.5), got {nu:g}")
+    return E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+
+
+@dataclass(frozen=True)
+class Material:
+    """Base record: Lame moduli at rest and density.
+
+    Parameters
+    ----------
+    mu, lam : float
+        Lame moduli of the linearisation at rest; need ``mu > 0`` and ``lam > -2 mu / 3`` (a
+        positive bulk modulus, equivalently ``-1 < nu < 1/2``).
+    density : float
+        Mass per unit volume (> 0; per unit area in 2D plane strain).
+
+    Raises
+    ------
+    MaterialError
+        Non-finite or out-of-range constants.
+    """
+
+    mu: float
+    lam: float
+    density: float = 1.0
+
+    name: ClassVar[str] = "material"
+
+    def __post_init__(self):
+        mu, lam = _finite(self.mu, "mu"), _finite(self.lam, "lambda")
+        rho = _finite(self.density, "density")
+        if mu <= 0.0:
+            raise MaterialError(f"{self.name}: shear modulus mu must be > 0, got {mu:g}")
+        if lam <= -2.0 * mu / 3.0:
+            raise MaterialError(f"{self.name}: lambda = {lam:g} <= -2 mu / 3 = {-2 * mu / 3:g} "
+                                "(negative bulk modulus: Poisson ratio <= -1)")
+        if rho <= 0.0:
+            raise MaterialError(f"{self.name}: density must be > 0, got {rho:g}")
+        object.__setattr__(self, "mu", mu)
+        object.__setattr__(self, "lam", lam)
+        object.__setattr__(self, "density", rho)
+
+    @classmethod
+    def from_young(cls, E: float, nu: float, density: float = 1.0, **extra) -> "Material":
+        """The material with Young's modulus ``E`` and Poisson ratio ``nu`` (3D relations;
+        in 2D the plane-strain body of the same material)."""
+        mu, lam = lame_from_young(E, nu)
+        return cls(mu, lam, density, **extra)
+
+    @property
+    def young(self) -> float:
+        """Young's modulus ``mu (3 lam + 2 mu) / (lam + mu)``."""
+        return self.mu * (3 * self.lam + 2 * self.mu) / (self.lam + self.mu)
+
+    @property
+    def poisson(self) -> float:
+        """Poisson ratio ``lam / (2 (lam + mu))``."""
+        return self.lam / (2.0 * (self.lam + self.mu))
+
+    def params(self) -> np.ndarray:
+        """The constants handed to the compiled energy, ``[mu, lam]`` by default."""
+        return np.array([self.mu, self.lam])
+
+    #: number of the material's point function in the compiled element pass
+    #: (:func:`femkit.solids.compiled.point`)
+    code: ClassVar[int] = -1
+
+
+@dataclass(frozen=True)
+class StretchMaterial(Material):
+    """A material given by its energy of the principal stretches (number ``code`` of
+    :func:`femkit.solids.compiled.stretch_energy`)."""
+
+
+    def stretch_derivatives(self, s) -> tuple[float, np.ndarray, np.ndarray]:
+        """``(W, dW/ds, d^2W/ds^2)`` at one set of stretches ``s`` (``d`` values)."""
+        s = np.ascontiguousarray(s, dtype=float)
+        g, H = np.zeros(len(s)), np.zeros((len(s), len(s)))
+        from ..compiled import stretch_energy
+
+        W = stretch_energy(self.code, s, self.params(), g, H)
+        return float(W), g, H

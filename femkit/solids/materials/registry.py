@@ -1,0 +1,67 @@
+"""The built-in materials and their registry ``MATERIALS`` (name -> class)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from ...registry import Registry
+from .base import Material, StretchMaterial
+
+__all__ = ["MATERIALS", "LinearElastic", "Corotational", "StVenantKirchhoff",
+           "StableNeoHookean", "material"]
+
+MATERIALS: Registry = Registry("material")
+
+
+@MATERIALS.register("linear")
+@dataclass(frozen=True)
+class LinearElastic(Material):
+    """Small-strain linear elasticity (not rotation invariant)."""
+
+    name: ClassVar[str] = "linear"
+    code: ClassVar[int] = 0
+
+
+@MATERIALS.register("corotational")
+@dataclass(frozen=True)
+class Corotational(StretchMaterial):
+    """Co-rotational linear elasticity ``mu |F - R|^2 + lam/2 tr(R^T F - I)^2``."""
+
+    name: ClassVar[str] = "corotational"
+    code: ClassVar[int] = 1
+
+
+@MATERIALS.register("stvk")
+@dataclass(frozen=True)
+class StVenantKirchhoff(StretchMaterial):
+    """St. Venant-Kirchhoff ``mu |E|^2 + lam/2 tr(E)^2`` (softens and collapses in compression)."""
+
+    name: ClassVar[str] = "stvk"
+    code: ClassVar[int] = 2
+
+
+@MATERIALS.register("stable_neo_hookean")
+@dataclass(frozen=True)
+class StableNeoHookean(StretchMaterial):
+    """Stable neo-Hookean (Smith, de Goes & Kim 2018), rest-stable and inversion-safe."""
+
+    name: ClassVar[str] = "stable_neo_hookean"
+    code: ClassVar[int] = 3
+
+
+def material(name: str, *, mu: float | None = None, lam: float | None = None,
+             E: float | None = None, nu: float | None = None, density: float = 1.0) -> Material:
+    """A registered material by name, from ``(mu, lam)`` or ``(E, nu)``.
+
+    >>> material("stvk", E=2.6, nu=0.3).mu
+    1.0
+    """
+    from ...errors import MaterialError
+
+    cls = MATERIALS.get(name)
+    if (mu is None) == (E is None) or (mu is None) != (lam is None) or (E is None) != (nu is None):
+        raise MaterialError(f"material {name!r}: give either (mu, lam) or (E, nu)")
+    if E is not None:
+        return cls.from_young(E, nu, density)
+    return cls(mu, lam, density)
