@@ -14,15 +14,11 @@ from typing import Iterable
 import numpy as np
 
 from ..errors import MeshError
-from .mesh import Mesh
+from .mesh import LOCAL_EDGES, Mesh
 
 __all__ = ["edges", "boundary_edges_topological", "boundary_nodes", "edge_ids", "boundary_edge_ids"]
 
 
-#: Local edges of a triangle (edge k opposite vertex k) and of a tetrahedron (Bey's order:
-#: 01, 02, 03, 12, 13, 23).
-LOCAL_EDGES = {3: np.array([[1, 2], [2, 0], [0, 1]]),
-               4: np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])}
 
 
 def _local_edges(cells: np.ndarray) -> np.ndarray:

@@ -49,6 +49,13 @@ def signed_volumes(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
     return np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0
 
 
+
+#: Local edges of a triangle (edge k opposite vertex k) and of a tetrahedron (Bey's order:
+#: 01, 02, 03, 12, 13, 23).
+LOCAL_EDGES = {3: np.array([[1, 2], [2, 0], [0, 1]]),
+               4: np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])}
+
+
 @dataclass(frozen=True, eq=False, init=False)
 class Mesh:
     """P1 simplex mesh: triangles in 2D, tetrahedra in 3D.

@@ -110,7 +110,7 @@ def validate(mesh: Mesh, *, rel_area_tol: float = 1e-12, dup_tol: float = 1e-12)
     if len(rep):
         raise DegenerateMeshError(f"{len(rep)} {cell}(s) repeat a vertex: element ids {_ids(rep)}",
                                   element_ids=rep)
-    from .edges import LOCAL_EDGES
+    from .mesh import LOCAL_EDGES
 
     p = mesh.points[tri]
     le = LOCAL_EDGES[d + 1]
