@@ -84,7 +84,8 @@ def unit_cube(h: float) -> Mesh:
 
 @register_geometry("beam", dim=3, measure=lambda length=5.0, width=1.0, height=1.0: (
     length * width * height, 2 * (length * width + width * height + height * length)),
-    boundary_tags=("boundary", "clamped", "tip"), cell_tags=("domain",))
+    boundary_tags=("xmin", "xmax", "ymin", "ymax", "zmin", "zmax", "boundary", "clamped", "tip"),
+    cell_tags=("domain",))
 def beam(h: float, length: float = 5.0, width: float = 1.0, height: float = 1.0) -> Mesh:
     """Beam ``[0, length] x [0, width] x [0, height]`` along x (volume ``length width height``).
 

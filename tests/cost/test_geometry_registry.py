@@ -39,8 +39,16 @@ def test_declared_measure_and_tags_match_the_mesh(name):
     """The declared area equals the generated mesh's (2 % at h = 0.05: circles are polygons) and
     the declared tag names are exactly the mesh's."""
     entry = GEOMETRIES.get(name)
-    if entry.dim != 2:
-        pytest.skip("3D geometries are checked with the tetrahedral meshes")
+    if entry.dim == 3:  # volume and surface area of the tetrahedral mesh (5 % at h = 0.25)
+        mesh = generate(name, 0.25)
+        volume, surface = entry.measure()
+        assert abs(float(mesh.volumes().sum()) / volume - 1) < 0.05
+        faces = mesh.boundary_facets[mesh.boundary_tags == mesh.tag("boundary")]
+        p = mesh.points[faces]
+        got = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum()
+        assert abs(got / surface - 1) < 0.05
+        assert set(mesh.tag_names) == set(entry.boundary_tags) | set(entry.cell_tags)
+        return
     mesh = generate(name, 0.05)
     dim, area, length = geometry_domain(name)
     assert dim == 2 and length > 0
