@@ -40,7 +40,9 @@ def test_poisson_prediction_within_targets(kw):
     assert abs(plan.peak_bytes / measured_peak - 1) < 0.30, (plan.peak_bytes, measured_peak)
     measured = sum(s["seconds"] for s in run["stages"].values())
     ratio = plan.seconds / measured  # at the calibration machine's speed
-    assert loaded * ratio > 0.5 and fast * ratio < 2.0, (plan.seconds, measured, fast, loaded)
+    # a factor 2 on a quiet machine; the lower bound is 1/3 because the suite runs on every core
+    # (xdist), so the measured subprocess can share its core with another worker's run
+    assert loaded * ratio > 1 / 3 and fast * ratio < 2.0, (plan.seconds, measured, fast, loaded)
 
 
 def test_scene_time_from_a_first_batch():
