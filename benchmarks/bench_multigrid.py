@@ -334,7 +334,6 @@ def vcycle_factors(omegas, levels=(3, 7), steps: int = 30):
     """Asymptotic energy-norm contraction of the V(2,2)-cycle's error propagator ``I - M A``
     (power iteration) on gmsh meshes (h = 0.5) of the unit square, L-shape and annulus, for each
     relaxation factor and number of levels (meshes): the table of docs/methods.md, section 5."""
-    import math
 
     from femkit.fem import apply_dirichlet, assemble_stiffness
     from femkit.mesh import MeshHierarchy, boundary_nodes, generate
@@ -349,14 +348,7 @@ def vcycle_factors(omegas, levels=(3, 7), steps: int = 30):
             s = apply_dirichlet(assemble_stiffness(m), np.zeros(m.n_points), boundary_nodes(m), 0.0)
             row = []
             for w in omegas:
-                mg = Multigrid(s.A, H, free=s.free, omega=w)
-                e = np.random.default_rng(0).standard_normal(s.A.shape[0])
-                rho = 0.0
-                for _ in range(steps):
-                    e /= math.sqrt(e @ (s.A @ e))
-                    e = e - mg.vcycle(s.A @ e)
-                    rho = math.sqrt(e @ (s.A @ e))
-                row.append(rho)
+                row.append(Multigrid(s.A, H, free=s.free, omega=w).contraction(steps))
             print(f"{geometry:12s} {nlev:6d} " + " ".join(f"{r:7.3f}" for r in row))
 
 

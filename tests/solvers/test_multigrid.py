@@ -8,7 +8,6 @@ Coarse meshes have h = 0.5; 7 levels (6 refinements) stay below ~82k unknowns.
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
@@ -35,18 +34,6 @@ def dirichlet_system(mesh, f=1.0, kappa=1.0, g=0.0):
     return apply_dirichlet(K, F, nodes, vals)
 
 
-def contraction(mg: Multigrid, steps: int = 30) -> float:
-    """Energy-norm contraction of ``I - M A`` (power iteration, asymptotic factor)."""
-    A = mg.levels[-1].A
-    e = np.random.default_rng(0).standard_normal(A.shape[0])
-    rho = 0.0
-    for _ in range(steps):
-        e /= math.sqrt(e @ (A @ e))
-        e = e - mg.vcycle(A @ e)
-        rho = math.sqrt(e @ (A @ e))
-    return rho
-
-
 @pytest.fixture(scope="module")
 def coarse_meshes():
     return {g: generate(g, 0.5) for g in GEOMETRIES}
@@ -58,7 +45,7 @@ def test_vcycle_factor_is_small_and_level_independent(geometry, coarse_meshes):
     for levels in (3, 7):   # refinements: 4 and 8 meshes
         H = MeshHierarchy.from_refinement(coarse_meshes[geometry], levels - 1)
         sys = dirichlet_system(H.finest)
-        rho[levels] = contraction(Multigrid(sys.A, H, free=sys.free, sweeps=2))
+        rho[levels] = Multigrid(sys.A, H, free=sys.free, sweeps=2).contraction(30)
     print(f"{geometry}: V(2,2) factor {rho[3]:.3f} (3 levels), {rho[7]:.3f} (7 levels)")
     assert rho[3] <= 0.15 and rho[7] <= 0.15
     assert rho[7] - rho[3] < GROWTH_LIMIT[geometry]

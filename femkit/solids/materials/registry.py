@@ -14,39 +14,46 @@ __all__ = ["MATERIALS", "LinearElastic", "Corotational", "StVenantKirchhoff",
 MATERIALS: Registry = Registry("material")
 
 
-@MATERIALS.register("linear")
+def register_material(name: str):
+    """Class decorator: register a material class as ``name`` and set its ``name`` attribute
+    (the name is written once, here)."""
+
+    def decorator(cls):
+        cls.name = name
+        return MATERIALS.register(name, cls)
+
+    return decorator
+
+
+@register_material("linear")
 @dataclass(frozen=True)
 class LinearElastic(Material):
     """Small-strain linear elasticity (not rotation invariant)."""
 
-    name: ClassVar[str] = "linear"
     code: ClassVar[int] = 0
 
 
-@MATERIALS.register("corotational")
+@register_material("corotational")
 @dataclass(frozen=True)
 class Corotational(StretchMaterial):
     """Co-rotational linear elasticity ``mu |F - R|^2 + lam/2 tr(R^T F - I)^2``."""
 
-    name: ClassVar[str] = "corotational"
     code: ClassVar[int] = 1
 
 
-@MATERIALS.register("stvk")
+@register_material("stvk")
 @dataclass(frozen=True)
 class StVenantKirchhoff(StretchMaterial):
     """St. Venant-Kirchhoff ``mu |E|^2 + lam/2 tr(E)^2`` (softens and collapses in compression)."""
 
-    name: ClassVar[str] = "stvk"
     code: ClassVar[int] = 2
 
 
-@MATERIALS.register("stable_neo_hookean")
+@register_material("stable_neo_hookean")
 @dataclass(frozen=True)
 class StableNeoHookean(StretchMaterial):
     """Stable neo-Hookean (Smith, de Goes & Kim 2018), rest-stable and inversion-safe."""
 
-    name: ClassVar[str] = "stable_neo_hookean"
     code: ClassVar[int] = 3
 
 

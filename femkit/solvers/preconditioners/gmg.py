@@ -326,6 +326,18 @@ class Multigrid:
             return np.zeros(0)
         return np.asarray(self.coarse_factor.solve(b)).ravel()
 
+    def contraction(self, steps: int = 30, seed: int = 0) -> float:
+        """Asymptotic energy-norm contraction of the V-cycle's error propagator ``I - M A`` on
+        the finest level, by ``steps`` power iterations from a seeded random error."""
+        A = self.levels[-1].A
+        e = np.random.default_rng(seed).standard_normal(A.shape[0])
+        rho = 0.0
+        for _ in range(steps):
+            e /= np.sqrt(e @ (A @ e))
+            e = e - self.vcycle(A @ e)
+            rho = float(np.sqrt(e @ (A @ e)))
+        return rho
+
     def vcycle(self, b: np.ndarray, level: int | None = None) -> np.ndarray:
         """``M_level b``: one V(sweeps, sweeps)-cycle on ``level`` (default the finest) from zero.
 
