@@ -326,11 +326,12 @@ class Multigrid:
             return np.zeros(0)
         return np.asarray(self.coarse_factor.solve(b)).ravel()
 
-    def contraction(self, steps: int = 30, seed: int = 0) -> float:
+    def contraction(self, steps: int = 30, start: int = 0) -> float:
         """Asymptotic energy-norm contraction of the V-cycle's error propagator ``I - M A`` on
-        the finest level, by ``steps`` power iterations from a seeded random error."""
+        the finest level, by ``steps`` power iterations from a reproducible random error
+        (``numpy.random.default_rng(start)``)."""
         A = self.levels[-1].A
-        e = np.random.default_rng(seed).standard_normal(A.shape[0])
+        e = np.random.default_rng(start).standard_normal(A.shape[0])
         rho = 0.0
         for _ in range(steps):
             e /= np.sqrt(e @ (A @ e))
