@@ -1,6 +1,6 @@
 """3D Poisson benchmark: P1 tetrahedra, femkit against scikit-fem (assembly) and pyamg (solve).
 
-Run by hand:  python benchmarks/bench_poisson3d.py [--coarse 3] [--levels 5] [--repeat 3]
+Run by hand:  python benchmarks/bench_poisson3d.py [--coarse 3] [--levels 5] [--repeat 3] [--no-solve]
 
 The mesh is ``structured_box(c, c, c)`` refined ``levels`` times by Bey's red refinement (the
 Kuhn box of ``c 2^levels`` cells per side; c = 3, levels = 5: 97^3 = 912,673 nodes, 5.3M
@@ -123,6 +123,7 @@ def main() -> None:
     ap.add_argument("--coarse", type=int, default=3)
     ap.add_argument("--levels", type=int, default=5)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--no-solve", action="store_true", help="assembly only")
     args = ap.parse_args()
     from femkit.mesh import MeshHierarchy, structured_box
 
@@ -131,7 +132,8 @@ def main() -> None:
     m = H.finest
     print(f"mesh: {m.n_points} nodes, {m.n_cells} tetrahedra (hierarchy {t:.2f} s)")
     assembly(m, args.repeat)
-    solve(H)
+    if not args.no_solve:
+        solve(H)
 
 
 if __name__ == "__main__":

@@ -12,11 +12,11 @@ from .neumann import assemble_neumann
 from .norms import energy_error, error_norms
 from .p1_stiffness import assemble_stiffness, local_stiffness
 from .poisson import PoissonProblem, PoissonSolution
-from .quadrature import QUADRATURE, TriangleRule, get_rule
+from .quadrature import QUADRATURE, TET_QUADRATURE, TriangleRule, get_rule
 from .sparsity import SparsityPattern
 
 __all__ = [
     "assemble_stiffness", "local_stiffness", "assemble_load", "assemble_neumann", "apply_dirichlet",
     "dirichlet_values", "DirichletSystem", "error_norms", "energy_error", "element_coefficient", "PoissonProblem",
-    "PoissonSolution", "SparsityPattern", "QUADRATURE", "TriangleRule", "get_rule",
+    "PoissonSolution", "SparsityPattern", "QUADRATURE", "TET_QUADRATURE", "TriangleRule", "get_rule",
 ]

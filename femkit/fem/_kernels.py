@@ -14,12 +14,10 @@ import numpy as np
 def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  # pragma: no cover - compiled
     """Node-wise P1 pattern: row i = sorted unique vertices of the elements around node i.
 
-    ``tri`` has ``w`` columns (3: triangles, 4: tetrahedra). ``indices`` is a buffer of at
-    least ``n + w (w - 1) m`` entries (each element adds at most ``w (w - 1) / 2`` edges, two
-    entries each); ``slots`` (m, w * w) is filled. With ``with_data`` (triangles only) the
-    stiffness (coefficient ``kappa``) is summed in the same element-order pass that writes
-    the slots. Returns ``(indptr, nnz, data, number of bad areas)`` (``data`` empty without
-    ``with_data``).
+    ``indices`` is a buffer of at least ``n + 6 m`` entries (each element adds at most three
+    edges, two entries each); ``slots`` (m, 9) is filled.  With ``with_data`` the stiffness
+    (coefficient ``kappa``) is summed in the same element-order pass that writes the slots.
+    Returns ``(indptr, nnz, data, number of bad areas)`` (``data`` empty without ``with_data``).
 
     Node numbers of a mesh are far apart within an element, so node-wise passes over
     ``tri`` would read it at random.  Instead the element's vertices are copied into the
@@ -27,6 +25,78 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
     built from that list sequentially (overwriting each vertex with its CSR position), and
     the slots are gathered back in element order.
     """
+    m = tri.shape[0]
+    # 1. node -> incidences, by counting sort; each incidence carries the element's vertices.
+    start = np.zeros(n + 1, np.int64)
+    for e in range(m):
+        for a in range(3):
+            start[tri[e, a] + 1] += 1
+    for i in range(n):
+        start[i + 1] += start[i]
+    verts = np.empty((3 * m, 3), slots.dtype)  # incidence k: the three vertices of its element
+    where = np.empty(3 * m, slots.dtype)  # 3 e + a -> incidence k
+    for e in range(m):
+        v0, v1, v2 = tri[e, 0], tri[e, 1], tri[e, 2]
+        for a in range(3):
+            i = tri[e, a]
+            k = start[i]
+            start[i] = k + 1
+            verts[k, 0] = v0
+            verts[k, 1] = v1
+            verts[k, 2] = v2
+            where[3 * e + a] = k
+    for i in range(n, 0, -1):  # start[i] now holds the old start[i + 1]: shift back
+        start[i] = start[i - 1]
+    start[0] = 0
+    # 2. per row: unique neighbours (stamp array), insertion sort (rows are short, ~7), then
+    #    each incidence's vertices replaced by the CSR positions of (i, vertex).
+    indptr = np.zeros(n + 1, np.int64)
+    stamp = np.full(n, -1, np.int64)
+    pos = np.empty(n, slots.dtype)
+    nnz = 0
+    for i in range(n):
+        s = nnz
+        for k in range(start[i], start[i + 1]):
+            for b in range(3):
+                j = verts[k, b]
+                if stamp[j] != i:
+                    stamp[j] = i
+                    q = nnz
+                    while q > s and indices[q - 1] > j:
+                        indices[q] = indices[q - 1]
+                        q -= 1
+                    indices[q] = j
+                    nnz += 1
+        for q in range(s, nnz):
+            pos[indices[q]] = q
+        for k in range(start[i], start[i + 1]):
+            for b in range(3):
+                verts[k, b] = pos[verts[k, b]]
+        indptr[i + 1] = nnz
+    # 3. slots in element order: entry (e, a, b) is position b of incidence (e, a); with
+    #    with_data the local stiffness goes straight to those positions.
+    data = np.zeros(nnz if with_data else 0)
+    bad = 0
+    for e in range(m):
+        for a in range(3):
+            k = where[3 * e + a]
+            for b in range(3):
+                slots[e, 3 * a + b] = verts[k, b]
+        if with_data:
+            _, _, _, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(tri, points, e)
+            if not (area > 0.0 and area < np.inf):
+                bad += 1
+                continue
+            sc = (kappa[0] if scalar_kappa else kappa[e]) / (4.0 * area)
+            _add_local_stiffness(data, slots, e, sc, ex0, ey0, ex1, ey1, ex2, ey2)
+    return indptr, nnz, data, bad
+
+
+@numba.njit(cache=True)
+def _pattern_cells(tri, n, indices, slots):  # pragma: no cover - compiled
+    """:func:`_pattern` for cells of any width ``w`` (tetrahedra: 4), without the fused
+    stiffness: the same three passes, loops over ``w`` (the triangle kernel keeps its
+    unrolled copies, which are faster). Returns ``(indptr, nnz)``."""
     m = tri.shape[0]
     w = tri.shape[1]
     # 1. node -> incidences, by counting sort; each incidence carries the element's vertices.
@@ -74,23 +144,13 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
             for b in range(w):
                 verts[k, b] = pos[verts[k, b]]
         indptr[i + 1] = nnz
-    # 3. slots in element order: entry (e, a, b) is position b of incidence (e, a); with
-    #    with_data the local stiffness goes straight to those positions.
-    data = np.zeros(nnz if with_data else 0)
-    bad = 0
+    # 3. slots in element order: entry (e, a, b) is position b of incidence (e, a)
     for e in range(m):
         for a in range(w):
             k = where[w * e + a]
             for b in range(w):
                 slots[e, w * a + b] = verts[k, b]
-        if with_data:
-            _, _, _, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(tri, points, e)
-            if not (area > 0.0 and area < np.inf):
-                bad += 1
-                continue
-            sc = (kappa[0] if scalar_kappa else kappa[e]) / (4.0 * area)
-            _add_local_stiffness(data, slots, e, sc, ex0, ey0, ex1, ey1, ex2, ey2)
-    return indptr, nnz, data, bad
+    return indptr, nnz
 
 
 def pattern_kernel(tri: np.ndarray, n: int, points: np.ndarray | None = None, kappa=None):
@@ -112,6 +172,9 @@ def pattern_kernel(tri: np.ndarray, n: int, points: np.ndarray | None = None, ka
     with_data = points is not None and kappa is not None and w == 3
     pts = np.ascontiguousarray(points, dtype=np.float64) if with_data else np.zeros((0, 2))
     kap, scalar = _values(kappa if with_data else 1.0)
+    if w != 3:
+        indptr, nnz = _pattern_cells(tri, n, indices, slots)
+        return indptr, indices[:nnz].copy(), slots, None
     indptr, nnz, data, bad = _pattern(tri, n, indices, slots, pts, kap, scalar, with_data)
     return indptr, indices[:nnz].copy(), slots, (data if with_data and not bad else None)
 
@@ -200,20 +263,30 @@ def load_kernel(mesh, idx, fvals):
 
 
 @numba.njit(cache=True)
-def _tetrahedron(tets, points, e):  # pragma: no cover - compiled
-    """Vertex ids, the three rows ``b x c, c x a, a x b`` (9 numbers) and ``D = 6 V_signed``."""
+def _tetrahedron(tets, points, e, g):  # pragma: no cover - compiled
+    """Fill ``g`` (4, 3) with ``D grad N_a`` of element ``e`` (rows ``b x c, c x a, a x b`` for
+    vertices 1..3, minus their sum for vertex 0; a buffer reused over the elements, no
+    allocation per element) and return ``D = 6 V_signed``."""
     i0, i1, i2, i3 = tets[e, 0], tets[e, 1], tets[e, 2], tets[e, 3]
     ax, ay, az = points[i1, 0] - points[i0, 0], points[i1, 1] - points[i0, 1], points[i1, 2] - points[i0, 2]
     bx, by, bz = points[i2, 0] - points[i0, 0], points[i2, 1] - points[i0, 1], points[i2, 2] - points[i0, 2]
     cx, cy, cz = points[i3, 0] - points[i0, 0], points[i3, 1] - points[i0, 1], points[i3, 2] - points[i0, 2]
-    g = np.empty((4, 3))
     g[1, 0], g[1, 1], g[1, 2] = by * cz - bz * cy, bz * cx - bx * cz, bx * cy - by * cx
     g[2, 0], g[2, 1], g[2, 2] = cy * az - cz * ay, cz * ax - cx * az, cx * ay - cy * ax
     g[3, 0], g[3, 1], g[3, 2] = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
     for d in range(3):
         g[0, d] = -(g[1, d] + g[2, d] + g[3, d])
-    det = ax * g[1, 0] + ay * g[1, 1] + az * g[1, 2]
-    return i0, i1, i2, i3, g, det
+    return ax * g[1, 0] + ay * g[1, 1] + az * g[1, 2]
+
+
+@numba.njit(cache=True)
+def _volume6(tets, points, e):  # pragma: no cover - compiled
+    """``D = 6 V_signed`` of element ``e``."""
+    i0, i1, i2, i3 = tets[e, 0], tets[e, 1], tets[e, 2], tets[e, 3]
+    ax, ay, az = points[i1, 0] - points[i0, 0], points[i1, 1] - points[i0, 1], points[i1, 2] - points[i0, 2]
+    bx, by, bz = points[i2, 0] - points[i0, 0], points[i2, 1] - points[i0, 1], points[i2, 2] - points[i0, 2]
+    cx, cy, cz = points[i3, 0] - points[i0, 0], points[i3, 1] - points[i0, 1], points[i3, 2] - points[i0, 2]
+    return ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx)
 
 
 @numba.njit(cache=True)
@@ -223,10 +296,10 @@ def _stiffness_tet(tets, points, idx, use_idx, kappa, scalar_kappa, slots, nnz):
     data = np.zeros(nnz)
     count = idx.shape[0] if use_idx else tets.shape[0]
     bad = 0
+    g = np.empty((4, 3))
     for k in range(count):
         e = idx[k] if use_idx else k
-        _, _, _, _, g, det = _tetrahedron(tets, points, e)
-        vol6 = abs(det)
+        vol6 = abs(_tetrahedron(tets, points, e, g))
         if not (vol6 > 0.0 and vol6 < np.inf):
             bad += 1
             continue
@@ -248,16 +321,13 @@ def _load_tet(tets, points, idx, use_idx, fvals, scalar_f, n):  # pragma: no cov
     bad = 0
     for k in range(count):
         e = idx[k] if use_idx else k
-        i0, i1, i2, i3, _, det = _tetrahedron(tets, points, e)
-        vol = abs(det) / 6.0
+        vol = abs(_volume6(tets, points, e)) / 6.0
         if not (vol > 0.0 and vol < np.inf):
             bad += 1
             continue
         w = vol * ((fvals[0] if scalar_f else fvals[k]) / 4.0)
-        out[i0] += w
-        out[i1] += w
-        out[i2] += w
-        out[i3] += w
+        for a in range(4):
+            out[tets[e, a]] += w
     return out, bad
 
 
@@ -286,6 +356,6 @@ def warm_up() -> None:
     p3 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
     ind3 = np.empty(4 + 12, np.int32)
     slots3 = np.empty((1, 16), np.int32)
-    _, nnz3, _, _ = _pattern(tet, 4, ind3, slots3, p3, np.ones(1), True, False)
+    _, nnz3 = _pattern_cells(tet, 4, ind3, slots3)
     _stiffness_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, slots3, nnz3)
     _load_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, 4)

@@ -60,17 +60,33 @@ def _rule(name, pts, wts, degree):
     _REGISTRIES[pts.shape[1] - 1].register(name, TriangleRule(name, pts, wts / wts.sum(), degree))
 
 
+def gauss_jacobi(n: int, alpha: float) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Jacobi points and weights on [-1, 1] for the weight ``(1 - t)^alpha`` (beta = 0),
+    by Golub-Welsch (eigenvalues of the Jacobi matrix of the monic recurrence; numpy only, so
+    importing this module stays cheap). Weights are relative (they sum to 1)."""
+    a, b = float(alpha), 0.0
+    k = np.arange(n, dtype=np.float64)
+    s = 2.0 * k + a + b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        diag = np.where(s + 2.0 != 0, (b * b - a * a) / (s * (s + 2.0)), 0.0)
+    diag[0] = (b - a) / (a + b + 2.0)
+    kk = k[1:]
+    s1 = 2.0 * kk + a + b
+    off = np.sqrt(4.0 * kk * (kk + a) * (kk + b) * (kk + a + b) / (s1 * s1 * (s1 + 1.0) * (s1 - 1.0)))
+    t, v = np.linalg.eigh(np.diag(diag) + np.diag(off, 1) + np.diag(off, -1))
+    w = v[0] ** 2
+    return t, w / w.sum()
+
+
 def conical_product_points(n: int) -> tuple[np.ndarray, np.ndarray]:
     """Stroud's conical-product rule on the tetrahedron with ``n^3`` points, exact to degree
     ``2 n - 1``: Gauss-Jacobi points in the collapsed coordinates ``x = u``,
     ``y = v (1 - u)``, ``z = w (1 - u)(1 - v)`` (weights ``(1 - u)^2`` and ``(1 - v)`` taken
     into the Jacobi weights). Returns barycentric points (n^3, 4) and weights summing to 1.
     """
-    from scipy.special import roots_jacobi
-
-    tu, wu = roots_jacobi(n, 2.0, 0.0)
-    tv, wv = roots_jacobi(n, 1.0, 0.0)
-    tw, ww = roots_jacobi(n, 0.0, 0.0)
+    tu, wu = gauss_jacobi(n, 2.0)
+    tv, wv = gauss_jacobi(n, 1.0)
+    tw, ww = gauss_jacobi(n, 0.0)
     u, v, w = (0.5 * (1.0 + t) for t in (tu, tv, tw))
     U, V, W = np.meshgrid(u, v, w, indexing="ij")
     weights = np.einsum("i,j,k->ijk", wu, wv, ww).ravel()

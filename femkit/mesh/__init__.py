@@ -6,6 +6,7 @@ them (generation and file I/O).
 """
 
 from .bisect import Bisection, bisect, label_longest_edge
+from .bisect3d import TetBisection
 from .edges import boundary_edges_topological, boundary_nodes, edges
 from .faces import boundary_faces_topological, faces
 from .geometries import GEOMETRIES, generate, geo_file
@@ -24,5 +25,5 @@ __all__ = [
     "check_tags", "remove_unreferenced", "orient_ccw", "refine", "quality", "boundary_nodes",
     "boundary_edges_topological", "edges", "structured_mesh", "grid_triangles",
     "bisect", "label_longest_edge", "Bisection", "refine_once", "MeshHierarchy", "renumber",
-    "rcm_permutation", "permute_nodes", "structured_box", "faces", "boundary_faces_topological",
+    "rcm_permutation", "permute_nodes", "TetBisection", "structured_box", "faces", "boundary_faces_topological",
 ]
