@@ -27,7 +27,7 @@ import time
 from ..cost import Plan, check_budget, plan_mesh, plan_poisson, plan_scene
 
 __all__ = ["plan_poisson_case", "plan_scene_case", "geometry_domain", "check_mesh_fits",
-           "measure_step_seconds", "OVERRIDE"]
+           "check_scene_fits", "measure_step_seconds", "OVERRIDE"]
 
 #: How a user overrides a refused budget (quoted in the one-line refusal).
 OVERRIDE = "--force"
@@ -102,48 +102,89 @@ def measure_step_seconds(system, integrator, dt: float, *, ctx=None, batch: int 
 
 
 def plan_poisson_case(case, *, measure: bool = True) -> Plan:
-    """The plan of a Poisson case; with ``measure`` its seconds are scaled by this machine's
-    speed now (:func:`femkit.cost.machine_speed`, ~0.25 s of probing)."""
+    """The plan of a Poisson case (from ``case.spec``); with ``measure`` its seconds are scaled
+    by this machine's speed now (:func:`femkit.cost.machine_speed`, ~0.25 s of probing)."""
     from ..cost import machine_speed, msh_triangle_count
 
-    d = case.data
-    spec = d["mesh"]
-    out = d["output"]
-    outputs = tuple(k for k, on in (("vtu", out["vtu"]), ("xdmf", out["xdmf"]), ("png", out["plot"])) if on)
-    common = dict(refine=spec.get("refine", 0), method=case.solver.method,
+    spec = case.spec
+    mesh, out = spec.mesh, spec.output
+    outputs = tuple(k for k, on in (("vtu", out.vtu), ("xdmf", out.xdmf), ("png", out.plot)) if on)
+    common = dict(refine=mesh.refine, method=case.solver.method,
                   speed=machine_speed() if measure else 1.0,
                   preconditioner=case.solver.preconditioner, rtol=case.solver.rtol,
                   outputs=outputs, errors="exact.u" in case.functions)
-    if "file" in spec:
-        triangles, how = msh_triangle_count(spec["file"])
+    if mesh.file is not None:
+        triangles, how = msh_triangle_count(mesh.file)
         plan = plan_poisson(triangles=triangles, **common)
-        plan.assumptions.insert(0, f"{triangles:,} triangles in {spec['file']} (from {how})")
+        plan.assumptions.insert(0, f"{triangles:,} triangles in {mesh.file} (from {how})")
     else:
-        dim, area, length = geometry_domain(spec["geometry"], spec.get("params"))
+        params = dict(mesh.params)
+        dim, area, length = geometry_domain(mesh.geometry, params)
         if dim != 2:
-            return Plan("poisson", f"{case.name}: {spec['geometry']} h={spec['h']:g}", {}, [],
+            return Plan("poisson", f"{case.name}: {mesh.geometry} h={mesh.h:g}", {}, [],
                         assumptions=[f"no cost model for {dim}D meshes yet: the run is not costed"])
-        plan = plan_poisson(area=area, line_length=length, h=spec["h"], name=spec["geometry"],
-                            params=spec.get("params"), **common)
+        plan = plan_poisson(area=area, line_length=length, h=mesh.h, name=mesh.geometry,
+                            params=params, **common)
     plan.title = f"{case.name}: {plan.title}"
-    if d.get("adaptive"):
+    if spec.adaptive:
         plan.assumptions.append("adaptive refinement: only the first level is costed; the "
                                 "adaptive budgets (max_dofs, max_time, max_levels) bound the rest")
     return plan
 
 
-def plan_scene_case(case, system, integrator, *, ctx=None, measure: bool = True) -> Plan:
-    """The plan of a scene from its system's size (``system.n``, ``n_springs``, ``dim``) and
-    time grid; with ``measure`` the seconds per step are timed on a first batch of steps (at
-    most 20 steps or 1 s, :func:`measure_step_seconds`) on ``system`` with ``ctx``."""
-    d = case.data
-    per_step = None
-    if measure:
-        per_step = measure_step_seconds(system, integrator, d["dt"], ctx=ctx)
-    out = d["output"]
-    outputs = tuple(k for k in ("vtu", "xdmf", "energy_csv", "png", "gif") if out[k])
-    return plan_scene(n_nodes=system.n, n_springs=system.n_springs, dim=system.dim, dt=d["dt"],
-                      t_end=d["t_end"], every=out.get("every"), interval=out.get("interval"),
-                      frames=out.get("frames"), outputs=outputs,
-                      method=integrator.name, implicit=integrator.implicit, step_seconds=per_step,
-                      name=case.name)
+def plan_scene_case(case, size, *, build=None, measure: bool = True) -> Plan:
+    """The plan of a scene from ``case.spec`` (time grid, cadence, outputs) and ``size`` (a
+    :class:`femkit.case.scene.systems.SystemSize`: nodes, springs, dim and the mesh it needs,
+    counted from the file's numbers), before anything is allocated.
+
+    With ``measure`` (and ``build() -> (system, integrator, ctx)``) the memory is checked first
+    (a scene that cannot fit is refused before it is built:
+    :class:`~femkit.errors.BudgetExceededError`, unless ``case.run_options["force"]``), then the
+    system is built and its seconds per step timed on a first batch of steps (at most 20 steps
+    or 1 s, :func:`measure_step_seconds`). ``size`` None (a system type that cannot count
+    itself) needs ``build``: the plan is then made from the built system.
+    """
+    spec = case.spec
+    method, implicit = spec.integrator.method, _implicit(spec.integrator)
+    system = integrator = ctx = None
+    if size is None:
+        if build is None:
+            return Plan("scene", f"{case.name}: {method}", {}, [],
+                        assumptions=["no size model for this system type: the run is not costed"])
+        system, integrator, ctx = build()
+        nodes, springs, dim, mesh = system.n, system.n_springs, system.dim, None
+    else:
+        nodes, springs, dim, mesh = size.nodes, size.springs, size.dim, size.mesh
+    common = dict(n_nodes=nodes, n_springs=springs, dim=dim, dt=spec.dt, t_end=spec.t_end,
+                  every=spec.output.every, outputs=spec.output.files(), method=method,
+                  implicit=implicit, name=case.name)
+    plan = _with_mesh(plan_scene(**common), mesh)
+    if not measure or build is None:
+        return plan
+    if system is None:
+        check_budget(plan, force=bool(case.run_options.get("force")), override=OVERRIDE)
+        system, integrator, ctx = build()
+    per_step = measure_step_seconds(system, integrator, spec.dt, ctx=ctx)
+    return _with_mesh(plan_scene(**common, step_seconds=per_step), mesh)
+
+
+def check_scene_fits(case, size) -> None:
+    """The memory guard of a scene before its system is built (``force`` skips it): the model's
+    peak from the file's numbers against the available memory."""
+    if size is None or case.run_options.get("force"):
+        return
+    check_budget(plan_scene_case(case, size, measure=False), override=OVERRIDE)
+
+
+def _implicit(integrator_spec) -> bool:
+    """Whether the integrator is implicit (the integrator object alone is built, no system)."""
+    return bool(integrator_spec.build().implicit)
+
+
+def _with_mesh(plan: Plan, mesh: dict | None) -> Plan:
+    """``plan`` with the mesh stages of a mesh system in front (generation, reading)."""
+    if mesh is not None:
+        stages = plan_mesh(**mesh).stages
+        plan.stages[:0] = stages
+        plan.assumptions.append("nodes ~ triangles / 2, springs ~ 3 triangles / 2 (the mesh's edges)")
+    return plan

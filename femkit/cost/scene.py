@@ -2,6 +2,8 @@
 
 * steps ``= round((t_end - t0) / dt)``; frames recorded ``= floor(steps / every) + 1`` plus the
   last step (what :func:`femkit.dynamics.simulate.simulate` keeps in memory and the scene writes);
+  the cadence ``every`` is a number the caller computed (a scene file's ``output`` is turned into
+  it once, by :func:`femkit.case.scene.spec.record_every`);
 * memory: the recorded trajectory (positions, velocities: ``2 d`` floats per node and frame,
   plus energies and momentum), the system (``bytes.system_per_spring``) and, for implicit
   integrators, the matrices and their factorisation (``scene.implicit_bytes_per_spring``);
@@ -12,7 +14,7 @@
   (``femkit.case.cost.measure_step_seconds``) when given, else the calibrated per-spring
   constant.
 
->>> p = plan_scene(n_nodes=100, n_springs=300, dim=3, dt=1e-9, t_end=2.0, frames=50)
+>>> p = plan_scene(n_nodes=100, n_springs=300, dim=3, dt=1e-9, t_end=2.0, every=40_000_000)
 >>> p.steps, p.sizes["frames"]
 (2000000000, 51)
 """
@@ -25,26 +27,13 @@ from ..errors import InputError
 from .constants import load_constants
 from .plan import Plan, Stage, format_seconds, round_down, round_up
 
-__all__ = ["plan_scene", "record_every"]
+__all__ = ["plan_scene"]
 
 _FLOAT = 8
 
 
-def record_every(steps: int, *, frames: int | None = None, every: int | None = None,
-                 interval: float | None = None, dt: float | None = None) -> int:
-    """Steps between recorded frames (``every``, ``round(interval / dt)`` or ``ceil(steps / frames)``)."""
-    if every is not None:
-        return max(int(every), 1)
-    if interval is not None and dt:
-        return max(1, int(round(interval / dt)))
-    if frames:
-        return max(1, math.ceil(steps / int(frames)))
-    return 1
-
-
 def plan_scene(*, n_nodes: int, n_springs: int, dim: int, dt: float, t_end: float,
-               t0: float = 0.0, frames: int | None = None, every: int | None = None,
-               interval: float | None = None, outputs=("vtu", "energy_csv"),
+               t0: float = 0.0, every: int = 1, outputs=("vtu", "energy_csv"),
                method: str = "", implicit: bool = False, step_seconds: float | None = None,
                name: str = "scene", constants: dict | None = None, speed: float = 1.0) -> Plan:
     """Predict a scene's cost (see the module docstring).
@@ -53,7 +42,7 @@ def plan_scene(*, n_nodes: int, n_springs: int, dim: int, dt: float, t_end: floa
     ----------
     n_nodes, n_springs, dim : the system's size
     dt, t_end, t0 : the time grid
-    frames, every, interval : output cadence (as in scene files)
+    every : steps between recorded frames (the start and the last step are recorded too)
     outputs : any of ``vtu``, ``xdmf``, ``energy_csv``, ``png``, ``gif``
     method, implicit : the integrator (name for the title; implicit ones cost more per step)
     step_seconds : measured seconds per step (first batch); ``None`` = calibrated constant
@@ -73,7 +62,7 @@ def plan_scene(*, n_nodes: int, n_springs: int, dim: int, dt: float, t_end: floa
         raise InputError(f"t_end must be finite and >= t0 = {t0}, got {t_end}")
     n, s, d = int(n_nodes), int(n_springs), int(dim)
     steps = int(round((t_end - t0) / dt))
-    every_n = record_every(steps, frames=frames, every=every, interval=interval, dt=dt)
+    every_n = max(int(every), 1)
     recorded = steps // every_n + 1 + (1 if steps % every_n else 0)
     frame_mem = (2 * d * n + 5 + d) * _FLOAT
     measured = step_seconds is not None
@@ -119,6 +108,8 @@ def plan_scene(*, n_nodes: int, n_springs: int, dim: int, dt: float, t_end: floa
         if what == "time":
             k = limit / max(plan.seconds, 1e-300)
             return f"dt >= {round_up(dt / k)} or t_end <= {round_down(t0 + (t_end - t0) * k)}"
+        if what == "memory" and sys_bytes >= traj_bytes:
+            return "fewer nodes and springs (a smaller system)"
         if what in ("output", "memory"):
             return "fewer frames (output.frames / output.every) or fewer output kinds"
         return ""

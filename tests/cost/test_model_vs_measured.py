@@ -55,7 +55,7 @@ def test_scene_time_from_a_first_batch():
     dt, steps = 0.01, 400
     per_step = measure_step_seconds(system, "implicit_euler", dt, ctx=StepContext())
     plan = plan_scene(n_nodes=system.n, n_springs=system.n_springs, dim=3, dt=dt, t_end=steps * dt,
-                      frames=10, outputs=(), method="implicit_euler", step_seconds=per_step)
+                      every=40, outputs=(), method="implicit_euler", step_seconds=per_step)
     t0 = time.perf_counter()
     traj = simulate(system, "implicit_euler", dt, steps * dt, ctx=StepContext(),
                     record_every=40)

@@ -3,7 +3,8 @@
 Schema :func:`femkit.case.scene.schema.scene_schema` (its force and system enums come from
 :data:`~femkit.case.scene.forces.FORCES` and :data:`~femkit.case.scene.systems.SYSTEMS`);
 load-time checks :func:`femkit.case.scene.run.prepare_scene`; the run
-:func:`femkit.case.scene.run.run_scene`; the cost plan :func:`femkit.case.cost.plan_scene_case`.
+:func:`femkit.case.scene.run.run_scene`; the cost plan :func:`femkit.case.cost.plan_scene_case` (priced from the system's counts,
+:func:`femkit.case.scene.systems.system_size`, before anything is built).
 The dynamics modules are imported on first use only.
 """
 
@@ -30,12 +31,17 @@ def _run(case, **kwargs):
     return run_scene(case, **kwargs)
 
 
-def _plan(case, **kwargs):
+def _plan(case, measure: bool = True):
     from ..cost import plan_scene_case
-    from .run import build_context, build_integrator, build_system
+    from .systems import system_size
 
-    return plan_scene_case(case, build_system(case)[0], build_integrator(case),
-                           ctx=build_context(case), **kwargs)
+    def build():
+        from .run import build_context, build_integrator, build_system
+
+        return build_system(case)[0], build_integrator(case), build_context(case)
+
+    # priced from the file's numbers first: nothing is allocated before the memory check
+    return plan_scene_case(case, system_size(case.spec.system), build=build, measure=measure)
 
 
 KIND = register_kind(Kind("mass_spring", "problem", _schema, _prepare, _run, _plan))

@@ -52,6 +52,7 @@ from ...io.atomic import EARLIER_RUN, check_output_dir
 from ...progress import Progress
 from ...solvers.defaults import DEFAULT_METHOD
 from ...timing import StageTimer
+from ..cost import check_scene_fits
 from ..expressions import compile_expression
 from ..frozen import freeze
 from ..load import Case
@@ -60,7 +61,7 @@ from ..specs import IntegratorSpec, limits_spec, solver_spec
 from .forces import FORCES
 from .output import write_scene_outputs
 from .spec import OutputSpec, SceneSpec, StabilitySpec, record_every
-from .systems import SYSTEMS
+from .systems import SYSTEMS, system_size
 
 __all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "build_context",
            "output_every", "n_steps", "SceneResult", "state_checksum", "FORCES", "SYSTEMS"]
@@ -463,6 +464,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     """
     if write:  # refuse a bad output location before any work (never replaces user files)
         check_output_dir(output_dir or case.spec.output.dir, EARLIER_RUN)
+    check_scene_fits(case, system_size(case.spec.system))  # before anything is allocated
     out = echo or print
     timer = StageTimer()
     t0 = time.perf_counter()

@@ -14,7 +14,7 @@ from typing import Any, Callable
 from ...registry import Registry
 from .fragments import COUNT2, DIM, NODES, NONNEG, POS, VEC, closed, pinned
 
-__all__ = ["SystemType", "SYSTEMS", "COMMON"]
+__all__ = ["SystemType", "SystemSize", "SYSTEMS", "COMMON", "system_size"]
 
 
 @dataclass(frozen=True)
@@ -25,11 +25,25 @@ class SystemType:
     ``velocity`` included: start from :data:`COMMON`); ``build(params, origin, kw) -> (system,
     triangles or None)`` where ``params`` is the mapping without ``type``, ``velocity``,
     ``damping`` and ``origin`` (a copy the builder may consume) and ``kw`` holds ``forces`` and
-    ``damping`` for the system's constructor.
+    ``damping`` for the system's constructor. ``size(system mapping) -> SystemSize`` counts
+    nodes and springs from the numbers of the mapping alone, allocating nothing: the cost plan
+    prices a scene with it before :attr:`build` runs (``None``: priced after building).
     """
 
     schema: dict
     build: Callable[[dict, Any, dict], tuple]
+    size: Callable[[Any], "SystemSize"] | None = None
+
+
+@dataclass(frozen=True)
+class SystemSize:
+    """A system's size from its file's numbers: ``nodes``, ``springs``, ``dim``, and for a mesh
+    system the mesh it needs (``mesh``: keywords of :func:`femkit.cost.plan_mesh`, else None)."""
+
+    nodes: float
+    springs: float
+    dim: int
+    mesh: dict | None = None
 
 
 #: system type -> :class:`SystemType`
@@ -92,6 +106,48 @@ def _mesh(s: dict, origin, kw: dict):
     return system, np.asarray(mesh.triangles, dtype=np.int64)
 
 
+def _rope_size(s) -> SystemSize:
+    return SystemSize(int(s["n"]), int(s["n"]) - 1, int(s.get("dim", 2)))
+
+
+def _cloth_size(s) -> SystemSize:
+    """Counts of :func:`femkit.dynamics.topology.grid_springs`, families of zero stiffness left out."""
+    nx, ny = int(s["nx"]), int(s["ny"])
+    springs = (nx - 1) * ny + nx * (ny - 1)
+    if s.get("k_shear"):
+        springs += 2 * (nx - 1) * (ny - 1)
+    if s.get("k_bending"):
+        springs += max(nx - 2, 0) * ny + nx * max(ny - 2, 0)
+    return SystemSize(nx * ny, springs, int(s.get("dim", 3)))
+
+
+def _mesh_size(s) -> SystemSize:
+    """Triangles from the geometry's measure and ``h`` (gmsh's model, :func:`femkit.cost.
+    predict_triangles`) or the mesh file's header; a triangulation of ``T`` triangles has about
+    ``T / 2`` nodes and ``3 T / 2`` edges (Euler's formula, boundary neglected)."""
+    from ...cost import msh_triangle_count, predict_triangles
+    from ..cost import geometry_domain
+
+    if "file" in s:
+        triangles = float(msh_triangle_count(s["file"])[0])
+        mesh = dict(triangles=triangles)
+    else:
+        dim, area, length = geometry_domain(s["geometry"], s.get("params"))
+        if dim != 2:
+            return None
+        triangles = predict_triangles(area, length, s["h"])
+        mesh = dict(area=area, line_length=length, h=s["h"], name=s["geometry"],
+                    params=dict(s.get("params") or {}))
+    return SystemSize(triangles / 2.0 + 1.0, 1.5 * triangles, int(s.get("dim", 2)), mesh)
+
+
+def system_size(system) -> SystemSize | None:
+    """The size of a validated ``system`` mapping, by its type's ``size`` (None: not countable
+    before building)."""
+    size = SYSTEMS.get(system["type"]).size
+    return None if size is None else size(system)
+
+
 def _single_spring(s: dict, origin, kw: dict):
     from ...dynamics import topology
 
@@ -103,7 +159,7 @@ SYSTEMS.register("rope", SystemType(closed({
     **COMMON,
     "origin": VEC, "n": COUNT2, "length": POS, "k": POS, "mass": POS, "total_mass": POS, "dim": DIM,
     "pinned": pinned(["first", "last", "both", "none"]),
-}, ["type", "n", "length", "k"]), _rope))
+}, ["type", "n", "length", "k"]), _rope, _rope_size))
 
 SYSTEMS.register("cloth", SystemType(closed({
     **COMMON,
@@ -111,7 +167,7 @@ SYSTEMS.register("cloth", SystemType(closed({
     "k_structural": POS, "k_shear": NONNEG, "k_bending": NONNEG,
     "mass": POS, "total_mass": POS, "plane": {"enum": ["xz", "xy"]}, "dim": DIM,
     "pinned": pinned(["top_corners", "corners", "top_edge", "none"]),
-}, ["type", "nx", "ny", "width", "height", "k_structural"]), _cloth))
+}, ["type", "nx", "ny", "width", "height", "k_structural"]), _cloth, _cloth_size))
 
 SYSTEMS.register("mesh", SystemType({
     **closed({
@@ -124,9 +180,10 @@ SYSTEMS.register("mesh", SystemType({
     }, ["type", "k"]),
     "oneOf": [{"required": ["geometry", "h"]}, {"required": ["file"]}],
     "x-message": "give either 'geometry' with 'h' (generated mesh) or 'file' (read mesh), not both",
-}, _mesh))
+}, _mesh, _mesh_size))
 
 SYSTEMS.register("single_spring", SystemType(closed({
     **COMMON,
     "k": POS, "m": POS, "rest": POS, "dim": DIM,
-}, ["type", "k", "m"]), _single_spring))
+}, ["type", "k", "m"]), _single_spring,
+    lambda s: SystemSize(2, 1, int(s.get("dim", 2)))))
