@@ -15,12 +15,21 @@ and the predicted remaining time).
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 
-from ..cost import Limits, Plan, check_budget
+from ..cost import Limits, Plan, check_budget, with_default_time
 from .cost import OVERRIDE
 
 __all__ = ["plan_case", "check_case"]
+
+#: Without a stated time limit, a run is measured (and checked against the default budget,
+#: :data:`femkit.cost.budget.DEFAULT_TIME_BUDGET`) only when the model predicts more than this
+#: fraction of it.
+MEASURE_FRACTION = 0.1
+
+#: How a user goes past the default time budget (quoted in the refusal).
+RAISE_TIME = f"{OVERRIDE} or a larger limits: {{time: ...}}"
 
 
 def plan_case(case, *, measure: bool = True) -> Plan:
@@ -41,10 +50,12 @@ def check_case(case, *, max_memory: float | None = None, force: bool = False,
                echo=None) -> Plan:
     """Plan ``case`` and refuse it when it exceeds a budget (before anything runs).
 
-    Limits: the file's ``limits:``, ``max_memory`` (bytes, ``--max-memory``) and the available
-    memory. Steps and memory are checked on the model alone (immediately, however large the
-    run); a time limit first measures: the machine's speed (Poisson) or a batch of steps (scenes). With ``force`` the
-    violations are printed as warnings on stderr and the run goes on (also past the
+    Limits: the file's ``limits:``, ``max_memory`` (bytes, ``--max-memory``), the available
+    memory and, when the file states no time limit, the default time budget
+    (:data:`femkit.cost.budget.DEFAULT_TIME_BUDGET`, one hour). Steps and memory are checked on
+    the model alone (immediately, however large the run); a time limit first measures: the
+    machine's speed (Poisson) or a batch of steps (scenes), for the default budget only when the
+    model predicts more than :data:`MEASURE_FRACTION` of it. With ``force`` the violations are printed as warnings on stderr and the run goes on (also past the
     memory guard before meshing: ``case.run_options["force"]``).
 
     Raises
@@ -52,19 +63,23 @@ def check_case(case, *, max_memory: float | None = None, force: bool = False,
     BudgetExceededError
         A limit is exceeded and ``force`` is false.
     """
-    limits = case.run_options.get("limits") or Limits()
+    limits = with_default_time(case.run_options.get("limits"))
     if max_memory is not None:
         limits = limits.merged(Limits(memory=max_memory))
     case.run_options["force"] = bool(force)
     say = echo or (lambda line: print(line, file=sys.stderr))
-    untimed = Limits(limits.memory, None, limits.steps, limits.output, limits.check_available)
+    untimed = dataclasses.replace(limits, time=None, time_is_default=False)
     plan = plan_case(case, measure=False)
     warnings = check_budget(plan, untimed, force=force, override=OVERRIDE)
-    if limits.time is not None:
+    timed = Limits(time=limits.time, check_available=False, time_is_default=limits.time_is_default)
+    # a stated time limit is checked on a measured plan; the default budget only when the model
+    # puts the run near it (a tenth of it), so short runs pay no measurement
+    if not limits.time_is_default or plan.seconds > MEASURE_FRACTION * limits.time:
         plan = plan_case(case, measure=True)
-        warnings += check_budget(plan, Limits(time=limits.time, check_available=False),
-                                 force=force, override=OVERRIDE)
+        warnings += check_budget(plan, timed, force=force, override=RAISE_TIME
+                                 if limits.time_is_default else OVERRIDE)
     for w in warnings:
-        say(f"femkit: warning: {w.replace(f' (or {OVERRIDE} to run anyway)', '')} ({OVERRIDE} given)")
+        w = w.replace(f" (or {OVERRIDE} to run anyway)", "").replace(f" (or {RAISE_TIME} to run anyway)", "")
+        say(f"femkit: warning: {w} ({OVERRIDE} given)")
     case.run_options["plan"] = plan  # long Poisson runs report each stage against it
     return plan

@@ -21,7 +21,15 @@ Importing this package imports neither numpy nor scipy.
 """
 
 from ..timing import format_seconds
-from .budget import LIMIT_KEYS, Limits, check_budget, parse_bytes, parse_seconds
+from .budget import (
+    DEFAULT_TIME_BUDGET,
+    LIMIT_KEYS,
+    Limits,
+    check_budget,
+    parse_bytes,
+    parse_seconds,
+    with_default_time,
+)
 from .constants import load_constants
 from .memory import available_memory, format_bytes, peak_rss
 from .meshfile import msh_triangle_count
@@ -30,7 +38,7 @@ from .poisson import plan_mesh, plan_poisson, predict_triangles
 from .scene import plan_scene
 from .speed import machine_speed
 
-__all__ = ["Plan", "Stage", "Limits", "LIMIT_KEYS", "check_budget", "parse_bytes", "parse_seconds",
+__all__ = ["Plan", "Stage", "Limits", "LIMIT_KEYS", "DEFAULT_TIME_BUDGET", "with_default_time", "check_budget", "parse_bytes", "parse_seconds",
            "load_constants", "available_memory", "peak_rss", "format_bytes", "format_seconds",
            "msh_triangle_count", "plan_mesh", "plan_poisson", "predict_triangles", "plan_scene",
            "machine_speed"]

@@ -23,10 +23,16 @@ from ..errors import BudgetExceededError, InputError
 from .memory import available_memory, format_bytes
 from .plan import Plan, format_seconds
 
-__all__ = ["Limits", "check_budget", "parse_bytes", "parse_seconds", "LIMIT_KEYS"]
+__all__ = ["Limits", "check_budget", "parse_bytes", "parse_seconds", "LIMIT_KEYS",
+           "DEFAULT_TIME_BUDGET", "with_default_time"]
 
 #: Keys of a ``limits:`` mapping in case and scene files.
 LIMIT_KEYS = ("memory", "time", "steps", "output")
+
+#: The time budget of a run whose file states none (``femkit solve``, ``femkit study``): one
+#: hour. A run predicted to take longer is refused with the estimate unless the user raises the
+#: budget (``limits: {time: ...}`` in the case file) or gives ``--force``. The one place it is set.
+DEFAULT_TIME_BUDGET = 3600.0
 
 _BYTE_UNITS = {"": 1, "b": 1, "k": 10**3, "kb": 10**3, "m": 10**6, "mb": 10**6, "g": 10**9,
                "gb": 10**9, "t": 10**12, "tb": 10**12, "kib": 2**10, "mib": 2**20, "gib": 2**30,
@@ -77,6 +83,7 @@ class Limits:
     steps: float | None = None
     output: float | None = None
     check_available: bool = True
+    time_is_default: bool = False  # ``time`` is :data:`DEFAULT_TIME_BUDGET`, not the user's
 
     @classmethod
     def from_mapping(cls, spec: dict | None, where: str = "limits") -> "Limits":
@@ -101,9 +108,22 @@ class Limits:
         """The tighter of two sets of limits, key by key."""
         def tight(a, b):
             return b if a is None else a if b is None else min(a, b)
-        return Limits(tight(self.memory, other.memory), tight(self.time, other.time),
+        time = tight(self.time, other.time)
+        default = ((self.time_is_default and time == self.time)
+                   or (other.time_is_default and time == other.time and self.time != time))
+        return Limits(tight(self.memory, other.memory), time,
                       tight(self.steps, other.steps), tight(self.output, other.output),
-                      self.check_available and other.check_available)
+                      self.check_available and other.check_available, default)
+
+
+def with_default_time(limits: Limits | None) -> Limits:
+    """``limits`` with :data:`DEFAULT_TIME_BUDGET` as its time budget when it states none."""
+    import dataclasses
+
+    limits = limits or Limits()
+    if limits.time is not None:
+        return limits
+    return dataclasses.replace(limits, time=DEFAULT_TIME_BUDGET, time_is_default=True)
 
 
 def _hint(plan: Plan, what: str, limit: float, default: str) -> str:
@@ -155,9 +175,10 @@ def check_budget(plan: Plan, limits: Limits | None = None, *, force: bool = Fals
                          f"{limits.steps:.3g} steps; use {tip}"))
     if limits.time is not None and plan.seconds > limits.time:
         tip = _hint(plan, "time", limits.time, "a smaller problem")
+        name = ("the default time budget" if limits.time_is_default else "the time limit")
         problems.append(("time", plan.seconds, limits.time,
-                         f"predicted time {format_seconds(plan.seconds)}{about} exceeds the time "
-                         f"limit {format_seconds(limits.time)}; use {tip}"))
+                         f"predicted time {format_seconds(plan.seconds)}{about} exceeds {name} "
+                         f"{format_seconds(limits.time)}; use {tip}"))
     if limits.output is not None and plan.output_bytes > limits.output:
         tip = _hint(plan, "output", limits.output, "fewer output files or frames")
         problems.append(("output", plan.output_bytes, limits.output,

@@ -67,8 +67,9 @@ def plan_scene(*, n_nodes: int, n_springs: int, dim: int, dt: float, t_end: floa
     frame_mem = (2 * d * n + 5 + d) * _FLOAT
     measured = step_seconds is not None
     per_step = (float(step_seconds) if measured else
-                speed * (sc["step_seconds_fixed"] + (sc["implicit_step_seconds_per_spring"] if implicit
-                                                     else sc["step_seconds_per_spring"]) * s))
+                speed * ((sc.get("implicit_step_seconds_fixed", sc["step_seconds_fixed"]) + sc[
+                    "implicit_step_seconds_per_spring"] * s) if implicit else
+                         (sc["step_seconds_fixed"] + sc["step_seconds_per_spring"] * s)))
     sys_bytes = (sc["system_bytes_per_spring"] + (sc["implicit_bytes_per_spring"] if implicit else 0.0)) * s
     traj_bytes = frame_mem * recorded
     stages = [Stage("simulate", per_step * steps, sys_bytes + traj_bytes,

@@ -48,16 +48,19 @@ def _arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _check_cost(study, args) -> bool:
-    """``--dry-run``: print the plan (True: done); else refuse a sweep that cannot fit."""
-    from ..cost import Limits, check_budget, parse_bytes
+    """``--dry-run``: print the plan (True: done); else refuse a sweep that cannot fit in the
+    memory or is predicted to outlast the default time budget."""
+    from ..cost import Limits, check_budget, machine_speed, parse_bytes, with_default_time
     from .cost import plan_study
 
-    plan = plan_study(study)
+    plan = plan_study(study, speed=machine_speed())
     if getattr(args, "dry_run", False):
         print(plan.render())
         return True
     max_memory = getattr(args, "max_memory", None)
-    limits = Limits(memory=None if max_memory is None else parse_bytes(max_memory, "--max-memory"))
+    # the default time budget (one hour, femkit.cost.DEFAULT_TIME_BUDGET): --force runs past it
+    limits = with_default_time(Limits(
+        memory=None if max_memory is None else parse_bytes(max_memory, "--max-memory")))
     for w in check_budget(plan, limits, force=getattr(args, "force", False), override="--force"):
         print(f"femkit study: warning: {w} (--force given)", file=sys.stderr)
     return False

@@ -419,11 +419,13 @@ def run_stability_study(study, *, progress_enabled=None) -> dict:
 
 @dataclass(frozen=True)
 class StressCase:
-    """One stress-case ``type``: ``run(case, study, quick_n) -> rows`` and the default ``values``
-    of its swept parameter."""
+    """One stress-case ``type``: ``run(case, study, quick_n) -> rows``, the default ``values``
+    of its swept parameter and ``price(case, study, quick_n) -> (seconds, runs)``, what the
+    study's plan sums (:func:`femkit.study.cost.plan_stability_study`)."""
 
     run: Callable
     values: tuple
+    price: Callable | None = None
 
 
 #: stress-case type -> :class:`StressCase`; the ``type`` enum of the schema is its names.
@@ -434,20 +436,67 @@ def _poisson(case, study, quick_n):
     return case_poisson(case, study.solvers, quick_n)
 
 
+def _poisson_price(case, study, quick_n):
+    """Per value: the mesh's assembly, a direct reference solve, every solver."""
+    from .prices import poisson_run_seconds
+
+    if case["type"] == "poisson_fine":
+        sizes = [2 * (max(2, int(round(np.sqrt(float(v)))) + 1)) ** 2 for v in case["values"]]
+    else:
+        sizes = [2 * case.get("n", quick_n) ** 2] * len(case["values"])
+    reference = case["type"] != "poisson_fine"  # the others solve directly for x_ref
+    seconds = sum(poisson_run_seconds(t, assemble=True, solve=reference)
+                  + sum(poisson_run_seconds(t, s, assemble=False) for s in study.solvers)
+                  for t in sizes)
+    return seconds, len(sizes) * len(study.solvers)
+
+
+def _neumann_price(case, study, quick_n):
+    from .prices import poisson_run_seconds
+
+    t = 2 * case.get("n", quick_n) ** 2
+    cg = _spec({"method": "cg", "rtol": 1e-10})
+    amg = _spec({"method": "pcg", "preconditioner": "amg", "rtol": 1e-10})
+    return (2 * poisson_run_seconds(t) + 2 * poisson_run_seconds(t, cg, assemble=False)
+            + poisson_run_seconds(t, amg, assemble=False)), 4
+
+
+def _dense_price(case, study, quick_n, n_default, iterations):
+    """A dense ``n x n`` system (QR or a matrix product, then ``iterations(n)`` matrix-vector
+    products), at ~1 ns per flop."""
+    n = case.get("n", n_default)
+    flops = 4.0 * n**3 + iterations(n) * 2.0 * n**2
+    return len(case["values"]) * flops * 1e-9, len(case["values"])
+
+
+def _dynamics_price(case, study, quick_n):
+    from .prices import steps_seconds
+
+    factors = case.get("dt_factors", [0.5, 0.9, 0.98, 1.02, 1.1, 2.0])
+    explicit = [s for s in study.integrators if not s.build().implicit]
+    runs = len(case["values"]) * len(case.get("mass_ratio", [1.0])) * len(explicit) * len(factors)
+    return runs * steps_seconds(int(case.get("t_end", 1000)), nodes=3, springs=2), runs
+
+
 for _name, _values in (("poisson_contrast", (1.0, 1e2, 1e4, 1e6, 1e8)),
                        ("poisson_anisotropic", (1.0, 10.0, 100.0, 1000.0)),
                        ("poisson_scaled", (1e-6, 1.0, 1e6)),
                        ("poisson_degenerate", (1e-2, 1e-4, 1e-6)),
                        ("poisson_fine", (1e6,))):
-    STRESS_CASES.register(_name, StressCase(_poisson, _values))
+    STRESS_CASES.register(_name, StressCase(_poisson, _values, _poisson_price))
 STRESS_CASES.register("poisson_neumann", StressCase(
-    lambda case, study, quick_n: case_neumann(case, quick_n), (0,)))
+    lambda case, study, quick_n: case_neumann(case, quick_n), (0,), _neumann_price))
 STRESS_CASES.register("cg_residual_drift", StressCase(
-    lambda case, study, quick_n: case_cg_drift(case), (1e4, 1e8, 1e12)))
+    lambda case, study, quick_n: case_cg_drift(case), (1e4, 1e8, 1e12),
+    lambda case, study, quick_n: _dense_price(case, study, quick_n, 300,
+                                              lambda n: case.get("maxiter", 20 * n))))
 STRESS_CASES.register("jacobi_divergence", StressCase(
-    lambda case, study, quick_n: case_jacobi(case), (0.05, 0.5, 0.9)))
+    lambda case, study, quick_n: case_jacobi(case), (0.05, 0.5, 0.9),
+    lambda case, study, quick_n: _dense_price(case, study, quick_n, 10,
+                                              lambda n: case.get("maxiter", 200))))
 STRESS_CASES.register("dynamics_stiffness", StressCase(
-    lambda case, study, quick_n: case_dynamics(case, study.integrators), (1e2, 1e5, 1e9)))
+    lambda case, study, quick_n: case_dynamics(case, study.integrators), (1e2, 1e5, 1e9),
+    _dynamics_price))
 
 
 def stress_case_schema() -> dict:

@@ -39,6 +39,12 @@ def _run(study, progress_enabled=None) -> dict:
     return run_adaptive_study(study, progress_enabled=progress_enabled)
 
 
+def _plan(study, **kwargs):
+    from ..cost import plan_adaptive_study
+
+    return plan_adaptive_study(study)
+
+
 def _report(*args) -> None:
     from ..adaptive import build_adaptive_report
 
@@ -51,5 +57,5 @@ def _summary(result) -> list[str]:
     return adaptive_summary(result)
 
 
-KIND = register_kind(Kind("adaptive", "kind", ADAPTIVE, _check, _run, report=_report,
+KIND = register_kind(Kind("adaptive", "kind", ADAPTIVE, _check, _run, plan=_plan, report=_report,
                           summary=_summary))

@@ -1,7 +1,7 @@
 """``kind: cloth_work_precision``: which implicit cloth method buys the most accuracy per millisecond.
 
 Everything of the kind is in :mod:`femkit.study.cloth` (schema, check, sweep, report, summary);
-this module registers it. No cost model yet (the plan counts runs).
+this module registers it. Cost plan :func:`femkit.study.cost.plan_cloth_study`.
 """
 
 from __future__ import annotations
@@ -27,6 +27,12 @@ def _run(study, progress_enabled=None) -> dict:
     return run_cloth_study(study, progress_enabled=progress_enabled)
 
 
+def _plan(study, **kwargs):
+    from ..cost import plan_cloth_study
+
+    return plan_cloth_study(study)
+
+
 def _report(*args) -> None:
     from ..cloth import build_cloth_report
 
@@ -40,4 +46,4 @@ def _summary(result) -> list[str]:
 
 
 KIND = register_kind(Kind("cloth_work_precision", "kind", _schema, _check, _run,
-                          report=_report, summary=_summary))
+                          plan=_plan, report=_report, summary=_summary))

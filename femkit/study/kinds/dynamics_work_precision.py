@@ -2,7 +2,7 @@
 
 Sweep :func:`femkit.study.dynamics.run_dynamics_study`, report
 :func:`femkit.study.report_dynamics.build_dynamics_report`; schema
-:data:`femkit.study.schema.DYNAMICS`. No cost model yet (the plan counts runs).
+:data:`femkit.study.schema.DYNAMICS`. Cost plan :func:`femkit.study.cost.plan_dynamics_study`.
 """
 
 from __future__ import annotations
@@ -29,6 +29,12 @@ def _run(study, progress_enabled=None) -> dict:
     return run_dynamics_study(study, progress_enabled=progress_enabled)
 
 
+def _plan(study, **kwargs):
+    from ..cost import plan_dynamics_study
+
+    return plan_dynamics_study(study)
+
+
 def _report(*args) -> None:
     from ..report_dynamics import build_dynamics_report
 
@@ -36,4 +42,4 @@ def _report(*args) -> None:
 
 
 KIND = register_kind(Kind("dynamics_work_precision", "kind", DYNAMICS, _check, _run,
-                          report=_report, summary=fit_lines))
+                          plan=_plan, report=_report, summary=fit_lines))

@@ -3,7 +3,7 @@
 Sweep :func:`femkit.study.stability.run_stability_study` over the stress-case types of
 :data:`femkit.study.stability.STRESS_CASES`, report
 :func:`femkit.study.report_stability.build_stability_report`; schema
-:func:`femkit.study.stability.stability_schema`. No cost model yet (the plan counts runs).
+:func:`femkit.study.stability.stability_schema`. Cost plan :func:`femkit.study.cost.plan_stability_study`.
 """
 
 from __future__ import annotations
@@ -34,6 +34,12 @@ def _run(study, progress_enabled=None) -> dict:
     return run_stability_study(study, progress_enabled=progress_enabled)
 
 
+def _plan(study, **kwargs):
+    from ..cost import plan_stability_study
+
+    return plan_stability_study(study)
+
+
 def _report(*args) -> None:
     from ..report_stability import build_stability_report
 
@@ -41,4 +47,4 @@ def _report(*args) -> None:
 
 
 KIND = register_kind(Kind("stability", "kind", _schema, _check, _run,
-                          report=_report, summary=fit_lines))
+                          plan=_plan, report=_report, summary=fit_lines))
