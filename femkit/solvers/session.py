@@ -231,20 +231,15 @@ class LinearSession:
         ``(n,)`` or ``(n, k)``). With ``cholesky`` the factor is the engine's (nested
         dissection; CHOLMOD's simplicial mode, the faster solves on these patterns;
         :class:`~femkit.errors.NotSPDError` if ``A`` is not SPD), otherwise SuperLU's."""
-        from .direct import factorize
+        from .kept import factorize_kept
 
         if self.spec.backend != "femkit":
             raise InputError(f"a factorisation kept for the whole run uses femkit's SuperLU; "
                              f"linear_solver.backend {self.spec.backend!r} is not supported "
                              f"here (use backend: femkit)")
         self._count("factorizations")
-        if self.spec.method == "cholesky":
-            from .cholesky import factorize_spd
-
-            engine = self.engine
-            return factorize_spd(A, ordering="nesdis", engine=engine,
-                                 mode="supernodal" if engine == "pardiso" else "simplicial")
-        return factorize(A)
+        cholesky = self.spec.method == "cholesky"
+        return factorize_kept(A, method=self.spec.method, engine=self.engine if cholesky else None)
 
     def _ordered_factor(self, A) -> Factor:
         """Factor of csr ``A``, reusing the kept SuperLU ordering when the pattern is unchanged."""

@@ -17,7 +17,8 @@ pass returns canonical CSR and the diagonal the smoother needs; it equals SciPy'
 One application is a V(nu, nu)-cycle from a zero initial guess: ``nu`` forward SOR sweeps
 (Gauss-Seidel over-relaxed by ``omega``, default 1.25) before the coarse correction, ``nu`` backward
 sweeps after it (compiled numba kernels), a cached direct factorisation
-(:func:`femkit.solvers.factorize`) on the coarsest level. Backward SOR is the ``A``-adjoint of
+(:func:`femkit.solvers.kept.factorize_kept`, the kept-factor path the linear-solve
+session uses too) on the coarsest level. Backward SOR is the ``A``-adjoint of
 forward SOR, so the cycle is a symmetric positive definite operator ``M ~ A^-1`` and PCG applies (Briggs, Henson and McCormick, *A Multigrid Tutorial*,
 2000; Saad, *Iterative Methods for Sparse Linear Systems*, 2nd ed., sec. 13.4).
 
@@ -247,7 +248,7 @@ class Multigrid:
 
     def __init__(self, A, hierarchy, *, free=None, sweeps: int = 2, coarse_operators=None,
                  omega: float = DEFAULT_OMEGA, check_symmetry: bool = True):
-        from ..direct import factorize
+        from ..kept import factorize_kept
 
         if hierarchy is None:
             raise _hierarchy_error("geometric multigrid")
@@ -306,7 +307,9 @@ class Multigrid:
         self.omega = float(omega)
         self.levels = [_Level(op, self.omega, d) for op, d in zip(ops, diags)]
         coarsest = ops[0]
-        self.coarse_factor = factorize(coarsest) if coarsest.shape[0] else None  # SuperLU, symmetric mode
+        # the one kept-factor path of the solvers (LinearSession.factorize uses it too): SuperLU
+        # in symmetric mode
+        self.coarse_factor = factorize_kept(coarsest) if coarsest.shape[0] else None
         nnz = [op.nnz for op in ops]
         sizes = [op.shape[0] for op in ops]
         self.info = {
