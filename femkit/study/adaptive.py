@@ -20,32 +20,26 @@ from .fit import fit_rate
 __all__ = ["run_adaptive_study", "build_adaptive_report", "adaptive_summary"]
 
 
-def _runs(d: dict) -> list[tuple[str, str, str]]:
-    """(label, refinement, estimator): uniform first (estimated with the first estimator)."""
-    ests = d["estimators"]
-    return [("uniform", "uniform", ests[0])] + [(f"adaptive ({e})", "adaptive", e) for e in ests]
-
-
 def run_adaptive_study(study, progress_enabled=None) -> dict:
     """The sweep: one adaptive run per estimator and one uniform run; records, fits, final meshes."""
     from ..case.poisson.run import exact_gradient
     from ..fem.adaptive import adaptive_solve, problem_solver
     from .problem import study_problem
 
-    d = study.data
+    d = study.spec
     spec = study_problem(study, need_exact=False)
     solver = study.solvers[0]
-    mesh0 = spec.base_mesh(d.get("h0"))
+    mesh0 = spec.base_mesh(d.h0)
     grad = exact_gradient(spec.case)
     solve_on = problem_solver(spec.problem, solver.solve, solver.method)
     solve_on(mesh0, None)                                   # warm-up: imports, AMG, caches
     records, fits, meshes, outcome = [], [], {}, []
     measured = "error" if grad is not None else "estimate"
-    for label, refinement, est in progress(list(_runs(d)), desc="refinements", unit="run",
+    for label, refinement, est in progress(d.runs(), desc="refinements", unit="run",
                                              enabled=progress_enabled, stop=active_flag()):
-        run = adaptive_solve(solve_on, mesh0, theta=d["theta"], target=d.get("target"),
-                             max_dofs=d["max_dofs"], max_time=d.get("max_time"),
-                             max_levels=d["max_levels"], estimator=est, refinement=refinement,
+        run = adaptive_solve(solve_on, mesh0, theta=d.theta, target=d.target,
+                             max_dofs=d.max_dofs, max_time=d.max_time,
+                             max_levels=d.max_levels, estimator=est, refinement=refinement,
                              grad_exact=grad)
         meshes[label] = (run.mesh, run.estimate.indicators)
         outcome.append({"run": label, "levels": len(run.levels), "dofs": run.levels[-1].dofs,
@@ -55,7 +49,7 @@ def run_adaptive_study(study, progress_enabled=None) -> dict:
         for lv in run.levels:
             records.append({"run": label, "refinement": refinement, "estimator": est, **lv.as_dict(),
                             "measured": lv.error if grad is not None else lv.estimate})
-        rows = [r for r in records if r["run"] == label and r["dofs"] >= d["fit_min_dofs"]]
+        rows = [r for r in records if r["run"] == label and r["dofs"] >= d.fit_min_dofs]
         if len(rows) >= 2:
             y = [r["measured"] for r in rows]
             for against, key in (("dofs", "dofs"), ("time", "elapsed")):
@@ -145,7 +139,7 @@ def build_adaptive_report(report, study, result, data, stage) -> None:
                          "estimate (true-error evaluation excluded), seconds")
     report.heading("Fitted rates")
     report.paragraph(f"Slope of log({measured}) against log(dofs) and against log(run time), over the levels "
-                     f"with at least {study.data['fit_min_dofs']} dofs. For P1 the optimal energy rate is "
+                     f"with at least {study.spec.fit_min_dofs} dofs. For P1 the optimal energy rate is "
                      "dofs^-1/2; a corner singularity r^a limits uniform refinement to dofs^-a/2 "
                      "(1/3 on the L-shape).")
     cols = ["run", "error", "against", "slope", "r2", "n"]

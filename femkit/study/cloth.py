@@ -77,14 +77,26 @@ def family_styles() -> dict:
 def _scene_case(study, path):
     from ..case import load_case
 
-    overrides = {f"system__{k}": v for k, v in (study.data.get("system_overrides") or {}).items()}
+    overrides = {f"system__{k}": v for k, v in study.spec.system_overrides.items()}
     return load_case(study.resolve(path), **overrides)
 
 
 def check_cloth_study(study) -> None:
+    """The load-time checks; builds ``study.spec`` (:class:`femkit.study.spec.ClothStudySpec`)
+    with the solver specs (the study's and each family's) validated once."""
+    from ..case.specs import solver_spec
     from ..dynamics.work_precision import expand_methods
+    from .spec import ClothStudySpec
 
-    for i, p in enumerate(study.data["scenes"]):
+    d = study.data
+    methods = _methods(d["methods"])
+    try:
+        expand_methods(methods)
+    except InputError as exc:
+        raise CaseFileError(f"methods: {exc}") from None
+    ls = solver_spec(d["linear_solver"], "linear_solver", default_method="cholesky")
+    study.spec = spec = ClothStudySpec.from_data(d, ls, methods)
+    for i, p in enumerate(spec.scenes):
         path = study.resolve(p)
         if not path.is_file():
             raise CaseFileError(f"scenes[{i}]: scene file not found: {path}")
@@ -92,13 +104,6 @@ def check_cloth_study(study) -> None:
         case = _scene_case(study, p)
         if case.problem != "mass_spring" or case.spec.system["type"] != "cloth":
             raise CaseFileError(f"scenes[{i}]: {path.name} is not a cloth scene (system.type: cloth)")
-    try:
-        expand_methods(_methods(study.data["methods"]))
-    except InputError as exc:
-        raise CaseFileError(f"methods: {exc}") from None
-    from ..case.specs import solver_spec
-
-    solver_spec(study.data["linear_solver"], "linear_solver", default_method="cholesky")
 
 
 def _methods(methods: list) -> list:
@@ -114,32 +119,31 @@ def _methods(methods: list) -> list:
 def run_cloth_study(study, progress_enabled=None) -> dict:
     """The sweep: one record per (scene, method setting), energies and references per scene."""
     from ..case.scene.run import build_system
-    from ..case.specs import solver_spec
     from ..dynamics.work_precision import cloth_work_precision
     from .pareto import pareto_front
     from ..interrupt import active_flag
     from ..progress import progress
 
-    d = study.data
-    spec = solver_spec(d["linear_solver"], "linear_solver", default_method="cholesky")
-    ref = d["reference"]  # every key filled from the schema's defaults
+    d = study.spec
+    spec = d.linear_solver
+    ref = d.reference
     records, energy, references, notes = [], {}, [], []
-    for path in progress(list(d["scenes"]), desc="cloth scenes", unit="run",
+    for path in progress(list(d.scenes), desc="cloth scenes", unit="run",
                          enabled=progress_enabled, stop=active_flag()):
         case = _scene_case(study, path)
         system, _ = build_system(case)
-        dt = float(d.get("dt") or case.spec.dt)
+        dt = float(d.dt or case.spec.dt)
         name = case.name
-        out = cloth_work_precision(system, dt, int(d["frames"]), _methods(d["methods"]), solver=spec,
-                                   reference_tol=ref["tol"], trajectory_reference=ref["trajectory"],
-                                   substeps=ref["substeps"], reference_solve=ref["solve"])
+        out = cloth_work_precision(system, dt, d.frames, [dict(m) for m in d.methods], solver=spec,
+                                   reference_tol=ref.tol, trajectory_reference=ref.trajectory,
+                                   substeps=ref.substeps, reference_solve=ref.solve)
         runs = out["runs"]
         cost = [r.time_per_frame for r in runs]
         front_s = set(pareto_front(cost, [r.solve_error for r in runs]).tolist())
         front_t = set(pareto_front(cost, [r.trajectory_error for r in runs]).tolist())
         for i, r in enumerate(runs):
             records.append({"scene": name, "nodes": system.n, "springs": system.n_springs, "dt": dt,
-                            "frames": int(d["frames"]), **r.summary(),
+                            "frames": d.frames, **r.summary(),
                             "options": ", ".join(f"{k}={v}" for k, v in r.options.items()),
                             "pareto_solve": i in front_s, "pareto_trajectory": i in front_t})
         energy[name] = {"times": out["times"], "runs": {r.label: r.energy for r in runs},

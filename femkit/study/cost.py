@@ -22,16 +22,6 @@ __all__ = ["plan_study", "plan_poisson_study", "plan_dynamics_study", "plan_stab
 
 
 
-def _levels(study) -> list[tuple[float, int]]:
-    """``(h, refinements)`` of each mesh level, as :func:`femkit.study.poisson._meshes` builds them."""
-    lv = study.data["levels"]
-    if "h" in lv:
-        hs = list(lv["h"])[: lv["max_level"] + 1] if "max_level" in lv else list(lv["h"])
-        return [(float(h), 0) for h in hs]
-    count = lv["count"] if "max_level" not in lv else min(lv["count"], lv["max_level"] + 1)
-    return [(float(lv["h0"]), k) for k in range(count)]
-
-
 def plan_poisson_study(study) -> Plan:
     """The plan of a ``poisson_convergence`` study: the runs :func:`femkit.study.poisson.
     run_poisson_study` does, each priced by :func:`femkit.cost.plan_poisson` on its level.
@@ -48,15 +38,15 @@ def plan_poisson_study(study) -> Plan:
 
     case = study_problem(study).case
     mesh = case.spec.mesh
-    d = study.data
-    repeats, rules = int(d["repeats"]), list(d["quadrature"])
-    reference = d["reference"] == "scikit-fem"
-    nested = d.get("stop_at_discretisation_error") is not None and "h" not in d["levels"]
+    d = study.spec
+    repeats, rules = d.repeats, list(d.quadrature)
+    reference = d.reference == "scikit-fem"
+    nested = d.stop_fraction is not None and d.levels.nested
     c = load_constants()["seconds"]
     imports = c["pyamg_import"]
     stages, peak, mesh_bytes, largest, p = [], 0.0, 0.0, 0.0, None
     amg = False
-    for level, (h, k) in enumerate(_levels(study)):
+    for level, (h, k) in enumerate(d.levels.sizes()):
         if mesh.file is not None:
             where = dict(triangles=msh_triangle_count(mesh.file)[0])
         else:
@@ -110,8 +100,8 @@ def plan_poisson_study(study) -> Plan:
         once = (imports if amg else 0.0) + (c.get("skfem_import", 0.0) if reference else 0.0)
         stages.insert(0, Stage("imports", once, 0.0, detail=", ".join(
             n for n, on in (("pyamg", amg), ("scikit-fem", reference)) if on) + ", once"))
-    runs = len(_levels(study)) * (len(study.solvers) * len(rules) + int(reference))
-    plan = Plan("study", f"{study.name}: poisson_convergence, {len(_levels(study))} levels",
+    runs = len(d.levels.sizes()) * (len(study.solvers) * len(rules) + int(reference))
+    plan = Plan("study", f"{study.name}: poisson_convergence, {len(d.levels.sizes())} levels",
                 {"runs": runs, "triangles": largest}, stages, p.baseline_bytes,
                 p.assumptions[:2] + [
                     "the meshes of every level stay in memory (~40 bytes per triangle); each "
@@ -151,27 +141,22 @@ def runs_plan(study, stages: list, runs: int, assumptions: list) -> Plan:
 def plan_dynamics_study(study) -> Plan:
     """The plan of a ``dynamics_work_precision`` study: every (integrator, dt) run ``repeats``
     times, the reference runs (when not analytic) and the warm-up, priced per step."""
-    from .dynamics import dt_values
-
-    d = study.data
-    scene = d["scene"]
-    nodes, springs = (2, 1) if scene["type"] != "rope" else (scene["n"], scene["n"] - 1)
-    t_end, dts = float(scene["t_end"]), dt_values(d["dt"])
+    d = study.spec
+    nodes, springs = d.scene.size
+    t_end, dts, ref = d.scene.t_end, d.dts, d.reference
     stages = []
-    ref = d.get("reference") or {}
-    if scene["type"] == "rope" or not ref.get("analytic", True):
-        rdt = float(ref.get("dt", min(dts) / 16))
-        every = max(1, int(round(max(dts) / rdt)))
+    if not (d.scene.analytic and ref.analytic):
+        every = max(1, int(round(max(dts) / ref.dt)))
         steps = t_end / (max(dts) / every) * (1.5 if every % 2 == 0 else 3.0)  # and its check run
         stages.append(Stage("reference", steps_seconds(steps, nodes=nodes, springs=springs), 0.0,
-                            detail=f"{ref.get('integrator', 'rk4')}, {steps:,.0f} steps"))
+                            detail=f"{ref.integrator}, {steps:,.0f} steps"))
     for spec in study.integrators:
         implicit = bool(spec.build().implicit)
-        steps = sum(t_end / dt for dt in dts) * int(d["repeats"])
-        steps += 20 if d["warmup"] else 0
+        steps = sum(t_end / dt for dt in dts) * d.repeats
+        steps += 20 if d.warmup else 0
         stages.append(Stage(spec.label, steps_seconds(steps, nodes=nodes, springs=springs,
                                                       implicit=implicit), 0.0,
-                            detail=f"{len(dts)} dt x {d['repeats']} repeat(s), {steps:,.0f} steps"))
+                            detail=f"{len(dts)} dt x {d.repeats} repeat(s), {steps:,.0f} steps"))
     runs = len(study.integrators) * len(dts)
     return runs_plan(study, stages, runs, [
         f"{nodes} nodes, {springs} springs; seconds per step from the scene model "
@@ -206,14 +191,14 @@ def plan_adaptive_study(study) -> Plan:
     from ..cost import load_constants, msh_triangle_count, predict_triangles
     from .problem import study_problem
 
-    d = study.data
+    d = study.spec
     mesh = study_problem(study, need_exact=False).case.spec.mesh
     if mesh.file is not None:
         triangles = float(msh_triangle_count(mesh.file)[0])
     else:
         _, area, length = geometry_domain(mesh.geometry, dict(mesh.params))
-        triangles = predict_triangles(area, length, float(d.get("h0") or mesh.h))
-    start, max_dofs = max(triangles / 2.0, 4.0), float(d["max_dofs"])
+        triangles = predict_triangles(area, length, float(d.h0 or mesh.h))
+    start, max_dofs = max(triangles / 2.0, 4.0), float(d.max_dofs)
     solver = study.solvers[0]
     fixed = load_constants()["seconds"].get("adaptive_level_fixed", 0.0)
 
@@ -229,13 +214,13 @@ def plan_adaptive_study(study) -> Plan:
             seconds, levels, dofs = seconds + level_seconds(dofs), levels + 1, dofs * growth
         return seconds, levels
 
-    adaptive, levels = sweep(1.0 + 0.8 * float(d["theta"]), int(d["max_levels"]))
-    uniform, uniform_levels = sweep(4.0, int(d["max_levels"]))
+    adaptive, levels = sweep(1.0 + 0.8 * d.theta, d.max_levels)
+    uniform, uniform_levels = sweep(4.0, d.max_levels)
     stages = [Stage(f"adaptive {name}", adaptive, 0.0, detail=f"~{levels} levels")
-              for name in d["estimators"]]
+              for name in d.estimators]
     stages.append(Stage("uniform", uniform, 0.0,
                         detail=f"{uniform_levels} levels up to {max_dofs:,.0f} unknowns"))
-    return runs_plan(study, stages, levels * len(d["estimators"]) + uniform_levels, [
+    return runs_plan(study, stages, levels * len(d.estimators) + uniform_levels, [
         f"from ~{start:,.0f} unknowns; adaptive levels grow the unknowns by 1 + 0.8 theta, "
         "uniform ones 4x; each level costed by the Poisson model (assembly, solve, error "
         "estimate, errors) plus a fixed cost per level (femkit/cost/constants.json)"])
@@ -248,16 +233,15 @@ def plan_cloth_study(study) -> Plan:
     from ..case.scene.systems import system_size
     from .cloth import _scene_case
 
-    d = study.data
-    frames = int(d["frames"])
-    substeps = int(d["reference"]["substeps"])
+    d = study.spec
+    frames, substeps = d.frames, d.reference.substeps
     stages, runs = [], 0
-    for path in d["scenes"]:
+    for path in d.scenes:
         case = _scene_case(study, path)
         size = system_size(case.spec.system)
         nodes, springs, dim = size.nodes, size.springs, size.dim
         solves = 0
-        for m in d["methods"]:
+        for m in d.methods:
             its = list(m.get("iterations") or [1])
             runs += len(its)
             solves += sum(its)

@@ -28,18 +28,18 @@ from .fit import fit_asymptotic
 from .timing import time_call
 
 
-def build_scene(scene: dict):
-    """(system, x0, v0, exact) with ``exact(times) -> (m, n, d)`` positions or None."""
+def build_scene(scene):
+    """(system, x0, v0, exact) of a :class:`~femkit.study.spec.DynamicsScene`, with
+    ``exact(times) -> (m, n, d)`` positions, or None for a scene without a closed form."""
     from ..dynamics import rope, single_spring
     from ..dynamics.forces import Gravity
 
-    kind = scene["type"]
-    k, m, g = scene["k"], scene["mass"], scene.get("gravity", 0.0)
-    if kind in ("harmonic_oscillator", "single_spring"):
-        sys_ = single_spring(k=k, m=m, rest=scene["rest"], gravity=g or None)
+    k, m, g = scene.k, scene.mass, scene.gravity
+    if scene.analytic:
+        sys_ = single_spring(k=k, m=m, rest=scene.rest, gravity=g or None)
         x0 = sys_.x0.copy()
-        y_eq = x0[0, 1] - scene["rest"] - m * g / k
-        y0 = y_eq - scene["amplitude"]
+        y_eq = x0[0, 1] - scene.rest - m * g / k
+        y0 = y_eq - scene.amplitude
         x0[1, 1] = y0
         w = np.sqrt(k / m)
 
@@ -50,9 +50,9 @@ def build_scene(scene: dict):
             return out
 
         return sys_, x0, np.zeros_like(x0), exact
-    n = scene["n"]
+    n = scene.n
     forces = [Gravity(g)] if g else []
-    sys_ = rope(n, scene["rest"] * (n - 1), k=k, mass=m, pinned="first", forces=forces)
+    sys_ = rope(n, scene.rest * (n - 1), k=k, mass=m, pinned="first", forces=forces)
     return sys_, sys_.x0.copy(), np.zeros_like(sys_.x0), None
 
 
@@ -65,18 +65,12 @@ def _simulate(system, name, opts, dt, t_end, x0, v0, every, limit):
                         energy_growth_limit=limit, **opts)
 
 
-def dt_values(d: dict) -> list[float]:
-    if "values" in d:
-        return sorted(float(v) for v in d["values"])[::-1]
-    return [2.0 ** (-k) for k in range(d["k_min"], d["k_max"] + 1)]
-
-
 def run_dynamics_study(study, *, progress_enabled=None) -> dict:
-    d = study.data
-    scene = d["scene"]
+    d = study.spec
+    scene = d.scene
     system, x0, v0, exact = build_scene(scene)
-    t_end = scene["t_end"]
-    dts = dt_values(d["dt"])
+    t_end = scene.t_end
+    dts = list(d.dts)
     dt_big = max(dts)
     ratios = [dt_big / dt for dt in dts]
     if not all(abs(r - round(r)) < 1e-9 for r in ratios) or abs(t_end / dt_big - round(t_end / dt_big)) > 1e-9:
@@ -87,14 +81,13 @@ def run_dynamics_study(study, *, progress_enabled=None) -> dict:
     n_common = int(round(t_end / dt_big))
     t_common = np.arange(n_common + 1) * dt_big
     notes, tables, ref_error = [], {}, 0.0
-    ref = d.get("reference") or {}
-    if exact is not None and ref.get("analytic", True):
+    ref = d.reference
+    if exact is not None and ref.analytic:
         ref_x = exact(t_common)
-        notes.append(f"Reference: the analytic solution y(t) = y_eq + (y0 - y_eq) cos(sqrt(k/m) t), k = {scene['k']:g}, "
-                     f"m = {scene['mass']:g}.")
+        notes.append(f"Reference: the analytic solution y(t) = y_eq + (y0 - y_eq) cos(sqrt(k/m) t), k = {scene.k:g}, "
+                     f"m = {scene.mass:g}.")
     else:
-        rname = ref.get("integrator", "rk4")
-        rdt = ref.get("dt", min(dts) / 16)
+        rname, rdt = ref.integrator, ref.dt
         every = max(1, int(round(dt_big / rdt)))
         rtraj, ref_error = _reference_run(system, rname, dt_big, every, t_end, x0, v0)
         ref_x = rtraj.x
@@ -106,7 +99,7 @@ def run_dynamics_study(study, *, progress_enabled=None) -> dict:
     free = ~system.pinned
     records, energy_series = [], {}
     integrators = [(i.method, i.options, i.label) for i in study.integrators]
-    if d["warmup"]:
+    if d.warmup:
         for name, opts, _ in integrators:
             try:
                 _simulate(system, name, opts, dts[-1], min(t_end, 20 * dts[-1]), x0, v0, 1, np.inf)
@@ -118,8 +111,8 @@ def run_dynamics_study(study, *, progress_enabled=None) -> dict:
         every = int(round(dt_big / dt))
         rec = {"integrator": label, "name": name, "dt": dt, "k": -np.log2(dt), "steps": int(round(t_end / dt))}
         try:
-            timing = time_call(lambda: _simulate(system, name, opts, dt, t_end, x0, v0, every, d["energy_growth_limit"]),
-                               repeats=d["repeats"], warmup=0)
+            timing = time_call(lambda: _simulate(system, name, opts, dt, t_end, x0, v0, every, d.energy_growth_limit),
+                               repeats=d.repeats, warmup=0)
             traj = timing.value
             diff = (traj.x - ref_x)[:, free]
             err_t = np.sqrt(np.sum(diff.reshape(len(diff), -1) ** 2, axis=1))

@@ -52,6 +52,9 @@ class Study:
         ``solvers:`` validated once (names, options, defaults from the one table).
     integrators : list of IntegratorSpec
         ``integrators:`` validated once.
+    spec : StudySpec
+        The kind's typed, frozen run spec (:mod:`femkit.study.spec`), built once by the
+        kind's ``prepare``; the sweep, the plan and the report read it.
     """
 
     kind: str
@@ -63,10 +66,11 @@ class Study:
     files: list = field(default_factory=list)
     solvers: list = field(default_factory=list)
     integrators: list = field(default_factory=list)
+    spec: Any = None
 
     @property
     def title(self) -> str:
-        return self.data.get("title") or self.name.replace("_", " ")
+        return self.spec.title or self.name.replace("_", " ")
 
     def resolve(self, rel: str) -> Path:
         """A path from the study file, resolved against its folder."""
@@ -75,8 +79,8 @@ class Study:
 
     def default_output(self) -> Path:
         """``output:`` if given, else ``femkit-out/<name>`` beside the study file (git-ignored)."""
-        if self.data.get("output"):
-            return self.resolve(self.data["output"])
+        if self.spec.output:
+            return self.resolve(self.spec.output)
         return self.base_dir / "femkit-out" / self.name
 
     def run(self, output_dir=None, *, progress: bool | None = None):
@@ -128,6 +132,10 @@ def _check_kind(study: Study) -> None:
     study.integrators = [IntegratorSpec.from_mapping(s, f"integrators[{i}]")
                          for i, s in enumerate(d.get("integrators") or ())]
     KINDS.get(study.kind, "kind").prepare(study)
+    if study.spec is None:  # a kind without a spec of its own (a plugin's): the common keys
+        from .spec import StudySpec
+
+        study.spec = StudySpec(**StudySpec.common(d))
 
 
 def load_study(path: str | os.PathLike, *, quick: bool = False, **overrides: Any) -> Study:

@@ -29,7 +29,7 @@ def _meshes(study, spec, timer_list):
     from ..mesh import MeshHierarchy, edges, refine
     from ..mesh.hierarchy import prolongation
 
-    lv = study.data["levels"]
+    lv = study.spec.levels
     meshes = []
     timer = StageTimer()
 
@@ -38,15 +38,13 @@ def _meshes(study, spec, timer_list):
             meshes.append(make())
         timer_list.append(timer.times[level])
 
-    if "h" in lv:
-        hs = list(lv["h"])
-        if "max_level" in lv:
-            hs = hs[: lv["max_level"] + 1]
-        for i, h in enumerate(hs):
+    sizes = lv.sizes()
+    if not lv.nested:
+        for i, (h, _) in enumerate(sizes):
             timed(i, lambda h=h: spec.base_mesh(h))
         return meshes, lambda level: None
-    count = lv["count"] if "max_level" not in lv else min(lv["count"], lv["max_level"] + 1)
-    timed(0, lambda: spec.base_mesh(lv["h0"]))
+    count = len(sizes)
+    timed(0, lambda: spec.base_mesh(lv.h0))
     from ..case.cost import check_mesh_fits
 
     for i in range(1, count):
@@ -164,12 +162,12 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
     """Run the sweep; return ``{"records", "fits", "nested", "meshes", "notes"}``."""
     from .problem import study_problem
 
-    d = study.data
+    d = study.spec
     spec = study_problem(study)
-    repeats, warmup, order = d["repeats"], d["warmup"], d["error_order"]
+    repeats, warmup, order = d.repeats, d.warmup, d.error_order
     mesh_times: list[float] = []
     meshes, hierarchy = _meshes(study, spec, mesh_times)
-    rules, solvers = d["quadrature"], study.solvers
+    rules, solvers = d.quadrature, study.solvers
     multigrid = any(s.needs_hierarchy for s in solvers)
     notes = []
     if warmup:
@@ -204,7 +202,7 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
             times = {"mesh": mesh_times[lvl], "assembly": ta.min, "boundary": tb.min,
                      "solve": ts.min, "errors": timer.times["errors"]}
             records.append(_record(lvl, mesh, sys, rule, s.label, s.to_dict(), res, errs, times))
-    if d["reference"] == "scikit-fem":
+    if d.reference == "scikit-fem":
         if spec.has_neumann:
             notes.append("scikit-fem reference skipped: the base case has Neumann boundaries.")
         else:
@@ -222,9 +220,9 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
             notes.append(f"scikit-fem reference: skfem {__import__('skfem').__version__} P1 (default 3-point "
                          f"quadrature), condense, pyamg smoothed aggregation + SciPy CG to rtol {rtol:g}.")
     nested = []
-    if d.get("stop_at_discretisation_error") is not None and "h" not in d["levels"]:
+    if d.stop_fraction is not None and d.levels.nested:
         nested = _nested_runs(study, spec, meshes, mesh_times, records, hierarchy)
-    elif d.get("stop_at_discretisation_error") is not None:
+    elif d.stop_fraction is not None:
         notes.append("stop_at_discretisation_error needs nested levels (levels: {h0, count}); skipped.")
     failed = [r for r in records if not r["converged"]]
     if failed:
@@ -354,9 +352,9 @@ def _nested_runs(study, spec, meshes, mesh_times, records, hierarchy=lambda leve
     """
     from ..solvers import solve as _solve_raw
 
-    d = study.data
-    frac = d["stop_at_discretisation_error"]["fraction"]
-    rule = d["quadrature"][0]
+    d = study.spec
+    frac = d.stop_fraction
+    rule = d.quadrature[0]
     out = []
     systems, exact, problems = [], [], []
     for mesh in meshes:
@@ -380,7 +378,7 @@ def _nested_runs(study, spec, meshes, mesh_times, records, hierarchy=lambda leve
                 x0 = np.zeros(sys.A.shape[0])
                 hist = cg_history(sys.A, sys.b, x0, s, mg)
                 lam0, h0 = smallest_ritz_value(hist["alpha"], hist["rz"]), fixed["h"]
-                tc = time_call(lambda: _solve(sys, s, mg=mg), repeats=d["repeats"], warmup=0)
+                tc = time_call(lambda: _solve(sys, s, mg=mg), repeats=d.repeats, warmup=0)
             else:
                 x0 = interpolate_nested(meshes[lvl - 1], mesh, prev)[sys.free]
                 hist = cg_history(sys.A, sys.b, x0, s, mg)
@@ -389,11 +387,11 @@ def _nested_runs(study, spec, meshes, mesh_times, records, hierarchy=lambda leve
                 if stop is not None:
                     bound, eta_m = float(np.sqrt(U[stop])), float(eta[stop])
                 s_run = s if stop is None else s.replace(maxiter=stop, label=s.label)
-                tc = time_call(lambda: _solve(sys, s_run, x0=x0.copy(), mg=mg), repeats=d["repeats"], warmup=0)
+                tc = time_call(lambda: _solve(sys, s_run, x0=x0.copy(), mg=mg), repeats=d.repeats, warmup=0)
             res, t_solve = tc.value, tc.min  # min over repeats, like the fixed-rtol runs
             u = sys.expand(res.x)
             prev = u
-            errs = spec.errors(problems[lvl], u, d["error_order"])
+            errs = spec.errors(problems[lvl], u, d.error_order)
             alg = _energy_norm(sys.A, res.x - exact[lvl])
             disc = _energy_norm_error(problems[lvl].kappa, fixed["H1_semi"])
             out.append({

@@ -62,16 +62,15 @@ def study_problem(study, *, need_exact: bool = True) -> StudyProblem:
     from ..case import load_case
     from ..case.load import case_from_dict
 
-    d = study.data
-    if "base_case" in d:
-        case = load_case(study.resolve(d["base_case"]))
-        where = f"base_case: {study.resolve(d['base_case'])}"
+    d = study.spec
+    if d.base_case is not None:
+        case = load_case(study.resolve(d.base_case))
+        where = f"base_case: {study.resolve(d.base_case)}"
     else:
-        data = {"problem": "poisson", **d["problem"]}
+        data = {"problem": "poisson", **d.problem}
         mesh = dict(data.get("mesh") or {})
         if "geometry" in mesh and "h" not in mesh:  # the levels give the sizes
-            lv = d.get("levels") or {"h0": d.get("h0")}
-            mesh["h"] = lv["h"][0] if "h" in lv else lv["h0"]
+            mesh["h"] = d.mesh_h
         data["mesh"] = mesh
         try:
             case = case_from_dict(data, study.base_dir, name=study.name)

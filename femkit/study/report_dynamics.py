@@ -41,11 +41,11 @@ def integrator_styles(study) -> dict:
 
 def build_dynamics_report(report, study, result, data, stage) -> None:
     recs = result.records
-    scene = study.data["scene"]
+    scene = study.spec.scene
     labels = list(dict.fromkeys(r["integrator"] for r in recs))
     fits = {f["integrator"]: f for f in result.fits}
     styles = integrator_styles(study)
-    report.paragraph(f"Scene: {scene['type']} (k = {scene['k']:g}, m = {scene['mass']:g}, t_end = {scene['t_end']:g}); "
+    report.paragraph(f"Scene: {scene.type} (k = {scene.k:g}, m = {scene.mass:g}, t_end = {scene.t_end:g}); "
                      f"dt = {', '.join(f'{dt:.4g}' for dt in data['dts'])}.")
     report.heading("Fitted orders")
     report.paragraph("Least-squares slope of log(max position error over the trajectory) against log(dt) over the "

@@ -113,8 +113,8 @@ def run_study(study, output_dir=None, *, progress: bool | None = None, write: bo
                          f"Python {platform.python_version()}; BLAS threads: "
                          f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS', 'unset')}. "
                          f"Input fingerprint `{result.fingerprint[:16]}`.")
-        if study.data.get("description"):
-            report.paragraph(study.data["description"])
+        if study.spec.description:
+            report.paragraph(study.spec.description)
         kind.report(report, study, result, data, stage)
         if result.notes:
             report.heading("Notes")

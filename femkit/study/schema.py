@@ -93,7 +93,8 @@ DYNAMICS = {
     "dt": _obj({"k_min": {"type": "integer"}, "k_max": {"type": "integer"},
                 "values": {"type": "array", "items": POS, "minItems": 2}}),
     "reference": _obj({"integrator": {"type": "string", "default": "rk4"},
-                       "dt": POS, "analytic": {"type": "boolean", "default": True}}),
+                       "dt": {**POS, "description": "default: the smallest swept dt / 16"},
+                       "analytic": {"type": "boolean", "default": True}}, default={}),
     "energy_growth_limit": {**POS, "default": 10.0},
 }
 

@@ -340,8 +340,8 @@ def load_cases(study) -> list[dict]:
     STRESS_CASE_SCHEMA = stress_case_schema()
 
     cases = []
-    overrides = study.data.get("case_overrides") or {}
-    for i, c in enumerate(study.data["cases"]):
+    overrides = study.spec.case_overrides
+    for i, c in enumerate(study.spec.cases):
         if isinstance(c, str):
             p = study.resolve(c)
             data = read_yaml(p)
@@ -396,12 +396,12 @@ def warm_up(solvers, integrators) -> list[str]:
 
 
 def run_stability_study(study, *, progress_enabled=None) -> dict:
-    d = study.data
+    d = study.spec
     cases = load_cases(study)
     quick_n = 16 if study.quick else 64
     rows = []
     notes = []
-    if d.get("warmup", 1):
+    if d.warmup:
         warmed = warm_up(study.solvers, study.integrators)
         notes.append("Warm-up before timing (untimed, on an 8 x 8 Poisson system and a two-spring chain): "
                      + ", ".join(warmed) + "; no timed run includes imports, AMG module loading or compilation.")

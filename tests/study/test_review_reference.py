@@ -42,7 +42,9 @@ def test_reference_error_estimate_matches_analytic_error(name, every):
 
     scene = {"type": "harmonic_oscillator", "k": 10.0, "mass": 1.0, "amplitude": 0.1, "rest": 1.0, "n": 8,
              "gravity": 0.0, "t_end": 4.0}
-    system, x0, v0, exact = build_scene(scene)
+    from femkit.study.spec import DynamicsScene
+
+    system, x0, v0, exact = build_scene(DynamicsScene(**scene))
     traj, est = _reference_run(system, name, 0.0625, every, 4.0, x0, v0)
     d = (traj.x - exact(np.arange(65) * 0.0625))[:, ~system.pinned]
     true = np.sqrt((d.reshape(len(d), -1) ** 2).sum(axis=1)).max()

@@ -10,6 +10,7 @@ from ...case.kinds import Kind, register_kind
 from ...errors import CaseFileError
 from ..checks import check_base_case, check_nested, check_problem_source
 from ..schema import ADAPTIVE
+from ..spec import AdaptiveStudySpec
 
 
 def _check(study) -> None:
@@ -25,6 +26,7 @@ def _check(study) -> None:
         lookup(ESTIMATORS, name, f"estimators[{i}]")
     check_settings(theta=d["theta"], target=d.get("target"), max_dofs=d["max_dofs"],
                    max_time=d.get("max_time"), max_levels=d["max_levels"])
+    study.spec = AdaptiveStudySpec.from_data(d)
     check_base_case(study)
     from ..problem import study_problem
 

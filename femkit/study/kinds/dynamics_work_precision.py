@@ -10,6 +10,7 @@ from __future__ import annotations
 from ...case.kinds import Kind, register_kind
 from ...errors import CaseFileError
 from ..schema import DYNAMICS
+from ..spec import DynamicsStudySpec
 from ..summary import fit_lines
 
 
@@ -21,6 +22,7 @@ def _check(study) -> None:
     dt = d["dt"]
     if "values" not in dt and not ("k_min" in dt and "k_max" in dt and dt["k_max"] > dt["k_min"]):
         raise CaseFileError("dt: give 'values' or 'k_min' < 'k_max' (dt = 2^-k)")
+    study.spec = DynamicsStudySpec.from_data(d)
 
 
 def _run(study, progress_enabled=None) -> dict:

@@ -11,6 +11,7 @@ from ...case.kinds import Kind, register_kind
 from ...errors import CaseFileError
 from ..checks import check_base_case, check_nested, check_problem_source
 from ..schema import POISSON
+from ..spec import PoissonStudySpec
 from ..summary import r2_text
 
 
@@ -20,6 +21,7 @@ def _check(study) -> None:
     if "h" not in lv and not ("h0" in lv and "count" in lv):
         raise CaseFileError("levels: give either 'h' (a list of mesh sizes) or 'h0' and 'count' "
                             "(uniform refinements of one mesh)")
+    study.spec = PoissonStudySpec.from_data(study.data)
     check_base_case(study)
     from ..problem import study_problem
 

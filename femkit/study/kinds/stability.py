@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from ...case.kinds import Kind, register_kind
 from ...errors import CaseFileError
+from ..spec import StabilityStudySpec
 from ..summary import fit_lines
 
 
@@ -26,6 +27,7 @@ def _check(study) -> None:
             if not p.is_file():
                 raise CaseFileError(f"cases[{i}]: stress case file not found: {p}")
             study.files.append(p)
+    study.spec = StabilityStudySpec.from_data(study.data)
 
 
 def _run(study, progress_enabled=None) -> dict:
