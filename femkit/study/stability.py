@@ -139,6 +139,11 @@ def case_poisson(case, solvers, quick_n):
     return rows
 
 
+#: The pure-Neumann case's solvers: CG on the singular system, AMG-PCG once a node is pinned.
+NEUMANN_CG = {"method": "cg", "rtol": 1e-10}
+NEUMANN_PINNED = {"method": "pcg", "preconditioner": "amg", "rtol": 1e-10}
+
+
 def case_neumann(case, quick_n):
     from ..fem import PoissonProblem
     from ..solvers import solve
@@ -173,17 +178,17 @@ def case_neumann(case, quick_n):
         rows.append({**base, "value": "singular K, direct", "method": "direct", "survived": True,
                      "outcome": "SingularSystemError (detected)", "detail": str(exc)[:200],
                      "time": time.perf_counter() - t0})
-    r = _solve_row(K, F_cons, _spec({"method": "cg", "rtol": 1e-10}), maxiter=case.get("maxiter", 5000))
+    r = _solve_row(K, F_cons, _spec(NEUMANN_CG), maxiter=case.get("maxiter", 5000))
     if "iterations" in r:
         r["error"] = None
     rows.append({**base, "value": "singular K, consistent rhs", "method": "cg", **r})
-    r = _solve_row(K, F_bad, _spec({"method": "cg", "rtol": 1e-10}), maxiter=case.get("maxiter", 2000))
+    r = _solve_row(K, F_bad, _spec(NEUMANN_CG), maxiter=case.get("maxiter", 2000))
     # surviving here means: not claiming convergence on an unsolvable system
     r["survived"] = not r.get("survived", False)
     r["outcome"] = "reported not converged: " + str(r.get("outcome")) if r["survived"] else "claimed convergence!"
     rows.append({**base, "value": "singular K, inconsistent rhs", "method": "cg", **r})
     # the fix: pin one node (value of the exact solution there) -> SPD
-    r = _solve_row(sys.A, sys.b, _spec({"method": "pcg", "preconditioner": "amg", "rtol": 1e-10}))
+    r = _solve_row(sys.A, sys.b, _spec(NEUMANN_PINNED))
     rows.append({**base, "value": "one node pinned (constant fixed)", "method": "pcg+amg", **r,
                  "error": pinned_err})
     return rows
@@ -455,8 +460,7 @@ def _neumann_price(case, study, quick_n):
     from .prices import poisson_run_seconds
 
     t = 2 * case.get("n", quick_n) ** 2
-    cg = _spec({"method": "cg", "rtol": 1e-10})
-    amg = _spec({"method": "pcg", "preconditioner": "amg", "rtol": 1e-10})
+    cg, amg = _spec(NEUMANN_CG), _spec(NEUMANN_PINNED)
     return (2 * poisson_run_seconds(t) + 2 * poisson_run_seconds(t, cg, assemble=False)
             + poisson_run_seconds(t, amg, assemble=False)), 4
 
