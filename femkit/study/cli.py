@@ -50,17 +50,21 @@ def _arguments(p: argparse.ArgumentParser) -> None:
 def _check_cost(study, args) -> bool:
     """``--dry-run``: print the plan (True: done); else refuse a sweep that cannot fit in the
     memory or is predicted to outlast the default time budget."""
+    from ..case.budget import MEASURE_FRACTION
     from ..cost import Limits, check_budget, machine_speed, parse_bytes, with_default_time
     from .cost import plan_study
 
-    plan = plan_study(study, speed=machine_speed())
     if getattr(args, "dry_run", False):
-        print(plan.render())
+        print(plan_study(study, speed=machine_speed()).render())
         return True
     max_memory = getattr(args, "max_memory", None)
-    # the default time budget (one hour, femkit.cost.DEFAULT_TIME_BUDGET): --force runs past it
+    # the default time budget (one hour, femkit.cost.DEFAULT_TIME_BUDGET): --force runs past it;
+    # the machine's speed is probed only for a sweep the model puts near it
     limits = with_default_time(Limits(
         memory=None if max_memory is None else parse_bytes(max_memory, "--max-memory")))
+    plan = plan_study(study)
+    if plan.seconds > MEASURE_FRACTION * limits.time:
+        plan = plan_study(study, speed=machine_speed())
     for w in check_budget(plan, limits, force=getattr(args, "force", False), override="--force"):
         print(f"femkit study: warning: {w} (--force given)", file=sys.stderr)
     return False

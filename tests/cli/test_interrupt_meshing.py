@@ -35,6 +35,7 @@ CASE = {
     "source": "1",
     "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
     "solver": {"method": "cg", "rtol": 1e-8},
+    "limits": {"time": "1d"},   # priced above the default one-hour budget: raised, it runs
     "output": {"dir": "out"},
 }
 

@@ -43,8 +43,8 @@ def test_raised_budget_or_force_lets_it_through(tmp_path):
     with pytest.raises(BudgetExceededError) as err:
         check_case(load_case(_rope(tmp_path)))
     assert err.value.what == "time" and err.value.predicted > 3600.0
-    days = err.value.predicted / 86400.0
-    raised = load_case(_rope(tmp_path, limits={"time": f"{10 * days + 1:.0f}d"}))
+    # raised far above the estimate (a first batch of steps on a busy machine varies 10x and more)
+    raised = load_case(_rope(tmp_path, limits={"time": "100000d"}))
     assert check_case(raised).seconds > 3600.0  # priced as before, now within the raised budget
     said = []
     plan = check_case(load_case(_rope(tmp_path)), force=True, echo=said.append)
