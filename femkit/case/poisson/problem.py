@@ -99,7 +99,10 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
     if k:
         # before numpy allocates
         check_mesh_fits(triangles=mesh.n_cells, refine=k, dim=mesh.dim, force=force)
-        big = mesh.n_cells * (2 ** mesh.dim) ** k >= RENUMBER_MIN_TRIANGLES
+        # tetrahedral hierarchies always: Gauss-Seidel sweeps run in storage order, and in the
+        # refinement's own numbering (coarse nodes first) the V(2,2) factor exceeds 0.2 at 6
+        # levels (0.209; 0.154 renumbered: docs/methods.md)
+        big = mesh.n_cells * (2 ** mesh.dim) ** k >= RENUMBER_MIN_TRIANGLES or mesh.dim == 3
         if big or case.solver.needs_hierarchy:
             levels = MeshHierarchy.from_refinement(mesh, k, renumber="rcm" if big else "none")
             mesh = levels.finest
