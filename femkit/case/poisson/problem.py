@@ -169,7 +169,7 @@ def element_kappa(case: Case, mesh) -> np.ndarray:
     if isinstance(coef, dict):
         from ...mesh import check_tags
 
-        values = np.full(mesh.n_triangles, float(coef.get("default", np.nan)))
+        values = np.full(mesh.n_cells, float(coef.get("default", np.nan)))
         for name, value in coef["regions"].items():
             (tag,) = check_tags(mesh, [name], kind="cell")
             values[mesh.cell_tags == tag] = float(value)
@@ -177,7 +177,7 @@ def element_kappa(case: Case, mesh) -> np.ndarray:
         if missing.size:
             tags = sorted(set(mesh.cell_tags[missing].tolist()))
             raise CaseFileError(
-                f"coefficient.regions: {missing.size} triangles (cell tags {tags}) are in no "
+                f"coefficient.regions: {missing.size} {mesh.cell_name}s (cell tags {tags}) are in no "
                 f"listed region; add them or give coefficient.default")
         return values
     kappa = case.functions.get("coefficient", coef)
