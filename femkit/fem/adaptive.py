@@ -47,7 +47,8 @@ class LevelRecord:
     gradient); ``iterations`` of the linear solver; times in seconds: ``solve_time`` (assembly and
     solve), ``estimate_time``, ``refine_time`` (marking and refining towards the next level) and
     ``elapsed`` (wall time since the start of the run up to the end of this level's estimate, the
-    true-error evaluation excluded).
+    true-error evaluation excluded); ``min_angle`` the smallest angle of the level's mesh in
+    degrees (of a triangle in 2D, the smallest dihedral angle in 3D).
     """
 
     level: int
@@ -64,6 +65,7 @@ class LevelRecord:
     refine_time: float
     elapsed: float
     marked: int = 0
+    min_angle: float | None = None
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -209,7 +211,7 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
                           iterations=int(getattr(result, "iterations", 0)),
                           converged=bool(getattr(result, "converged", True)),
                           solve_time=t1 - t0, estimate_time=t2 - t1, refine_time=0.0,
-                          elapsed=elapsed)
+                          elapsed=elapsed, min_angle=_min_angle(mesh))
         levels.append(rec)
         stop = _stop_reason(settings, rec, len(levels))
         marked = None
@@ -237,6 +239,14 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
         x0 = step.prolong(u)
         mesh = step.mesh
         state = step if state is not None else None
+
+
+def _min_angle(mesh) -> float:
+    """Smallest triangle angle (2D) or dihedral angle (3D) of ``mesh``, in degrees."""
+    from ..mesh.quality import dihedral_angles, side_lengths_and_angles
+
+    p = mesh.points[mesh.cells]
+    return float(np.min(dihedral_angles(p) if mesh.dim == 3 else side_lengths_and_angles(p)[1]))
 
 
 def _stop_reason(settings: dict, rec: LevelRecord, n_levels: int) -> str | None:

@@ -5,6 +5,8 @@ needs a start mesh whose tetrahedra are Kuhn's six per axis-aligned cube; a gmsh
 These geometries are unions of cubes of side ``h`` (``1 / h`` a whole number) cut as in
 :func:`femkit.mesh.structured_box`:
 
+* ``kuhn_cube``: the unit cube, with the tags of the gmsh ``unit_cube`` (faces ``xmin`` ...
+  ``zmax``, ``boundary``; cells ``domain``);
 * ``kuhn_fichera``: the Fichera corner, the cube ``(-1, 1)^3`` minus the octant ``[0, 1]^3``
   (volume 7, surface 24), as the gmsh geometry ``l_shape_3d``, with the same tags: faces
   ``reentrant`` (the three faces of the removed octant), ``outer`` (the rest), ``boundary``
@@ -24,7 +26,7 @@ from ..errors import InputError
 from .faces import boundary_faces_topological
 from .geometries import register_geometry
 from .mesh import Mesh
-from .structured import structured_box
+from .structured import SIDES_3D, structured_box
 
 
 def _cubes_per_unit(h: float) -> int:
@@ -33,6 +35,20 @@ def _cubes_per_unit(h: float) -> int:
         raise InputError(f"a Kuhn-type geometry needs 1/h to be a whole number (cubes of side h); "
                          f"got h = {h!r}, try h = {1.0 / max(n, 1):g}")
     return n
+
+
+@register_geometry("kuhn_cube", dim=3, measure=lambda: (1.0, 6.0),
+                   boundary_tags=("xmin", "xmax", "ymin", "ymax", "zmin", "zmax", "boundary"),
+                   cell_tags=("domain",))
+def kuhn_cube(h: float) -> Mesh:
+    """The unit cube of Kuhn cubes of side ``h`` (``1 / h`` whole): :func:`structured_box`
+    with the cell tag ``domain``."""
+    n = _cubes_per_unit(h)
+    box = structured_box(n, n, n)
+    domain = max(SIDES_3D.values()) + 1
+    return Mesh(box.points, box.cells, cell_tags=np.full(box.n_cells, domain, np.int32),
+                boundary_facets=box.boundary_facets, boundary_tags=box.boundary_tags,
+                tag_names={**box.tag_names, "domain": domain})
 
 
 @register_geometry("kuhn_fichera", dim=3, measure=lambda: (7.0, 24.0),

@@ -381,8 +381,11 @@ class CaseResult:
             met = ("target met" if a["target_met"] else
                    f"target NOT met: stopped by {a['stop_reason']}" if a.get("target") is not None
                    else f"stopped by {a['stop_reason']}")
+            worst = min((lv.get("min_angle") or nan) for lv in a["levels"])
+            kind = "dihedral angle" if self.mesh.dim == 3 else "angle"
             lines.append(f"adaptive  {len(a['levels'])} levels, theta {a['theta']:g}, "
-                         f"{a['levels'][0]['dofs']} -> {a['levels'][-1]['dofs']} dofs; {met}")
+                         f"{a['levels'][0]['dofs']} -> {a['levels'][-1]['dofs']} dofs; {met}; "
+                         f"smallest {kind} on any level {worst:.1f} deg")
         lines.append("time      " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timings.items()))
         if self.output_dir is not None:
             lines.append(f"output    {self.output_dir} ({', '.join(self.files)})")
