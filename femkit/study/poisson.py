@@ -219,8 +219,9 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
                 s = {"method": "cg", "preconditioner": "pyamg_sa"}
                 records.append(_record(lvl, mesh, sys_like, "skfem-default", "scikit-fem+pyamg", s,
                                        _Res(iters, relres, 1.0, conv), errs, times, source="scikit-fem"))
-            notes.append(f"scikit-fem reference: skfem {__import__('skfem').__version__} P1 (default 3-point "
-                         f"quadrature), condense, pyamg smoothed aggregation + SciPy CG to rtol {rtol:g}.")
+            element = "ElementTetP1, default 4-point" if meshes[0].dim == 3 else "P1, default 3-point"
+            notes.append(f"scikit-fem reference: skfem {__import__('skfem').__version__} {element} "
+                         f"quadrature, condense, pyamg smoothed aggregation + SciPy CG to rtol {rtol:g}.")
     nested = []
     if d.get("stop_at_discretisation_error") is not None and "h" not in d["levels"]:
         nested = _nested_runs(study, spec, meshes, mesh_times, records, hierarchy)
