@@ -1,4 +1,4 @@
-"""Safe arithmetic expressions of ``x`` and ``y`` for case files.
+"""Safe arithmetic expressions of ``x``, ``y`` (and ``z`` on tetrahedra) for case files.
 
 An expression string such as ``"2*pi**2*sin(pi*x)*sin(pi*y)"`` is parsed with
 :func:`ast.parse` (``mode="eval"``, an expression only), every node of the tree is checked against a
@@ -23,6 +23,9 @@ offending piece and listing what is allowed.
 19.739209
 >>> compile_expression("3")(np.zeros(2), np.zeros(2))
 array([3., 3.])
+>>> g = compile_expression("x + y", ("x", "y", "z"))  # z unused: callable with (x, y) too
+>>> float(g(1.0, 2.0)), float(g(1.0, 2.0, 5.0)), sorted(g.used)
+(3.0, 3.0, ['x', 'y'])
 >>> compile_expression("x.__class__")  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
@@ -101,21 +104,27 @@ class Expression:
         Names of the positional arguments.
     is_constant : bool
         True when the expression uses no variable.
+    used : frozenset of str
+        The variables the expression uses.
     label : str
         Where the expression comes from (a case-file key path); prefixes error messages.
     """
 
     def __init__(self, source: str, variables: tuple[str, ...], fn: Callable,
-                 is_constant: bool, check_finite: bool):
+                 is_constant: bool, check_finite: bool, used: frozenset = frozenset()):
         self.source = source
         self.variables = variables
         self._fn = fn
         self.is_constant = is_constant
+        self.used = frozenset(used)
         self.check_finite = check_finite
         self.label = ""  # where the expression comes from (e.g. "source"), used in messages
 
     def __call__(self, *args):
-        if len(args) != len(self.variables):
+        # Trailing variables the expression does not use may be left out: an expression of
+        # (x, y, z) that never names z is also a function of (x, y) (a 2D mesh).
+        n = len(args)
+        if n > len(self.variables) or self.used & set(self.variables[n:]):
             raise TypeError(f"expression {self.source!r} takes {len(self.variables)} arguments "
                             f"({', '.join(self.variables)}), got {len(args)}")
         arrays = [np.asarray(a, dtype=np.float64) for a in args]
@@ -205,7 +214,8 @@ def compile_expression(text, variables: Sequence[str] = ("x", "y"),
         fn = _build(tree.body, source, variables, names, constants, used)
     except RecursionError:
         raise ExpressionError(f"expression {source!r} is nested too deeply") from None
-    expr = Expression(source, variables, fn, not (used & set(variables)), check_finite)
+    expr = Expression(source, variables, fn, not (used & set(variables)), check_finite,
+                      frozenset(used & set(variables)))
     if expr.is_constant and check_finite:
         expr(*([0.0] * len(variables)))  # a constant that is NaN/inf fails at load time
     return expr

@@ -2,7 +2,9 @@
 
 Each level solves on the current mesh, estimates the energy-norm error element by element
 (:mod:`femkit.fem.estimators`), marks a Dörfler set (:func:`~femkit.fem.marking.dorfler_mark`) and
-refines it by newest-vertex bisection (:func:`femkit.mesh.bisect.bisect`), until the estimate
+refines it by newest-vertex bisection (:func:`femkit.mesh.bisect.bisect`; on tetrahedra Maubach's
+conforming bisection, :class:`femkit.mesh.bisect3d.TetBisection`, from a Kuhn-type start mesh),
+until the estimate
 meets ``target`` or a budget (``max_dofs``, ``max_time``, ``max_levels``) is spent. The next level's
 solve starts from the current solution interpolated onto the new mesh (nested iteration), so an
 iterative solver needs a few iterations per level only. ``refinement="uniform"`` runs the same loop
@@ -45,7 +47,8 @@ class LevelRecord:
     gradient); ``iterations`` of the linear solver; times in seconds: ``solve_time`` (assembly and
     solve), ``estimate_time``, ``refine_time`` (marking and refining towards the next level) and
     ``elapsed`` (wall time since the start of the run up to the end of this level's estimate, the
-    true-error evaluation excluded).
+    true-error evaluation excluded); ``min_angle`` the smallest angle of the level's mesh in
+    degrees (of a triangle in 2D, the smallest dihedral angle in 3D).
     """
 
     level: int
@@ -62,6 +65,7 @@ class LevelRecord:
     refine_time: float
     elapsed: float
     marked: int = 0
+    min_angle: float | None = None
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -177,7 +181,12 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
         raise AdaptivityError(f"target_on must be 'estimate', or 'error' with an exact gradient; "
                               f"got {target_on!r}")
     settings["target_on"] = target_on
-    if refinement == "adaptive":
+    state = None                                   # tetrahedra: the bisection state (Maubach)
+    if refinement == "adaptive" and mesh.dim == 3:
+        from ..mesh.bisect3d import TetBisection
+
+        state = TetBisection.start(mesh)
+    elif refinement == "adaptive":
         mesh = label_longest_edge(mesh)
     levels: list[LevelRecord] = []
     x0 = None
@@ -196,13 +205,13 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
         elapsed = t2 - t_start - excluded          # earlier levels' true-error evaluations removed
         excluded += time.perf_counter() - t2
         system = problem.system
-        rec = LevelRecord(level=len(levels), n_elements=mesh.n_triangles, n_nodes=mesh.n_points,
+        rec = LevelRecord(level=len(levels), n_elements=mesh.n_cells, n_nodes=mesh.n_points,
                           dofs=int(system.A.shape[0]) if system is not None else mesh.n_points,
                           estimate=est.energy, error=error, effectivity=eff,
                           iterations=int(getattr(result, "iterations", 0)),
                           converged=bool(getattr(result, "converged", True)),
                           solve_time=t1 - t0, estimate_time=t2 - t1, refine_time=0.0,
-                          elapsed=elapsed)
+                          elapsed=elapsed, min_angle=_min_angle(mesh))
         levels.append(rec)
         stop = _stop_reason(settings, rec, len(levels))
         marked = None
@@ -213,14 +222,14 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
                 if not len(marked):
                     stop = "no_marked"
                 else:
-                    step = bisect(mesh, marked)
+                    step = bisect(mesh, marked) if state is None else state.refine(marked)
             else:
                 step = _uniform_step(mesh)
             if stop is None:
                 if settings["max_dofs"] is not None and step.mesh.n_points > settings["max_dofs"]:
                     stop = "max_dofs"
                 rec.refine_time = time.perf_counter() - t3
-                rec.marked = int(len(marked)) if marked is not None else mesh.n_triangles
+                rec.marked = int(len(marked)) if marked is not None else mesh.n_cells
         if callback is not None:
             callback(rec)
         if stop is not None:
@@ -229,6 +238,15 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
                                   result=result)
         x0 = step.prolong(u)
         mesh = step.mesh
+        state = step if state is not None else None
+
+
+def _min_angle(mesh) -> float:
+    """Smallest triangle angle (2D) or dihedral angle (3D) of ``mesh``, in degrees."""
+    from ..mesh.quality import dihedral_angles, side_lengths_and_angles
+
+    p = mesh.points[mesh.cells]
+    return float(np.min(dihedral_angles(p) if mesh.dim == 3 else side_lengths_and_angles(p)[1]))
 
 
 def _stop_reason(settings: dict, rec: LevelRecord, n_levels: int) -> str | None:
@@ -249,7 +267,7 @@ def _uniform_step(mesh):
     from ..mesh.refine import refine
 
     edge_nodes, _ = edges(mesh)
-    return Bisection(mesh=refine(mesh), parent=np.repeat(np.arange(mesh.n_triangles), 4),
+    return Bisection(mesh=refine(mesh), parent=np.repeat(np.arange(mesh.n_cells), 2 ** mesh.dim),
                      new_node_edges=edge_nodes)
 
 

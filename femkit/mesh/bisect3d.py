@@ -33,7 +33,7 @@ from ..errors import MeshError
 from .edges import LOCAL_EDGES
 from .mesh import Mesh, signed_volumes
 
-__all__ = ["TetBisection", "kuhn_order"]
+__all__ = ["TetBisection", "kuhn_order", "is_kuhn_path"]
 
 
 def kuhn_order(mesh: Mesh) -> np.ndarray:
@@ -42,6 +42,20 @@ def kuhn_order(mesh: Mesh) -> np.ndarray:
     s = mesh.points[mesh.cells].sum(axis=2)
     order = np.argsort(s, axis=1, kind="stable")
     return np.take_along_axis(mesh.cells, order, axis=1)
+
+
+def is_kuhn_path(p: np.ndarray) -> np.ndarray:
+    """Per tetrahedron (vertices ``p`` (m, 4, 3) in :func:`kuhn_order`): True when its three
+    path steps go along three different axes, in the positive direction (a Kuhn tetrahedron of
+    an axis-aligned box)."""
+    steps = np.diff(p, axis=1)                                         # (m, 3, 3)
+    length = np.abs(steps).max(axis=2)                                 # (m, 3)
+    tol = 1e-9 * np.maximum(length.max(axis=1), 1e-300)
+    axis = np.abs(steps).argmax(axis=2)
+    along = np.take_along_axis(steps, axis[..., None], axis=2)[..., 0]
+    off = np.abs(steps).sum(axis=2) - np.abs(along)
+    return ((along > 0).all(axis=1) & (off <= tol[:, None]).all(axis=1)
+            & (np.sort(axis, axis=1) == np.arange(3)).all(axis=1))
 
 
 def _edge_keys(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
@@ -79,6 +93,12 @@ class TetBisection:
         if mesh.dim != 3:
             raise MeshError(f"TetBisection needs a tetrahedral mesh; this mesh is {mesh.dim}D")
         ordered = kuhn_order(mesh)
+        bad = int((~is_kuhn_path(mesh.points[ordered])).sum())
+        if bad:
+            raise MeshError(f"conforming tetrahedral bisection needs a Kuhn-type mesh (six "
+                            f"tetrahedra per axis-aligned box: structured_box, geometry "
+                            f"'kuhn_fichera', or their red refinements); {bad} of {mesh.n_cells} "
+                            f"tetrahedra are not")
         return cls(mesh, ordered, np.full(mesh.n_cells, 3, np.int64), np.arange(mesh.n_cells),
                    np.zeros((0, 2), np.int64))
 

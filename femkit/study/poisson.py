@@ -48,7 +48,7 @@ def _meshes(study, spec, timer_list):
     from ..case.cost import check_mesh_fits
 
     for i in range(1, count):
-        check_mesh_fits(triangles=meshes[-1].n_triangles, refine=1)  # before numpy allocates
+        check_mesh_fits(triangles=meshes[-1].n_cells, refine=1, dim=meshes[-1].dim)  # before numpy allocates
         timed(i, lambda: refine(meshes[-1], 1))
 
     prols: list = []  # built once, on the first request that reaches them
@@ -106,7 +106,7 @@ def _record(level, mesh, sys, rule, label, s, res, errs, times, *, source="femki
     h = quality(mesh)["h_max"] if h is None else h
     rec = {
         "source": source, "mode": mode, "level": level, "h": float(h), "nodes": mesh.n_points,
-        "elements": mesh.n_triangles, "dofs": int(sys.A.shape[0]), "nnz": int(sys.A.nnz),
+        "elements": mesh.n_cells, "dofs": int(sys.A.shape[0]), "nnz": int(sys.A.nnz),
         "quadrature": rule, "solver": label, "method": s["method"], "preconditioner": s["preconditioner"],
         "converged": bool(res.converged), "iterations": int(res.iterations),
         "true_residual": float(res.true_residual), "relative_residual": float(res.relative_residual),
@@ -217,8 +217,9 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
                 s = {"method": "cg", "preconditioner": "pyamg_sa"}
                 records.append(_record(lvl, mesh, sys_like, "skfem-default", "scikit-fem+pyamg", s,
                                        _Res(iters, relres, 1.0, conv), errs, times, source="scikit-fem"))
-            notes.append(f"scikit-fem reference: skfem {__import__('skfem').__version__} P1 (default 3-point "
-                         f"quadrature), condense, pyamg smoothed aggregation + SciPy CG to rtol {rtol:g}.")
+            element = "ElementTetP1, default 4-point" if meshes[0].dim == 3 else "P1, default 3-point"
+            notes.append(f"scikit-fem reference: skfem {__import__('skfem').__version__} {element} "
+                         f"quadrature, condense, pyamg smoothed aggregation + SciPy CG to rtol {rtol:g}.")
     nested = []
     if d.stop_fraction is not None and d.levels.nested:
         nested = _nested_runs(study, spec, meshes, mesh_times, records, hierarchy)

@@ -135,19 +135,25 @@ def test_a_user_geometry_runs_through_femkit_solve(tmp_path):
     assert "predicted peak memory" in refused.stderr and "h >= " in refused.stderr
 
 
-def test_a_3d_geometry_is_not_costed_as_triangles():
-    """A dim-3 entry (volume, surface area): the triangle model does not apply, so the guard
-    lets it through and a case's plan says it is not costed, instead of a wrong number."""
+def test_a_3d_geometry_is_priced_by_tetrahedra_not_as_triangles():
+    """A dim-3 entry (volume, surface area): the mesh guard prices its tetrahedra (volume / h^3)
+    and refuses a mesh beyond the machine; a case's plan says the run is not costed (the
+    stage model is the triangle one), instead of a wrong number."""
     import femkit
     from femkit.case.cost import check_mesh_fits, plan_poisson_case
+    from femkit.errors import BudgetExceededError
 
     register_geometry("test_cube", measure=lambda side=1.0: (side ** 3, 6 * side ** 2), dim=3,
                       boundary_tags=("boundary",), cell_tags=("domain",))(lambda h, side=1.0: None)
     try:
         assert geometry_domain("test_cube", {"side": 2.0}) == (3, 8.0, 24.0)
-        assert check_mesh_fits(geometry="test_cube", h=1e-6) is None
+        assert check_mesh_fits(geometry="test_cube", h=0.1) is None
+        with pytest.raises(BudgetExceededError):
+            check_mesh_fits(geometry="test_cube", h=1e-6)   # ~1e19 tetrahedra
         case = femkit.load_case("cases/poisson_unit_square.yaml",
-                                mesh={"geometry": "test_cube", "h": 1e-6})
+                                mesh={"geometry": "test_cube", "h": 1e-6},
+                                exact={"grad": ["pi*cos(pi*x)*sin(pi*y)",
+                                                "pi*sin(pi*x)*cos(pi*y)", 0]})
         plan = plan_poisson_case(case, measure=False)
         assert plan.stages == [] and "no cost model for 3D meshes" in plan.assumptions[0]
     finally:

@@ -1,7 +1,11 @@
 """Geometric multigrid and fmg on nested tetrahedral meshes (Bey's red refinement), unchanged.
 
-Measured (V(2,2), omega 1.25, unit cube from one Kuhn cube): 0.061 / 0.138 / 0.196 / 0.209 at
-3 / 4 / 5 / 6 levels; V(3,3): the numbers asserted below (docs/methods.md).
+The hierarchy is numbered as the case pipeline numbers every tetrahedral hierarchy
+(``renumber="rcm"``: reverse Cuthill-McKee on the coarse mesh, each refinement's midpoints right
+after their edges), so the Gauss-Seidel sweeps, which run in storage order, move through the
+domain as a wavefront. In the refinement's own numbering (all coarse nodes first) the default
+V(2,2) factor was 0.061 / 0.138 / 0.196 / 0.209 at 3 / 4 / 5 / 6 levels, above the issue's 0.2
+(docs/methods.md).
 """
 
 from __future__ import annotations
@@ -28,20 +32,23 @@ def _system(mesh, f=1.0, g=0.0):
 
 @pytest.fixture(scope="module")
 def hierarchy():
-    return MeshHierarchy.from_refinement(structured_box(1, 1, 1), 5)     # 6 levels, 35937 nodes
+    # 6 levels, 35937 nodes, numbered as the case pipeline numbers tetrahedral hierarchies
+    return MeshHierarchy.from_refinement(structured_box(1, 1, 1), 5, renumber="rcm")
 
 
 def _sub(H, levels):
     return MeshHierarchy(H.meshes[:levels], H.prolongations[:levels - 1], H.injections[:levels - 1])
 
 
-def test_vcycle_contraction_bounded_for_3_to_6_levels(hierarchy):
+@pytest.mark.parametrize("sweeps", [2, 3], ids=["V(2,2) default", "V(3,3)"])
+def test_vcycle_contraction_bounded_for_3_to_6_levels(hierarchy, sweeps):
     rho = {}
     for levels in (3, 4, 5, 6):
         sub = _sub(hierarchy, levels)
         sys = _system(sub.finest)
-        rho[levels] = Multigrid(sys.A, sub, free=sys.free, sweeps=3).contraction(20)
-    print("V(3,3) contraction by level count:", {k: round(v, 3) for k, v in rho.items()})
+        rho[levels] = Multigrid(sys.A, sub, free=sys.free, sweeps=sweeps).contraction(30)
+    print(f"V({sweeps},{sweeps}) contraction by level count:",
+          {k: round(v, 3) for k, v in rho.items()})
     assert max(rho.values()) <= 0.2
     # the growth slows down: level independence, not a creeping factor
     assert rho[6] - rho[5] <= rho[5] - rho[4]

@@ -148,3 +148,31 @@ def test_adaptive_case_refuses_the_petsc_backend(tmp_path):
     assert proc.stderr.strip() == ("femkit: error: adaptive: adaptive refinement runs on the femkit "
                                    "backend only; remove adaptive or use solver.backend: femkit")
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.usefixtures("needs_mpi")
+def test_solve_backend_petsc_on_tetrahedra_matches_serial(tmp_path):
+    """The bundled cube case (its mesh refined once, PCG + AMG to 1e-10) on 2 ranks: the
+    partition, the assembly and the pieces take tetrahedra; u equals the serial one to 1e-8."""
+    case = yaml.safe_load((ROOT / "cases" / "cube.yaml").read_text())
+    case["mesh"]["refine"] = 1
+    case["solver"] = {"method": "pcg", "preconditioner": "amg", "rtol": 1e-10}
+    case["output"] = {"vtu": True}
+    path = tmp_path / "cube.yaml"
+    path.write_text(yaml.safe_dump(case))
+    femkit(["solve", path, "--quiet", "--output", tmp_path / "serial"])
+    femkit(["solve", path, "--quiet", "--backend", "petsc", "--output", tmp_path / "petsc"],
+           ranks=2)
+    serial = json.loads((tmp_path / "serial" / "result.json").read_text())
+    petsc = json.loads((tmp_path / "petsc" / "result.json").read_text())
+    assert petsc["mesh"] == serial["mesh"] and serial["mesh"]["dim"] == 3
+    assert petsc["parallel"]["ranks"] == 2 and petsc["converged"]
+    assert (petsc["dofs"], petsc["nnz"]) == (serial["dofs"], serial["nnz"])
+    import meshio
+
+    s, p = (meshio.read(tmp_path / d / "solution.vtu") for d in ("serial", "petsc"))
+    np.testing.assert_array_equal(s.points, p.points)
+    u0, u1 = s.point_data["u"], p.point_data["u"]
+    assert np.max(np.abs(u1 - u0)) <= 1e-8 * np.max(np.abs(u0))
+    for key, value in serial["errors"].items():
+        assert petsc["errors"][key] == pytest.approx(value, rel=1e-6), key

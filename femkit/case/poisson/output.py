@@ -48,15 +48,35 @@ def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarr
 def write_plot(path: str | os.PathLike, mesh, u: np.ndarray, title: str = "",
                indicators: np.ndarray | None = None, estimator: str = "") -> Path:
     """Save a PNG of ``u`` with a colour bar (matplotlib, Agg backend); with ``indicators`` a second
-    panel shows the element error indicators ``eta_T`` on a logarithmic colour scale."""
+    panel shows the element error indicators ``eta_T`` on a logarithmic colour scale.
+
+    On a tetrahedral mesh both panels show the section by the plane ``z`` = the middle of the
+    mesh's z range (:func:`~femkit.case.poisson.section.plane_section`: the P1 field on that
+    plane exactly, each section triangle coloured by its tetrahedron's indicator)."""
     from matplotlib.colors import LogNorm
     from matplotlib.tri import Triangulation
 
-    tri = Triangulation(mesh.points[:, 0], mesh.points[:, 1], mesh.triangles)
+    u = np.asarray(u, dtype=np.float64)
+    total = None if indicators is None else float(np.sqrt(np.sum(np.asarray(indicators) ** 2)))
+    if mesh.dim == 3:
+        from .section import plane_section
+
+        zs = mesh.points[:, 2]
+        cut = plane_section(mesh, 0.5 * (zs.min() + zs.max()))
+        tri = Triangulation(cut.points[:, 0], cut.points[:, 1], cut.triangles)
+        u = cut.interpolate(u)
+        if indicators is not None:
+            indicators = np.asarray(indicators)[cut.cells]
+        title = f"{title}\nsection z = {cut.z:.4g}" if title else f"section z = {cut.z:.4g}"
+    else:
+        tri = Triangulation(mesh.points[:, 0], mesh.points[:, 1], mesh.triangles)
     panels = 1 if indicators is None else 2
     fig = new_figure(6 * panels, 5, dpi=120)
     ax = fig.add_subplot(1, panels, 1)
-    art = ax.tripcolor(tri, np.asarray(u, dtype=np.float64), shading="gouraud", cmap="viridis")
+    if mesh.dim == 3:  # thin section triangles leave seams in Gouraud shading: fill contours
+        art = ax.tricontourf(tri, u, levels=24, cmap="viridis")
+    else:
+        art = ax.tripcolor(tri, u, shading="gouraud", cmap="viridis")
     fig.colorbar(art, ax=ax, label="u")
     ax.set_title(title, fontsize=9)
     axes = [ax]
@@ -69,7 +89,7 @@ def write_plot(path: str | os.PathLike, mesh, u: np.ndarray, title: str = "",
         art2 = ax2.tripcolor(tri, facecolors=np.maximum(eta, lo), cmap="magma",
                              norm=LogNorm(vmin=max(lo, hi * 1e-8), vmax=hi))
         fig.colorbar(art2, ax=ax2, label="error indicator eta_T (log scale)")
-        ax2.set_title(f"{estimator} indicators: estimate {np.sqrt(np.sum(eta ** 2)):.3e}", fontsize=9)
+        ax2.set_title(f"{estimator} indicators: estimate {total:.3e}", fontsize=9)
         axes.append(ax2)
     from matplotlib.ticker import MaxNLocator
 
@@ -128,7 +148,9 @@ def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None) ->
         elif opts.xdmf:
             write_solution(tmp / "solution.xdmf", result.mesh, result.u, result.kappa)
         if opts.plot and result.u is not None:
-            title = (f"{result.case.name}: {result.mesh.n_triangles} triangles, "
+            from ...mesh.mesh import CELLS_NAME
+
+            title = (f"{result.case.name}: {result.mesh.n_cells} {CELLS_NAME[result.mesh.dim]}, "
                      f"h_max = {result.quality.get('h_max', float('nan')):.3g}")
             est = result.error_estimate or {}
             write_plot(tmp / "solution.png", result.mesh, result.u, title,

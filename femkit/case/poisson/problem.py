@@ -17,11 +17,46 @@ from ...errors import CaseFileError, ExpressionError, InputError
 from ..load import Case
 from ..names import with_prefix
 
-__all__ = ["build_mesh", "build_mesh_levels", "multigrid_inputs", "multigrid_overrides",
+__all__ = ["VARIABLES", "check_dimension", "build_mesh", "build_mesh_levels", "multigrid_inputs", "multigrid_overrides",
            "element_kappa", "poisson_problem", "is_pure_neumann", "exact_gradient",
            "compute_errors", "CaseResult", "nullspace_facts"]
 
 # ----------------------------------------------------------------------------- stages
+
+#: The variables of a Poisson case's expressions; ``z`` exists on tetrahedral meshes only
+#: (an expression that does not name it is called with ``(x, y)`` on a triangle mesh).
+VARIABLES = ("x", "y", "z")
+
+
+def check_dimension(case: Case, dim: int, where: str) -> None:
+    """Refuse, in one line naming the option, what does not exist in ``dim`` dimensions: ``z``
+    in an expression on a triangle mesh, an ``exact.grad`` with another number of components,
+    a load quadrature rule of the other cell shape. ``where`` names the mesh (for the message).
+
+    Raises
+    ------
+    CaseFileError
+    """
+    from ...fem.quadrature import get_rule
+    from ...errors import UnknownNameError
+    from ...mesh.mesh import CELLS_NAME
+
+    if dim == 2:
+        for key, fn in case.functions.items():
+            if "z" in fn.used:
+                raise CaseFileError(f"{key}: uses z, which exists on 3D meshes only; {where} is "
+                                    f"a 2D mesh (triangles)")
+    grad = (case.data.get("exact") or {}).get("grad")
+    if grad and len(grad) != dim:
+        names = ", ".join(f"du/d{c}" for c in VARIABLES[:dim])
+        raise CaseFileError(f"exact.grad: {len(grad)} components, but {where} is a {dim}D mesh "
+                            f"({CELLS_NAME[dim]}): give {dim} ({names})")
+    rule = case.data["quadrature"]["load"]
+    try:
+        get_rule(rule, dim=dim)
+    except UnknownNameError as exc:
+        raise CaseFileError(f"quadrature.load: {rule!r} is not a rule on {CELLS_NAME[dim]}, and "
+                            f"{where} is a {dim}D mesh; {str(exc).split('; ', 1)[-1]}") from None
 
 #: Refined meshes with at least this many triangles are renumbered for memory locality
 #: (reverse Cuthill-McKee on the coarse mesh, midpoints next to their edges: see
@@ -57,11 +92,17 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
         mesh = validate(mesh)
     except InputError as exc:
         raise with_prefix(exc, where) from None
+    if spec.file is not None:
+        check_dimension(case, mesh.dim, where)
     hierarchy = None
     k = spec.refine
     if k:
-        check_mesh_fits(triangles=mesh.n_triangles, refine=k, force=force)  # before numpy allocates
-        big = mesh.n_triangles * 4 ** k >= RENUMBER_MIN_TRIANGLES
+        # before numpy allocates
+        check_mesh_fits(triangles=mesh.n_cells, refine=k, dim=mesh.dim, force=force)
+        # tetrahedral hierarchies always: Gauss-Seidel sweeps run in storage order, and in the
+        # refinement's own numbering (coarse nodes first) the V(2,2) factor exceeds 0.2 at 6
+        # levels (0.209; 0.154 renumbered: docs/methods.md)
+        big = mesh.n_cells * (2 ** mesh.dim) ** k >= RENUMBER_MIN_TRIANGLES or mesh.dim == 3
         if big or case.solver.needs_hierarchy:
             levels = MeshHierarchy.from_refinement(mesh, k, renumber="rcm" if big else "none")
             mesh = levels.finest
@@ -128,7 +169,7 @@ def element_kappa(case: Case, mesh) -> np.ndarray:
     if isinstance(coef, dict):
         from ...mesh import check_tags
 
-        values = np.full(mesh.n_triangles, float(coef.get("default", np.nan)))
+        values = np.full(mesh.n_cells, float(coef.get("default", np.nan)))
         for name, value in coef["regions"].items():
             (tag,) = check_tags(mesh, [name], kind="cell")
             values[mesh.cell_tags == tag] = float(value)
@@ -136,7 +177,7 @@ def element_kappa(case: Case, mesh) -> np.ndarray:
         if missing.size:
             tags = sorted(set(mesh.cell_tags[missing].tolist()))
             raise CaseFileError(
-                f"coefficient.regions: {missing.size} triangles (cell tags {tags}) are in no "
+                f"coefficient.regions: {missing.size} {mesh.cell_name}s (cell tags {tags}) are in no "
                 f"listed region; add them or give coefficient.default")
         return values
     kappa = case.functions.get("coefficient", coef)
@@ -180,8 +221,7 @@ def poisson_problem(case: Case, mesh, *, load_rule: str | None = None):
     if not dirichlet:
         extra = dict(nullspace=bnd.nullspace, compatibility_rtol=bnd.compatibility_rtol)
         if bnd.nullspace == "pin" and "exact.u" in case.functions:
-            x0, y0 = mesh.points[0]
-            u0 = case.functions["exact.u"](np.array([x0]), np.array([y0]))
+            u0 = case.functions["exact.u"](*mesh.points[:1].T)
             extra["pin_value"] = float(np.asarray(u0).ravel()[0])
     return PoissonProblem(mesh, element_kappa(case, mesh), case.functions["source"],
                           dirichlet=dirichlet, neumann=neumann,
@@ -194,13 +234,15 @@ def is_pure_neumann(case: Case) -> bool:
 
 
 def exact_gradient(case: Case):
-    """``grad u`` of ``exact`` as one callable ``(x, y) -> (gx, gy)``, or None."""
+    """``grad u`` of ``exact`` as one callable ``(x, y) -> (gx, gy)`` (``(x, y, z) -> (gx, gy,
+    gz)`` on tetrahedra), or None."""
     if "exact.grad[0]" not in case.functions:
         return None
-    gx, gy = case.functions["exact.grad[0]"], case.functions["exact.grad[1]"]
+    parts = [case.functions[f"exact.grad[{i}]"] for i in range(len(VARIABLES))
+             if f"exact.grad[{i}]" in case.functions]
 
-    def grad(x, y):
-        return gx(x, y), gy(x, y)
+    def grad(*xyz):
+        return tuple(g(*xyz) for g in parts)
 
     return grad
 
@@ -214,6 +256,12 @@ def compute_errors(case: Case, problem, u: np.ndarray, *, order: int = 5) -> dic
 
 
 # ----------------------------------------------------------------------------- result
+
+#: The mesh quality numbers result.json reports, per dimension (:func:`femkit.mesh.quality`).
+_QUALITY_KEYS = {2: ("n_points", "n_triangles", "h_max", "h_min", "h_mean", "min_angle",
+                     "max_aspect_ratio", "area"),
+                 3: ("n_points", "n_tetrahedra", "h_max", "h_min", "h_mean", "min_dihedral",
+                     "max_dihedral", "min_radius_ratio", "volume")}
 
 @dataclass
 class CaseResult:
@@ -249,11 +297,12 @@ class CaseResult:
         from ..._version import __version__
 
         spec = self.case.spec.mesh
-        mesh_info = {k: self.quality.get(k) for k in (
-            "n_points", "n_triangles", "h_max", "h_min", "h_mean", "min_angle",
-            "max_aspect_ratio", "area")}
+        from ...mesh.mesh import CELLS_NAME
+
+        mesh_info = {"dim": self.mesh.dim}
+        mesh_info.update({k: self.quality.get(k) for k in _QUALITY_KEYS[self.mesh.dim]})
         mesh_info["n_points"] = self.mesh.n_points
-        mesh_info["n_triangles"] = self.mesh.n_triangles
+        mesh_info[f"n_{CELLS_NAME[self.mesh.dim]}"] = self.mesh.n_cells
         mesh_info["source"] = spec.source()
         mesh_info["refine"] = spec.refine
         return {
@@ -284,10 +333,15 @@ class CaseResult:
         """Short human summary (what ``femkit solve`` prints)."""
         s = self.solve
         q = self.quality
+        from ...mesh.mesh import CELLS_NAME
+
+        nan = float("nan")
+        angle = (f"min angle {q.get('min_angle', nan):.1f} deg" if self.mesh.dim == 2 else
+                 f"min dihedral angle {q.get('min_dihedral', nan):.1f} deg")
         lines = [
             f"case      {self.case.name} (problem {self.case.problem})",
-            f"mesh      {self.mesh.n_points} points, {self.mesh.n_triangles} triangles, "
-            f"h_max {q.get('h_max', float('nan')):.3g}, min angle {q.get('min_angle', float('nan')):.1f} deg",
+            f"mesh      {self.mesh.n_points} points, {self.mesh.n_cells} "
+            f"{CELLS_NAME[self.mesh.dim]}, h_max {q.get('h_max', nan):.3g}, {angle}",
             f"system    {self.dofs} dofs ({self.n_dirichlet} Dirichlet nodes eliminated), nnz {self.nnz}",
         ]
         if self.nullspace is not None:
@@ -327,8 +381,11 @@ class CaseResult:
             met = ("target met" if a["target_met"] else
                    f"target NOT met: stopped by {a['stop_reason']}" if a.get("target") is not None
                    else f"stopped by {a['stop_reason']}")
+            worst = min((lv.get("min_angle") or nan) for lv in a["levels"])
+            kind = "dihedral angle" if self.mesh.dim == 3 else "angle"
             lines.append(f"adaptive  {len(a['levels'])} levels, theta {a['theta']:g}, "
-                         f"{a['levels'][0]['dofs']} -> {a['levels'][-1]['dofs']} dofs; {met}")
+                         f"{a['levels'][0]['dofs']} -> {a['levels'][-1]['dofs']} dofs; {met}; "
+                         f"smallest {kind} on any level {worst:.1f} deg")
         lines.append("time      " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timings.items()))
         if self.output_dir is not None:
             lines.append(f"output    {self.output_dir} ({', '.join(self.files)})")

@@ -3,8 +3,8 @@
 ``femkit check`` (:mod:`femkit.case.poisson.cross_check`) and the convergence study's reference
 rows (:mod:`femkit.study.poisson`) assemble, condense and solve the same problem with
 scikit-fem (Gustafsson & McBain, "scikit-fem: A Python package for finite element assembly",
-JOSS 2020) through these functions, on femkit's own mesh (points and triangles in femkit's
-order):
+JOSS 2020) through these functions, on femkit's own mesh (points and cells in femkit's order;
+triangles or tetrahedra):
 
 * :func:`assemble` -> ``(K, F)``: stiffness with a per-element ``kappa`` and the load of a
   source ``f(x, y)``, with scikit-fem's default quadrature for P1 or, with ``one_point=True``,
@@ -27,11 +27,13 @@ def assemble(mesh, kappa: np.ndarray, f, *, one_point: bool = False):
 
     Parameters
     ----------
-    mesh : a femkit mesh (``points`` (n, 2), ``triangles`` (m, 3))
+    mesh : a femkit mesh: triangles (``MeshTri`` + ``ElementTriP1``) or tetrahedra
+        (``MeshTet`` + ``ElementTetP1``)
     kappa : (m,) per-element coefficient
-    f : source, ``f(x, y)`` on arrays
-    one_point : the centroid rule (weight = the reference triangle's area 1/2) instead of
-        scikit-fem's default rule for P1; scikit-fem's ``intorder=1`` would pick a 3-point rule.
+    f : source, ``f(x, y)`` (``f(x, y, z)`` on tetrahedra) on arrays
+    one_point : the centroid rule (weight = the reference cell's measure, 1/2 or 1/6) instead
+        of scikit-fem's default rule for P1; scikit-fem's ``intorder=1`` would pick a 3-point
+        rule on triangles.
 
     Returns
     -------
@@ -41,9 +43,13 @@ def assemble(mesh, kappa: np.ndarray, f, *, one_point: bool = False):
     import skfem
     from skfem.helpers import dot, grad
 
-    m = skfem.MeshTri(mesh.points.T.copy(), mesh.triangles.T.copy(), sort_t=False)
-    quadrature = (np.array([[1 / 3], [1 / 3]]), np.array([0.5])) if one_point else None
-    basis = skfem.Basis(m, skfem.ElementTriP1(), quadrature=quadrature)
+    if mesh.dim == 3:  # the centroid of the reference tetrahedron, weight its volume 1/6
+        m = skfem.MeshTet(mesh.points.T.copy(), mesh.cells.T.copy(), sort_t=False)
+        element, centroid = skfem.ElementTetP1(), (np.full((3, 1), 0.25), np.array([1 / 6]))
+    else:
+        m = skfem.MeshTri(mesh.points.T.copy(), mesh.triangles.T.copy(), sort_t=False)
+        element, centroid = skfem.ElementTriP1(), (np.array([[1 / 3], [1 / 3]]), np.array([0.5]))
+    basis = skfem.Basis(m, element, quadrature=centroid if one_point else None)
 
     @skfem.BilinearForm
     def stiffness(u, v, w):
@@ -51,7 +57,7 @@ def assemble(mesh, kappa: np.ndarray, f, *, one_point: bool = False):
 
     @skfem.LinearForm
     def load(v, w):
-        return f(w.x[0], w.x[1]) * v
+        return f(*w.x) * v
 
     kap = np.repeat(np.asarray(kappa, dtype=np.float64)[:, None], basis.X.shape[1], axis=1)
     return stiffness.assemble(basis, kappa=kap).tocsr(), load.assemble(basis)

@@ -32,9 +32,9 @@ from ..frozen import freeze
 from ..load import Case
 from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
 from .spec import BoundarySpec, MeshSpec, PoissonOutputSpec, PoissonSpec
-from .problem import (CaseResult, build_mesh, build_mesh_levels, compute_errors, element_kappa,
-                      exact_gradient, is_pure_neumann, multigrid_inputs, multigrid_overrides,
-                      nullspace_facts, poisson_problem)
+from .problem import (VARIABLES, CaseResult, build_mesh, build_mesh_levels, check_dimension,
+                      compute_errors, element_kappa, exact_gradient, is_pure_neumann,
+                      multigrid_inputs, multigrid_overrides, nullspace_facts, poisson_problem)
 
 __all__ = ["prepare_poisson", "run_poisson", "build_mesh", "build_mesh_levels",
            "multigrid_inputs", "multigrid_overrides", "element_kappa", "poisson_problem", "compute_errors", "CaseResult"]
@@ -44,7 +44,7 @@ __all__ = ["prepare_poisson", "run_poisson", "build_mesh", "build_mesh_levels",
 
 def _compile(case: Case, key: str, text, *, check_finite: bool = True):
     try:
-        fn = compile_expression(text, ("x", "y"), case.data.get("constants") or {},
+        fn = compile_expression(text, VARIABLES, case.data.get("constants") or {},
                                 check_finite=check_finite)
     except ExpressionError as exc:
         raise ExpressionError(f"{key}: {exc}") from None
@@ -90,9 +90,10 @@ def prepare_poisson(case: Case) -> None:
         raise HierarchyError(f"solver: {what} needs nested meshes: give the mesh 'refine: k' "
                              f"(k >= 1), or use method pcg with preconditioner amg_rs")
 
-    from ...fem.quadrature import QUADRATURE
+    from ...fem.quadrature import QUADRATURE, TET_QUADRATURE
 
-    lookup(QUADRATURE, d["quadrature"]["load"], "quadrature.load")
+    if d["quadrature"]["load"] not in TET_QUADRATURE:  # the dimension is checked with the mesh
+        lookup(QUADRATURE, d["quadrature"]["load"], "quadrature.load")
 
     coef = d["coefficient"]
     if isinstance(coef, str):
@@ -121,6 +122,11 @@ def prepare_poisson(case: Case) -> None:
         except InputError as exc:
             raise with_prefix(exc, "adaptive") from None
 
+    if "geometry" in mesh:  # a generated mesh's dimension is known now; a file's once read
+        from ...mesh.geometries import GEOMETRIES
+
+        check_dimension(case, GEOMETRIES.get(mesh["geometry"]).dim,
+                        f"mesh.geometry {mesh['geometry']!r}")
     out = d["output"]
     out["dir"] = str((base / out.get("dir", os.path.join("runs", case.name))).resolve())
     bnd = d["boundary"]

@@ -114,7 +114,7 @@ POISSON_SCHEMA: dict = {
             "required": ["u"],
             "properties": {
                 "u": _NUMBER_OR_EXPR,
-                "grad": {"type": "array", "minItems": 2, "maxItems": 2, "items": _NUMBER_OR_EXPR},
+                "grad": {"type": "array", "minItems": 2, "maxItems": 3, "items": _NUMBER_OR_EXPR},
             },
         },
         # error estimator of result.json and of adaptive refinement (checked against the

@@ -65,21 +65,23 @@ def add_nodal(vec, layout: Layout, nodes: np.ndarray, values: np.ndarray) -> Non
 
 
 def assemble_matrix(problem, layout: Layout, comm, local: np.ndarray, *, timer=None):
-    """The MPIAIJ matrix ``K[free, free]`` from this rank's local matrices ``local`` (k, 3, 3);
+    """The MPIAIJ matrix ``K[free, free]`` from this rank's local matrices ``local`` (k, 3, 3)
+    on triangles, (k, 4, 4) on tetrahedra;
     ``timer("pattern")`` times the one-off pattern analysis (MatSetPreallocationCOO),
     ``timer("stiffness")`` the values (MatSetValuesCOO)."""
     import contextlib
 
     PETSc = require_petsc()
     timer = timer or (lambda stage: contextlib.nullcontext())
-    tri = problem.mesh.triangles[layout.elements]
-    d = layout.dof[tri].astype(PETSc.IntType)  # (k, 3), -1 on eliminated nodes
+    tri = problem.mesh.cells[layout.elements]
+    d = layout.dof[tri].astype(PETSc.IntType)  # (k, 3 or 4), -1 on eliminated nodes
+    nv = tri.shape[1]
     N = int(layout.dof_offsets[-1])
     A = PETSc.Mat().create(comm=comm)
     A.setSizes(((layout.n_local_dofs, N), (layout.n_local_dofs, N)))
     A.setType(PETSc.Mat.Type.AIJ)
     with timer("pattern"):  # local[k, a, b] sits at (d[k, a], d[k, b])
-        coo.set_pattern(A, np.repeat(d, 3, axis=1).ravel(), np.tile(d, (1, 3)).ravel())
+        coo.set_pattern(A, np.repeat(d, nv, axis=1).ravel(), np.tile(d, (1, nv)).ravel())
     with timer("stiffness"):
         coo.set_values(A, local.reshape(-1))
     A.setOption(PETSc.Mat.Option.SPD, True)
@@ -99,7 +101,7 @@ def assemble_poisson(problem, layout: Layout, comm, fixed: np.ndarray, values: n
     timer = timer or (lambda stage: contextlib.nullcontext())
     mesh = problem.mesh
     own = layout.elements
-    tri = mesh.triangles[own]
+    tri = mesh.cells[own]
     with timer("stiffness"):
         local = local_stiffness(mesh, problem.kappa, elements=own)
     A = assemble_matrix(problem, layout, comm, local, timer=timer)

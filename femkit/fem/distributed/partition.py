@@ -30,17 +30,18 @@ def naive_ranges(n: int, size: int) -> np.ndarray:
     return np.concatenate([[0], np.cumsum(counts)])
 
 
-def adjacency_rows(triangles: np.ndarray, start: int, end: int):
+def adjacency_rows(cells: np.ndarray, start: int, end: int):
     """CSR ``(indptr, indices)`` of the node graph (mesh edges, no diagonal) for rows
-    ``start <= i < end``, column indices sorted."""
+    ``start <= i < end``, column indices sorted; ``cells`` are triangles or tetrahedra."""
     import scipy.sparse as sp
 
-    mine = (triangles >= start) & (triangles < end)
-    tri = triangles[mine.any(axis=1)]
-    i = np.repeat(tri, 3, axis=1).ravel()  # every ordered vertex pair of each triangle
-    j = np.tile(tri, (1, 3)).ravel()
+    mine = (cells >= start) & (cells < end)
+    tri = cells[mine.any(axis=1)]
+    k = cells.shape[1]
+    i = np.repeat(tri, k, axis=1).ravel()  # every ordered vertex pair of each cell
+    j = np.tile(tri, (1, k)).ravel()
     keep = (i >= start) & (i < end) & (i != j)
-    n = int(triangles.max()) + 1 if triangles.size else 0
+    n = int(cells.max()) + 1 if cells.size else 0
     G = sp.csr_matrix((np.ones(int(keep.sum()), dtype=np.int8), (i[keep] - start, j[keep])),
                       shape=(end - start, n))  # duplicates summed: one entry per edge
     G.sort_indices()
@@ -58,7 +59,7 @@ def partition_nodes(mesh, comm, *, method: str = DEFAULT_PARTITIONER) -> np.ndar
         raise InputError(f"{n} nodes cannot be shared by {size} ranks")
     off = naive_ranges(n, size)
     r = comm.getRank()
-    indptr, cols = adjacency_rows(mesh.triangles, int(off[r]), int(off[r + 1]))
+    indptr, cols = adjacency_rows(mesh.cells, int(off[r]), int(off[r + 1]))
     nloc = int(off[r + 1] - off[r])
     adj = PETSc.Mat().createAIJ(size=((nloc, n), (nloc, n)),
                                 csr=(indptr.astype(PETSc.IntType), cols.astype(PETSc.IntType),
@@ -132,9 +133,10 @@ class Layout:
         return self.dof[self.owned] >= 0
 
 
-def element_owners(triangles: np.ndarray, owner: np.ndarray) -> np.ndarray:
-    """Rank of each element: the middle of its vertices' owners (a majority when two agree)."""
-    return np.sort(owner[triangles], axis=1)[:, 1]
+def element_owners(cells: np.ndarray, owner: np.ndarray) -> np.ndarray:
+    """Rank of each element: the second smallest of its vertices' owners (on a triangle the
+    middle one, a majority when two agree)."""
+    return np.sort(owner[cells], axis=1)[:, 1]
 
 
 def build_layout(mesh, owner: np.ndarray, fixed: np.ndarray, rank: int, size: int) -> Layout:
@@ -151,6 +153,6 @@ def build_layout(mesh, owner: np.ndarray, fixed: np.ndarray, rank: int, size: in
     dof[order[free_in_order]] = np.arange(int(free_in_order.sum()))
     dof_offsets = np.concatenate([[0], np.cumsum(np.bincount(owner[is_free], minlength=size))])
     owned = order[node_offsets[rank]:node_offsets[rank + 1]]
-    elements = np.flatnonzero(element_owners(mesh.triangles, owner) == rank)
+    elements = np.flatnonzero(element_owners(mesh.cells, owner) == rank)
     return Layout(rank=rank, size=size, owner=owner, node_id=node_id, node_offsets=node_offsets,
                   owned=owned, dof=dof, dof_offsets=dof_offsets, elements=elements)

@@ -163,7 +163,7 @@ def parallel_errors(mesh, u_vec, layout, comm, exact, grad_exact=None, order: in
     from mpi4py import MPI
 
     mpi = comm.tompi4py()
-    nodes = np.unique(mesh.triangles[layout.elements])
+    nodes = np.unique(mesh.cells[layout.elements])
     u = np.zeros(mesh.n_points)
     u[nodes] = values_at(u_vec, layout, nodes, comm)
     if modulo_constant:

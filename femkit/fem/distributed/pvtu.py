@@ -30,8 +30,8 @@ def write_pvtu(directory, name: str, mesh, u_vec, layout, comm,
     directory = Path(directory)
     rank, size = layout.rank, layout.size
     own = layout.elements
-    nodes, local_tri = np.unique(mesh.triangles[own], return_inverse=True)
-    sub = Mesh(mesh.points[nodes], local_tri.reshape(-1, 3),
+    nodes, local_cells = np.unique(mesh.cells[own], return_inverse=True)
+    sub = Mesh(mesh.points[nodes], local_cells.reshape(-1, mesh.cells.shape[1]),
                None if mesh.cell_tags is None else mesh.cell_tags[own])
     u = values_at(u_vec, layout, nodes, comm)
     cells = {"rank": np.full(len(own), rank, dtype=np.int32)}
