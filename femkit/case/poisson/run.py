@@ -247,6 +247,8 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         out = echo or print
         for line in result.summary_lines():
             out(line)
+        for note in case.run_options.get("notes", ()):  # e.g. a mesh file's unused nodes
+            out(f"note      {note}")
     return result
 
 
