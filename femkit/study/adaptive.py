@@ -41,7 +41,7 @@ def run_adaptive_study(study, progress_enabled=None) -> dict:
     solve_on(mesh0, None)                                   # warm-up: imports, AMG, caches
     records, fits, meshes, outcome = [], [], {}, []
     measured = "error" if grad is not None else "estimate"
-    for label, refinement, est in progress(list(_runs(d)), desc="refinements", unit="run",
+    for label, refinement, est in progress(list(_runs(d)), desc="adaptive loops", unit="loop",
                                              enabled=progress_enabled, stop=active_flag()):
         run = adaptive_solve(solve_on, mesh0, theta=d["theta"], target=d.get("target"),
                              max_dofs=d["max_dofs"], max_time=d.get("max_time"),
