@@ -27,40 +27,134 @@ _EPILOG = """\
 exit codes:
   0  success
   1  ran, but did not reach its goal (solver not converged, check out of tolerance)
-  2  bad input (case file, expression, solver name, mesh), or a predicted cost
-     above a budget (--force runs anyway); a one-line message on stderr and no
-     output written
+  2  bad input (case file, --set value, expression, solver name, mesh), or a
+     predicted cost above a budget (--force runs anyway); a one-line message on
+     stderr and no output written
   130, 143  stopped by SIGINT / SIGTERM; what was computed is written (result.json
-     with interrupted: true)
+     with interrupted: true); a second Ctrl-C stops at once, the output may then
+     be incomplete
 
 examples:
   femkit solve cases/poisson_unit_square.yaml
   femkit solve cases/poisson_lshape.yaml --output runs/lshape --quiet
+  femkit solve cases/poisson_unit_square.yaml --set mesh.h=0.02 --set solver.preconditioner=ic0
   femkit solve cases/poisson_unit_square.yaml --dry-run
   femkit check cases/poisson_unit_square.yaml
+  femkit list solvers
 
 Case-file reference: docs/case-files.md; command line: docs/cli.md.
 """
+
+_CHECK_EPILOG = """\
+exit codes (check writes no files):
+  0  every row within its tolerance
+  1  a row out of tolerance (the table says which)
+  2  bad input (case file, --set value, not a Poisson case); one line on stderr
+  130, 143  stopped by SIGINT / SIGTERM
+
+examples:
+  femkit check cases/poisson_unit_square.yaml
+  femkit check cases/poisson_lshape.yaml --set mesh.h=0.05 --quiet
+"""
+
+_STUDY_EPILOG = """\
+study kinds (the file's kind:):
+{kinds}
+
+exit codes:
+  0  report written (runs that failed or went unstable are reported as data)
+  2  bad input (study file, --set value, a case it names), or a predicted cost
+     above a budget (--force runs anyway); one line on stderr, nothing written
+  130, 143  stopped by SIGINT / SIGTERM: answered within a second, inside the
+     current run; nothing new is written and an earlier report is kept as it was;
+     a second Ctrl-C stops at once
+
+examples:
+  femkit study studies/poisson_convergence.yaml --quick
+  femkit study studies/stress.yaml --output runs/stress
+  femkit study studies/poisson_convergence.yaml --set levels.count=3 --dry-run
+
+Study-file reference: docs/studies.md.
+"""
+
+
+def _study_epilog() -> str:
+    """``femkit study --help``'s epilog: the study kinds read from the registry (plugins too)."""
+    from .catalog import entries
+
+    rows = entries("studies")
+    width = max((len(n) for n, _ in rows), default=0)
+    return _STUDY_EPILOG.format(kinds="\n".join(f"  {n.ljust(width)}  {d}" for n, d in rows))
 
 
 class _Parser(argparse.ArgumentParser):
     """argparse, but usage errors exit with code 2 and one line (no usage dump)."""
 
+    #: a function returning the epilog, called only when the help is shown (``femkit study``
+    #: lists the registered kinds: importing them for every command would be slow)
+    epilog_fn: Callable[[], str] | None = None
+
     def error(self, message: str):  # noqa: D401 - argparse API
         self.exit(EXIT_BAD_INPUT, f"femkit: error: {message} (see '{self.prog} --help')\n")
+
+    def format_help(self) -> str:
+        if self.epilog_fn is not None:
+            self.epilog = self.epilog_fn()
+        return super().format_help()
 
 
 # ----------------------------------------------------------------------------- solve
 
 def _case_parser(sub, name: str, help: str, description: str, case_help: str, quiet_help: str,
-                 handler: Callable) -> argparse.ArgumentParser:
+                 handler: Callable, epilog: str = _EPILOG) -> argparse.ArgumentParser:
     """A subcommand taking one CASE file and ``--quiet`` (the shape of ``solve`` and ``check``)."""
-    p = sub.add_parser(name, help=help, description=description, epilog=_EPILOG,
+    p = sub.add_parser(name, help=help, description=description, epilog=epilog,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("case", metavar="CASE", help=case_help)
     p.add_argument("-q", "--quiet", action="store_true", help=quiet_help)
+    _add_set_flag(p)
     p.set_defaults(handler=handler)
     return p
+
+
+# ----------------------------------------------------------------------------- --set
+
+def _add_set_flag(p: argparse.ArgumentParser) -> None:
+    """``--set KEY=VALUE`` (repeatable), shared by ``solve``, ``check`` and ``study``."""
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                   help="change one key of the file before it is validated, e.g. --set mesh.h=0.02 "
+                        "or --set solver.method=direct (dotted path; VALUE read as in a file: 0.02, "
+                        "1e-6, true, direct, [1, 2]); repeatable; checked like the file itself")
+
+
+def parse_sets(sets: Sequence[str]) -> dict:
+    """``["mesh.h=0.02", ...]`` -> the overrides of :func:`femkit.case.load_case` /
+    :func:`femkit.study.load.load_study` (``{"mesh__h": 0.02}``); a malformed item is an
+    :class:`~femkit.errors.InputError` naming it.
+
+    >>> parse_sets(["mesh.h=0.02", "solver.rtol=1e-6", "output.png=true", "name=a=b"])
+    {'mesh__h': 0.02, 'solver__rtol': 1e-06, 'output__png': True, 'name': 'a=b'}
+    """
+    from .errors import InputError
+
+    out: dict = {}
+    for item in sets:
+        key, eq, text = item.partition("=")
+        parts = key.strip().split(".")
+        if not eq or not all(p.strip() for p in parts):
+            raise InputError(f"--set {item!r}: expected KEY=VALUE with a dotted KEY, "
+                             "e.g. --set mesh.h=0.02")
+        import yaml
+
+        from .case.load import _loader  # the case files' own reading (1e-6 is a number)
+
+        try:
+            value = yaml.load(text, Loader=_loader()) if text.strip() else ""
+        except yaml.YAMLError as exc:
+            problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+            raise InputError(f"--set {item!r}: the value is not valid YAML: {problem}") from None
+        out["__".join(p.strip() for p in parts)] = value
+    return out
 
 
 def _add_solve(sub) -> None:
@@ -110,7 +204,9 @@ def _run_solve(args) -> int:
     from .case.budget import check_case, plan_case
     from .interrupt import exit_code, stop_on_signals
 
-    overrides = {"solver": {"backend": args.backend}} if args.backend else {}
+    overrides = dict(args.overrides)
+    if args.backend:
+        overrides["solver__backend"] = args.backend
     case = load_case(args.case, **overrides)
     if args.dry_run:
         print(plan_case(case).render())
@@ -149,14 +245,14 @@ def _add_check(sub) -> None:
             "Prints each relative difference next to its tolerance; nothing is written. "
             "Tolerances: K and F 1e-12 relative; solutions 10*rtol relative (at least 1e-10)."),
         case_help="Poisson case file (.yaml)", quiet_help="print only failures",
-        handler=_run_check)
+        handler=_run_check, epilog=_CHECK_EPILOG)
 
 
 def _run_check(args) -> int:
     from .case import load_case
     from .case.poisson.cross_check import cross_check, format_table
 
-    case = load_case(args.case)
+    case = load_case(args.case, **args.overrides)
     rows = cross_check(case)
     ok = all(r.passed for r in rows)
     if not args.quiet or not ok:
@@ -164,14 +260,54 @@ def _run_check(args) -> int:
     return EXIT_OK if ok else EXIT_FAILED
 
 
-#: Subcommands, in help order: each adds its parser to the subparsers object.
 def _add_study(sub) -> None:
     from .study.cli import add_parser  # standard library only at import time
 
-    add_parser(sub)
+    p = add_parser(sub)
+    _add_set_flag(p)
+    p.epilog_fn = _study_epilog
+    p.formatter_class = argparse.RawDescriptionHelpFormatter
 
 
-SUBCOMMANDS: list[Callable] = [_add_solve, _add_check, _add_study]
+# ----------------------------------------------------------------------------- list
+
+#: the groups of ``femkit list`` (kept equal to femkit.catalog.GROUPS by a test; listed here so
+#: that ``femkit list --help`` imports nothing)
+LIST_GROUPS = ("geometries", "solvers", "preconditioners", "backends", "integrators", "forces",
+               "systems", "materials", "problems", "studies")
+
+
+def _add_list(sub) -> None:
+    p = sub.add_parser(
+        "list", help="list the names case and study files may use (geometries, solvers, ...)",
+        description=(
+            "Print every registered name of each GROUP with one line on what it is: "
+            + ", ".join(LIST_GROUPS) + " (default: all). Read from the live registries, "
+            "plugins included, so it is never out of date. Nothing is written."),
+        epilog="exit codes:\n  0  listed\n  2  unknown group (the valid ones are named)\n\n"
+               "examples:\n  femkit list\n  femkit list solvers preconditioners\n",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("groups", nargs="*", metavar="GROUP", help="a group (singular accepted: solver)")
+    p.set_defaults(handler=_run_list)
+
+
+def _list_group(name: str) -> str:
+    """``solver`` -> ``solvers``, ``geometry`` -> ``geometries``, ``study`` -> ``studies``."""
+    for group in LIST_GROUPS:
+        if name in (group, group[:-1], group[:-3] + "y"):
+            return group
+    return name  # unknown: femkit.catalog names the valid groups
+
+
+def _run_list(args) -> int:
+    from .catalog import render
+
+    print(render([_list_group(g) for g in args.groups]))
+    return EXIT_OK
+
+
+#: Subcommands, in help order: each adds its parser to the subparsers object.
+SUBCOMMANDS: list[Callable] = [_add_solve, _add_check, _add_study, _add_list]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -201,6 +337,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     handler = getattr(args, "handler", None) or getattr(args, "func")  # func: femkit.study.cli style
     speaks = _mpi_rank() == 0  # under mpirun every rank raises the same error: rank 0 says it
     try:
+        args.overrides = parse_sets(getattr(args, "sets", ()))
         return int(handler(args))
     except InputError as exc:
         if speaks:

@@ -11,10 +11,16 @@ One interface, :class:`Progress`, for every long piece of work, in three uses:
 
 On a terminal it shows a tqdm bar; when stderr is not a terminal (a log file, a batch
 job, CI) it prints one line per ``every_fraction`` (10 %) of the work, or per ``every_seconds``
-(60 s) when that comes first, with the elapsed time and the predicted remaining time (linear
-extrapolation from the rate so far), so a log shows that a long run is alive::
+(60 s) when that comes first, with the elapsed time and the predicted remaining time, so a log
+shows that a long run is alive::
 
     scene hanging_cloth: 30% (60/200 steps), elapsed 12 s, remaining ~28 s
+
+Lines are at least ``min_interval`` (5 s) apart, and the last one (100 %) is always printed: a
+short run prints that one line only. The remaining time is the elapsed time scaled by the
+predicted cost still to do over the predicted cost done (``cost=`` of :meth:`Progress.update`:
+e.g. the triangles of a mesh level, the springs of a cloth, the steps of a run), so cheap first
+runs do not promise a quick end; without costs every unit counts the same.
 
 >>> import io
 >>> out = io.StringIO()
@@ -58,12 +64,15 @@ class Progress:
     mode : ``"auto"`` (bar on a terminal, lines otherwise), ``"bar"``, ``"lines"`` or ``"off"``
     quiet : same as ``mode="off"``
     stream : where to write (default ``sys.stderr``)
-    every_fraction, every_seconds : line cadence (lines mode)
+    every_fraction, every_seconds, min_interval : line cadence (lines mode)
+    cost : predicted cost of all the work (same unit as the ``cost`` of :meth:`update`); the
+        remaining time is then scaled by cost instead of by count
     """
 
     def __init__(self, total: int | None, desc: str = "", *, unit: str = "step", mode: str = "auto",
                  quiet: bool = False, stream=None, every_fraction: float = 0.1,
-                 every_seconds: float = 60.0, clock=time.monotonic):
+                 every_seconds: float = 60.0, min_interval: float = 5.0, cost: float | None = None,
+                 clock=time.monotonic):
         if mode not in MODES:
             raise ValueError(f"progress mode must be one of {', '.join(MODES)}, got {mode!r}")
         self.stream = stream if stream is not None else sys.stderr
@@ -78,6 +87,10 @@ class Progress:
         self.clock = clock
         self.start = clock()
         self.every_seconds = float(every_seconds)
+        self.min_interval = float(min_interval)
+        self._last_line = self.start
+        self.cost_total = float(cost) if cost else 0.0
+        self.cost_done = 0.0
         self._step = max(int(self.total * every_fraction), 1) if self.total else 0
         self._next_count = self._step if self.total else 0
         self._next_time = self.start + self.every_seconds
@@ -103,7 +116,11 @@ class Progress:
             head = f"{self.desc}: {100 * frac:.0f}% ({self.count}/{self.total} {self._units(self.total)})"
             tail = ""
             if 0 < self.count < self.total:
-                tail = f", remaining ~{format_seconds(elapsed * (self.total - self.count) / self.count)}"
+                if self.cost_total and self.cost_done > 0:
+                    left = max(self.cost_total - self.cost_done, 0.0) / self.cost_done
+                else:
+                    left = (self.total - self.count) / self.count
+                tail = f", remaining ~{format_seconds(elapsed * left)}"
             return f"{head}, elapsed {format_seconds(elapsed)}{tail}"
         return f"{self.desc}: {self.count} {self._units(self.count)}, elapsed {format_seconds(elapsed)}"
 
@@ -111,18 +128,26 @@ class Progress:
         print(text, file=self.stream, flush=True)
         self.lines += 1
 
-    def update(self, n: int = 1) -> None:
-        """Count ``n`` more units done (cheap: a comparison and a clock read, ~0.1 us)."""
+    def update(self, n: int = 1, cost: float | None = None) -> None:
+        """Count ``n`` more units done, of predicted ``cost`` (see the class docstring; cheap:
+        a comparison and a clock read, ~0.1 us)."""
         self.count += n
+        if cost is not None:
+            self.cost_done += float(cost)
         if self.mode == "off":
             return
         if self._bar is not None:
             self._bar.update(n)
             return
         due = bool(self.total) and self.count >= self._next_count
-        if due or self.clock() >= self._next_time:
-            self._emit(self.line())
-            self._next_time = self.clock() + self.every_seconds
+        now = None
+        if due or (now := self.clock()) >= self._next_time:
+            now = self.clock() if now is None else now
+            last = bool(self.total) and self.count >= self.total
+            if last or now >= self._next_time or now - self._last_line >= self.min_interval:
+                self._emit(self.line())
+                self._next_time = now + self.every_seconds
+                self._last_line = now
             if self.total:
                 while self._next_count <= self.count:
                     self._next_count += self._step
@@ -193,34 +218,49 @@ class Progress:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
-        self.close()
+        flag = getattr(exc, "flag", None)  # femkit.interrupt.Interrupted
+        by = getattr(flag, "name", None) or ("SIGINT" if exc_type is KeyboardInterrupt else None)
+        self.close(interrupted=by)
 
 
 def progress(items: Iterable[T], *, total: int | None = None, desc: str = "", unit: str = "job",
              enabled: bool | None = None, mode: str = "auto", stream=None,
-             stop=None) -> Iterator[T]:
+             stop=None, sizes=None, costs=None) -> Iterator[T]:
     """Iterate over ``items`` reporting progress (:class:`Progress`); ``enabled=False`` is quiet.
 
     ``stop``: a :class:`femkit.interrupt.StopFlag`; once set, the next item is not started:
     :class:`~femkit.interrupt.Interrupted` is raised naming it (``before run 3 of 8 (2 done)``).
+    ``sizes``: how many units each item is (e.g. the runs of one mesh level: one per solver), so
+    the count agrees with what the work reports; ``costs``: each item's predicted cost (the
+    remaining time is scaled by it; see :class:`Progress`).
 
     >>> list(progress(range(3), enabled=False))
     [0, 1, 2]
     """
-    if total is None:
+    items = list(items) if sizes is not None or costs is not None else items
+    if sizes is not None:
+        total = int(sum(sizes))
+    elif total is None:
         try:
             total = len(items)  # type: ignore[arg-type]
         except TypeError:
             total = None
-    bar = Progress(total, desc, unit=unit, mode=mode, quiet=enabled is False, stream=stream)
+    bar = Progress(total, desc, unit=unit, mode=mode, quiet=enabled is False, stream=stream,
+                   cost=sum(costs) if costs is not None else None)
+    from .interrupt import active_flag
+
+    done = 0
     try:
         for i, item in enumerate(items):
             if stop:
                 from .interrupt import Interrupted
 
                 of = f" of {total}" if total else ""
-                raise Interrupted(stop, where=f"before {unit} {i + 1}{of} ({i} done)")
+                raise Interrupted(stop, where=f"before {unit} {done + 1}{of} ({done} done)")
             yield item
-            bar.update()
+            n = int(sizes[i]) if sizes is not None else 1
+            done += n
+            bar.update(n, cost=costs[i] if costs is not None else None)
     finally:
-        bar.close()
+        flag = stop if stop is not None else active_flag()
+        bar.close(interrupted=flag.name if flag else None)

@@ -249,7 +249,9 @@ def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | 
         ``stop() -> bool`` checked between steps (e.g. a
         :class:`femkit.interrupt.StopFlag`); when true the run ends early and returns the
         trajectory so far with ``interrupted=True`` and ``completed=False`` (the state at the
-        stop is recorded; ``reason`` names the signal when ``stop`` has a ``name``).
+        stop is recorded; ``reason`` names the signal when ``stop`` has a ``name``). Without
+        ``stop``, a stop request of an enclosing :func:`femkit.interrupt.stop_on_signals` block
+        raises :class:`~femkit.interrupt.Interrupted` (a study's run keeps nothing partial).
     x0, v0, t0 : initial state (default the system's ``x0``, ``v0`` and 0).
 
     Returns
@@ -319,11 +321,18 @@ def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | 
         raise InstabilityError(method, step, t, ratio, dt, dt_crit, reason, partial)
 
     stopped_at = None
+    # without a stop of its own, a run inside a stop_on_signals block (a study's) raises
+    # Interrupted at a stop request instead of being recorded as complete
+    from ..interrupt import Interrupted, active_flag
+
+    watch = active_flag() if stop is None else None
     try:
         for step in range(1, n_steps + 1):
             if stop is not None and stop():
                 stopped_at = step - 1
                 break
+            if watch:
+                raise Interrupted(watch, where=f"at step {step - 1} of {n_steps} of {method}")
             new = integrator.step(system, state, dt, ctx)
             if not (np.isfinite(new.x).all() and np.isfinite(new.v).all()):
                 fail(step, new.t, math.inf, "non-finite state", state)

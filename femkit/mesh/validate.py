@@ -16,7 +16,8 @@ from typing import Iterable
 import numpy as np
 
 from ..errors import DegenerateMeshError, MeshError
-from .mesh import Mesh
+from .faces import LOCAL_FACES, unique_rows
+from .mesh import LOCAL_EDGES, Mesh
 
 _SHOW = 10  # how many ids an error message lists
 
@@ -55,6 +56,33 @@ def orient_ccw(mesh: Mesh) -> Mesh:
 orient = orient_ccw
 
 
+def unreferenced(mesh: Mesh) -> np.ndarray:
+    """Ids of the nodes no cell uses (ascending)."""
+    used = np.zeros(mesh.n_points, bool)
+    used[mesh.cells.ravel()] = True
+    return np.flatnonzero(~used)
+
+
+def drop_unreferenced(mesh: Mesh) -> tuple[Mesh, str | None]:
+    """:func:`remove_unreferenced` and a note saying what it dropped (None when nothing), for
+    the caller to print: a mesh file's unused nodes (e.g. the circle centres gmsh writes) are
+    dropped, never silently.
+
+    >>> from femkit.mesh import Mesh
+    >>> m = Mesh(points=np.array([[0., 0.], [9., 9.], [1., 0.], [0., 1.]]),
+    ...          triangles=np.array([[0, 2, 3]]))
+    >>> kept, note = drop_unreferenced(m)
+    >>> kept.n_points, note
+    (3, '1 node used by no triangle dropped (node ids 1)')
+    """
+    un = unreferenced(mesh)
+    if not len(un):
+        return mesh, None
+    nodes = "node" if len(un) == 1 else "nodes"
+    return remove_unreferenced(mesh), (f"{len(un)} {nodes} used by no {mesh.cell_name} dropped "
+                                       f"(node ids {_ids(un)})")
+
+
 def remove_unreferenced(mesh: Mesh) -> Mesh:
     """Drop nodes no cell uses and renumber (order kept); facets on dropped nodes go too."""
     used = np.zeros(mesh.n_points, bool)
@@ -69,7 +97,8 @@ def remove_unreferenced(mesh: Mesh) -> Mesh:
                     boundary_facets=be[keep], boundary_tags=mesh.boundary_tags[keep])
 
 
-def validate(mesh: Mesh, *, rel_area_tol: float = 1e-12, dup_tol: float = 1e-12) -> Mesh:
+def validate(mesh: Mesh, *, rel_area_tol: float = 1e-12, dup_tol: float = 1e-12,
+             overlap_tol: float = 1e-9) -> Mesh:
     """Check a mesh (triangles or tetrahedra); return it positively oriented or raise naming
     the problem.
 
@@ -77,7 +106,9 @@ def validate(mesh: Mesh, *, rel_area_tol: float = 1e-12, dup_tol: float = 1e-12)
     boundary facets); cells repeating a vertex; zero/near-zero area or volume cells
     (``area <= rel_area_tol * longest_edge**2``, ``volume <= rel_area_tol *
     longest_edge**3``, scale-free tests); unreferenced nodes; duplicate nodes (closer than
-    ``dup_tol`` times the bounding-box diagonal).
+    ``dup_tol`` times the bounding-box diagonal); overlapping cells (:func:`check_overlaps`:
+    two cells on one node set, or a total area off the boundary's enclosed area by more than
+    ``overlap_tol`` relative).
 
     Raises
     ------
@@ -110,8 +141,6 @@ def validate(mesh: Mesh, *, rel_area_tol: float = 1e-12, dup_tol: float = 1e-12)
     if len(rep):
         raise DegenerateMeshError(f"{len(rep)} {cell}(s) repeat a vertex: element ids {_ids(rep)}",
                                   element_ids=rep)
-    from .mesh import LOCAL_EDGES
-
     p = mesh.points[tri]
     le = LOCAL_EDGES[d + 1]
     e = p[:, le[:, 1]] - p[:, le[:, 0]]
@@ -123,10 +152,8 @@ def validate(mesh: Mesh, *, rel_area_tol: float = 1e-12, dup_tol: float = 1e-12)
         raise DegenerateMeshError(
             f"{len(degen)} degenerate {cell}(s) ({what} <= {rel_area_tol:g} x longest edge^{d}): "
             f"element ids {_ids(degen)}", element_ids=degen)
-    used = np.zeros(n, bool)
-    used[tri.ravel()] = True
-    if not used.all():
-        un = np.flatnonzero(~used)
+    un = unreferenced(mesh)
+    if len(un):
         raise MeshError(f"{len(un)} unreferenced node(s) (used by no {cell}): node ids {_ids(un)}; "
                         "femkit.mesh.validate.remove_unreferenced(mesh) drops them")
     dup = _duplicate_pairs(mesh.points, dup_tol)
@@ -134,7 +161,85 @@ def validate(mesh: Mesh, *, rel_area_tol: float = 1e-12, dup_tol: float = 1e-12)
         pairs = ", ".join(f"{a}={b}" for a, b in dup[:_SHOW])
         raise MeshError(f"{len(dup)} pair(s) of coincident nodes: {pairs}"
                         + (" ..." if len(dup) > _SHOW else ""))
-    return orient_ccw(mesh)
+    mesh = orient_ccw(mesh)
+    check_overlaps(mesh, rel_tol=overlap_tol)
+    return mesh
+
+
+def check_overlaps(mesh: Mesh, *, rel_tol: float = 1e-9) -> None:
+    """Refuse overlapping cells of a positively oriented mesh, naming them.
+
+    Two checks (Shewchuk's conformity conditions for a simplicial mesh, in their cheap form):
+
+    * no two cells have the same node set (a triangle listed twice);
+    * the cells' total area (volume) equals the area (volume) enclosed by the mesh's boundary,
+      the facets used by exactly one cell, computed from them alone by the divergence theorem
+      (the shoelace formula ``1/2 sum (x_i y_j - x_j y_i)`` over boundary edges; ``1/6 sum
+      p0 . (p1 x p2)`` over boundary faces). Cells covering a region twice add to the total but
+      not to the enclosed measure.
+
+    The cells named are those on a facet used by more than two cells or twice in the same
+    direction (an overlap's seam).
+
+    Raises
+    ------
+    MeshError
+        With the element ids.
+    """
+    cells, d, cell = mesh.cells, mesh.dim, mesh.cell_name
+    local = LOCAL_EDGES[3] if d == 2 else LOCAL_FACES  # outward-oriented facets of each cell
+    facets = cells[:, local].reshape(-1, d)
+    inverse = _row_ids(np.sort(facets, axis=1), mesh.n_points)
+    counts = np.bincount(inverse)
+    # orientation of each facet against its sorted form: +1 / -1 (parity of the permutation)
+    if d == 2:
+        sign = np.where(facets[:, 0] < facets[:, 1], 1.0, -1.0)
+    else:
+        a, b, c = facets.T
+        sign = 1.0 - 2.0 * (((a > b).astype(np.int8) + (a > c) + (b > c)) % 2)
+    net = np.bincount(inverse, weights=sign)
+    bad_facet = (counts > 2) | ((counts == 2) & (net != 0))
+    total = float(np.abs(mesh.signed_volumes()).sum())
+    enclosed = _enclosed(mesh.points, facets[counts[inverse] == 1])
+    if not bad_facet.any() and abs(total - enclosed) <= rel_tol * total:
+        return
+    # a cell listed twice (every facet of it is a seam): say so first
+    same_set = _row_ids(np.sort(cells, axis=1), mesh.n_points)
+    twice = np.bincount(same_set)[same_set] > 1
+    if twice.any():
+        groups: dict = {}
+        for e in np.flatnonzero(twice)[:_SHOW * 4]:
+            groups.setdefault(int(same_set[e]), []).append(str(e))
+        listed = "; ".join(" = ".join(g) for g in list(groups.values())[:_SHOW])
+        raise MeshError(f"{int(twice.sum())} {cell}(s) share their node set with another (an "
+                        f"element listed twice): element ids {listed}")
+    what, cells_name = ("area", "triangles") if d == 2 else ("volume", "tetrahedra")
+    on_seam = np.unique(np.flatnonzero(bad_facet[inverse]) // local.shape[0])
+    where = f"element ids {_ids(on_seam)}" if len(on_seam) else "elements not located"
+    raise MeshError(f"overlapping {cells_name}: their total {what} {total:.6g} differs from the "
+                    f"{what} {enclosed:.6g} enclosed by the mesh boundary; {where}")
+
+
+def _row_ids(rows: np.ndarray, n: int) -> np.ndarray:
+    """A number per distinct row of a sorted-row int array (equal rows, equal numbers): rows
+    packed into one int64 when ``n ** width`` fits, else a lexicographic sort."""
+    rows = np.asarray(rows, dtype=np.int64)
+    if float(n) ** rows.shape[1] < 2.0 ** 62:
+        key = rows[:, 0]
+        for k in range(1, rows.shape[1]):
+            key = key * n + rows[:, k]
+        return np.unique(key, return_inverse=True)[1].ravel()
+    return unique_rows(rows)[1]
+
+
+def _enclosed(points: np.ndarray, facets: np.ndarray) -> float:
+    """Area (volume) enclosed by outward-oriented boundary edges (faces): divergence theorem."""
+    x = points - points.mean(axis=0)  # smaller products, less cancellation
+    if facets.shape[1] == 2:
+        a, b = x[facets[:, 0]], x[facets[:, 1]]
+        return 0.5 * float(np.sum(a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]))
+    a, b, c = (x[facets[:, k]] for k in range(3))
+    return float(np.einsum("ij,ij->", a, np.cross(b, c))) / 6.0
 
 
 def _duplicate_pairs(points: np.ndarray, rel_tol: float) -> np.ndarray:

@@ -35,7 +35,7 @@ def run_adaptive_study(study, progress_enabled=None) -> dict:
     solve_on(mesh0, None)                                   # warm-up: imports, AMG, caches
     records, fits, meshes, outcome = [], [], {}, []
     measured = "error" if grad is not None else "estimate"
-    for label, refinement, est in progress(d.runs(), desc="refinements", unit="run",
+    for label, refinement, est in progress(list(d.runs()), desc="adaptive loops", unit="loop",
                                              enabled=progress_enabled, stop=active_flag()):
         run = adaptive_solve(solve_on, mesh0, theta=d.theta, target=d.target,
                              max_dofs=d.max_dofs, max_time=d.max_time,

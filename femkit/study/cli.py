@@ -31,8 +31,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("study", help="study YAML file (kind: poisson_convergence, dynamics_work_precision, "
-                   "stability, adaptive, cloth_work_precision, or a plugin's kind)")
+    p.add_argument("study", help="study YAML file (its kind: one of the study kinds below)")
     p.add_argument("-o", "--output", help="report directory (default: the file's output: key, "
                    "else femkit-out/<name> beside the study file)")
     p.add_argument("--quick", action="store_true", help="apply the file's quick: block (small sizes)")
@@ -85,7 +84,7 @@ def cli_main(args) -> int:
 
     with stop_on_signals():  # until the end: a signal after the sweep must not kill the summary
         try:
-            study = load_study(args.study, quick=args.quick)
+            study = load_study(args.study, quick=args.quick, **getattr(args, "overrides", {}))
             if _check_cost(study, args):
                 return 0
             result = run_study(study, args.output, progress=False if args.no_progress else None)

@@ -107,7 +107,8 @@ def run_dynamics_study(study, *, progress_enabled=None) -> dict:
                 pass
     jobs = [(i, dt) for i in integrators for dt in dts]
     for (name, opts, label), dt in progress(jobs, total=len(jobs), desc=study.name, unit="run",
-                                                enabled=progress_enabled, stop=active_flag()):
+                                                enabled=progress_enabled, stop=active_flag(),
+                                                costs=[t_end / dt for _, dt in jobs]):  # steps
         every = int(round(dt_big / dt))
         rec = {"integrator": label, "name": name, "dt": dt, "k": -np.log2(dt), "steps": int(round(t_end / dt))}
         try:

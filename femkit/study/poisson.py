@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..interrupt import active_flag
-from ..progress import progress
+from ..interrupt import checkpoint
+from ..progress import Progress
 from .fit import fit_rate
 from .timing import StageTimer, time_call
 
@@ -180,8 +180,14 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
     records = []
     systems = {}  # (level, rule) -> system: fmg's lower levels (its coarse right-hand sides)
     jobs = [(lvl, rule) for lvl in range(len(meshes)) for rule in rules]
-    for lvl, rule in progress(jobs, total=len(jobs), desc=f"{study.name}", unit="run",
-                                 enabled=progress_enabled, stop=active_flag()):
+    # one unit per record (a solver run, a scikit-fem reference run), the remaining time scaled
+    # by the levels' triangles
+    reference = d.reference == "scikit-fem" and not spec.has_neumann
+    bar = Progress(len(jobs) * len(solvers) + (len(meshes) if reference else 0), study.name,
+                   unit="run", quiet=progress_enabled is False,
+                   cost=sum(m.n_cells for m in meshes) * (len(rules) * len(solvers) + reference))
+    for lvl, rule in jobs:
+        checkpoint(f"before level {lvl} ({rule})")
         mesh = meshes[lvl]
         ta = time_call(lambda: _assemble(spec, mesh, rule), repeats=repeats, warmup=0)
         prob, K, F = ta.value
@@ -202,6 +208,7 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
             times = {"mesh": mesh_times[lvl], "assembly": ta.min, "boundary": tb.min,
                      "solve": ts.min, "errors": timer.times["errors"]}
             records.append(_record(lvl, mesh, sys, rule, s.label, s.to_dict(), res, errs, times))
+        bar.update(len(solvers), cost=len(solvers) * mesh.n_cells)
     if d.reference == "scikit-fem":
         if spec.has_neumann:
             notes.append("scikit-fem reference skipped: the base case has Neumann boundaries.")
@@ -217,9 +224,11 @@ def run_poisson_study(study, *, progress_enabled=None) -> dict:
                 s = {"method": "cg", "preconditioner": "pyamg_sa"}
                 records.append(_record(lvl, mesh, sys_like, "skfem-default", "scikit-fem+pyamg", s,
                                        _Res(iters, relres, 1.0, conv), errs, times, source="scikit-fem"))
+                bar.update(1, cost=mesh.n_cells)
             element = "ElementTetP1, default 4-point" if meshes[0].dim == 3 else "P1, default 3-point"
             notes.append(f"scikit-fem reference: skfem {__import__('skfem').__version__} {element} "
                          f"quadrature, condense, pyamg smoothed aggregation + SciPy CG to rtol {rtol:g}.")
+    bar.close()
     nested = []
     if d.stop_fraction is not None and d.levels.nested:
         nested = _nested_runs(study, spec, meshes, mesh_times, records, hierarchy)

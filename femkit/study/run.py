@@ -3,7 +3,8 @@
 The report directory holds ``report.md``, ``report.html`` (figures embedded), ``figures/*.png``,
 ``runs.csv`` (one row per run), extra CSV tables per kind, and ``results.json`` with everything
 (records, fitted rates, notes, the input fingerprint). It appears atomically: a failing study
-leaves an earlier report untouched. :class:`StudyResult` carries the same data in memory.
+leaves an earlier report untouched, and so does a study stopped by SIGINT/SIGTERM: the sweep and the
+report run inside :func:`femkit.interrupt.raising`, so a signal stops them at once, wherever they are. :class:`StudyResult` carries the same data in memory.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..case.kinds import KINDS
+from ..interrupt import raising
 from .cache import fingerprint
 from .report import Report, staged_output, write_csv, write_json
 
@@ -95,7 +97,8 @@ def run_study(study, output_dir=None, *, progress: bool | None = None, write: bo
         check_output_dir(output_dir if output_dir is not None else study.default_output(),
                          EARLIER_REPORT)
     kind = KINDS.get(study.kind, "kind")
-    data = kind.run(study, progress_enabled=progress)
+    with raising(f"the {study.name} sweep"):  # a signal stops the current run at once
+        data = kind.run(study, progress_enabled=progress)
     result = StudyResult(kind=study.kind, name=study.name, records=data["records"], fits=data.get("fits", []),
                          tables=data.get("tables", {}), notes=data.get("notes", []),
                          fingerprint=fingerprint(study.files, extra={"quick": study.quick, "data": study.data}))
@@ -105,7 +108,7 @@ def run_study(study, output_dir=None, *, progress: bool | None = None, write: bo
     if not write:
         return result
     out = Path(output_dir) if output_dir is not None else study.default_output()
-    with staged_output(out) as stage:  # refuses a non-report directory (never deletes user files)
+    with raising("the report"), staged_output(out) as stage:  # refuses a non-report directory (never deletes user files)
         os.makedirs(stage / "figures", exist_ok=True)
         report = Report(study.title)
         report.paragraph(f"Study `{study.name}` ({study.kind}{', quick mode' if study.quick else ''}); "

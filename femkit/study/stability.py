@@ -410,7 +410,9 @@ def run_stability_study(study, *, progress_enabled=None) -> dict:
         warmed = warm_up(study.solvers, study.integrators)
         notes.append("Warm-up before timing (untimed, on an 8 x 8 Poisson system and a two-spring chain): "
                      + ", ".join(warmed) + "; no timed run includes imports, AMG module loading or compilation.")
-    for case in progress(cases, total=len(cases), desc=study.name, unit="run",
+    # one unit per stress case (a case gives one row per parameter value and method: the
+    # summary counts rows)
+    for case in progress(cases, total=len(cases), desc=f"{study.name} cases", unit="case",
                          enabled=progress_enabled, stop=active_flag()):
         rows += STRESS_CASES.get(case["type"]).run(case, study, quick_n)
     tables = {}

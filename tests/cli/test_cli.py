@@ -220,7 +220,7 @@ def test_help_texts_describe_exit_codes_and_examples(argv, capsys):
         main(argv)
     assert info.value.code == 0
     out = capsys.readouterr().out
-    assert "exit codes" in out and "femkit solve cases/" in out
+    assert "exit codes" in out and f"femkit {'check' if argv[0] == 'check' else 'solve'} cases/" in out
     if argv[0] == "solve":
         assert "--output" in out and "result.json" in out
     if argv[0] == "check":

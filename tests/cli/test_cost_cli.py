@@ -2,6 +2,7 @@
 5 s, --force, --dry-run, progress lines without a terminal, SIGTERM keeps what was computed."""
 
 import json
+import re
 import signal
 import subprocess
 import sys
@@ -129,8 +130,12 @@ def test_long_scene_prints_progress_lines_without_a_terminal(tmp_path):
     out, _ = femkit("solve", scene, cwd=tmp_path, timeout=120)
     assert out.returncode == 0, out.stderr
     lines = [ln for ln in out.stderr.splitlines() if ln.startswith("scene rope: ")]
-    assert len(lines) == 10 and lines[0].startswith("scene rope: 10% (1000/10000 steps), elapsed ")
-    assert "remaining ~" in lines[0] and lines[-1].startswith("scene rope: 100%")
+    # one line per 10 % but at least 5 s apart, and the last always: a run of a few seconds
+    # prints its last line (and one more per 5 s it took)
+    elapsed = float(re.search(r"elapsed ([\d.]+) s$", lines[-1]).group(1))
+    assert lines[-1].startswith("scene rope: 100% (10000/10000 steps), elapsed ")
+    assert len(lines) <= 1 + elapsed // 5
+    assert all("remaining ~" in ln for ln in lines[:-1])
     short = write(tmp_path, rope_scene(dt=1e-3, t_end=0.5, output={"dir": "out2"}), "short.yaml")
     quiet, _ = femkit("solve", short, "--quiet", cwd=tmp_path, timeout=120)
     assert quiet.returncode == 0 and quiet.stderr == ""
@@ -141,7 +146,7 @@ def test_sigterm_leaves_a_loadable_partial_scene(tmp_path):
 
     scene = write(tmp_path, rope_scene(dt=1e-4, t_end=30.0, output={"every": 2000, "dir": "out"}))
     first, code, err = signal_after_first_line(tmp_path, "solve", scene)
-    assert first.startswith("scene rope: 10% "), first  # the run was stepping
+    assert re.match(r"scene rope: \d+% ", first), first  # the run was stepping
     assert code == 143, err
     assert "interrupted by SIGTERM" in err.strip().splitlines()[-1]
     result = json.loads((tmp_path / "out" / "result.json").read_text())
@@ -165,6 +170,7 @@ def test_study_dry_run_and_interruption_keeps_the_earlier_report(tmp_path):
     assert first.startswith("poisson_convergence: "), first  # the sweep was running
     assert code == 143, err
     last = err.strip().splitlines()[-1]
-    assert "interrupted by SIGTERM before run" in last and "nothing written" in last
+    assert "interrupted by SIGTERM during the poisson_convergence sweep" in last
+    assert "nothing written" in last
     assert sorted(p.name for p in earlier.iterdir()) == ["report.md", "results.json"]
     assert (earlier / "results.json").read_text() == '{"earlier": true}'

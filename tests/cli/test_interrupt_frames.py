@@ -11,27 +11,7 @@ import pytest
 import yaml
 
 sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared helper
-from _signals import signal_when_ready  # noqa: E402
-
-# the console script's path, with a spy that announces the first frame being written
-DRIVER = r"""
-import sys
-import femkit.case.scene.output as output
-
-real = output.write_cells
-seen = []
-
-def spy(*args, **kwargs):
-    if not seen:
-        seen.append(1)
-        print("WRITING FRAMES", file=sys.stderr, flush=True)
-    return real(*args, **kwargs)
-
-output.write_cells = spy
-from femkit.cli import entry
-sys.argv = ["femkit", "solve", sys.argv[1], "--quiet"]
-entry()
-"""
+from _signals import signal_inside  # noqa: E402
 
 SCENE = {
     "problem": "mass_spring",
@@ -50,10 +30,11 @@ SCENE = {
 def test_signal_while_writing_frames_keeps_a_consistent_marked_output(tmp_path, sig, code):
     case = tmp_path / "scene.yaml"
     case.write_text(yaml.safe_dump(SCENE))
-    returncode, elapsed, err = signal_when_ready(DRIVER, [str(case)], "WRITING FRAMES", sig,
-                                                 cwd=tmp_path)
+    # signalled once the first frame is being written
+    returncode, elapsed, err = signal_inside("femkit.case.scene.output:write_cells",
+                                             ["solve", str(case), "--quiet"], sig, cwd=tmp_path)
     assert returncode == code, err
-    assert elapsed < 1.0, elapsed
+    assert elapsed < 3.0, elapsed  # target 1 s; slack for a loaded machine
     assert f"interrupted by {sig.name}" in err and "Traceback" not in err
     out = tmp_path / "out"
     result = json.loads((out / "result.json").read_text())

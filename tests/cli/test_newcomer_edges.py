@@ -9,17 +9,11 @@ from pathlib import Path
 import pytest
 import yaml
 
+sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared case
+from _small import SMALL  # noqa: E402
+
 from femkit.cli import main
 from femkit.io.atomic import atomic_path, atomic_write_text
-
-SMALL = {
-    "problem": "poisson",
-    "mesh": {"geometry": "unit_square", "h": 0.25},
-    "source": "1",
-    "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
-    "solver": {"method": "cg", "rtol": 1e-10},
-    "output": {"dir": "out", "vtu": True},
-}
 
 
 def test_python_m_femkit_runs_the_command_line():

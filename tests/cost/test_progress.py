@@ -1,4 +1,6 @@
-"""Progress lines without a terminal: one per 10 % or per minute, with elapsed and remaining time."""
+"""Progress lines without a terminal: one per 10 % or per minute, with elapsed and remaining time,
+at least ``min_interval`` apart (a short run prints its last line only), the remaining time
+scaled by the predicted cost of the work left."""
 
 import io
 
@@ -16,7 +18,7 @@ class FakeClock:
 def test_ten_lines_for_a_full_run_with_remaining_time():
     clock = FakeClock()
     out = io.StringIO()
-    bar = Progress(2000, "scene cloth", mode="lines", stream=out, clock=clock)
+    bar = Progress(2000, "scene cloth", mode="lines", stream=out, clock=clock, min_interval=0)
     for _ in range(2000):
         clock.t += 0.01  # 0.01 s per step: 20 s in all
         bar.update()
@@ -56,7 +58,67 @@ def test_quiet_prints_nothing_and_interruption_is_reported():
 def test_progress_iterator():
     out = io.StringIO()
     assert list(progress(range(20), desc="study", stream=out, mode="lines")) == list(range(20))
-    assert out.getvalue().count("\n") == 10 and "(20/20 jobs)" in out.getvalue()
+    assert out.getvalue().count("\n") == 1 and "100% (20/20 jobs)" in out.getvalue()
+
+
+def test_a_short_run_prints_its_last_line_only_and_lines_stay_min_interval_apart():
+    """Issue 17: a 0.06 s run printed 10 lines. 2000 steps of 0.01 s with lines >= 5 s apart:
+    the 10 % marks at 6, 12 and 18 s, then the end."""
+    clock = FakeClock()
+    out = io.StringIO()
+    bar = Progress(2000, "scene", mode="lines", stream=out, clock=clock)
+    for _ in range(2000):
+        clock.t += 0.01
+        bar.update()
+    assert [line.split(",")[1] for line in out.getvalue().splitlines()] == [
+        " elapsed 6 s", " elapsed 12 s", " elapsed 18 s", " elapsed 20 s"]
+    short = io.StringIO()
+    clock.t = 0.0
+    bar = Progress(10, "short", mode="lines", stream=short, clock=clock)
+    for _ in range(10):
+        clock.t += 0.006  # 0.06 s in all
+        bar.update()
+    assert short.getvalue().splitlines() == ["short: 100% (10/10 steps), elapsed 0.06 s"]
+
+
+def test_remaining_time_follows_the_predicted_cost_not_the_first_runs():
+    """Issue 17: '1.6 s remaining' before 11 minutes. Two cheap runs (cost 1 each, 1 s each)
+    then one of cost 98: after the cheap ones ~98 s remain, not ~0.5 s."""
+    clock = FakeClock()
+    out = io.StringIO()
+    bar = Progress(3, "study", unit="run", mode="lines", stream=out, clock=clock, cost=100.0,
+                   min_interval=0)
+    for cost in (1.0, 1.0):
+        clock.t += 1.0
+        bar.update(cost=cost)
+    assert out.getvalue().splitlines()[-1] == "study: 67% (2/3 runs), elapsed 2 s, remaining ~1.6 min"
+    uniform = Progress(3, "study", unit="run", mode="off", clock=clock)
+    clock.t, uniform.start = 2.0, 0.0
+    uniform.update(2)
+    assert uniform.line().endswith("remaining ~1 s")  # without costs: by count
+
+
+def test_progress_counts_sizes_and_reports_an_interruption():
+    from femkit.interrupt import StopFlag
+
+    out = io.StringIO()
+    assert list(progress("abc", sizes=[2, 3, 1], desc="conv", unit="run", stream=out,
+                         mode="lines")) == ["a", "b", "c"]
+    assert len(out.getvalue().splitlines()) == 1
+    assert out.getvalue().startswith("conv: 100% (6/6 runs)")
+    import pytest
+
+    from femkit.interrupt import Interrupted
+
+    flag, out = StopFlag(), io.StringIO()
+
+    with pytest.raises(Interrupted, match=r"before run 3 of 6 \(2 done\)"):
+        for item in progress("abc", sizes=[2, 3, 1], unit="run", stream=out, mode="lines",
+                             stop=flag):
+            flag.request(2)
+    last = out.getvalue().splitlines()[-1]
+    assert ": 33% (2/6 runs), elapsed " in last
+    assert last.endswith("; interrupted by SIGINT")
 
 
 def test_progress_stops_before_the_next_item_on_request():

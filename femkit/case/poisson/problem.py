@@ -77,6 +77,7 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
     """:func:`build_mesh` and the :class:`~femkit.mesh.MeshHierarchy` of its refinement when the
     case's solver is geometric multigrid (``None`` otherwise): ``(mesh, hierarchy)``."""
     from ...mesh import MeshHierarchy, check_tags, generate, read_mesh, refine, validate
+    from ...mesh.validate import drop_unreferenced
     from ..cost import check_mesh_fits
 
     spec = case.spec.mesh
@@ -84,14 +85,19 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
     force = case.run_options.get("force", False)  # --force also passes the memory guard
     try:
         if spec.file is not None:
-            mesh = read_mesh(spec.file)
+            # a file's unused nodes (gmsh's circle centres ...) are dropped with a printed note
+            mesh, note = drop_unreferenced(read_mesh(spec.file, compact=False))
+            notes = case.run_options.setdefault("notes", [])
+            if note and f"mesh.file: {note}" not in notes:
+                notes.append(f"mesh.file: {note}")
         else:
             hv = spec.h if h is None else h
             check_mesh_fits(geometry=spec.geometry, h=hv, params=dict(spec.params), force=force)
             mesh = generate(spec.geometry, hv, **spec.params)
         mesh = validate(mesh)
-    except InputError as exc:
-        raise with_prefix(exc, where) from None
+    except InputError as exc:  # a message naming the file already says where
+        named = spec.file is not None and str(spec.file) in str(exc)
+        raise with_prefix(exc, "mesh.file" if named else where) from None
     if spec.file is not None:
         check_dimension(case, mesh.dim, where)
     hierarchy = None

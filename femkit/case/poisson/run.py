@@ -19,13 +19,14 @@ atomically (see :func:`femkit.io.atomic.atomic_directory`).
 
 from __future__ import annotations
 
+import contextlib
 import os
 from typing import Any, Callable
 
 import numpy as np
 
 from ...errors import CaseFileError, ExpressionError, InputError
-from ...interrupt import Interrupted
+from ...interrupt import Interrupted, raising
 from ...progress import Progress
 from ..expressions import compile_expression
 from ..frozen import freeze
@@ -197,7 +198,8 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         if stop:
             raise Interrupted(stop, stage=where)
 
-    with stage("mesh"):
+    # stages that keep nothing partial run inside raising(): a signal stops them at once
+    with raising("meshing"), stage("mesh"):
         mesh, hierarchy = build_mesh_levels(case)
     check_stop("mesh")
     grad = exact_gradient(case)
@@ -205,33 +207,37 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
     if case.spec.adaptive:
         from .estimate import solve_adaptive
 
-        with stage("adaptive"):
+        with raising("the adaptive loop"), stage("adaptive"):
             run = solve_adaptive(case, mesh)
         mesh, problem, u, res, est = run.mesh, run.problem, run.u, run.result, run.estimate
         system = problem.system
     else:
         problem = poisson_problem(case, mesh)
-        with stage("assembly"):
+        with raising("assembly"), stage("assembly"):
             K, F = problem.assemble_matrices()
         check_stop("assembly")
-        with stage("boundary"):
+        with raising("the boundary conditions"), stage("boundary"):
             system = problem.reduce(K, F, case.solver.method)
         check_stop("boundary")
-        with stage("assembly"):  # the coarser levels' systems (fmg only): added to the stage
+        with raising("assembly"), stage("assembly"):  # the coarser levels' systems (fmg only)
             mg = multigrid_inputs(case, hierarchy, system)
         with stage("solve"):
             res = _solve(case, system, stop, **mg)
             u = system.expand(res.x)
         report.done("solve")
-    q = quality(mesh)
-    errors = None
-    if "exact.u" in case.functions:
-        with stage("errors"):
-            errors = compute_errors(case, problem, u)
-    from .estimate import adaptive_facts, estimate_facts
+    # after a complete solve a signal during the errors or the estimate stops at once (nothing
+    # written); after an interrupted solve they run to write its last iterate
+    after = contextlib.nullcontext() if res.reason == "interrupted" else raising("the error estimate")
+    with after:
+        q = quality(mesh)
+        errors = None
+        if "exact.u" in case.functions:
+            with stage("errors"):
+                errors = compute_errors(case, problem, u)
+        from .estimate import adaptive_facts, estimate_facts
 
-    with stage("estimate"):
-        estimate, effectivity, est = estimate_facts(case, problem, u, grad, est)
+        with stage("estimate"):
+            estimate, effectivity, est = estimate_facts(case, problem, u, grad, est)
     result = CaseResult(case=case, mesh=mesh, u=u, kappa=problem.kappa, solve=res, errors=errors,
                         timings=stage.times, quality=q, dofs=int(system.A.shape[0]),
                         n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
@@ -247,6 +253,8 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         out = echo or print
         for line in result.summary_lines():
             out(line)
+        for note in case.run_options.get("notes", ()):  # e.g. a mesh file's unused nodes
+            out(f"note      {note}")
     return result
 
 

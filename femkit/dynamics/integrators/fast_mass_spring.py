@@ -46,7 +46,8 @@ damping coefficients, topology and the pinned set, so the factor and the spring 
 of its ``mass``, ``k``, ``rest``, ``damping``, ``springs``, ``pinned`` and ``forces`` attributes (the cache
 holds references, so identities cannot be recycled): assigning a new array invalidates it,
 modifying one of those arrays in place does not (clear ``ctx.cache`` then). No array is hashed
-per step. ``ctx.stats["factorizations"]`` counts factorisations.
+per step. ``ctx.stats["factorizations"]`` counts factorisations, ``ctx.stats["linear_solves"]``
+the global solves (one per iteration, all coordinates at once).
 
 With the ``cholesky`` solver the matrix is factorised by CHOLMOD
 (:func:`femkit.solvers.factorize_spd`) and the local step and ``J d`` are one compiled pass over
@@ -265,6 +266,7 @@ class FastMassSpring(Integrator):
             if ops.B_free is not None:
                 x[free] = x_free
                 rhs += ops.B_free @ x                # h B x_k (the damping split)
+            ctx.count("linear_solves")               # one global solve (all d columns) per sweep
             return ops.factor.solve(rhs if compiled else np.asfortranarray(rhs))
 
         return sweep

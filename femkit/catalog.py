@@ -1,0 +1,162 @@
+"""What ``femkit list`` prints: every name a case or study file may use, read from the registries.
+
+Each group is one registry (:data:`GROUPS`: group name -> a function returning that registry),
+so a geometry, solver, force or kind registered anywhere (a plugin included) is listed with no
+table to keep in step. A name's description is the first line of its docstring (a class with
+only the generated dataclass signature falls back to its module's docstring), or what the
+record itself says (a geometry's dimension, parameters and tags).
+
+>>> rows = entries("preconditioners")
+>>> ("none" in dict(rows), all(isinstance(d, str) for _, d in rows))
+(True, True)
+"""
+
+from __future__ import annotations
+
+import inspect
+import re
+import sys
+from typing import Callable
+
+__all__ = ["GROUPS", "entries", "describe", "render"]
+
+
+def _geometries():
+    from .mesh.geometries import GEOMETRIES
+
+    return GEOMETRIES
+
+
+def _solvers():
+    from .solvers.registry import SOLVERS
+
+    return SOLVERS
+
+
+def _preconditioners():
+    from .solvers.registry import PRECONDITIONERS
+
+    return PRECONDITIONERS
+
+
+def _backends():
+    from .solvers.registry import BACKENDS
+
+    return BACKENDS
+
+
+def _integrators():
+    from .dynamics.integrators.registry import INTEGRATORS
+
+    return INTEGRATORS
+
+
+def _forces():
+    from .case.scene.forces import FORCES
+
+    return FORCES
+
+
+def _systems():
+    from .case.scene.systems import SYSTEMS
+
+    return SYSTEMS
+
+
+def _materials():
+    from .solids.materials.registry import MATERIALS
+
+    return MATERIALS
+
+
+class _Family:
+    """One family of :data:`femkit.case.kinds.KINDS` seen as a registry (``names``/``get``)."""
+
+    def __init__(self, key: str):
+        self.key = key
+
+    def names(self) -> list[str]:
+        from .case.kinds import KINDS
+
+        return KINDS.names(self.key)
+
+    def get(self, name: str):
+        from .case.kinds import KINDS
+
+        return KINDS.get(name, self.key)
+
+
+#: group name -> (what it is, function returning its registry). Order = ``femkit list`` order.
+GROUPS: dict[str, tuple[str, Callable]] = {
+    "geometries": ("mesh.geometry / system.geometry of a case", _geometries),
+    "solvers": ("solver.method", _solvers),
+    "preconditioners": ("solver.preconditioner", _preconditioners),
+    "backends": ("solver.backend (--backend)", _backends),
+    "integrators": ("integrator.method of a scene", _integrators),
+    "forces": ("forces of a scene", _forces),
+    "systems": ("system.type of a scene", _systems),
+    "materials": ("material of an elastic solid", _materials),
+    "problems": ("problem: of a case file (femkit solve)", lambda: _Family("problem")),
+    "studies": ("kind: of a study file (femkit study)", lambda: _Family("kind")),
+}
+
+
+def _first_line(text: str | None) -> str:
+    """The first sentence of a docstring's first paragraph, without reST markup.
+
+    >>> _first_line("``kind: x``: does y with :func:`~a.b` (see\\n  there). More.\\n\\nBody")
+    'does y with b (see there).'
+    """
+    para = " ".join((text or "").strip().split("\n\n")[0].split())
+    para = re.sub(r"^``[^`]*``: ", "", para)  # the ``kind: name``: heading of a kind's module
+    para = re.sub(r":\w+:`~?(?:[\w.]*\.)?([^`]+)`", r"\1", para).replace("``", "")
+    return re.split(r"(?<=[.:])\s+(?=[A-Z])", para)[0].split(", registered as")[0]
+
+
+def describe(obj) -> str:
+    """One line saying what a registered ``obj`` is (see the module docstring)."""
+    from .mesh.geometries import Geometry
+
+    if isinstance(obj, Geometry):
+        params = ", ".join(obj.parameters) or "none"
+        return f"{obj.dim}D; parameters: {params}; tags: {', '.join(obj.boundary_tags + obj.cell_tags)}"
+    schema = getattr(obj, "schema", None)
+    if isinstance(schema, dict) and "properties" in schema:  # forces, system types
+        keys = [k for k in schema["properties"] if k != "type"]
+        return "keys: " + ", ".join(keys) if keys else "no keys"
+    run = getattr(obj, "run", None)
+    if callable(run) and hasattr(obj, "key"):  # a file kind: its module says what it is
+        return _first_line(sys.modules[run.__module__].__doc__)
+    text = _first_line(getattr(obj, "__doc__", None))
+    if inspect.isclass(obj) and text.startswith(obj.__name__ + "("):  # generated signature
+        text = _first_line(sys.modules[obj.__module__].__doc__)
+    return text
+
+
+def _group(group: str):
+    from .errors import UnknownNameError
+
+    if group not in GROUPS:
+        raise UnknownNameError("group", group, GROUPS)
+    return GROUPS[group][1]()
+
+
+def entries(group: str) -> list[tuple[str, str]]:
+    """``(name, description)`` of every entry of ``group`` (a key of :data:`GROUPS`), sorted."""
+    registry = _group(group)
+    return [(name, describe(registry.get(name))) for name in registry.names()]
+
+
+def render(groups=None) -> str:
+    """The text ``femkit list [GROUP ...]`` prints."""
+    from .case.plugins import load_plugins
+
+    load_plugins()  # a plugin's entries are listed too
+    blocks = []
+    for group in groups or GROUPS:
+        rows = entries(group)
+        width = max((len(n) for n, _ in rows), default=0)
+        lines = [f"{group} ({GROUPS[group][0]}):"]
+        lines += [f"  {n.ljust(width)}  {d}".rstrip() for n, d in rows]
+        blocks.append("\n".join(lines))
+    return "\n\n".join(blocks)

@@ -1,0 +1,113 @@
+"""A stop request inside a run answers at once (issue 17: the cloth study's Liu reference ignored
+SIGINT for 657 s, the stress study waited 37 s for its current run): during a Poisson case's
+assembly, during its long iterative solve, and inside a study's run. Each test signals a
+``femkit`` subprocess once it has entered the work under test and measures signal-to-exit time
+(the target is 1 s; the assertion allows 3 s for a loaded machine), the exit code, the one line
+saying what was kept, and the kept output."""
+
+import json
+import signal
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared helper
+from _signals import signal_inside  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[2]
+SIGNALS = pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
+                                  ids=["SIGINT", "SIGTERM"])
+SLACK = 3.0  # seconds from the signal to the exit (target 1 s)
+
+
+def _poisson(tmp_path, refine: int, rtol: float, method: str = "cg") -> Path:
+    case = tmp_path / "case.yaml"
+    case.write_text(yaml.safe_dump({
+        "problem": "poisson",
+        "mesh": {"geometry": "unit_square", "h": 0.02, "refine": refine},
+        "source": "1",
+        "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
+        "solver": {"method": method, "rtol": rtol, "maxiter": 10_000_000},
+        "output": {"dir": "out", "vtu": False}}))
+    return case
+
+
+@SIGNALS
+def test_signal_during_assembly_stops_at_once_and_writes_nothing(tmp_path, sig, code):
+    case = _poisson(tmp_path, refine=3, rtol=1e-8)   # 373k triangles: assembly takes seconds
+    rc, elapsed, err = signal_inside("femkit.fem.poisson:PoissonProblem.assemble_matrices",
+                                     ["solve", str(case), "--quiet"], sig, cwd=tmp_path)
+    assert rc == code, err
+    assert elapsed < SLACK, elapsed
+    assert f"interrupted by {sig.name} during assembly; nothing written" in err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+
+
+@SIGNALS
+def test_signal_during_a_long_solve_writes_the_last_iterate_marked(tmp_path, sig, code):
+    # Jacobi to 1e-12 on 12k unknowns: minutes of cheap iterations, then a small estimate
+    case = _poisson(tmp_path, refine=1, rtol=1e-12, method="jacobi")
+    rc, elapsed, err = signal_inside("femkit.interrupt:stopping_callback",
+                                     ["solve", str(case), "--quiet"], sig, cwd=tmp_path)
+    assert rc == code, err
+    assert elapsed < SLACK, elapsed
+    assert f"interrupted by {sig.name}" in err and "Traceback" not in err
+    result = json.loads((tmp_path / "out" / "result.json").read_text())
+    assert result["interrupted"] is True
+    assert result["solver"]["converged"] is False and result["solver"]["iterations"] > 0
+
+
+def _earlier_report(out: Path) -> dict:
+    out.mkdir()
+    files = {"results.json": '{"earlier": true}\n', "report.md": "# the earlier report\n"}
+    for name, text in files.items():
+        (out / name).write_text(text)
+    return files
+
+
+def _check_study_stopped(rc, elapsed, err, sig, code, out, files):
+    assert rc == code, err
+    assert elapsed < SLACK, elapsed
+    lines = err.strip().splitlines()
+    assert f"interrupted by {sig.name} during" in lines[-1], err
+    assert "earlier report" in lines[-1] and "Traceback" not in err
+    assert {p.name: p.read_text() for p in out.iterdir()} == files  # kept as it was
+
+
+@SIGNALS
+def test_signal_inside_the_cloth_studys_reference_run(tmp_path, sig, code):
+    # the Liu-style reference: local/global iterations run to a tolerance never met in time
+    study = tmp_path / "cloth.yaml"
+    study.write_text(yaml.safe_dump({
+        "kind": "cloth_work_precision",
+        "scenes": [str(REPO / "cases" / "scenes" / "hanging_cloth.yaml")],
+        "system_overrides": {"nx": 30, "ny": 30}, "frames": 50,
+        "linear_solver": {"method": "cholesky"},
+        "methods": [{"family": "fast_mass_spring", "iterations": [1]}],
+        "reference": {"tol": 1e-15, "solve": "local_global", "trajectory": "rk4", "substeps": 2}}))
+    out = tmp_path / "report"
+    files = _earlier_report(out)
+    rc, elapsed, err = signal_inside(
+        "femkit.dynamics.integrators.fast_mass_spring:FastMassSpring.step",
+        ["study", str(study), "--output", str(out), "--quiet"], sig, cwd=tmp_path)
+    _check_study_stopped(rc, elapsed, err, sig, code, out, files)
+
+
+@SIGNALS
+def test_signal_inside_a_poisson_studys_solve(tmp_path, sig, code):
+    study = tmp_path / "conv.yaml"
+    study.write_text(yaml.safe_dump({
+        "kind": "poisson_convergence",
+        "problem": {"mesh": {"geometry": "unit_square"}, "source": "2*pi**2*sin(pi*x)*sin(pi*y)",
+                    "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
+                    "exact": {"u": "sin(pi*x)*sin(pi*y)"}},
+        "levels": {"h0": 0.02, "count": 3},
+        "solvers": [{"method": "cg", "rtol": 1e-15, "maxiter": 1000000}], "repeats": 1}))
+    out = tmp_path / "report"
+    files = _earlier_report(out)
+    rc, elapsed, err = signal_inside("femkit.study.poisson:_assemble", ["study", str(study), "--output",
+                                     str(out), "--quiet"], sig, cwd=tmp_path)
+    _check_study_stopped(rc, elapsed, err, sig, code, out, files)
