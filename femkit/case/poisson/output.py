@@ -21,7 +21,7 @@ __all__ = ["write_solution", "write_plot", "write_outputs", "output_location",
 #: Top-level keys of result.json.
 RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs", "nnz",
                "solver", "converged", "errors", "error_estimate", "effectivity", "adaptive",
-               "timings", "expressions", "files", "backend", "parallel")
+               "timings", "wall", "expressions", "files", "backend", "parallel")
 
 
 def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarray | None = None,
