@@ -132,7 +132,8 @@ def prepare_poisson(case: Case) -> None:
         load_rule=d["quadrature"]["load"], estimator=d["estimator"],
         adaptive=freeze(d["adaptive"]) if d.get("adaptive") else None, solver=case.solver,
         output=PoissonOutputSpec(out["dir"], bool(out["vtu"]), bool(out["xdmf"]),
-                                 bool(out["plot"]), out.get("gather_limit")))
+                                 bool(out["plot"]), out.get("gather_limit"),
+                                 out.get("compression", "none")))
 
 
 def _prepare_nullspace(bnd: dict) -> None:
