@@ -193,9 +193,12 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         if stop:
             raise Interrupted(stop, stage=where)
 
+    say = None if quiet else (echo or print)
+    _compile_stage(case, None, stage, say)  # multigrid: before refinement, which has kernels too
     with stage("mesh"):
         mesh, hierarchy = build_mesh_levels(case)
     check_stop("mesh")
+    _compile_stage(case, mesh, stage, say)  # a large mesh without multigrid
     grad = exact_gradient(case)
     run = est = None
     if case.spec.adaptive:
@@ -247,6 +250,16 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
             out(line)
         out(clock.summary(result.timings))
     return result
+
+
+def _compile_stage(case: Case, mesh, stage, echo) -> None:
+    """The first run after an install compiles the kernels it needs ahead, in its own
+    ``compile`` stage (not inside assembly and solve), saying so on the terminal (``echo``)."""
+    from .warmup import must_compile, warm_up
+
+    if must_compile(mesh, case.solver.needs_hierarchy):
+        with stage("compile"):
+            warm_up(echo)
 
 
 def _solve(case: Case, system, stop, **mg):
