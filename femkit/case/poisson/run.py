@@ -215,12 +215,14 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         check_stop("assembly")
         with stage("boundary"):
             system = problem.reduce(K, F, case.solver.method)
+        del K, F  # the reduced system is what the later stages use
         check_stop("boundary")
         with stage("assembly"):  # the coarser levels' systems (fmg only): added to the stage
             mg = multigrid_inputs(case, hierarchy, system)
         with stage("solve"):
             res = _solve(case, system, stop, **mg)
             u = system.expand(res.x)
+        del mg, hierarchy  # the coarser levels and their operators: not needed after the solve
         report.done("solve")
     with stage("mesh"):  # the mesh's numbers (its edges are shared with the estimator)
         q = quality(mesh)
