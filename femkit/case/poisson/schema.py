@@ -135,7 +135,7 @@ POISSON_SCHEMA: dict = {
                 "xdmf": {"type": "boolean", "default": False},
                 "plot": {"type": "boolean", "default": False},
                 # compression of solution.vtu's arrays (femkit.mesh.vtk.COMPRESSIONS)
-                "compression": {"enum": ["none", "zlib", "lzma"], "default": "none"},
+                "compression": {"enum": ["none", "zlib", "lzma"]},  # unset: none
                 "gather_limit": {"type": "integer", "minimum": 0},
             },
         },
