@@ -21,7 +21,7 @@ __all__ = ["edges", "boundary_edges_topological", "boundary_nodes", "edge_ids", 
 
 #: Meshes with at least this many cells find their edges with the compiled counting-sort kernel
 #: (:mod:`femkit.mesh._edges_kernel`); smaller ones with ``np.unique``.
-NUMBA_THRESHOLD = 50_000
+NUMBA_THRESHOLD = 200_000
 
 #: ``edges(mesh)`` per mesh, computed once while the mesh lives: refinement, the prolongations,
 #: the quality numbers and the estimators all ask for the same edges. The arrays are read-only.
