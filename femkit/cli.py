@@ -260,6 +260,25 @@ def _run_check(args) -> int:
     return EXIT_OK if ok else EXIT_FAILED
 
 
+# ----------------------------------------------------------------------------- warmup
+
+def _add_warmup(sub) -> None:
+    p = sub.add_parser(
+        "warmup", help="compile femkit's kernels now (once after an install; cached afterwards)",
+        description=("Compile the compiled (numba) kernels of the Poisson pipeline (assembly, "
+                     "edges, geometric multigrid) on a tiny problem, so the first real "
+                     "'femkit solve' does not pay for it. Without it that first large run "
+                     "compiles them itself, in a stage named 'compile'."))
+    p.set_defaults(handler=_run_warmup)
+
+
+def _run_warmup(args) -> int:
+    from .case.poisson.warmup import warm_up
+
+    print(f"kernels ready in {warm_up(print):.1f} s")
+    return EXIT_OK
+
+
 def _add_study(sub) -> None:
     from .study.cli import add_parser  # standard library only at import time
 
@@ -307,7 +326,7 @@ def _run_list(args) -> int:
 
 
 #: Subcommands, in help order: each adds its parser to the subparsers object.
-SUBCOMMANDS: list[Callable] = [_add_solve, _add_check, _add_study, _add_list]
+SUBCOMMANDS: list[Callable] = [_add_solve, _add_check, _add_study, _add_list, _add_warmup]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -38,10 +38,32 @@ class TriangleRule:
 
     def physical_points(self, mesh, tri: np.ndarray) -> tuple[np.ndarray, ...]:
         """Coordinates ``(x, y)`` (``(x, y, z)`` on tetrahedra) of the points on each cell,
-        each shape (m, q)."""
-        p = mesh.points[tri]  # (m, d + 1, d)
-        xy = np.einsum("qa,mad->dmq", self.points, p)
-        return tuple(xy)
+        each shape (m, q): ``sum_a lambda_a X[tri[:, a]]`` per coordinate, summed vertex by vertex
+        in order (the same rounding as a contraction over ``a``, without its (m, d + 1, d) copy)."""
+        out = []
+        for d in range(mesh.points.shape[1]):
+            xd = mesh.points[:, d]
+            acc = xd[tri[:, 0], None] * self.points[:, 0]
+            for a in range(1, tri.shape[1]):
+                acc += xd[tri[:, a], None] * self.points[:, a]
+            out.append(acc)
+        return tuple(out)
+
+
+#: Elements per block of the quadrature loops (:func:`blocks`): the (block, q) arrays of one
+#: block stay in cache, and a 2M-unknown mesh's quadrature values are never all in memory.
+BLOCK = 1 << 15
+
+
+def blocks(m: int, size: int | None = None) -> list[slice]:
+    """Slices of ``range(m)`` in blocks of ``size`` elements (default :data:`BLOCK`; one empty
+    slice when ``m = 0``).
+
+    >>> blocks(5, 2)
+    [slice(0, 2, None), slice(2, 4, None), slice(4, 5, None)]
+    """
+    size = size or BLOCK
+    return [slice(lo, min(lo + size, m)) for lo in range(0, m, size)] or [slice(0, 0)]
 
 
 QUADRATURE: Registry[TriangleRule] = Registry("quadrature rule")

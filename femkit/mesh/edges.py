@@ -9,6 +9,7 @@
 
 from __future__ import annotations
 
+import weakref
 from typing import Iterable
 
 import numpy as np
@@ -18,7 +19,13 @@ from .mesh import LOCAL_EDGES, Mesh
 
 __all__ = ["edges", "boundary_edges_topological", "boundary_nodes", "edge_ids", "boundary_edge_ids"]
 
+#: Meshes with at least this many cells find their edges with the compiled counting-sort kernel
+#: (:mod:`femkit.mesh._edges_kernel`); smaller ones with ``np.unique``.
+NUMBA_THRESHOLD = 200_000
 
+#: ``edges(mesh)`` per mesh, computed once while the mesh lives: refinement, the prolongations,
+#: the quality numbers and the estimators all ask for the same edges. The arrays are read-only.
+_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 def _local_edges(cells: np.ndarray) -> np.ndarray:
@@ -37,11 +44,31 @@ def edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     cell_edges : (m, 3) or (m, 6) int64
         ``cell_edges[t, k]`` is the edge of triangle ``t`` opposite its local vertex ``k``, or
         the local edge ``k`` of a tetrahedron (:data:`LOCAL_EDGES`).
+
+    Computed once per mesh (cached while the mesh lives; the arrays are read-only).
     """
+    try:
+        hit = _CACHE.get(mesh)
+    except TypeError:  # a mesh-like object that cannot be weakly referenced
+        return _edges(mesh)
+    if hit is None:
+        hit = _edges(mesh)
+        for a in hit:
+            a.flags.writeable = False
+        _CACHE[mesh] = hit
+    return hit
+
+
+def _edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     n = max(mesh.n_points, 1)
     k = 3 if mesh.dim == 2 else 6
     loc = _local_edges(mesh.cells).reshape(-1, 2)
     lo, hi = loc.min(axis=1), loc.max(axis=1)
+    if mesh.n_cells >= NUMBA_THRESHOLD:
+        from ._edges_kernel import unique_edges
+
+        elo, ehi, inverse = unique_edges(lo, hi, n)
+        return np.stack([elo, ehi], axis=1), inverse.reshape(-1, k)
     keys, inverse = np.unique(lo * n + hi, return_inverse=True)
     edge_nodes = np.stack([keys // n, keys % n], axis=1)
     return edge_nodes, inverse.reshape(-1, k).astype(np.int64)

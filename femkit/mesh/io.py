@@ -265,7 +265,7 @@ def _points3(mesh: Mesh) -> np.ndarray:
 
 def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = None,
                cell_data: dict | None = None, *, msh_version: str = "4.1",
-               binary: bool = False) -> None:
+               binary: bool = False, compression: str | None = None) -> None:
     """Write a mesh (and optional data) in the format given by the extension.
 
     Parameters
@@ -276,6 +276,8 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = No
     point_data : ``{name: (n,) or (n, k) array}``
     cell_data : ``{name: (m,) or (m, k) array}`` on the cells (tagged boundary facets get
         zeros in the written file)
+    compression : ``.vtu`` only: ``none``, ``zlib`` or ``lzma``
+        (:data:`femkit.mesh.vtk.COMPRESSIONS`; default :data:`~femkit.mesh.vtk.DEFAULT_COMPRESSION`)
 
     Physical tags go to ``gmsh:physical`` / ``gmsh:geometrical`` on the ``triangle`` and
     ``line`` blocks (``tetra`` and ``triangle`` for a tetrahedral mesh) and names to
@@ -329,7 +331,8 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = No
             write_cells(p, mesh.points, cells, cell_data=cdata, field_data=fdata,
                         file_format="gmsh22", binary=binary)
         else:
-            write_cells(p, mesh.points, cells, point_data=pdata, cell_data=cdata, field_data=fdata)
+            write_cells(p, mesh.points, cells, point_data=pdata, cell_data=cdata, field_data=fdata,
+                        **({} if compression is None else {"compression": compression}))
             if mesh.tag_names:
                 Path(_sidecar(p)).write_text(json.dumps(mesh.tag_names, sort_keys=True))
     except MeshError:

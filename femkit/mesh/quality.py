@@ -108,25 +108,40 @@ def quality(mesh: Mesh) -> dict:
         return _quality_3d(mesh)
     from .edges import edges
 
-    lens, ang = side_lengths_and_angles(mesh.points[mesh.triangles])
     area = mesh.areas()
+    aspect = np.empty(mesh.n_cells)
+    h_max, h_min, a_min, a_max = -np.inf, np.inf, np.nan, np.nan
+    for lo in range(0, max(mesh.n_cells, 1), _BLOCK):  # block by block: small temporaries
+        s = slice(lo, lo + _BLOCK)
+        lens, ang = side_lengths_and_angles(mesh.points[mesh.triangles[s]])
+        if not lens.size:
+            continue
+        h_max, h_min = max(h_max, float(lens.max())), min(h_min, float(lens.min()))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if not np.isnan(ang).all():
+                a_min = np.nanmin([a_min, np.nanmin(ang)])
+                a_max = np.nanmax([a_max, np.nanmax(ang)])
+            ar = area[s]
+            half = 0.5 * lens.sum(axis=1)
+            circum = lens.prod(axis=1) / (4.0 * ar)
+            inr = ar / half
+            aspect[s] = np.where(ar > 0, circum / (2.0 * inr), np.inf)
     edge_nodes, _ = edges(mesh)
     d = mesh.points[edge_nodes[:, 1]] - mesh.points[edge_nodes[:, 0]]
     unique_len = np.hypot(d[:, 0], d[:, 1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = 0.5 * lens.sum(axis=1)
-        circum = lens.prod(axis=1) / (4.0 * area)
-        inr = area / s
-        aspect = np.where(area > 0, circum / (2.0 * inr), np.inf)
     return {
         "n_points": mesh.n_points,
         "n_triangles": mesh.n_triangles,
-        "h_max": float(lens.max()),
-        "h_min": float(lens.min()),
+        "h_max": h_max,
+        "h_min": h_min,
         "h_mean": float(unique_len.mean()),
-        "min_angle": float(np.nanmin(ang)),
-        "max_angle": float(np.nanmax(ang)),
+        "min_angle": float(a_min),
+        "max_angle": float(a_max),
         "max_aspect_ratio": float(aspect.max()),
         "mean_aspect_ratio": float(aspect.mean()),
         "area": float(area.sum()),
     }
+
+
+#: Triangles per block of :func:`quality` (its (block, 3, 2) temporaries stay small).
+_BLOCK = 1 << 16

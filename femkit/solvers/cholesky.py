@@ -79,8 +79,10 @@ MODES = ("supernodal", "simplicial")
 #: Factorisation libraries accepted by ``engine=``: ``cholmod`` (SuiteSparse CHOLMOD through
 #: scikit-sparse, the default; the fastest solves) and ``pardiso`` (Intel oneMKL PARDISO,
 #: :mod:`femkit.solvers.pardiso`; the fastest numeric factorisation, 2.5-3.5x CHOLMOD's on the
-#: cloth matrices, so the engine for a matrix refactorised every step). Chosen by name only.
-ENGINES = ("cholmod", "pardiso")
+#: cloth matrices, so the engine for a matrix refactorised every step) and ``cholespy`` (CHOLMOD
+#: bundled in the cholespy wheel, :class:`femkit.solvers.factor.CholespyFactor`: pip alone, any
+#: OS; no separate numeric phase). Chosen by name only.
+ENGINES = ("cholmod", "pardiso", "cholespy")
 
 #: Number of sparsity patterns whose symbolic analysis is kept (least recently used dropped).
 CACHE_SIZE = 8
@@ -291,6 +293,10 @@ def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, mode: str = "supernoda
         from ..errors import UnknownNameError
 
         raise UnknownNameError("cholesky engine", engine, ENGINES)
+    if engine == "cholespy":
+        from .factor import CholespyFactor
+
+        return CholespyFactor(_as_symmetric_csc(A, check_symmetry))
     if engine == "pardiso":
         if mode != "supernodal":
             raise InputError(f"cholesky: mode {mode!r} is CHOLMOD's (engine 'cholmod'); PARDISO "

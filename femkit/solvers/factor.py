@@ -1,7 +1,8 @@
 """The one interface of a kept sparse factorisation, and the factor of a permuted matrix.
 
 Every engine femkit factorises with (SuperLU in :mod:`femkit.solvers.direct`, CHOLMOD in
-:mod:`femkit.solvers.cholesky`, MKL PARDISO in :mod:`femkit.solvers.pardiso`) returns a
+:mod:`femkit.solvers.cholesky`, MKL PARDISO in :mod:`femkit.solvers.pardiso`, CHOLMOD bundled
+in the cholespy wheel: :class:`CholespyFactor`) returns a
 :class:`Factor`: ``solve(b)`` for one right-hand side ``(n,)`` or a block ``(n, k)``,
 ``refactor(A)`` for new values on the same sparsity pattern (the numeric phase only, where the
 engine offers it), and the counters and facts in ``info``. The checks every solve makes on its
@@ -24,7 +25,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["Factor", "PermutedFactor", "NOT_SPD_ADVICE"]
+__all__ = ["Factor", "PermutedFactor", "CholespyFactor", "cholespy_available", "NOT_SPD_ADVICE"]
 
 #: The advice every NotSPDError of both Cholesky engines ends with.
 NOT_SPD_ADVICE = ("use method 'direct' (SuperLU) for indefinite systems, or a definiteness fix "
@@ -106,4 +107,75 @@ class PermutedFactor(Factor):
         y = self.factor.solve(b[self.perm])
         x = np.empty_like(y)
         x[self.perm] = y
+        return x
+
+
+def cholespy_available() -> bool:
+    """Whether cholespy (a wheel that bundles CHOLMOD: ``pip install "femkit[fast]"``) imports."""
+    try:
+        import cholespy  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+class CholespyFactor(Factor):
+    """Sparse Cholesky ``A = L L^T`` by CHOLMOD as bundled in the cholespy wheel (Nicolet et al.
+    2021, "Large Steps in Inverse Rendering of Geometry"; Chen, Davis, Hager & Rajamanickam 2008
+    for CHOLMOD): the ``cholesky`` solver's engine ``cholespy``, installable by pip alone on any
+    OS (``pip install "femkit[fast]"``), where scikit-sparse needs the system's SuiteSparse.
+
+    cholespy offers no separate numeric phase: :meth:`refactor` factorises afresh (in place, so
+    the factor object stays the one a solver session keeps) and ``symbolic_reused`` is False.
+
+    Raises
+    ------
+    NotSPDError
+        ``A`` is not positive definite (CHOLMOD's pivot check).
+    BackendUnavailableError
+        cholespy is not installed.
+    """
+
+    symmetric = True
+
+    def __init__(self, A):
+        self.info = {"backend": "cholmod (cholespy)", "ordering": "cholmod default",
+                     "symbolic_reused": False, "symbolic_uses": 1, "symmetric": True}
+        self.refactor(A)
+
+    def refactor(self, A) -> "CholespyFactor":
+        """Factorise ``A`` (CSR or CSC, symmetric; its lower triangle is read) afresh; returns self."""
+        import time
+
+        import scipy.sparse as sp
+
+        from ..errors import BackendUnavailableError, NotSPDError
+
+        try:
+            import cholespy
+        except ImportError:
+            raise BackendUnavailableError(
+                "engine 'cholespy' needs the cholespy wheel: pip install \"femkit[fast]\" (or "
+                "pip install cholespy)") from None
+        A = sp.csr_matrix(A)
+        n = A.shape[0]
+        if A.shape != (n, n) or n == 0:
+            raise InputError(f"A must be square and non-empty, got {A.shape}")
+        t0 = time.perf_counter()
+        try:
+            self._s = cholespy.CholeskySolverD(n, A.indptr.astype(np.int32), A.indices.astype(np.int32),
+                                               np.ascontiguousarray(A.data, dtype=np.float64),
+                                               cholespy.MatrixType.CSR)
+        except ValueError as exc:
+            raise NotSPDError(f"cholesky (cholespy): the matrix is not positive definite ({exc}); "
+                              f"{NOT_SPD_ADVICE}") from None
+        self.shape = (n, n)
+        self.setup_time = time.perf_counter() - t0
+        self.info.update(nnz_A=int(A.nnz), numeric_time=self.setup_time)
+        return self
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        b = np.ascontiguousarray(b, dtype=np.float64)
+        x = np.zeros_like(b)
+        self._s.solve(b, x)
         return x

@@ -95,7 +95,7 @@ def test_unknown_preconditioner_option_names_the_option(pc):
 
 @pytest.mark.parametrize("where, data, text", [
     ("solver", {"method": "cholesky", "options": {"engine": "mumps"}},
-     "solver.options: unknown cholesky engine 'mumps'; valid cholesky engines: cholmod, pardiso"),
+     "solver.options: unknown cholesky engine 'mumps'; valid cholesky engines: cholespy, cholmod, pardiso"),
     ("linear_solver", {"method": "cholesky", "options": {"ordering": "rcm"}},
      "linear_solver.options: unknown cholesky ordering 'rcm'"),
 ], ids=["engine", "ordering"])

@@ -21,11 +21,11 @@ __all__ = ["write_solution", "write_plot", "write_outputs", "output_location",
 #: Top-level keys of result.json.
 RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs", "nnz",
                "solver", "converged", "errors", "error_estimate", "effectivity", "adaptive",
-               "timings", "expressions", "files", "backend", "parallel")
+               "timings", "wall", "expressions", "files", "backend", "parallel")
 
 
 def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarray | None = None,
-                   extra_point_data: dict | None = None) -> Path:
+                   extra_point_data: dict | None = None, compression: str | None = None) -> Path:
     """Write the mesh with point data ``u`` and cell data ``kappa`` and ``tag`` (vtu/xdmf by extension).
 
     Not atomic by itself (meshio may write sibling files); use it inside
@@ -41,7 +41,7 @@ def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarr
     # Written in place: sibling files (XDMF's .h5, a tag-name sidecar) are named after the
     # file, so a temporary name would orphan them. Callers write into an atomic directory.
     target = Path(path)
-    write_mesh(target, mesh, point_data=point_data, cell_data=cell_data)
+    write_mesh(target, mesh, point_data=point_data, cell_data=cell_data, compression=compression)
     return target
 
 
@@ -141,7 +141,8 @@ def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None) ->
         if opts.vtu and write_pieces is not None:
             write_pieces(tmp)
         elif opts.vtu:
-            write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa)
+            write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa,
+                           compression=opts.compression)
         if result.u is None:
             result.parallel["not_written"] = [f"solution.{e}" for e, k in
                                               (("xdmf", "xdmf"), ("png", "plot")) if getattr(opts, k)]

@@ -293,6 +293,7 @@ class CaseResult:
     adaptive: dict | None = None
     parallel: dict | None = None
     interrupted: str | None = None
+    clock: Any = None  # a femkit.timing.WallClock: result.json's "wall" (start-up, stages, other)
 
     @property
     def converged(self) -> bool:
@@ -329,6 +330,7 @@ class CaseResult:
             "effectivity": self.effectivity,
             "adaptive": self.adaptive,
             "timings": dict(self.timings),
+            "wall": self.clock.facts(self.timings) if self.clock is not None else None,
             "expressions": {k: f.source for k, f in self.case.functions.items()},
             "files": list(self.files),
             "backend": self.case.solver.backend,

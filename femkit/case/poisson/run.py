@@ -139,7 +139,8 @@ def prepare_poisson(case: Case) -> None:
         load_rule=d["quadrature"]["load"], estimator=d["estimator"],
         adaptive=freeze(d["adaptive"]) if d.get("adaptive") else None, solver=case.solver,
         output=PoissonOutputSpec(out["dir"], bool(out["vtu"]), bool(out["xdmf"]),
-                                 bool(out["plot"]), out.get("gather_limit")))
+                                 bool(out["plot"]), out.get("gather_limit"),
+                                 out.get("compression", "none")))
 
 
 def _prepare_nullspace(bnd: dict) -> None:
@@ -180,8 +181,9 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
 
         return run_poisson_petsc(case, output_dir, quiet=quiet, write=write, echo=echo)
     from ...mesh import quality
-    from ...timing import StageTimer
+    from ...timing import StageTimer, WallClock
 
+    clock = WallClock()  # start-up (interpreter, imports, case file) is the process's age now
     stage = StageTimer()
     target = None
     if write:  # a bad output location is bad input: refuse it before any work is done
@@ -198,10 +200,13 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         if stop:
             raise Interrupted(stop, stage=where)
 
+    say = None if quiet else (echo or print)
+    _compile_stage(case, None, stage, say)  # multigrid: before refinement, which has kernels too
     # stages that keep nothing partial run inside raising(): a signal stops them at once
     with raising("meshing"), stage("mesh"):
         mesh, hierarchy = build_mesh_levels(case)
     check_stop("mesh")
+    _compile_stage(case, mesh, stage, say)  # a large mesh without multigrid
     grad = exact_gradient(case)
     run = est = None
     if case.spec.adaptive:
@@ -218,22 +223,25 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         check_stop("assembly")
         with raising("the boundary conditions"), stage("boundary"):
             system = problem.reduce(K, F, case.solver.method)
+        del K, F  # the reduced system is what the later stages use
         check_stop("boundary")
         with raising("assembly"), stage("assembly"):  # the coarser levels' systems (fmg only)
             mg = multigrid_inputs(case, hierarchy, system)
         with stage("solve"):
             res = _solve(case, system, stop, **mg)
             u = system.expand(res.x)
+        del mg, hierarchy  # the coarser levels and their operators: not needed after the solve
         report.done("solve")
     # after a complete solve a signal during the errors or the estimate stops at once (nothing
     # written); after an interrupted solve they run to write its last iterate
     after = contextlib.nullcontext() if res.reason == "interrupted" else raising("the error estimate")
     with after:
-        q = quality(mesh)
+        with stage("mesh"):  # the mesh's numbers (its edges are shared with the estimator)
+            q = quality(mesh)
         errors = None
         if "exact.u" in case.functions:
-            with stage("errors"):
-                errors = compute_errors(case, problem, u)
+            with stage("errors"):  # with the gradient the estimate stage's energy error gets
+                errors = problem.errors(u, case.functions["exact.u"], grad)
         from .estimate import adaptive_facts, estimate_facts
 
         with stage("estimate"):
@@ -244,7 +252,8 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
                         nnz=int(system.A.nnz), nullspace=nullspace_facts(system),
                         error_estimate=estimate, effectivity=effectivity, indicators=est.indicators,
                         adaptive=adaptive_facts(run) if run is not None else None,
-                        interrupted=stop.name if res.reason == "interrupted" else None)
+                        interrupted=stop.name if res.reason == "interrupted" else None,
+                        clock=clock)
     if write:
         from .output import write_outputs
 
@@ -255,7 +264,18 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
             out(line)
         for note in case.run_options.get("notes", ()):  # e.g. a mesh file's unused nodes
             out(f"note      {note}")
+        out(clock.summary(result.timings))
     return result
+
+
+def _compile_stage(case: Case, mesh, stage, echo) -> None:
+    """The first run after an install compiles the kernels it needs ahead, in its own
+    ``compile`` stage (not inside assembly and solve), saying so on the terminal (``echo``)."""
+    from .warmup import must_compile, warm_up
+
+    if must_compile(mesh, case.solver.needs_hierarchy):
+        with stage("compile"):
+            warm_up(echo)
 
 
 def _solve(case: Case, system, stop, **mg):

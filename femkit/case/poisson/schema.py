@@ -134,6 +134,8 @@ POISSON_SCHEMA: dict = {
                 "vtu": {"type": "boolean", "default": True},
                 "xdmf": {"type": "boolean", "default": False},
                 "plot": {"type": "boolean", "default": False},
+                # compression of solution.vtu's arrays (femkit.mesh.vtk.COMPRESSIONS)
+                "compression": {"enum": ["none", "zlib", "lzma"]},  # unset: none
                 "gather_limit": {"type": "integer", "minimum": 0},
             },
         },

@@ -59,6 +59,7 @@ class PoissonOutputSpec:
     xdmf: bool
     plot: bool
     gather_limit: int | None
+    compression: str = "none"
 
 
 @dataclass(frozen=True)

@@ -516,4 +516,22 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     if not quiet:
         for line in result.summary_lines():
             out(line)
+        hint = fast_path_hint(case, system, integrator)
+        if hint:
+            out(hint)
     return result
+
+
+#: Degrees of freedom from which an implicit scene on SuperLU is worth the Cholesky fast path
+#: (Liu's 81 x 81 cloth, 19,683 dofs: 2-3x per step in benchmarks/bench_dynamics.py).
+FAST_PATH_DOFS = 5_000
+
+
+def fast_path_hint(case, system, integrator) -> str | None:
+    """One line saying how to switch on the fast path when an implicit scene of at least
+    :data:`FAST_PATH_DOFS` unknowns factorises with SuperLU (``method: direct``); else None."""
+    if (case.solver.method != "direct" or not getattr(integrator, "implicit", False)
+            or system.ndof < FAST_PATH_DOFS):
+        return None
+    return ('hint      this scene factorises with SuperLU; the fast path is pip install '
+            '"femkit[fast]" and linear_solver: {method: cholesky, options: {engine: cholespy}}')

@@ -1,0 +1,61 @@
+"""The first run after an install compiles the kernels in its own ``compile`` stage, saying so;
+``femkit warmup`` does it ahead; a warm cache compiles nothing."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+import yaml
+
+CASE = {
+    "problem": "poisson",
+    "mesh": {"geometry": "unit_square", "h": 0.25, "refine": 1},
+    "source": "2*pi**2*sin(pi*x)*sin(pi*y)",
+    "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
+    "solver": {"method": "fmg"},
+    "output": {"dir": "out", "vtu": False},
+}
+
+
+def _run(args, cwd, cache=None):
+    env = dict(os.environ, **({} if cache is None else {"NUMBA_CACHE_DIR": str(cache)}))
+    proc = subprocess.run([sys.executable, "-m", "femkit.cli", *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr
+    return proc.stdout
+
+
+@pytest.mark.slow
+def test_first_run_compiles_in_its_own_stage_then_never_again(tmp_path):
+    """An empty compile cache (a fresh install): the first fmg run says it compiles and books a
+    ``compile`` stage; the second run of the same case has neither."""
+    (tmp_path / "case.yaml").write_text(yaml.safe_dump(CASE))
+    cache = tmp_path / "numba-cache"
+    first = _run(["solve", "case.yaml"], tmp_path, cache)
+    timings = json.loads((tmp_path / "out" / "result.json").read_text())["timings"]
+    assert "compiling kernels (first run, cached afterwards)..." in first
+    assert timings["compile"] > 0 and list(timings)[:2] == ["compile", "mesh"]
+    second = _run(["solve", "case.yaml"], tmp_path, cache)
+    assert "compiling" not in second
+    assert "compile" not in json.loads((tmp_path / "out" / "result.json").read_text())["timings"]
+
+
+def test_warmup_fills_the_cache(tmp_path):
+    """``femkit warmup`` with the package's own cache (compiled once, loaded afterwards); an
+    empty cache directory is seen as empty."""
+    from femkit.case.poisson.warmup import COMPILE_MESSAGE
+
+    out = _run(["warmup"], tmp_path)
+    assert COMPILE_MESSAGE in out and "kernels ready in" in out
+    probe = ("from femkit.case.poisson.warmup import kernels_cached; "
+             "print(kernels_cached())")
+    res = subprocess.run([sys.executable, "-c", probe], env=dict(os.environ), capture_output=True,
+                         text=True)
+    assert res.stdout.strip() == "True"
+    empty = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                           env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "other")))
+    assert empty.stdout.strip() == "False"
