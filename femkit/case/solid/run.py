@@ -38,7 +38,7 @@ from ..specs import IntegratorSpec, limits_spec, solver_spec
 from .schema import COMPONENTS
 from .spec import Boundary, SolidOutput, SolidSpec, StaticSpec
 
-__all__ = ["prepare_solid", "run_solid", "build_mesh", "build_problem", "SolidProblem",
+__all__ = ["prepare_solid", "run_solid", "build_mesh", "folded_cells", "build_problem", "SolidProblem",
            "SolidResult", "frame_energies"]
 
 
@@ -64,7 +64,7 @@ def _boundaries(d, dynamic: bool) -> tuple:
         if b["type"] == "traction":
             out.append(Boundary(b["tag"], "traction", traction=tuple(b["traction"])))
             continue
-        comps = tuple(COMPONENTS.index(c) for c in b.get("fix", COMPONENTS))
+        comps = tuple(COMPONENTS.index(c) for c in b.get("fix", ()))  # () = every component
         disp = tuple(b.get("displacement", ()))
         if dynamic and (b["type"] == "roller" or "fix" in b or any(disp)):
             raise CaseFileError(f"{where}: a {b['type']} condition on some components or with a "
@@ -168,9 +168,40 @@ def prepare_solid(case) -> None:
 
 # ----------------------------------------------------------------------------- build
 
+def folded_cells(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """Cells folded over a neighbour: two cells sharing a facet whose opposite vertices lie on
+    the same side of it overlap, so one is inverted whatever its vertex order (a reader that
+    reorients cells hides the order, not the overlap). Returns the cells taking part in the
+    most such folds (the inverted ones when they are isolated), sorted; empty when none."""
+    m, nv = cells.shape
+    d = nv - 1
+    facets = np.concatenate([np.delete(cells, k, axis=1) for k in range(nv)])
+    opposite = np.concatenate([cells[:, k] for k in range(nv)])
+    owner = np.tile(np.arange(m), nv)
+    key = np.sort(facets, axis=1)
+    order = np.lexsort(key.T[::-1])
+    key, facets, opposite, owner = key[order], facets[order], opposite[order], owner[order]
+    pair = np.flatnonzero(np.all(key[1:] == key[:-1], axis=1))
+    if not len(pair):
+        return np.zeros(0, np.int64)
+    base = key[pair]                                   # the same vertex order for both sides
+    P = points[base]                                    # (k, d, d)
+    edges = P[:, 1:] - P[:, :1]                         # (k, d-1, d)
+
+    def side(p):
+        return np.sign(np.linalg.det(np.concatenate([edges, (p - P[:, 0])[:, None]], axis=1)))
+
+    same = side(points[opposite[pair]]) * side(points[opposite[pair + 1]]) > 0
+    if not same.any():
+        return np.zeros(0, np.int64)
+    count = np.bincount(np.concatenate([owner[pair[same]], owner[pair[same] + 1]]), minlength=m)
+    return np.flatnonzero(count == count.max())
+
+
 def build_mesh(spec: SolidSpec):
-    """The validated rest mesh: generated or read; a mesh whose cells do not all share one
-    orientation has inverted elements (named: the minority), refused."""
+    """The validated rest mesh, generated or read; refused with
+    :class:`~femkit.errors.DegenerateMeshError` naming the elements when some are inverted
+    (cells of opposite orientation, or cells folded over a neighbour: :func:`folded_cells`)."""
     from ...mesh import generate, read_mesh, validate
 
     m = spec.mesh
@@ -178,15 +209,14 @@ def build_mesh(spec: SolidSpec):
     try:
         mesh = read_mesh(m["file"]) if "file" in m else generate(m["geometry"], m["h"],
                                                                    **dict(m.get("params") or {}))
-        vol = mesh.signed_volumes()
-        neg = vol < 0
-        if neg.any() and not neg.all():
-            bad = np.flatnonzero(neg if neg.sum() <= (~neg).sum() else ~neg)
+        neg = mesh.signed_volumes() < 0
+        bad = np.flatnonzero(neg if neg.sum() <= (~neg).sum() else ~neg) if neg.any() else \
+            folded_cells(mesh.points, mesh.cells)
+        if len(bad):
             raise DegenerateMeshError(
-                f"{len(bad)} inverted {mesh.cell_name}(s) (orientation opposite to the other "
-                f"{mesh.n_cells - len(bad)}): element ids "
-                f"{', '.join(map(str, bad[:10]))}{' ...' if len(bad) > 10 else ''}",
-                element_ids=bad)
+                f"{len(bad)} inverted {mesh.cell_name}(s) in the input mesh (overlapping their "
+                f"neighbours): element ids {', '.join(map(str, bad[:10]))}"
+                f"{' ...' if len(bad) > 10 else ''}", element_ids=bad)
         return validate(mesh)
     except InputError as exc:
         raise with_prefix(exc, where) from None
@@ -259,7 +289,10 @@ def build_problem(case) -> SolidProblem:
                 fixed.append(nodes)
                 disp = np.zeros(d)
                 disp[:len(b.displacement)] = b.displacement
-                fixes.append((nodes, list(b.components), disp))
+                if any(c >= d for c in b.components):
+                    raise CaseFileError(f"fix: a {d}D mesh has components "
+                                        f"{', '.join(COMPONENTS[:d])} only")
+                fixes.append((nodes, list(b.components) or None, disp))
         except InputError as exc:
             raise with_prefix(exc, where) from None
     g = np.zeros(d) if spec.gravity is None else np.asarray(spec.gravity, dtype=float)
@@ -270,16 +303,18 @@ def build_problem(case) -> SolidProblem:
     return problem
 
 
-def frame_energies(problem: SolidProblem, x: np.ndarray, v: np.ndarray | None = None) -> dict:
+def frame_energies(problem: SolidProblem, x: np.ndarray, v: np.ndarray | None = None,
+                   load_factor: float = 1.0) -> dict:
     """Energies of one frame: ``kinetic`` (lumped masses), ``elastic``, ``gravity``
-    (``-sum m_i g . u_i``, zero at rest), ``load`` (``-f_traction . u``) and ``total``."""
+    (``-sum m_i g . u_i``, zero at rest), ``load`` (``-f_traction . u``) and ``total``; the
+    external loads times ``load_factor`` (a static load step applies that part of them)."""
     body = problem.body
     u = x - body.rest_positions
     out = {"kinetic": 0.0 if v is None else
            float(0.5 * np.einsum("n,nd,nd->", body.lumped_masses(), v, v)),
            "elastic": body.energy(x),
-           "gravity": 0.0 - float(np.einsum("nd,nd->", problem.weight, u)),
-           "load": 0.0 - float(np.einsum("nd,nd->", problem.traction, u))}
+           "gravity": 0.0 - load_factor * float(np.einsum("nd,nd->", problem.weight, u)),
+           "load": 0.0 - load_factor * float(np.einsum("nd,nd->", problem.traction, u))}
     out["total"] = sum(out.values())
     return out
 
@@ -426,7 +461,7 @@ def _run_static(case, problem: SolidProblem, stop) -> dict:
         out["times"].append(k / K)
         out["x"].append(x)
         out["v"].append(np.zeros_like(x))
-        out["energies"].append(frame_energies(problem, x))
+        out["energies"].append(frame_energies(problem, x, load_factor=k / K))
     return out
 
 
