@@ -423,7 +423,8 @@ def element_pass(code, x, cells, grads, vol, elems, params, level, project,
     P = np.zeros((d, d))
     lam = np.zeros(dd)
     Q = np.zeros((dd, d, d))
-    w = np.empty((dd, nv * d))
+    w = np.empty((nv * d, dd))          # w[i, k]: mode k at dof i (contiguous in k)
+    wl = np.empty((nv * d, dd))         # lam[k] w[i, k]
     work = np.zeros((6, d, d))
     vec = np.zeros((2, d))
     base = np.empty((nv * nv, d), dtype=np.int64)
@@ -458,17 +459,20 @@ def element_pass(code, x, cells, grads, vol, elems, params, level, project,
             for b in range(d):
                 g2 += grads[e, n, b] * grads[e, n, b]
         ng = 0.0
+        na = 0                          # the modes kept (a clamped one adds nothing)
         for k in range(dd):
             if lam[k] < 0.0:
                 ng -= lam[k]
                 if project:
-                    lam[k] = 0.0
+                    continue
             for n in range(nv):
                 for a in range(d):
                     acc = 0.0
                     for b in range(d):
                         acc += Q[k, a, b] * grads[e, n, b]
-                    w[k, n * d + a] = acc
+                    w[n * d + a, na] = acc
+                    wl[n * d + a, na] = v * lam[k] * acc
+            na += 1
         neg[e] = v * ng * g2
         # CSR position of entry (n, a), (m, c): see BlockPattern
         for n in range(nv):
@@ -484,9 +488,8 @@ def element_pass(code, x, cells, grads, vol, elems, params, level, project,
             for j in range(i, nv * d):
                 m, c = j // d, j % d
                 acc = 0.0
-                for k in range(dd):
-                    acc += lam[k] * w[k, i] * w[k, j]
-                acc *= v
+                for k in range(na):
+                    acc += wl[i, k] * w[j, k]
                 data[base[n * nv + m, a] + c] += acc
                 if j != i:
                     data[base[m * nv + n, c] + a] += acc
