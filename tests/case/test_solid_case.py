@@ -318,3 +318,13 @@ def test_plan_counts_tetrahedra_from_the_geometry_measure():
     mesh_cells = 1471  # gmsh's beam at h = 0.25 (a count, not a femkit result)
     assert 0.7 * mesh_cells < plan.sizes["tetrahedra"] < 1.4 * mesh_cells
     assert plan.peak_bytes > 0 and plan.sizes["steps"] == 4
+
+
+def test_every_schema_key_is_documented():
+    from femkit.case.solid.schema import solid_schema
+
+    doc = (Path(__file__).parents[2] / "docs" / "solids.md").read_text()
+    schema = solid_schema()["properties"]
+    keys = set(schema) | set(schema["output"]["properties"])
+    missing = sorted(k for k in keys if f"`{k}`" not in doc)
+    assert not missing, f"keys missing from docs/solids.md: {missing}"
