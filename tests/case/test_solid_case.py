@@ -88,6 +88,8 @@ BAD = {
                                       "traction": [1.0, 0.0, 0.0]}]), "no fixed or roller"),
     "unknown_integrator": (_edit(static=None, integrator="rk5", dt=0.1, t_end=1.0),
                            "valid values: central_difference"),
+    "ruinous_mesh": (_edit(mesh={"geometry": "unit_cube", "h": 0.001}),
+                     "exceeds the available memory"),
     "fix_component": (_edit(boundaries=[{"tag": "xmin", "type": "roller", "fix": ["w"]}]),
                       "boundaries[0].fix[0]"),
 }
