@@ -3,6 +3,7 @@
 from .base import Material, StretchMaterial, lame_from_young
 from .registry import (MATERIALS, Corotational, LinearElastic, StableNeoHookean, StVenantKirchhoff,
                        material)
+from .spec import material_from_spec
 
 __all__ = ["Material", "StretchMaterial", "lame_from_young", "MATERIALS", "LinearElastic",
-           "Corotational", "StVenantKirchhoff", "StableNeoHookean", "material"]
+           "Corotational", "StVenantKirchhoff", "StableNeoHookean", "material", "material_from_spec"]
