@@ -1,8 +1,10 @@
 """Materials as energies of the principal stretches (see :mod:`.base`)."""
 
 from .base import Material, StretchMaterial, lame_from_young
+from .designed import EnergyMaterial, designed, material_from_spec
 from .registry import (MATERIALS, Corotational, LinearElastic, StableNeoHookean, StVenantKirchhoff,
                        material)
 
 __all__ = ["Material", "StretchMaterial", "lame_from_young", "MATERIALS", "LinearElastic",
-           "Corotational", "StVenantKirchhoff", "StableNeoHookean", "material"]
+           "Corotational", "StVenantKirchhoff", "StableNeoHookean", "material", "EnergyMaterial", "designed",
+           "material_from_spec"]
