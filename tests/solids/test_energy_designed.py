@@ -149,3 +149,15 @@ def test_material_from_spec_both_forms():
         material_from_spec({"energy": "s1", "stiffness": 1})
     with pytest.raises(Exception, match="valid materials"):
         material_from_spec({"model": "rubber", "E": 1.0, "nu": 0.3})
+
+
+@pytest.mark.parametrize("name", ["stable_neo_hookean", "stvk", "separable_fgh", "full_W"])
+def test_uniaxial_curve_starts_with_young_modulus_and_poisson_ratio(name):
+    from femkit.solids.materials.curves import uniaxial_curve
+
+    mat = material(name, E=2.6, nu=0.3) if name in MATERIALS else _user(name)
+    eps = 1e-5
+    t, P = uniaxial_curve(mat, [1.0 - eps, 1.0, 1.0 + eps])
+    assert P[1] == pytest.approx(0.0, abs=1e-12)
+    assert (P[2] - P[0]) / (2 * eps) == pytest.approx(mat.young, rel=1e-8)
+    assert (t[2] - t[0]) / (2 * eps) == pytest.approx(-mat.poisson, rel=1e-7)
