@@ -108,8 +108,16 @@ def sym_eig(A, V):  # pragma: no cover - compiled
     """Eigen-decomposition of a small symmetric ``A`` by cyclic Jacobi rotations, in place:
     on return ``diag(A)`` holds the eigenvalues and the columns of ``V`` (a rotation) the
     eigenvectors (Golub & Van Loan, Matrix Computations, section 8.5). Converges quadratically;
-    a 3x3 needs ~4 sweeps. No allocation."""
-    d = A.shape[0]
+    a 3x3 needs ~4 sweeps. No allocation. The size is passed as a constant to the inlined body,
+    so its loops are unrolled for 2x2 and 3x3."""
+    if A.shape[0] == 3:
+        _sym_eig(A, V, 3)
+    else:
+        _sym_eig(A, V, 2)
+
+
+@numba.njit(cache=True, inline="always")
+def _sym_eig(A, V, d):  # pragma: no cover - compiled
     for a in range(d):
         for b in range(d):
             V[a, b] = 1.0 if a == b else 0.0
@@ -151,6 +159,15 @@ def sym_eig(A, V):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def signed_svd(F, U, s, V, A):  # pragma: no cover - compiled
+    """:func:`_signed_svd` with the size a constant (loops unrolled for 2x2 and 3x3)."""
+    if F.shape[0] == 3:
+        _signed_svd(F, U, s, V, A, 3)
+    else:
+        _signed_svd(F, U, s, V, A, 2)
+
+
+@numba.njit(cache=True, inline="always")
+def _signed_svd(F, U, s, V, A, d):  # pragma: no cover - compiled
     """``F = U diag(s) V^T`` with ``det U = det V = 1`` into ``U, s, V`` (``A`` scratch); ``s``
     by decreasing magnitude, the last one negative when ``det F < 0``.
 
@@ -158,14 +175,13 @@ def signed_svd(F, U, s, V, A):  # pragma: no cover - compiled
     ``F^T F`` (sorted, made a rotation), then a Givens QR of ``F V = U R``: ``U`` is a product of
     rotations and ``diag(R)`` the signed stretches, accurate even for nearly collapsed elements
     (where ``sqrt`` of the eigenvalues of ``F^T F`` would not be). No allocation, no LAPACK."""
-    d = F.shape[0]
     for a in range(d):
         for b in range(d):
             acc = 0.0
             for k in range(d):
                 acc += F[k, a] * F[k, b]
             A[a, b] = acc
-    sym_eig(A, V)
+    _sym_eig(A, V, d)
     for i in range(d):                                   # sort by decreasing eigenvalue
         best = i
         for j in range(i + 1, d):
@@ -346,10 +362,16 @@ def stretch_point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no c
     ``dP/dF`` (``lam``, ``Q[k]`` the unit ``d x d`` mode in F-space). Returns ``psi``.
     ``work`` ``(6, d, d)`` and ``vec`` ``(2, d)`` are scratch (no allocation per element).
     """
-    d = F.shape[0]
+    if F.shape[0] == 3:
+        return _stretch_point(code, F, params, level, P, lam, Q, work, vec, 3)
+    return _stretch_point(code, F, params, level, P, lam, Q, work, vec, 2)
+
+
+@numba.njit(cache=True, inline="always")
+def _stretch_point(code, F, params, level, P, lam, Q, work, vec, d):  # pragma: no cover - compiled
     U, V, A, H, E = work[0], work[1], work[2], work[3], work[4]
     s, g = vec[0], vec[1]
-    signed_svd(F, U, s, V, A)
+    _signed_svd(F, U, s, V, A, d)
     for i in range(d):
         g[i] = 0.0
         for j in range(d):
@@ -368,7 +390,7 @@ def stretch_point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no c
     for i in range(d):
         for j in range(d):
             A[i, j] = H[i, j]
-    sym_eig(A, E)                      # eigenpairs of the stretch Hessian (H kept for the limits)
+    _sym_eig(A, E, d)                  # eigenpairs of the stretch Hessian (H kept for the limits)
     for k in range(d):
         lam[k] = A[k, k]
         for a in range(d):
@@ -416,14 +438,26 @@ def element_pass(code, x, cells, grads, vol, elems, params, level, project,
     ``(m, d, d)`` and ``level >= 1`` the first Piola-Kirchhoff stress of each element is written
     there too.
     """
-    d = x.shape[1]
+    if x.shape[1] == 3:
+        _element_pass(code, x, cells, grads, vol, elems, params, level, project, node_slots,
+                      node_indptr, energy, grad, data, neg, stress, 3)
+    else:
+        _element_pass(code, x, cells, grads, vol, elems, params, level, project, node_slots,
+                      node_indptr, energy, grad, data, neg, stress, 2)
+
+
+@numba.njit(cache=True, inline="always")
+def _element_pass(code, x, cells, grads, vol, elems, params, level, project, node_slots,
+                  node_indptr, energy, grad, data, neg, stress, d):  # pragma: no cover - compiled
+    """The body of :func:`element_pass` for dimension ``d`` (a constant after inlining)."""
     nv = d + 1
     dd = d * d
     F = np.empty((d, d))
     P = np.zeros((d, d))
     lam = np.zeros(dd)
     Q = np.zeros((dd, d, d))
-    w = np.empty((dd, nv * d))
+    w = np.empty((nv * d, dd))          # w[i, k]: mode k at dof i (contiguous in k)
+    wl = np.empty((nv * d, dd))         # lam[k] w[i, k]
     work = np.zeros((6, d, d))
     vec = np.zeros((2, d))
     base = np.empty((nv * nv, d), dtype=np.int64)
@@ -458,17 +492,20 @@ def element_pass(code, x, cells, grads, vol, elems, params, level, project,
             for b in range(d):
                 g2 += grads[e, n, b] * grads[e, n, b]
         ng = 0.0
+        na = 0                          # the modes kept (a clamped one adds nothing)
         for k in range(dd):
             if lam[k] < 0.0:
                 ng -= lam[k]
                 if project:
-                    lam[k] = 0.0
+                    continue
             for n in range(nv):
                 for a in range(d):
                     acc = 0.0
                     for b in range(d):
                         acc += Q[k, a, b] * grads[e, n, b]
-                    w[k, n * d + a] = acc
+                    w[n * d + a, na] = acc
+                    wl[n * d + a, na] = v * lam[k] * acc
+            na += 1
         neg[e] = v * ng * g2
         # CSR position of entry (n, a), (m, c): see BlockPattern
         for n in range(nv):
@@ -484,9 +521,8 @@ def element_pass(code, x, cells, grads, vol, elems, params, level, project,
             for j in range(i, nv * d):
                 m, c = j // d, j % d
                 acc = 0.0
-                for k in range(dd):
-                    acc += lam[k] * w[k, i] * w[k, j]
-                acc *= v
+                for k in range(na):
+                    acc += wl[i, k] * w[j, k]
                 data[base[n * nv + m, a] + c] += acc
                 if j != i:
                     data[base[m * nv + n, c] + a] += acc

@@ -37,7 +37,7 @@ def test_study_entries_resolve(name):
 
 
 def test_unknown_problem_lists_the_valid_ones_of_its_family():
-    with pytest.raises(UnknownNameError, match="valid problems: mass_spring, poisson$"):
+    with pytest.raises(UnknownNameError, match="valid problems: mass_spring, poisson, solid$"):
         KINDS.get("heat", "problem")
     with pytest.raises(UnknownNameError, match="unknown study kind 'poisson'"):
         KINDS.get("poisson", "kind")  # a problem is not a study kind

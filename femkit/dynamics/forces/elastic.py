@@ -22,7 +22,7 @@ import numpy as np
 
 from .base import Force
 
-__all__ = ["ElasticForce", "elastic_system"]
+__all__ = ["ElasticForce", "DeadLoad", "elastic_system"]
 
 
 class ElasticForce(Force):
@@ -78,6 +78,44 @@ class ElasticForce(Force):
     def __repr__(self) -> str:
         mats = ", ".join(m.name for m in self.body.materials)
         return f"ElasticForce({self.body.rest.n_cells} elements, {mats})"
+
+
+class DeadLoad(Force):
+    """Constant nodal forces ``f`` ``(n, d)`` (surface tractions of a solid as dead loads,
+    :func:`femkit.solids.traction_forces`); potential ``-f . x`` over the unpinned nodes,
+    reported in the ``"gravity"`` bucket (the bucket of constant external forces).
+
+    >>> import numpy as np
+    >>> from femkit.dynamics.system import MassSpringSystem
+    >>> s = MassSpringSystem(np.zeros((2, 2)), 1.0, np.zeros((0, 2), int), 0.0, pinned=[0],
+    ...                      forces=[DeadLoad([[1., 0.], [0., -2.]])])
+    >>> s.force(s.x0, s.v0).tolist()
+    [[0.0, 0.0], [0.0, -2.0]]
+    """
+
+    kind = "gravity"
+    constant = True
+
+    def __init__(self, forces):
+        self.forces = np.asarray(forces, dtype=float)
+
+    def bind(self, system) -> None:
+        from ...errors import InputError
+
+        super().bind(system)
+        if self.forces.shape != (system.n, system.dim) or not np.all(np.isfinite(self.forces)):
+            raise InputError(f"dead load must be finite with shape ({system.n}, {system.dim}), "
+                             f"got {self.forces.shape}")
+        self._f = np.where(system.pinned[:, None], 0.0, self.forces)
+
+    def add_force(self, x, v, t, out) -> None:
+        out += self._f
+
+    def energy(self, x) -> float:
+        return float(-np.einsum("nd,nd->", self._f, x))
+
+    def __repr__(self) -> str:
+        return f"DeadLoad({len(self.forces)} nodes)"
 
 
 def elastic_system(body, *, x0=None, v0=None, pinned=None, forces: Iterable[Force] = ()):

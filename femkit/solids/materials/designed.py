@@ -24,7 +24,10 @@ import numpy as np
 from ...errors import MaterialError
 from .base import Material, StretchMaterial
 
-__all__ = ["EnergyMaterial", "designed", "material_from_spec"]
+__all__ = ["EnergyMaterial", "designed", "ENERGY_KEYS"]
+
+#: The keys of a material mapping designed by its energy (:func:`.spec.material_from_spec`).
+ENERGY_KEYS = ("energy", "constants", "density")
 
 _SYMBOLIC: dict = {}   # (energy, constant names) -> SymPy W
 _KERNELS: dict = {}    # (energy, constant names) -> generated module (one per process)
@@ -126,38 +129,3 @@ def designed(material: Material) -> EnergyMaterial:
     return EnergyMaterial.from_energy(expr, {"mu": material.mu, "lam": material.lam},
                                       material.density, label=material.name)
 
-
-def material_from_spec(spec: Mapping) -> Material:
-    """A material from a case-file mapping: ``{energy: {f:, g:, h:} or {W:} or "W",
-    constants: {...}, density: ...}`` (designed by its energy), or
-    ``{model: name, E:, nu:}`` / ``{model: name, mu:, lam:}`` plus ``density`` (a registered
-    material, :func:`~.registry.material`).
-
-    >>> material_from_spec({"model": "stvk", "E": 2.6, "nu": 0.3}).mu
-    1.0
-
-    Raises
-    ------
-    MaterialError
-        Unknown keys (the valid ones listed) or any error of the material itself.
-    """
-    from .registry import material
-
-    if not isinstance(spec, Mapping):
-        raise MaterialError(f"material must be a mapping, got {spec!r}")
-    if "energy" in spec:
-        unknown = sorted(set(spec) - {"energy", "constants", "density"})
-        if unknown:
-            raise MaterialError(f"material: unknown key(s) {', '.join(map(repr, unknown))}; valid "
-                                "keys with an energy: energy, constants, density")
-        constants = spec.get("constants") or {}
-        if not isinstance(constants, Mapping):
-            raise MaterialError(f"material constants must be a mapping name: value, got {constants!r}")
-        return EnergyMaterial.from_energy(spec["energy"], constants, spec.get("density", 1.0))
-    unknown = sorted(set(spec) - {"model", "E", "nu", "mu", "lam", "density"})
-    if unknown or "model" not in spec:
-        raise MaterialError(f"material: unknown key(s) {', '.join(map(repr, unknown)) or '(none)'}"
-                            f"{'' if 'model' in spec else ', no model'}; valid keys: model, E, nu, "
-                            "mu, lam, density, or energy, constants, density")
-    rest = {k: spec[k] for k in ("E", "nu", "mu", "lam") if k in spec}
-    return material(spec["model"], density=spec.get("density", 1.0), **rest)

@@ -1,0 +1,96 @@
+"""The cost of a solid case before it runs (``KINDS["solid"].plan``, ``--dry-run``, budgets).
+
+Element counts come from the geometry's measure (:data:`femkit.mesh.GEOMETRIES`: volume and
+surface area in 3D, area and line length in 2D) and ``h``; a mesh file is counted from its header
+(:func:`femkit.cost.msh_triangle_count` counts the highest-dimensional cells). The constants
+are stated in the plan's assumptions: gmsh's tetrahedra number about ``5.5 V / h^3`` (measured on
+the ``beam`` and ``unit_cube`` geometries: 5.0-5.7), its triangles ``2.3 A / h^2``; P1 rows hold
+about 15 nodes in 3D and 7 in 2D; a sparse direct factor of a 3D stiffness matrix fills in
+about ``n^(1/3)`` times its nonzeros (nested dissection), 2D ``log n``; the compiled element pass
+runs at least 5e4 elements/s (gradient + projected Hessian, docs/benchmarks.md).
+
+:func:`check_solid_fits` is the memory guard the runner calls before gmsh starts (the role
+:func:`femkit.case.cost.check_mesh_fits` has for the other kinds, in tetrahedra as well).
+"""
+
+from __future__ import annotations
+
+import math
+
+from ...cost import Plan, Stage, check_budget, load_constants
+from ..cost import OVERRIDE, geometry_domain
+
+__all__ = ["plan_solid_case", "solid_sizes", "check_solid_fits"]
+
+#: cells per h^dim of measure, boundary nodes per h^(dim-1) of boundary measure
+CELLS_PER_MEASURE = {2: 2.3, 3: 5.5}
+ROW_NODES = {2: 7.0, 3: 15.0}
+ELEMENTS_PER_SECOND = 5e4
+REST_BYTES_PER_CELL = 400.0     # rest data, element fields and the pass's work arrays
+
+
+def solid_sizes(mesh: dict) -> tuple[int, float, float]:
+    """``(dim, cells, points)`` predicted for a solid's ``mesh:`` mapping."""
+    if "file" in mesh:
+        from ...cost import msh_triangle_count
+
+        cells, _ = msh_triangle_count(mesh["file"])
+        dim = 3  # a .msh counted by its header: assume the worse (3D) node ratio
+        return dim, float(cells), float(cells) / 4.5
+    dim, size, boundary = geometry_domain(mesh["geometry"], mesh.get("params"))
+    h = float(mesh["h"])
+    cells = CELLS_PER_MEASURE[dim] * size / h ** dim
+    points = cells / (4.5 if dim == 3 else 2.0) + 0.5 * boundary / h ** (dim - 1)
+    return dim, cells, points
+
+
+def plan_solid_case(case, *, measure: bool = True) -> Plan:
+    """The plan of a solid case: mesh, the Newton solves (static load steps or time steps) and
+    the frames written. ``measure`` is accepted for the kind interface; the model is not
+    calibrated by a timed run (its seconds are an order of magnitude)."""
+    spec = case.spec
+    dim, cells, points = solid_sizes(spec.mesh)
+    dofs = dim * points
+    nnz = dim * dim * ROW_NODES[dim] * points
+    fill = max(1.0, dofs ** (1.0 / 3.0)) if dim == 3 else max(1.0, math.log(max(dofs, 2.0)))
+    factor_bytes = 12.0 * nnz * fill
+    steps = spec.steps
+    iterations = steps * (4 if spec.static is not None else 3)
+    frames = steps // spec.output.every + 1
+    pass_s = cells / ELEMENTS_PER_SECOND
+    factor_s = nnz * fill * 2e-8
+    frame_bytes = 8.0 * (6 * points + (dim + 1) * cells + (dim + 3) * cells)
+    out = spec.output
+    out_bytes = (frames * frame_bytes if out.vtu else 0.0) + (2e5 if out.png else 0.0) \
+        + (frames * 1e5 if out.gif else 0.0)
+    what = "triangles" if dim == 2 else "tetrahedra"
+    stages = [
+        Stage("mesh", cells * 2e-5, cells * (8.0 * (dim + 1) + 64.0), 0.0,
+              f"{what} ~{cells:,.0f}"),
+        Stage("solve", iterations * (pass_s + factor_s),
+              cells * REST_BYTES_PER_CELL + 3 * 12.0 * nnz + factor_bytes
+              + frames * 16.0 * dofs, 0.0,
+              f"{iterations} Newton iterations (~{4 if spec.static else 3} per "
+              f"{'load' if spec.static else 'time'} step)"),
+        Stage("output", frames * frame_bytes / 2e7, frame_bytes * 4, out_bytes,
+              f"{frames} frames"),
+    ]
+    title = (f"{case.name}: {spec.mesh.get('geometry', spec.mesh.get('file'))} "
+             f"{'static' if spec.static else spec.integrator.method}")
+    sizes = {what: cells, "points": points, "unknowns": dofs, "nonzeros": nnz,
+             "steps": steps, "frames": frames}
+    return Plan("solid", title, sizes, stages, load_constants()["bytes"]["baseline"],
+                assumptions=[
+                    f"{CELLS_PER_MEASURE[dim]} x measure / h^{dim} {what} (gmsh)",
+                    f"direct factor fill {fill:.0f}x the matrix nonzeros",
+                    f"element pass >= {ELEMENTS_PER_SECOND:.0e} elements/s; seconds are an "
+                    "order of magnitude (not calibrated on this machine)"])
+
+
+def check_solid_fits(case) -> None:
+    """Refuse, before meshing, a solid run whose predicted memory exceeds the available memory
+    (:class:`~femkit.errors.BudgetExceededError`, one line); ``--force`` skips it."""
+    if case.run_options.get("force"):
+        return
+    check_budget(plan_solid_case(case, measure=False), case.run_options.get("limits"),
+                 override=OVERRIDE)

@@ -1,0 +1,73 @@
+"""Outputs of a solid run: VTU frames + ``solid.pvd``, ``result.json``, ``deformed.png``,
+``animation.gif``, written into a temporary directory moved into place when complete
+(:func:`femkit.io.atomic.atomic_directory`).
+
+Each frame ``frames/frame_NNNNN.vtu`` (femkit's one VTK writer, :func:`femkit.mesh.vtk.write_cells`)
+holds the rest mesh (``tetra`` or ``triangle`` cells) with point data ``displacement`` (3
+components) and ``velocity``, and cell data ``principal_stretches`` (3 components, the signed
+stretches of the invertible SVD; 1 in the plane-strain direction in 2D), ``von_mises``, ``J``
+(``det F``) and ``region`` (the cell tag). ParaView's "Warp By Vector" on ``displacement``
+shows the deformed body; the ``.pvd`` lists the frames with their times (static runs: the load
+factor).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ...io.atomic import EARLIER_RUN, atomic_directory
+from ...io.writers import write_json
+from ...mesh.vtk import pad3, write_cells, write_collection
+
+__all__ = ["write_solid_outputs", "write_solid_frames"]
+
+
+def write_solid_frames(directory: str | os.PathLike, result) -> list[str]:
+    """One VTU per frame in ``directory/frames``; returns their relative names."""
+    body = result.problem.body
+    ctype = "tetra" if body.dim == 3 else "triangle"
+    cells = [(ctype, np.asarray(body.rest.cells, dtype=np.int64))]
+    region = np.asarray(result.problem.mesh.cell_tags, dtype=np.int32)
+    names = []
+    for k in range(len(result.x)):
+        f = result.fields(k)
+        s = np.ones((body.rest.n_cells, 3))
+        s[:, :body.dim] = f["principal_stretches"]
+        name = f"frames/frame_{k:05d}.vtu"
+        write_cells(Path(directory) / name, body.rest_positions, cells,
+                    point_data={"displacement": pad3(result.x[k] - body.rest_positions),
+                                "velocity": pad3(result.v[k])},
+                    cell_data={"principal_stretches": [s], "von_mises": [f["von_mises"]],
+                               "J": [f["J"]], "region": [region]})
+        names.append(name)
+    return names
+
+
+def write_solid_outputs(result, directory: str | os.PathLike) -> Path:
+    """Every requested output of ``result`` (a SolidResult) into ``directory``, atomically."""
+    opts = result.case.spec.output
+    final = Path(directory).resolve()
+    result.output_dir = final
+    files: list[str] = []
+    with atomic_directory(final, EARLIER_RUN) as tmp:
+        if opts.vtu:
+            frames = write_solid_frames(tmp, result)
+            write_collection(tmp / "solid.pvd", result.times, frames)
+            files += ["solid.pvd", *frames]
+        if opts.png:
+            from .plot import write_solid_png
+
+            write_solid_png(tmp / "deformed.png", result)
+            files.append("deformed.png")
+        if opts.gif:
+            from .plot import write_solid_gif
+
+            write_solid_gif(tmp / "animation.gif", result)
+            files.append("animation.gif")
+        files.append("result.json")
+        result.files = files
+        write_json(tmp / "result.json", result.to_dict())
+    return final

@@ -1,0 +1,134 @@
+"""Pictures of a deformed solid: PNG of a frame, animated GIF of the run (matplotlib, Agg).
+
+3D: the boundary surface of the deformed tetrahedra, each face coloured by the von Mises stress
+of its element and shaded by its normal against a fixed light (a headless matplotlib render, no
+OpenGL). 2D: the deformed triangles filled by von Mises stress, the rest outline in grey. Both
+with a colour bar, fixed axes over a whole animation, the frame's time (or load factor) and
+largest displacement in the title. Matplotlib and Pillow are imported inside the functions.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["surface_faces", "plot_solid_frame", "write_solid_png", "write_solid_gif"]
+
+#: Local faces of a positively oriented tetrahedron, face k opposite vertex k, outward.
+_TET_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
+_LIGHT = np.array([0.35, -0.55, 0.76])
+
+
+def surface_faces(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Boundary faces ``(k, 3)`` (outward) of positively oriented tetrahedra and the element
+    each belongs to ``(k,)``."""
+    loc = cells[:, _TET_FACES].reshape(-1, 3)
+    _, inverse, counts = np.unique(np.sort(loc, axis=1), axis=0, return_inverse=True,
+                                   return_counts=True)
+    keep = counts[inverse.ravel()] == 1
+    return loc[keep], np.repeat(np.arange(len(cells)), 4)[keep]
+
+
+def _norm(result, frames):
+    from matplotlib.colors import Normalize
+
+    top = max(float(np.nanmax(result.fields(k)["von_mises"], initial=0.0)) for k in frames)
+    return Normalize(0.0, top if top > 0 else 1.0)
+
+
+def _limits(result, frames) -> np.ndarray:
+    pts = np.concatenate([result.x[k] for k in frames] + [result.problem.body.rest_positions])
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    pad = 0.05 * float(np.max(hi - lo))
+    return np.stack([lo - pad, hi + pad])
+
+
+def _title(result, k: int) -> str:
+    u = result.x[k] - result.problem.body.rest_positions
+    when = (f"load factor {result.times[k]:.3g}" if result.case.spec.static is not None
+            else f"t = {result.times[k]:.4g}")
+    return f"{result.case.name}: {when}, max |u| = {np.linalg.norm(u, axis=1).max():.4g}"
+
+
+def plot_solid_frame(result, k: int = -1, *, norm=None, limits=None, dpi: float = 100):
+    """A figure of frame ``k`` of a :class:`~femkit.case.solid.run.SolidResult`."""
+    from matplotlib import colormaps
+    from matplotlib.cm import ScalarMappable
+
+    from ...io.figures import new_figure
+
+    k = k % len(result.x)
+    body = result.problem.body
+    x = result.x[k]
+    vm = np.nan_to_num(result.fields(k)["von_mises"], nan=0.0)
+    norm = norm or _norm(result, [k])
+    lim = _limits(result, [k]) if limits is None else limits
+    cmap = colormaps["viridis"]
+    fig = new_figure(7.0, 5.0, dpi=dpi)
+    if body.dim == 3:
+        from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+        ax = fig.add_subplot(1, 1, 1, projection="3d")
+        faces, owner = surface_faces(body.rest.cells)
+        tri = x[faces]
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+        shade = 0.45 + 0.55 * np.abs(n @ (_LIGHT / np.linalg.norm(_LIGHT)))
+        colours = cmap(norm(vm[owner]))
+        colours[:, :3] *= shade[:, None]
+        ax.add_collection3d(Poly3DCollection(body.rest_positions[faces], facecolors=(0.5, 0.5, 0.5, 0.06),
+                                             edgecolors=(0.4, 0.4, 0.4, 0.08), linewidths=0.2))
+        ax.add_collection3d(Poly3DCollection(tri, facecolors=colours, edgecolors=(0, 0, 0, 0.15),
+                                             linewidths=0.2))
+        from matplotlib.ticker import MaxNLocator
+
+        for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+            axis.set_major_locator(MaxNLocator(4))
+        ax.set_xlim(*lim[:, 0]), ax.set_ylim(*lim[:, 1]), ax.set_zlim(*lim[:, 2])
+        ax.set_box_aspect(np.maximum(lim[1] - lim[0], 1e-9 * np.max(lim[1] - lim[0])))
+        ax.view_init(elev=22, azim=-60)
+        ax.set_xlabel("x"), ax.set_ylabel("y"), ax.set_zlabel("z")
+    else:
+        ax = fig.add_subplot(1, 1, 1)
+        from matplotlib.collections import LineCollection
+
+        from ...mesh.edges import boundary_edges_topological
+
+        outline = body.rest_positions[boundary_edges_topological(result.problem.mesh)]
+        ax.add_collection(LineCollection(outline, colors="0.6", linewidths=0.6))
+        ax.tripcolor(x[:, 0], x[:, 1], body.rest.cells, facecolors=vm, cmap=cmap, norm=norm,
+                     edgecolors="k", linewidth=0.1)
+        ax.set_xlim(*lim[:, 0]), ax.set_ylim(*lim[:, 1])
+        ax.set_aspect("equal")
+        ax.set_xlabel("x"), ax.set_ylabel("y")
+    fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.7,
+                 label="von Mises stress")
+    ax.set_title(_title(result, k) + ("  (rest shape in grey)" if body.dim == 2 else ""), fontsize=10)
+    return fig
+
+
+def write_solid_png(path: str | os.PathLike, result, k: int = -1) -> Path:
+    """PNG of frame ``k`` (default the last)."""
+    from ...io.figures import save_figure
+
+    return save_figure(plot_solid_frame(result, k), path)
+
+
+def write_solid_gif(path: str | os.PathLike, result, *, max_frames: int = 40,
+                    dpi: float = 80) -> Path:
+    """Animated GIF of at most ``max_frames`` evenly spaced frames, fixed axes and colour scale."""
+    from ...io.atomic import atomic_path
+    from ..scene.plot import _rgb_image, gif_frame_times, gif_frames
+
+    picks = gif_frames(len(result.x), max_frames)
+    norm, lim = _norm(result, picks), _limits(result, picks)
+    images = [_rgb_image(plot_solid_frame(result, int(k), norm=norm, limits=lim, dpi=dpi))
+              for k in picks]
+    frames = [im.quantize(colors=128) for im in images]
+    ms = [int(round(1000 * d)) for d in gif_frame_times(result.times, picks)]
+    with atomic_path(path) as tmp:
+        frames[0].save(tmp, format="GIF", save_all=True, append_images=frames[1:], duration=ms,
+                       loop=0, optimize=False, disposal=1)
+    return Path(path)

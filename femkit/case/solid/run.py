@@ -1,0 +1,542 @@
+"""Run a ``problem: solid`` case: mesh, materials per region, boundaries, then a quasi-static
+solve (load steps) or a time integration, then the outputs.
+
+:func:`prepare_solid` checks everything it can at load time -- material constants and names,
+boundary and region tags of a registered geometry, the integrator or ``static`` choice, the
+linear solver -- and builds the frozen :class:`~femkit.case.solid.spec.SolidSpec`;
+:func:`run_solid` checks the rest (tags of a mesh file, inverted input elements) before anything
+is written. Every such failure is a one-line :class:`~femkit.errors.InputError` (exit 2).
+
+A Newton failure of the static solve (:class:`~femkit.errors.EquilibriumError`) and an unstable
+time integration do not escape :func:`run_solid`: the frames computed before (load steps or
+time steps) are written, ``result.json`` says ``converged: false`` with the failure and, for
+Newton, the residual history; ``femkit solve`` exits 1.
+
+Static runs take load step ``k`` of ``K`` by :func:`femkit.solids.solve_static` from the
+previous equilibrium with ``k/K`` of the loads and prescribed displacements (what
+``solve_static(load_steps=K)`` does inside), keeping each equilibrium as a frame.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from ...errors import (CaseFileError, DegenerateMeshError, EquilibriumError, InputError,
+                       InstabilityError, with_prefix)
+from ...io.atomic import EARLIER_RUN, check_output_dir
+from ...timing import StageTimer
+from ..frozen import freeze
+from ..names import check_geometry_spec, resolve_file
+from ..specs import IntegratorSpec, limits_spec, solver_spec
+from .schema import COMPONENTS
+from .spec import Boundary, SolidOutput, SolidSpec, StaticSpec
+
+__all__ = ["prepare_solid", "run_solid", "build_mesh", "folded_cells", "build_problem", "SolidProblem",
+           "SolidResult", "frame_energies"]
+
+
+# ----------------------------------------------------------------------------- prepare
+
+def _materials(d) -> dict:
+    from ...solids.materials import material_from_spec
+
+    out = {}
+    for where, spec in [("material", d["material"])] + [
+            (f"regions.{name}", s) for name, s in d["regions"].items()]:
+        try:
+            out[None if where == "material" else where.split(".", 1)[1]] = material_from_spec(spec)
+        except InputError as exc:
+            raise with_prefix(exc, where) from None
+    return out
+
+
+def _boundaries(d, dynamic: bool) -> tuple:
+    out = []
+    for i, b in enumerate(d["boundaries"]):
+        where = f"boundaries[{i}]"
+        if b["type"] == "traction":
+            out.append(Boundary(b["tag"], "traction", traction=tuple(b["traction"])))
+            continue
+        comps = tuple(COMPONENTS.index(c) for c in b.get("fix", ()))  # () = every component
+        disp = tuple(b.get("displacement", ()))
+        if dynamic and (b["type"] == "roller" or "fix" in b or any(disp)):
+            raise CaseFileError(f"{where}: a {b['type']} condition on some components or with a "
+                                "displacement needs 'static: true' (time integration pins whole "
+                                "nodes at rest)")
+        out.append(Boundary(b["tag"], b["type"], comps, disp))
+    return tuple(out)
+
+
+def _check_geometry_tags(d, boundaries) -> int | None:
+    """Boundary tags and region names of a registered geometry, checked now; its dimension."""
+    if "geometry" not in d["mesh"]:
+        return None
+    from ...mesh.geometries import GEOMETRIES
+
+    entry = GEOMETRIES.get(d["mesh"]["geometry"])
+    for i, b in enumerate(boundaries):
+        if isinstance(b.tag, str) and b.tag not in entry.boundary_tags:
+            raise CaseFileError(f"boundaries[{i}].tag: unknown boundary tag {b.tag!r} of geometry "
+                                f"{entry.name!r}; valid tags: {', '.join(entry.boundary_tags)}")
+    for name in d["regions"]:
+        if name not in entry.cell_tags:
+            raise CaseFileError(f"regions: unknown region {name!r} of geometry {entry.name!r}; "
+                                f"valid regions: {', '.join(entry.cell_tags) or '(none)'}")
+    return entry.dim
+
+
+def prepare_solid(case) -> None:
+    """Check a validated solid case and build its :class:`SolidSpec` (``case.spec``).
+
+    Raises
+    ------
+    MaterialError
+        ``E <= 0``, ``nu`` outside ``(-1, 1/2)``, ``density <= 0``, missing constants.
+    UnknownNameError
+        Unknown material, geometry, integrator, solver (valid names listed).
+    CaseFileError
+        Unknown boundary tag or region of a geometry, both or neither of ``static`` and
+        ``integrator``, a vector of the wrong dimension, rollers in a dynamic run.
+    """
+    d = case.data
+    if d.get("name"):
+        case.name = d["name"]
+    mesh = dict(d["mesh"])
+    if "file" in mesh:
+        resolve_file(mesh, "mesh", case.base_dir)
+    else:
+        check_geometry_spec(mesh, "mesh")
+    materials = _materials(d)
+    static = d["static"]
+    dynamic = "integrator" in d
+    if bool(static) == dynamic:
+        raise CaseFileError("give either 'static: true' (equilibrium) or an 'integrator' with "
+                            "'dt' and 't_end' (time integration)" if not dynamic else
+                            "'static' and 'integrator' exclude each other: give one")
+    boundaries = _boundaries(d, dynamic)
+    dim = _check_geometry_tags(d, boundaries)
+    for key in ("gravity", "velocity"):
+        if dim is not None and key in d and len(d[key]) != dim:
+            raise CaseFileError(f"{key}: needs {dim} components for a {dim}D mesh, got {len(d[key])}")
+    for i, b in enumerate(boundaries):
+        for what in ("displacement", "traction"):
+            v = getattr(b, what)
+            if dim is not None and v and len(v) != dim:
+                raise CaseFileError(f"boundaries[{i}].{what}: needs {dim} components, got {len(v)}")
+    if not dynamic and all(b.kind == "traction" for b in boundaries):
+        raise CaseFileError("boundaries: no fixed or roller condition (a free body has "
+                            "rigid-body motions and no unique equilibrium)")
+    case.solver = solver = solver_spec(d["linear_solver"], "linear_solver", default_method="direct")
+    case.run_options["limits"] = limits_spec(d.get("limits"))
+    out = d["output"]
+    if dynamic:
+        for key in ("dt", "t_end"):
+            if key not in d:
+                raise CaseFileError(f"{key}: a time integration needs 'dt' and 't_end'")
+        integ = IntegratorSpec.from_mapping(d["integrator"], "integrator")
+        from ..scene.run import _time_value  # dt / t_end: numbers or constant expressions
+
+        dt, t_end = _time_value(case, "dt"), _time_value(case, "t_end")
+        steps = int(round(t_end / dt))
+        if steps < 1:
+            raise CaseFileError(f"t_end: {t_end:g} is shorter than one step dt = {dt:g}")
+        static_spec = None
+        every = int(out["every"]) if "every" in out else max(1, math.ceil(steps / int(out["frames"])))
+    else:
+        for key in ("dt", "t_end", "velocity"):
+            if key in d:
+                raise CaseFileError(f"{key}: only for a time integration (this case is static)")
+        integ, dt, t_end = None, None, None
+        static_spec = StaticSpec(**({} if static is True else dict(static)))
+        steps, every = static_spec.load_steps, int(out.get("every", 1))
+    directory = str((case.base_dir / out.get("dir", os.path.join("runs", case.name))).resolve())
+    out["dir"] = directory
+    case.spec = SolidSpec(
+        mesh=freeze(mesh), materials=freeze(materials), boundaries=boundaries,
+        gravity=tuple(d["gravity"]) if "gravity" in d else None, static=static_spec,
+        integrator=integ, solver=solver, dt=dt, t_end=t_end, steps=steps,
+        velocity=tuple(d["velocity"]) if "velocity" in d else None,
+        output=SolidOutput(directory, every, bool(out["vtu"]), bool(out["png"]), bool(out["gif"])))
+
+
+# ----------------------------------------------------------------------------- build
+
+def folded_cells(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """Cells folded over a neighbour: two cells sharing a facet whose opposite vertices lie on
+    the same side of it overlap, so one is inverted whatever its vertex order (a reader that
+    reorients cells hides the order, not the overlap). Returns the cells taking part in the
+    most such folds (the inverted ones when they are isolated), sorted; empty when none."""
+    m, nv = cells.shape
+    d = nv - 1
+    facets = np.concatenate([np.delete(cells, k, axis=1) for k in range(nv)])
+    opposite = np.concatenate([cells[:, k] for k in range(nv)])
+    owner = np.tile(np.arange(m), nv)
+    key = np.sort(facets, axis=1)
+    order = np.lexsort(key.T[::-1])
+    key, facets, opposite, owner = key[order], facets[order], opposite[order], owner[order]
+    pair = np.flatnonzero(np.all(key[1:] == key[:-1], axis=1))
+    if not len(pair):
+        return np.zeros(0, np.int64)
+    base = key[pair]                                   # the same vertex order for both sides
+    P = points[base]                                    # (k, d, d)
+    edges = P[:, 1:] - P[:, :1]                         # (k, d-1, d)
+
+    def side(p):
+        return np.sign(np.linalg.det(np.concatenate([edges, (p - P[:, 0])[:, None]], axis=1)))
+
+    same = side(points[opposite[pair]]) * side(points[opposite[pair + 1]]) > 0
+    if not same.any():
+        return np.zeros(0, np.int64)
+    count = np.bincount(np.concatenate([owner[pair[same]], owner[pair[same] + 1]]), minlength=m)
+    return np.flatnonzero(count == count.max())
+
+
+def build_mesh(spec: SolidSpec):
+    """The validated rest mesh, generated or read; refused with
+    :class:`~femkit.errors.DegenerateMeshError` naming the elements when some are inverted
+    (cells of opposite orientation, or cells folded over a neighbour: :func:`folded_cells`)."""
+    from ...mesh import generate, read_mesh, validate
+
+    m = spec.mesh
+    where = f"mesh.file {m['file']}" if "file" in m else f"mesh.geometry {m['geometry']}"
+    try:
+        mesh = read_mesh(m["file"]) if "file" in m else generate(m["geometry"], m["h"],
+                                                                   **dict(m.get("params") or {}))
+        neg = mesh.signed_volumes() < 0
+        bad = np.flatnonzero(neg if neg.sum() <= (~neg).sum() else ~neg) if neg.any() else \
+            folded_cells(mesh.points, mesh.cells)
+        if len(bad):
+            raise DegenerateMeshError(
+                f"{len(bad)} inverted {mesh.cell_name}(s) in the input mesh (overlapping their "
+                f"neighbours): element ids {', '.join(map(str, bad[:10]))}"
+                f"{' ...' if len(bad) > 10 else ''}", element_ids=bad)
+        return validate(mesh)
+    except InputError as exc:
+        raise with_prefix(exc, where) from None
+
+
+@dataclass
+class SolidProblem:
+    """The built problem: mesh, body, Dirichlet data, external nodal loads (traction and
+    gravity, ``(n, d)`` each), fixed nodes (dynamic runs) and the gravity vector."""
+
+    mesh: Any
+    body: Any
+    fixes: list
+    traction: np.ndarray
+    weight: np.ndarray
+    fixed_nodes: np.ndarray
+    gravity: np.ndarray
+
+    def dirichlet(self, scale: float = 1.0):
+        """The :class:`~femkit.solids.Dirichlet` data with every prescribed displacement times
+        ``scale`` (a load step)."""
+        from ...solids import Dirichlet
+
+        bc = Dirichlet(self.body.n, self.body.dim)
+        for nodes, comps, disp in self.fixes:
+            bc.fix(nodes, components=comps, displacement=scale * disp)
+        return bc
+
+
+def build_problem(case) -> SolidProblem:
+    """Mesh, body (a material per region), boundary conditions and loads of a prepared case."""
+    from ...solids import ElasticBody, body_forces, traction_forces
+    from ...solids.boundary import tagged_facets
+
+    spec = case.spec
+    mesh = build_mesh(spec)
+    d = mesh.dim
+    for key, v in (("gravity", spec.gravity), ("velocity", spec.velocity)):
+        if v is not None and len(v) != d:
+            raise CaseFileError(f"{key}: needs {d} components for a {d}D mesh, got {len(v)}")
+    mats = dict(spec.materials)
+    default = mats.pop(None)
+    regions = {}
+    for name, mat in mats.items():
+        try:
+            regions[mesh.tag(name)] = mat
+        except InputError as exc:
+            raise with_prefix(exc, f"regions.{name}") from None
+    if regions:
+        tags = np.unique(mesh.cell_tags)
+        regions.update({int(t): default for t in tags if int(t) not in regions})
+        material = regions
+    else:
+        material = default
+    body = ElasticBody(mesh.points, mesh.cells, material, cell_tags=mesh.cell_tags)
+    traction = np.zeros((body.n, d))
+    fixed, fixes = [], []
+    for i, b in enumerate(spec.boundaries):
+        where = f"boundaries[{i}]"
+        try:
+            facets = tagged_facets(mesh, b.tag)
+            for what in ("displacement", "traction"):
+                v = getattr(b, what)
+                if v and len(v) != d:
+                    raise CaseFileError(f"{what}: needs {d} components, got {len(v)}")
+            if b.kind == "traction":
+                traction += traction_forces(mesh.points, facets, b.traction)
+            else:
+                nodes = np.unique(facets)
+                fixed.append(nodes)
+                disp = np.zeros(d)
+                disp[:len(b.displacement)] = b.displacement
+                if any(c >= d for c in b.components):
+                    raise CaseFileError(f"fix: a {d}D mesh has components "
+                                        f"{', '.join(COMPONENTS[:d])} only")
+                fixes.append((nodes, list(b.components) or None, disp))
+        except InputError as exc:
+            raise with_prefix(exc, where) from None
+    g = np.zeros(d) if spec.gravity is None else np.asarray(spec.gravity, dtype=float)
+    weight = body_forces(body, body.density()[:, None] * g[None, :])
+    fixed_nodes = np.unique(np.concatenate(fixed)) if fixed else np.zeros(0, np.int64)
+    problem = SolidProblem(mesh, body, fixes, traction, weight, fixed_nodes, g)
+    problem.dirichlet(1.0)  # a dof prescribed twice with different values: InputError now
+    return problem
+
+
+def frame_energies(problem: SolidProblem, x: np.ndarray, v: np.ndarray | None = None,
+                   load_factor: float = 1.0) -> dict:
+    """Energies of one frame: ``kinetic`` (lumped masses), ``elastic``, ``gravity``
+    (``-sum m_i g . u_i``, zero at rest), ``load`` (``-f_traction . u``) and ``total``; the
+    external loads times ``load_factor`` (a static load step applies that part of them)."""
+    body = problem.body
+    u = x - body.rest_positions
+    out = {"kinetic": 0.0 if v is None else
+           float(0.5 * np.einsum("n,nd,nd->", body.lumped_masses(), v, v)),
+           "elastic": body.energy(x),
+           "gravity": 0.0 - load_factor * float(np.einsum("nd,nd->", problem.weight, u)),
+           "load": 0.0 - load_factor * float(np.einsum("nd,nd->", problem.traction, u))}
+    out["total"] = sum(out.values())
+    return out
+
+
+# ----------------------------------------------------------------------------- result
+
+@dataclass
+class SolidResult:
+    """What a solid run produced: frames (times or load factors, positions, velocities), their
+    energies and fields, and the facts of ``result.json``."""
+
+    case: Any
+    problem: SolidProblem
+    times: np.ndarray
+    x: list
+    v: list
+    energies: list
+    records: list = field(default_factory=list)
+    failure: str | None = None
+    residual_history: list | None = None
+    verdict: str = "converged"
+    wall_time: float = 0.0
+    timings: dict = field(default_factory=dict)
+    stats: dict = field(default_factory=dict)
+    output_dir: Any = None
+    files: list = field(default_factory=list)
+    _fields: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def converged(self) -> bool:
+        return self.failure is None
+
+    interrupted = None
+
+    def fields(self, k: int) -> dict:
+        """Per-element fields of frame ``k`` (:meth:`femkit.solids.ElasticBody.element_fields`)."""
+        k = k % len(self.x)
+        if k not in self._fields:
+            self._fields[k] = self.problem.body.element_fields(self.x[k])
+        return self._fields[k]
+
+    def tip(self, k: int = -1) -> np.ndarray:
+        """The largest displacement of frame ``k`` (the node moving most), ``(d,)``."""
+        u = self.x[k] - self.problem.body.rest_positions
+        return u[int(np.argmax(np.linalg.norm(u, axis=1)))]
+
+    def to_dict(self) -> dict:
+        from ..._version import __version__
+
+        spec, body = self.case.spec, self.problem.body
+        u = self.x[-1] - body.rest_positions
+        fields = self.fields(len(self.x) - 1)
+        inverted = body.inverted(self.x[-1])
+        return {
+            "case": self.case.name, "problem": "solid",
+            "case_file": str(self.case.path) if self.case.path else None,
+            "femkit_version": __version__,
+            "mesh": {"dim": body.dim, "points": int(body.n), "cells": int(body.rest.n_cells),
+                     "cell_type": "tetra" if body.dim == 3 else "triangle",
+                     "fixed_dofs": int(len(self.problem.dirichlet().dofs))},
+            "materials": [{"model": m.name, "mu": m.mu, "lam": m.lam, "E": m.young,
+                           "nu": m.poisson, "density": m.density} for m in body.materials],
+            "mode": "static" if spec.static else "dynamic",
+            "integrator": None if spec.integrator is None else spec.integrator.to_dict(),
+            "static": None if spec.static is None else {
+                "load_steps": spec.static.load_steps, "project": spec.static.project},
+            "linear_solver": spec.solver.to_dict(),
+            "dt": spec.dt, "t_end": spec.t_end, "steps_planned": spec.steps,
+            "frames": len(self.x),
+            "times": [float(t) for t in self.times],
+            "energies": [dict(e) for e in self.energies],
+            "load_steps": [{"load_factor": r.load_factor, "iterations": r.iterations,
+                            "residuals": list(map(float, r.residuals)),
+                            "converged": r.converged} for r in self.records],
+            "max_displacement": float(np.linalg.norm(u, axis=1).max()),
+            "tip_displacement": [float(c) for c in self.tip()],
+            "volume": {"rest": float(body.rest.volumes.sum()),
+                       "final": float((body.rest.volumes * fields["J"]).sum())},
+            "von_mises_max": float(np.nanmax(fields["von_mises"])),
+            "stretch_range": [float(fields["principal_stretches"].min()),
+                              float(fields["principal_stretches"].max())],
+            "inverted_elements": int(len(inverted)),
+            "verdict": self.verdict, "converged": self.converged, "failure": self.failure,
+            "residual_history": self.residual_history,
+            "stats": dict(self.stats),
+            "wall_time": float(self.wall_time), "timings": dict(self.timings),
+            "files": list(self.files),
+        }
+
+    def summary_lines(self) -> list[str]:
+        d = self.to_dict()
+        m = d["mesh"]
+        mats = ", ".join(f"{x['model']} (E {x['E']:.4g}, nu {x['nu']:.3g})" for x in d["materials"])
+        how = (f"static, {d['static']['load_steps']} load steps, "
+               f"{sum(r['iterations'] for r in d['load_steps'])} Newton iterations"
+               if d["mode"] == "static" else
+               f"{d['integrator']['method']}, dt {d['dt']:.4g}, t_end {d['t_end']:.4g}")
+        e = d["energies"][-1]
+        lines = [f"solid     {self.case.name}: {m['cells']} {m['cell_type']} cells, {m['points']} "
+                 f"nodes ({m['dim']}D), {mats}",
+                 f"method    {how}",
+                 f"result    max displacement {d['max_displacement']:.6g}, tip "
+                 f"[{', '.join(f'{c:.6g}' for c in d['tip_displacement'])}], volume "
+                 f"{d['volume']['final'] / d['volume']['rest'] - 1:+.3%}, von Mises max "
+                 f"{d['von_mises_max']:.4g}",
+                 f"energy    elastic {e['elastic']:.6g}, kinetic {e['kinetic']:.6g}, gravity "
+                 f"{e['gravity']:.6g}, load {e['load']:.6g} (last frame of {d['frames']})",
+                 f"verdict   {self.verdict}" + (f": {self.failure}" if self.failure else "")]
+        if self.output_dir is not None:
+            lines.append(f"output    {self.output_dir} ({len(self.files)} files)")
+        return lines
+
+
+# ----------------------------------------------------------------------------- run
+
+def _run_static(case, problem: SolidProblem, stop) -> dict:
+    from ...solids import solve_static
+
+    spec, body = case.spec, problem.body
+    st = spec.static
+    K = st.load_steps
+    f = problem.traction + problem.weight
+    x = body.rest_positions.copy()
+    out = {"times": [0.0], "x": [x], "v": [np.zeros_like(x)],
+           "energies": [frame_energies(problem, x)], "records": []}
+    for k in range(1, K + 1):
+        if stop:
+            break
+        bc = problem.dirichlet(k / K)
+        try:
+            res = solve_static(body, bc, f * (k / K), load_steps=1, project=st.project,
+                               rtol=st.rtol, max_iterations=st.max_iterations,
+                               linear_solver=spec.solver, x0=x)
+        except EquilibriumError as exc:
+            history = [float(r) for s in (exc.record.steps if exc.record else []) for r in s.residuals]
+            out["failure"] = (f"load step {k}/{K} (load factor {k / K:g}): "
+                              + " ".join(str(exc).split()))
+            out["residual_history"] = history or None
+            break
+        rec = res.steps[0]
+        rec.load_factor = k / K
+        out["records"].append(rec)
+        x = res.x
+        out["times"].append(k / K)
+        out["x"].append(x)
+        out["v"].append(np.zeros_like(x))
+        out["energies"].append(frame_energies(problem, x, load_factor=k / K))
+    return out
+
+
+def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
+    from ...dynamics.forces.elastic import DeadLoad, elastic_system
+    from ...dynamics.forces.gravity import Gravity
+    from ...dynamics.integrators import StepContext
+    from ...dynamics.simulate import simulate
+
+    spec, body = case.spec, problem.body
+    forces = [Gravity(problem.gravity)] if spec.gravity is not None else []
+    if np.any(problem.traction):
+        forces.append(DeadLoad(problem.traction))
+    v0 = None
+    if spec.velocity is not None:
+        v0 = np.broadcast_to(np.asarray(spec.velocity, float), (body.n, body.dim)).copy()
+    system = elastic_system(body, v0=v0, pinned=problem.fixed_nodes, forces=forces)
+    out: dict = {}
+    try:
+        traj = simulate(system, spec.integrator.build(), spec.dt, spec.t_end,
+                        ctx=StepContext(spec.solver), record_every=spec.output.every,
+                        progress=progress, stop=stop)
+    except InstabilityError as exc:
+        traj = exc.partial
+        out["failure"] = " ".join(str(exc).split())
+    out.update(times=list(traj.times), x=list(traj.x), v=list(traj.v),
+               energies=[frame_energies(problem, x, v) for x, v in zip(traj.x, traj.v)],
+               records=[], stats=dict(traj.stats))
+    return out
+
+
+def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = False,
+              write: bool = True, echo: Callable[[str], Any] | None = None) -> SolidResult:
+    """Run a prepared solid case: build, solve (static or dynamic), write, print the summary.
+
+    Returns
+    -------
+    SolidResult
+        ``converged`` false when Newton failed in a load step or the integration became
+        unstable; the frames before are kept and written.
+    """
+    from ...progress import Progress
+    from .cost import check_solid_fits
+
+    if write:
+        check_output_dir(output_dir or case.spec.output.dir, EARLIER_RUN)
+    check_solid_fits(case)
+    timer = StageTimer()
+    t0 = time.perf_counter()
+    with timer("build"):
+        problem = build_problem(case)
+    stop = case.run_options.get("stop")
+    with timer("solve"):
+        if case.spec.static is not None:
+            run = _run_static(case, problem, stop)
+        else:
+            progress = Progress(case.spec.steps, f"solid {case.name}", unit="step", quiet=quiet)
+            run = _run_dynamic(case, problem, stop, progress)
+    failure = run.get("failure")
+    result = SolidResult(case=case, problem=problem, times=np.asarray(run["times"], float),
+                         x=run["x"], v=run["v"], energies=run["energies"],
+                         records=run["records"], failure=failure,
+                         residual_history=run.get("residual_history"),
+                         verdict="converged" if failure is None else (
+                             "newton_failed" if case.spec.static else "unstable"),
+                         wall_time=time.perf_counter() - t0, timings=timer.times,
+                         stats=run.get("stats", {}))
+    if write:
+        from .output import write_solid_outputs
+
+        with timer("output"):
+            write_solid_outputs(result, output_dir or case.spec.output.dir)
+    if failure is not None:
+        print(f"femkit: {result.verdict.replace('_', ' ')}: {failure}", file=sys.stderr)
+    if not quiet:
+        for line in result.summary_lines():
+            (echo or print)(line)
+    return result
