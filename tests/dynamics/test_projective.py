@@ -154,3 +154,13 @@ def test_run_record_and_bad_input():
     springs = MassSpringSystem(np.array([[0.0, 0], [1, 0]]), np.ones(2), np.array([[0, 1]]), 1.0)
     with pytest.raises(InputError, match="exactly one elastic solid"):
         _step(springs, "projective")
+
+
+def test_run_summary_keeps_the_residuals_as_numbers():
+    from femkit.dynamics.simulate import simulate
+
+    tr = simulate(_scene(), "projective", H, 3 * H, iterations=5)
+    stats = tr.summary()["stats"]
+    assert stats["projective_iterations"] == {"total": 15, "max": 5}
+    res = stats["projective_residual"]
+    assert 0.0 < res["last"] <= res["max"] < 1.0
