@@ -24,7 +24,7 @@ Adding a kind is one module::
 >>> KINDS.get("heat", "problem")
 Traceback (most recent call last):
 ...
-femkit.errors.UnknownNameError: unknown problem 'heat'; valid problems: mass_spring, poisson
+femkit.errors.UnknownNameError: unknown problem 'heat'; valid problems: mass_spring, poisson, solid
 """
 
 from __future__ import annotations

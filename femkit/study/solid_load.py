@@ -167,6 +167,8 @@ def _figure(path, title: str, records) -> None:
     styles = ("-", "--", "-.", ":")
     for i, name in enumerate(dict.fromkeys(r["material"] for r in records)):
         rows = [r for r in records if r["material"] == name]
+        if not rows:  # no equilibrium at the first load step: nothing to draw (see the notes)
+            continue
         a = [0.0] + [r["alpha"] for r in rows]
         line, = ax1.plot(a, [0.0] + [abs(r["tip_deflection"]) for r in rows], marker="o", ms=3,
                          ls=styles[i % 4], label=name)

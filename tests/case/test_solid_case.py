@@ -88,6 +88,8 @@ BAD = {
                                       "traction": [1.0, 0.0, 0.0]}]), "no fixed or roller"),
     "unknown_integrator": (_edit(static=None, integrator="rk5", dt=0.1, t_end=1.0),
                            "valid values: central_difference"),
+    "ruinous_mesh": (_edit(mesh={"geometry": "unit_cube", "h": 0.001}),
+                     "exceeds the available memory"),
     "fix_component": (_edit(boundaries=[{"tag": "xmin", "type": "roller", "fix": ["w"]}]),
                       "boundaries[0].fix[0]"),
 }
@@ -328,3 +330,23 @@ def test_every_schema_key_is_documented():
     keys = set(schema) | set(schema["output"]["properties"])
     missing = sorted(k for k in keys if f"`{k}`" not in doc)
     assert not missing, f"keys missing from docs/solids.md: {missing}"
+
+
+def test_a_mesh_file_with_physical_groups_runs_with_its_tags(tmp_path):
+    """A .msh written with named groups: boundaries and a region by name; the material of the
+    region 'domain' (every cell) replaces the default."""
+    from femkit.mesh import Mesh, structured_box, write_mesh
+
+    m = structured_box(3, 3, 3, (1.0, 1.0, 1.0))
+    write_mesh(tmp_path / "cube.msh", Mesh(points=m.points, cells=m.cells,
+                                           cell_tags=np.full(m.n_cells, 8),
+                                           boundary_facets=m.boundary_facets,
+                                           boundary_tags=m.boundary_tags,
+                                           tag_names={**m.tag_names, "domain": 8}))
+    data = _edit(mesh={"file": "cube.msh"},
+                 regions={"domain": {"model": "linear", "E": 2000.0, "nu": 0.25}})
+    result = femkit.case.load.case_from_dict(data, tmp_path).run(write=False, quiet=True)
+    assert result.converged and result.problem.body.rest.n_cells == m.n_cells
+    assert [mat.name for mat in result.problem.body.materials] == ["linear"]
+    assert result.problem.body.materials[0].young == pytest.approx(2000.0)
+    assert result.tip()[2] < 0
