@@ -122,9 +122,17 @@ class Trajectory:
             "omega_max": self.omega_max, "dt_crit": self.dt_crit,
             "dt_exceeds_critical": self.dt_exceeds_critical,
             "energy_drift": self.energy_drift,
-            "stats": {k: (v if not isinstance(v, list) else {"total": int(sum(v)), "max": int(max(v, default=0))})
+            "stats": {k: (v if not isinstance(v, list) else _list_summary(v))
                       for k, v in self.stats.items()},
         }
+
+
+def _list_summary(v: list) -> dict:
+    """A per-step counter list as ``{total, max}``; a per-step float list (a residual) as
+    ``{last, max}``."""
+    if all(isinstance(a, (int, np.integer)) for a in v):
+        return {"total": int(sum(v)), "max": int(max(v, default=0))}
+    return {"last": float(v[-1]), "max": float(max(v))}
 
 
 class _Recorder:

@@ -34,9 +34,7 @@ def point_tangent(material: Material, F, *, project: bool = False):
     F = np.ascontiguousarray(F, dtype=float)
     d = F.shape[0]
     P, lam, Q = np.zeros((d, d)), np.zeros(d * d), np.zeros((d * d, d, d))
-    from .compiled import point
-
-    psi = point(material.code, F, material.params(), 2, P, lam, Q, np.zeros((6, d, d)),
+    psi = material.kernels().point(material.code, F, material.params(), 2, P, lam, Q, np.zeros((6, d, d)),
                 np.zeros((2, d)))
     if project:
         lam = np.maximum(lam, 0.0)
@@ -155,8 +153,6 @@ class ElasticBody:
         bounds the negative part of element ``e``'s unprojected Hessian (see
         :meth:`negative_bound`). ``stress``: an ``(m, d, d)`` array to receive the first
         Piola-Kirchhoff stress per element (``level >= 1``)."""
-        from .compiled import element_pass
-
         x = self._state(x)
         m = self.rest.n_cells
         energy = np.zeros(m)
@@ -170,7 +166,7 @@ class ElasticBody:
         r = self.rest
         P = np.zeros((0, self.dim, self.dim)) if stress is None else stress
         for elems, mat in self.groups:
-            element_pass(mat.code, x, r.cells, r.gradients, r.volumes, elems, mat.params(),
+            mat.kernels().element_pass(mat.code, x, r.cells, r.gradients, r.volumes, elems, mat.params(),
                          int(level), bool(project), slots, indptr, energy, grad, data, neg, P)
         if not np.all(np.isfinite(energy)):
             bad = np.flatnonzero(~np.isfinite(energy))

@@ -70,10 +70,9 @@ def test_invertible_svd_signs(rng):
             assert (s < 0).sum() == negatives and s[-1] < 0
 
 
-@pytest.mark.parametrize("name,d,kind", POINT_CASES)
-def test_stress_and_tangent_match_finite_differences(name, d, kind, rng):
-    mat = _mat(name)
-    F = _F(kind, d, rng)
+def assert_point_derivatives(mat, F):
+    """``P`` against finite differences of ``psi`` and ``dP/dF`` against those of ``P``."""
+    d = F.shape[0]
     psi, P, A = point_tangent(mat, F)
 
     def dpsi(h):
@@ -97,6 +96,11 @@ def test_stress_and_tangent_match_finite_differences(name, d, kind, rng):
     assert np.isfinite(psi)
     assert _min_rel(P, dpsi) <= 1e-6
     assert _min_rel(A, dP) <= 1e-6
+
+
+@pytest.mark.parametrize("name,d,kind", POINT_CASES)
+def test_stress_and_tangent_match_finite_differences(name, d, kind, rng):
+    assert_point_derivatives(_mat(name), _F(kind, d, rng))
 
 
 @pytest.mark.parametrize("name,d,kind", POINT_CASES)

@@ -36,8 +36,17 @@ _FIX = {"type": "array", "minItems": 1, "maxItems": 3, "uniqueItems": True,
 def _material() -> dict:
     from ...solids.materials import MATERIALS
 
-    return closed({"model": {"enum": MATERIALS.names()}, "E": _NUM, "nu": _NUM, "mu": _NUM,
-                   "lam": _NUM, "density": _NUM}, ["model"])
+    model = closed({"model": {"enum": MATERIALS.names()}, "E": _NUM, "nu": _NUM, "mu": _NUM,
+                    "lam": _NUM, "density": _NUM}, ["model"])
+    text = {"type": ["string", "number"]}
+    energy = closed({"energy": {"anyOf": [{"type": "string", "minLength": 1},
+                                          closed({"W": text, "f": text, "g": text, "h": text}, [])]},
+                     "constants": {"type": "object", "additionalProperties": _NUM},
+                     "density": _NUM}, ["energy"])
+    return {"anyOf": [model, energy],
+            "x-message": "expected {model: name, E: .., nu: .. (or mu, lam), density: ..} or a "
+                         "material designed by its energy {energy: {f: .., g: .., h: ..} or "
+                         "{W: ..}, constants: {..}, density: ..}"}
 
 
 def _integrator() -> dict:

@@ -22,6 +22,7 @@ from . import (  # noqa: F401  (registration side effects)
     newmark,
     variational_symplectic,
     fast_mass_spring,
+    projective,
 )
 
 __all__ = ["INTEGRATORS", "get_integrator", "Integrator", "StepContext", "StepperState"]

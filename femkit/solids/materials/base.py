@@ -119,6 +119,14 @@ class Material:
     #: (:func:`femkit.solids.compiled.point`)
     code: ClassVar[int] = -1
 
+    def kernels(self):
+        """The module of compiled kernels evaluating this material (``point``,
+        ``element_pass``, ``stretch_energy``): :mod:`femkit.solids.compiled` for the
+        hand-written ones, a generated module for a material designed by its energy."""
+        from .. import compiled
+
+        return compiled
+
 
 @dataclass(frozen=True)
 class StretchMaterial(Material):
@@ -130,7 +138,5 @@ class StretchMaterial(Material):
         """``(W, dW/ds, d^2W/ds^2)`` at one set of stretches ``s`` (``d`` values)."""
         s = np.ascontiguousarray(s, dtype=float)
         g, H = np.zeros(len(s)), np.zeros((len(s), len(s)))
-        from ..compiled import stretch_energy
-
-        W = stretch_energy(self.code, s, self.params(), g, H)
+        W = self.kernels().stretch_energy(self.code, s, self.params(), g, H)
         return float(W), g, H

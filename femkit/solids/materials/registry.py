@@ -6,6 +6,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from ...registry import Registry
+from ..energy import Energy
 from .base import Material, StretchMaterial
 
 __all__ = ["MATERIALS", "LinearElastic", "Corotational", "StVenantKirchhoff",
@@ -39,6 +40,8 @@ class Corotational(StretchMaterial):
     """Co-rotational linear elasticity ``mu |F - R|^2 + lam/2 tr(R^T F - I)^2``."""
 
     code: ClassVar[int] = 1
+    energy_expression: ClassVar[Energy] = Energy(
+        W="mu*((s1 - 1)**2 + (s2 - 1)**2 + (s3 - 1)**2) + lam/2*(s1 + s2 + s3 - 3)**2")
 
 
 @register_material("stvk")
@@ -47,6 +50,9 @@ class StVenantKirchhoff(StretchMaterial):
     """St. Venant-Kirchhoff ``mu |E|^2 + lam/2 tr(E)^2`` (softens and collapses in compression)."""
 
     code: ClassVar[int] = 2
+    energy_expression: ClassVar[Energy] = Energy(
+        W="mu/4*((s1**2 - 1)**2 + (s2**2 - 1)**2 + (s3**2 - 1)**2)"
+          " + lam/8*(s1**2 + s2**2 + s3**2 - 3)**2")
 
 
 @register_material("stable_neo_hookean")
@@ -55,6 +61,8 @@ class StableNeoHookean(StretchMaterial):
     """Stable neo-Hookean (Smith, de Goes & Kim 2018), rest-stable and inversion-safe."""
 
     code: ClassVar[int] = 3
+    energy_expression: ClassVar[Energy] = Energy(
+        W="mu/2*(s1**2 + s2**2 + s3**2 - 3) - mu*(J - 1) + (lam + mu)/2*(J - 1)**2")
 
 
 def material(name: str, *, mu: float | None = None, lam: float | None = None,

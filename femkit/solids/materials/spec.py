@@ -1,6 +1,8 @@
 """A material from a plain mapping (what a case file's ``material:`` holds): :func:`material_from_spec`.
 
-One function turns ``{model: name, E: .., nu: .. | mu: .., lam: .., density: ..}`` into a
+One function turns ``{model: name, E: .., nu: .. | mu: .., lam: .., density: ..}`` or
+``{energy: {f: .., g: .., h: ..} | {W: ..} | "W", constants: {..}, density: ..}`` (a material
+designed by its energy, :class:`~femkit.solids.materials.designed.EnergyMaterial`) into a
 :class:`~femkit.solids.materials.base.Material`, so the case layer and any other reader of
 mappings build materials the same way. A new way of describing a material (for instance an
 energy written by the user) is one more branch here, keyed by its own entry in the mapping.
@@ -34,7 +36,9 @@ def material_from_spec(spec: Mapping[str, Any]) -> Material:
     ----------
     spec : mapping
         ``model`` (a name of :data:`MATERIALS`), either ``E`` and ``nu`` (Young's modulus,
-        Poisson ratio) or ``mu`` and ``lam`` (Lame moduli), and ``density`` (default 1).
+        Poisson ratio) or ``mu`` and ``lam`` (Lame moduli), and ``density`` (default 1); or
+        ``energy`` (the separable ``f, g, h`` or a full ``W``, docs/materials.md), its named
+        ``constants`` and ``density``.
 
     Raises
     ------
@@ -46,10 +50,21 @@ def material_from_spec(spec: Mapping[str, Any]) -> Material:
     """
     if not isinstance(spec, Mapping):
         raise MaterialError(f"a material is a mapping {{model: ..., E: ..., nu: ...}}, got {spec!r}")
+    if "energy" in spec:
+        from .designed import ENERGY_KEYS, EnergyMaterial
+
+        unknown = sorted(set(spec) - set(ENERGY_KEYS))
+        if unknown:
+            raise MaterialError(f"unknown material keys {', '.join(unknown)}; valid keys with an "
+                                f"energy: {', '.join(ENERGY_KEYS)}")
+        constants = spec.get("constants") or {}
+        if not isinstance(constants, Mapping):
+            raise MaterialError(f"material constants must be a mapping name: value, got {constants!r}")
+        return EnergyMaterial.from_energy(spec["energy"], constants, spec.get("density", 1.0))
     unknown = sorted(set(spec) - set(SPEC_KEYS))
     if unknown:
         raise MaterialError(f"unknown material keys {', '.join(unknown)}; valid keys: "
-                            f"{', '.join(SPEC_KEYS)}")
+                            f"{', '.join(SPEC_KEYS)} (or energy, constants, density)")
     if "model" not in spec:
         raise MaterialError(f"a material needs 'model', one of {', '.join(MATERIALS.names())}")
     MATERIALS.get(spec["model"])  # unknown names: UnknownNameError listing the valid ones

@@ -1,0 +1,152 @@
+"""Compiled kernels of an energy of the principal stretches, generated from its SymPy tree.
+
+For an energy ``W(s1, s2, s3)`` (plane strain: ``s3 = 1``) the derivatives ``dW/ds_i`` and
+``d^2W/ds_i ds_j`` are taken symbolically once, common subexpressions are shared
+(:func:`sympy.cse`) and the three are printed as one numba function
+``energy(s, params, grad, hess) -> W`` per dimension -- the signature of the hand-written
+energies of :mod:`femkit.solids.compiled`. The generated module then carries the *same* point and
+element kernels as the built-in materials: the source of every compiled function that reaches
+``stretch_energy`` through its calls (:func:`copied_kernels`: the stretch point function, the
+point dispatch, the element pass and any inlined bodies of theirs) is copied in unchanged, so
+their global ``stretch_energy`` resolves to the generated energy and everything else (signed SVD, SVD
+derivative, repeated-stretch limits, PSD projection, CSR assembly) is shared code, inlined by numba
+as for the built-ins. No Python runs per element.
+
+The module is written once to a cache directory (``FEMKIT_CACHE_DIR``, else
+``~/.cache/femkit``) under a name that hashes the energy, the constants' order and the source of
+:mod:`femkit.solids.compiled` (so an edit there regenerates it: numba's cache would not notice an
+edited callee), and numba caches its machine code beside it; a later process pays neither SymPy
+nor compilation.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import inspect
+import os
+import sys
+import tempfile
+from pathlib import Path
+from types import ModuleType
+from typing import Sequence
+
+__all__ = ["energy_module", "energy_source", "cache_dir"]
+
+
+_LOADED: dict[str, ModuleType] = {}
+
+
+def cache_dir() -> Path:
+    """Where generated energy modules live (``FEMKIT_CACHE_DIR`` or ``~/.cache/femkit``)."""
+    root = os.environ.get("FEMKIT_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "femkit")
+    return Path(root) / "energies"
+
+
+def _energy_function(name: str, W, d: int, n_params: int) -> str:
+    """Source of ``name(s, params, grad, hess) -> W`` for ``d`` stretches (``W`` over the
+    symbols ``s_1..s_d`` and ``c_0..``)."""
+    import sympy
+    from sympy.printing.pycode import PythonCodePrinter
+
+    s = sympy.symbols(f"s_1:{d + 1}")
+    grad = [sympy.diff(W, si) for si in s]
+    hess = [sympy.diff(grad[i], s[j]) for i in range(d) for j in range(i, d)]
+    reps, reduced = sympy.cse([W, *grad, *hess], symbols=sympy.numbered_symbols("t"))
+    pr = PythonCodePrinter({"fully_qualified_modules": True, "standard": "python3"})
+    lines = ["@numba.njit(cache=True, fastmath=False)",
+             f"def {name}(s, params, grad, hess):  # pragma: no cover - compiled"]
+    lines += [f"    s_{i + 1} = s[{i}]" for i in range(d)]
+    lines += [f"    c_{k} = params[{k}]" for k in range(n_params)]
+    lines += [f"    {sym} = {pr.doprint(expr)}" for sym, expr in reps]
+    for i in range(d):
+        lines.append(f"    grad[{i}] = {pr.doprint(reduced[1 + i])}")
+    k = 1 + d
+    for i in range(d):
+        for j in range(i, d):
+            lines.append(f"    hess[{i}, {j}] = {pr.doprint(reduced[k])}")
+            if j != i:
+                lines.append(f"    hess[{j}, {i}] = hess[{i}, {j}]")
+            k += 1
+    lines.append(f"    return {pr.doprint(reduced[0])}")
+    if any("not supported" in ln.lower() for ln in lines):
+        from ...errors import MaterialError
+
+        raise MaterialError(f"energy {W}: uses a function the kernel generator cannot print")
+    return "\n".join(lines)
+
+
+def copied_kernels(module) -> list[str]:
+    """Names of the compiled functions of ``module`` that reach ``stretch_energy`` through their
+    calls (read from each function's code object): these are copied into a generated module, so
+    that they resolve the generated energy; the others are imported."""
+    funcs = {n: f.py_func for n, f in vars(module).items() if hasattr(f, "py_func")}
+    calls = {n: set(f.__code__.co_names) & set(funcs) for n, f in funcs.items()}
+    reach = {"stretch_energy"}
+    grew = True
+    while grew:
+        new = {n for n, c in calls.items() if c & reach} - reach
+        reach |= new
+        grew = bool(new)
+    reach.discard("stretch_energy")
+    return sorted(reach, key=lambda n: funcs[n].__code__.co_firstlineno)
+
+
+def energy_source(W, stretches: Sequence, constants: Sequence) -> str:
+    """The text of the generated module for ``W`` (a SymPy expression of the three symbols
+    ``stretches`` and the symbols ``constants``, whose values come in that order as ``params``)."""
+    import sympy
+
+    from .. import compiled
+
+    s = sympy.symbols("s_1:4")
+    safe = {**{a: b for a, b in zip(stretches, s)},
+            **{c: sympy.Symbol(f"c_{k}") for k, c in enumerate(constants)}}
+    W3 = sympy.piecewise_fold(W.xreplace(safe).rewrite(sympy.Piecewise))
+    W2 = W3.subs(s[2], 1)
+    copied = copied_kernels(compiled)
+    shared = [n for n in vars(compiled) if not n.startswith("__") and n not in copied
+              and n != "stretch_energy" and n != "annotations"]
+    parts = ['"""Generated by femkit.solids.energy.codegen: do not edit.', "",
+             f"W(s1, s2, s3) = {W3}", '"""', "",
+             "import math", "", "import numba", "import numpy as np", "",
+             f"from femkit.solids.compiled import {', '.join(sorted(shared))}", "", "",
+             _energy_function("energy_2", W2, 2, len(constants)), "", "",
+             _energy_function("energy_3", W3, 3, len(constants)), "", "",
+             "@numba.njit(cache=True)",
+             "def stretch_energy(code, s, params, grad, hess):  # pragma: no cover - compiled",
+             "    if s.shape[0] == 2:",
+             "        return energy_2(s, params, grad, hess)",
+             "    return energy_3(s, params, grad, hess)", ""]
+    for name in copied:
+        parts += ["", inspect.getsource(getattr(compiled, name)).rstrip(), ""]
+    return "\n".join(parts)
+
+
+def energy_module(W, stretches: Sequence, constants: Sequence) -> ModuleType:
+    """The compiled kernels of ``W`` (see :func:`energy_source`): a module with
+    ``stretch_energy``, ``point`` and ``element_pass`` taking the arguments of
+    :mod:`femkit.solids.compiled`'s; generated and written once, then loaded from the cache."""
+    from .. import compiled
+
+    text = energy_source(W, stretches, constants)
+    key = hashlib.sha256((text + inspect.getsource(compiled)).encode()).hexdigest()[:20]
+    mod = _LOADED.get(key)
+    if mod is not None:
+        return mod
+    folder = cache_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"femkit_energy_{key}.py"
+    if not path.exists() or path.read_text() != text:
+        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        os.replace(tmp, path)          # atomic: parallel test workers may write the same file
+    name = f"femkit_energy_{key}"
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[name] = mod
+    spec.loader.exec_module(mod)
+    _LOADED[key] = mod
+    return mod
