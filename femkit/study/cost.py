@@ -253,3 +253,18 @@ def plan_cloth_study(study) -> Plan:
     return runs_plan(study, stages, runs, [
         "one implicit solve per inner iteration (implicit per-spring constant), the reference's "
         "solve ~40 iterations per frame, RK4 = 4 explicit steps per substep"])
+
+
+def plan_solid_load_study(study) -> Plan:
+    """The plan of a ``solid_load`` study: each material's run priced by the solid kind's plan
+    (:func:`femkit.case.solid.cost.plan_solid_case`) of the case it runs."""
+    from ..case.kinds import KINDS
+    from .solid_load import material_cases
+
+    stages, assumptions = [], []
+    for name, case in material_cases(study):
+        plan = KINDS.get("solid", "problem").plan(case, measure=False)
+        stages.append(Stage(name, plan.seconds, plan.peak_bytes - plan.baseline_bytes,
+                            detail=f"{study.spec.load_steps} load steps"))
+        assumptions = plan.assumptions
+    return runs_plan(study, stages, len(stages), assumptions[:3])

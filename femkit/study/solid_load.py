@@ -29,7 +29,7 @@ import numpy as np
 from ..errors import CaseFileError
 
 __all__ = ["solid_load_schema", "check_solid_load", "run_solid_load", "build_solid_load_report",
-           "solid_load_summary", "elastica_deflection"]
+           "solid_load_summary", "elastica_deflection", "material_cases"]
 
 
 def solid_load_schema() -> dict:
@@ -52,10 +52,11 @@ def solid_load_schema() -> dict:
 def _base(study):
     from ..case import load_case
 
-    path = study.resolve(study.data["base_case"])
+    d = study.spec
+    path = study.resolve(d.base_case)
     if not path.is_file():
         raise CaseFileError(f"base_case: file not found: {path}")
-    return path, load_case(path, **dict(study.data["case_overrides"]))
+    return path, load_case(path, **dict(d.case_overrides))
 
 
 def _traction(case) -> tuple:
@@ -67,7 +68,11 @@ def _traction(case) -> tuple:
 
 
 def check_solid_load(study) -> None:
-    """Load the base case now (its own checks), and check it is a loaded cantilever."""
+    """Build ``study.spec`` (:class:`femkit.study.spec.SolidLoadStudySpec`), load the base case
+    now (its own checks), and check it is a loaded cantilever."""
+    from .spec import SolidLoadStudySpec
+
+    study.spec = SolidLoadStudySpec.from_data(study.data)
     path, case = _base(study)
     if case.problem != "solid":
         raise CaseFileError(f"base_case: {path.name} is not a solid case (problem: solid)")
@@ -97,14 +102,35 @@ def elastica_deflection(alpha: float) -> float:
     return float(shoot(k0)[1])
 
 
+def material_cases(study, path=None, base=None):
+    """``(material name, case)`` for each material of the study: the base case with its
+    tractions and gravity times ``scale`` in ``load_steps`` load steps (the sweep's runs, and
+    the cases the cost plan prices)."""
+    from ..case import load_case
+
+    if base is None:
+        path, base = _base(study)
+    d = study.spec
+    mat = base.data["material"]
+    static = base.data["static"] if isinstance(base.data["static"], dict) else {}
+    for name in d.materials:
+        over = {**d.case_overrides, "material": {**mat, "model": name},
+                "static": {**static, "load_steps": d.load_steps},
+                "boundaries": [{**b, "traction": list(np.asarray(b["traction"]) * d.scale)}
+                               if b["type"] == "traction" else dict(b)
+                               for b in base.data["boundaries"]]}
+        if "gravity" in base.data:
+            over["gravity"] = list(np.asarray(base.data["gravity"]) * d.scale)
+        yield name, load_case(path, **over)
+
+
 def run_solid_load(study, progress_enabled=None) -> dict:
     """One record per (material, load step): load, ``alpha``, tip deflection, ratios."""
-    from ..case import load_case
     from ..solids.boundary import tagged_nodes
     from ..progress import Progress
 
     path, base = _base(study)
-    d = study.data
+    d = study.spec
     trac = _traction(base)
     p = dict(base.spec.mesh.get("params") or {})
     L, W, H = (float(p.get(k, v)) for k, v in (("length", 5.0), ("width", 1.0), ("height", 1.0)))
@@ -112,22 +138,13 @@ def run_solid_load(study, progress_enabled=None) -> dict:
     E = float(mat["E"]) if "E" in mat else \
         float(mat["mu"]) * (3 * mat["lam"] + 2 * mat["mu"]) / (mat["lam"] + mat["mu"])
     I = W * H ** 3 / 12.0
-    t = np.asarray(trac.traction, float) * d["scale"]
+    t = np.asarray(trac.traction, float) * d.scale
     direction = t / np.linalg.norm(t)
     P_total = float(np.linalg.norm(t)) * W * H          # a uniform traction on the W x H tip face
     records, notes = [], []
-    bar = Progress(len(d["materials"]), "solid_load", unit="material",
+    bar = Progress(len(d.materials), "solid_load", unit="material",
                    quiet=progress_enabled is False)
-    for name in d["materials"]:
-        over = {**d["case_overrides"], "material": {**mat, "model": name},
-                "static": {**(base.data["static"] if isinstance(base.data["static"], dict) else {}),
-                           "load_steps": int(d["load_steps"])},
-                "boundaries": [{**b, "traction": list(np.asarray(b["traction"]) * d["scale"])}
-                               if b["type"] == "traction" else dict(b)
-                               for b in base.data["boundaries"]]}
-        if "gravity" in base.data:
-            over["gravity"] = list(np.asarray(base.data["gravity"]) * d["scale"])
-        case = load_case(path, **over)
+    for name, case in material_cases(study, path, base):
         res = case.run(write=False, quiet=True)
         tip = tagged_nodes(res.problem.mesh, trac.tag)
         X = res.problem.body.rest_positions

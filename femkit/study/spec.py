@@ -17,7 +17,7 @@ from typing import Any, Mapping
 
 __all__ = ["StudySpec", "PoissonSource", "LevelsSpec", "PoissonStudySpec", "AdaptiveStudySpec", "DynamicsScene",
            "DynamicsReference", "DynamicsStudySpec", "StabilityStudySpec", "ClothReference",
-           "ClothStudySpec"]
+           "ClothStudySpec", "SolidLoadStudySpec"]
 
 
 @dataclass(frozen=True)
@@ -255,3 +255,22 @@ class ClothStudySpec(StudySpec):
                    linear_solver=linear_solver, methods=_plain(methods),
                    reference=ClothReference(float(ref["tol"]), str(ref["solve"]),
                                             str(ref["trajectory"]), int(ref["substeps"])))
+
+
+# ----------------------------------------------------------------------------- solid studies
+
+@dataclass(frozen=True)
+class SolidLoadStudySpec(StudySpec):
+    """``kind: solid_load`` (defaults: :func:`femkit.study.solid_load.solid_load_schema`)."""
+
+    base_case: str
+    materials: tuple
+    scale: float
+    load_steps: int
+    case_overrides: Mapping
+
+    @classmethod
+    def from_data(cls, d: Mapping) -> "SolidLoadStudySpec":
+        return cls(**cls.common(d), base_case=str(d["base_case"]), materials=tuple(d["materials"]),
+                   scale=float(d["scale"]), load_steps=int(d["load_steps"]),
+                   case_overrides=_plain(d.get("case_overrides") or {}))

@@ -27,6 +27,12 @@ def _run(study, progress_enabled=None) -> dict:
     return run_solid_load(study, progress_enabled=progress_enabled)
 
 
+def _plan(study, **kwargs):
+    from ..cost import plan_solid_load_study
+
+    return plan_solid_load_study(study)
+
+
 def _report(*args) -> None:
     from ..solid_load import build_solid_load_report
 
@@ -39,5 +45,5 @@ def _summary(result) -> list[str]:
     return solid_load_summary(result)
 
 
-KIND = register_kind(Kind("solid_load", "kind", _schema, _check, _run,
+KIND = register_kind(Kind("solid_load", "kind", _schema, _check, _run, plan=_plan,
                           report=_report, summary=_summary))
