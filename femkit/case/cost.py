@@ -116,7 +116,7 @@ def measure_step_seconds(system, integrator, dt: float, *, ctx=None, batch: int 
 def plan_poisson_case(case, *, measure: bool = True) -> Plan:
     """The plan of a Poisson case (from ``case.spec``); with ``measure`` its seconds are scaled
     by this machine's speed now (:func:`femkit.cost.machine_speed`, ~0.25 s of probing)."""
-    from ..cost import machine_speed, msh_triangle_count
+    from ..cost import machine_speed, msh_has_volume, msh_triangle_count
 
     spec = case.spec
     mesh, out = spec.mesh, spec.output
@@ -126,21 +126,42 @@ def plan_poisson_case(case, *, measure: bool = True) -> Plan:
                   preconditioner=case.solver.preconditioner, rtol=case.solver.rtol,
                   outputs=outputs, errors="exact.u" in case.functions)
     if mesh.file is not None:
-        triangles, how = msh_triangle_count(mesh.file)
-        plan = plan_poisson(triangles=triangles, **common)
-        plan.assumptions.insert(0, f"{triangles:,} triangles in {mesh.file} (from {how})")
+        cells, how = msh_triangle_count(mesh.file)
+        if msh_has_volume(mesh.file):
+            plan = _tetrahedral_plan(cells, f"{cells:,} elements in {mesh.file} (from {how})",
+                                     f"mesh file ({cells:,} elements)", common)
+        else:
+            plan = plan_poisson(triangles=cells, **common)
+            plan.assumptions.insert(0, f"{cells:,} triangles in {mesh.file} (from {how})")
     else:
         params = dict(mesh.params)
-        dim, area, length = geometry_domain(mesh.geometry, params)
-        if dim != 2:
-            return Plan("poisson", f"{case.name}: {mesh.geometry} h={mesh.h:g}", {}, [],
-                        assumptions=[f"no cost model for {dim}D meshes yet: the run is not costed"])
-        plan = plan_poisson(area=area, line_length=length, h=mesh.h, name=mesh.geometry,
-                            params=params, **common)
+        dim, size, length = geometry_domain(mesh.geometry, params)
+        if dim == 3:
+            tets = TETS_PER_H3 * size / float(mesh.h) ** 3
+            plan = _tetrahedral_plan(tets, f"{tets:,.0f} tetrahedra: {TETS_PER_H3:g} per h^3 of "
+                                     f"volume {size:g}", f"{mesh.geometry} h={mesh.h:g}", common)
+        else:
+            plan = plan_poisson(area=size, line_length=length, h=mesh.h, name=mesh.geometry,
+                                params=params, **common)
     plan.title = f"{case.name}: {plan.title}"
     if spec.adaptive:
         plan.assumptions.append("adaptive refinement: only the first level is costed; the "
                                 "adaptive budgets (max_dofs, max_time, max_levels) bound the rest")
+    return plan
+
+
+def _tetrahedral_plan(tets: float, source: str, title: str, common: dict) -> Plan:
+    """The plan of a tetrahedral Poisson run of ``tets`` cells before refinement, priced as
+    :func:`check_mesh_fits` does with ``dim=3``: :data:`TET_AS_TRIANGLES` triangles of the 2D
+    model per tetrahedron, 8 children per refinement (Bey 1995); sizes in tetrahedra."""
+    k = common["refine"]
+    plan = plan_poisson(triangles=TET_AS_TRIANGLES * tets * 2.0 ** k, **common)
+    rest = {key: v for key, v in plan.sizes.items() if key != "triangles"}
+    plan.sizes = {"tetrahedra": tets * 8.0 ** k, **rest}
+    plan.title = title
+    plan.assumptions[0] = (f"{source}; a tetrahedron priced as {TET_AS_TRIANGLES:.3g} triangles "
+                           "of the 2D model (its 4 x 4 stiffness block against 3 x 3), x8 per "
+                           "refinement")
     return plan
 
 

@@ -32,7 +32,7 @@ from .budget import (
 )
 from .constants import load_constants
 from .memory import available_memory, format_bytes, peak_rss
-from .meshfile import msh_triangle_count
+from .meshfile import msh_has_volume, msh_triangle_count
 from .plan import Plan, Stage
 from .poisson import plan_mesh, plan_poisson, predict_triangles
 from .scene import plan_scene
@@ -40,5 +40,5 @@ from .speed import machine_speed
 
 __all__ = ["Plan", "Stage", "Limits", "LIMIT_KEYS", "DEFAULT_TIME_BUDGET", "with_default_time", "check_budget", "parse_bytes", "parse_seconds",
            "load_constants", "available_memory", "peak_rss", "format_bytes", "format_seconds",
-           "msh_triangle_count", "plan_mesh", "plan_poisson", "predict_triangles", "plan_scene",
+           "msh_has_volume", "msh_triangle_count", "plan_mesh", "plan_poisson", "predict_triangles", "plan_scene",
            "machine_speed"]

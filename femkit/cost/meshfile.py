@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import os
 
-__all__ = ["msh_triangle_count", "BYTES_PER_TRIANGLE"]
+__all__ = ["msh_triangle_count", "msh_has_volume", "BYTES_PER_TRIANGLE"]
 
 #: File bytes per triangle when only the size is known (ASCII .msh 4.1 written by femkit: ~95;
 #: .vtu with data: ~50); the smaller value, so the estimate errs on the large side.
@@ -54,3 +54,35 @@ def msh_triangle_count(path: str | os.PathLike, max_scan: int = 1 << 26) -> tupl
     except (OSError, ValueError, IndexError):
         return estimate
     return estimate
+
+
+def msh_has_volume(path: str | os.PathLike, max_scan: int = 1 << 26) -> bool:
+    """Whether an ASCII ``.msh`` file holds a volume (tetrahedra), read from its header only:
+    format 4.1 counts its volumes in the line after ``$Entities``; format 2.2 has no entities,
+    so its element lines are scanned for type 4 (a tetrahedron), at most ``max_scan`` bytes.
+    False when unknown (binary, other formats): the file is priced as triangles."""
+    p = os.fspath(path)
+    if not p.lower().endswith(".msh"):
+        return False
+    scanned, in_elements = 0, False
+    try:
+        with open(p, "rb") as fh:
+            for raw in fh:
+                scanned += len(raw)
+                if scanned > max_scan:
+                    break
+                line = raw.strip()
+                if line == b"$Entities":
+                    return int(fh.readline().split()[3]) > 0
+                if line == b"$Elements":
+                    fh.readline()
+                    in_elements = True
+                elif in_elements:
+                    parts = line.split()
+                    if line.startswith(b"$") or len(parts) < 2:
+                        return False
+                    if parts[1] == b"4":
+                        return True
+    except (OSError, ValueError, IndexError):
+        return False
+    return False

@@ -98,7 +98,7 @@ class Plan:
     def size_phrase(self) -> str:
         """The sizes in a few words: ``'2.3e+10 triangles, 1.2e+10 unknowns'``."""
         parts = []
-        for key in ("triangles", "unknowns", "nodes", "springs", "steps", "frames"):
+        for key in ("triangles", "tetrahedra", "unknowns", "nodes", "springs", "steps", "frames"):
             if key in self.sizes and self.sizes[key] is not None:
                 parts.append(f"{_count(self.sizes[key])} {key}")
         return ", ".join(parts)

@@ -168,9 +168,10 @@ def _check_volume_file(p: str, tets, tet_tags, tri, names, groups) -> None:
             raise MeshError(f"{p} mixes dimensions: {loose} triangle(s) are not faces of its "
                             f"{len(tets)} tetrahedra (a 2D domain beside the volume?); femkit "
                             "needs one volume with its boundary faces")
-    has_volume_groups = any(d == 3 for _, d in groups.values())
+    # with no physical group at all gmsh writes every element (untagged, as in 2D): accepted;
+    # any group but some tetrahedra in no Physical Volume: refused, named
     untagged = int((tet_tags == 0).sum())
-    if has_volume_groups and untagged:
+    if groups and untagged:
         raise MeshError(f"{p}: {untagged} of {len(tets)} tetrahedra belong to no physical "
                         "volume; add them to a Physical Volume (or remove the other groups)")
 

@@ -137,8 +137,8 @@ def test_a_user_geometry_runs_through_femkit_solve(tmp_path):
 
 def test_a_3d_geometry_is_priced_by_tetrahedra_not_as_triangles():
     """A dim-3 entry (volume, surface area): the mesh guard prices its tetrahedra (volume / h^3)
-    and refuses a mesh beyond the machine; a case's plan says the run is not costed (the
-    stage model is the triangle one), instead of a wrong number."""
+    and refuses a mesh beyond the machine; a case's plan prices the same tetrahedra (9 per
+    h^3 of volume), not the volume's measure as triangles."""
     import femkit
     from femkit.case.cost import check_mesh_fits, plan_poisson_case
     from femkit.errors import BudgetExceededError
@@ -155,7 +155,9 @@ def test_a_3d_geometry_is_priced_by_tetrahedra_not_as_triangles():
                                 exact={"grad": ["pi*cos(pi*x)*sin(pi*y)",
                                                 "pi*sin(pi*x)*cos(pi*y)", 0]})
         plan = plan_poisson_case(case, measure=False)
-        assert plan.stages == [] and "no cost model for 3D meshes" in plan.assumptions[0]
+        assert "triangles" not in plan.sizes
+        assert plan.sizes["tetrahedra"] == pytest.approx(9.0 / 1e-18)  # volume 1 (side 1)
+        assert plan.stages and plan.peak_bytes > 1e18
     finally:
         GEOMETRIES.remove("test_cube")
 

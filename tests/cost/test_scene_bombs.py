@@ -84,12 +84,12 @@ def test_counts_from_numbers_match_the_built_systems():
     ]
     for spec in cases:
         params = {k: v for k, v in spec.items() if k != "type"}
-        system, _ = SYSTEMS.get(spec["type"]).build(dict(params), None, {"forces": [], "damping": 0.0})
+        system, *_ = SYSTEMS.get(spec["type"]).build(dict(params), None, {"forces": [], "damping": 0.0})
         size = system_size(spec)
         assert (size.nodes, size.springs, size.dim) == (system.n, system.n_springs, system.dim), spec
     mesh = {"type": "mesh", "geometry": "disk", "h": 0.05, "k": 1.0}
     params = {k: v for k, v in mesh.items() if k != "type"}
-    system, _ = SYSTEMS.get("mesh").build(dict(params), None, {"forces": [], "damping": 0.0})
+    system, *_ = SYSTEMS.get("mesh").build(dict(params), None, {"forces": [], "damping": 0.0})
     size = system_size(mesh)
     assert size.nodes == pytest.approx(system.n, rel=0.15)
     assert size.springs == pytest.approx(system.n_springs, rel=0.15)

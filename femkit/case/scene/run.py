@@ -224,11 +224,13 @@ def build_system(case: Case):
     origin = s.pop("origin", None)
     builder = SYSTEMS.get(kind).build  # the schema admits only registered types
     try:
-        system, triangles = builder(s, origin, dict(forces=forces, damping=damping))
+        system, triangles, *notes = builder(s, origin, dict(forces=forces, damping=damping))
     except CaseFileError:
         raise
     except InputError as exc:
         raise with_prefix(exc, "system") from None
+    known = case.run_options.setdefault("notes", [])
+    known.extend(n for n in (notes[0] if notes else ()) if n not in known)
     vel = [case.functions[f"system.velocity[{i}]"]
            for i in range(len(case.spec.system.get("velocity") or []))]
     if vel:
@@ -516,6 +518,8 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     if not quiet:
         for line in result.summary_lines():
             out(line)
+        for note in case.run_options.get("notes", ()):  # e.g. a mesh file's unused nodes
+            out(f"note      {note}")
         hint = fast_path_hint(case, system, integrator)
         if hint:
             out(hint)

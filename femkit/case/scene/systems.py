@@ -23,7 +23,7 @@ class SystemType:
 
     ``schema``: the JSON schema of its ``system`` mapping (``type``, ``damping`` and
     ``velocity`` included: start from :data:`COMMON`); ``build(params, origin, kw) -> (system,
-    triangles or None)`` where ``params`` is the mapping without ``type``, ``velocity``,
+    triangles or None[, notes])`` (notes: lines the run prints, e.g. a mesh file's dropped nodes) where ``params`` is the mapping without ``type``, ``velocity``,
     ``damping`` and ``origin`` (a copy the builder may consume) and ``kw`` holds ``forces`` and
     ``damping`` for the system's constructor. ``size(system mapping) -> SystemSize`` counts
     nodes and springs from the numbers of the mapping alone, allocating nothing: the cost plan
@@ -75,16 +75,21 @@ def _cloth(s: dict, origin, kw: dict):
     return system, grid_triangles(nx, ny)
 
 
-def scene_mesh(spec: dict):
-    """The validated mesh of a ``type: mesh`` system (generated or read)."""
+def scene_mesh(spec: dict, notes: list | None = None):
+    """The validated mesh of a ``type: mesh`` system (generated or read); a file's unused nodes
+    are dropped with a note appended to ``notes`` (as for a Poisson case's mesh file)."""
     from ...errors import InputError, with_prefix
     from ...mesh import generate, read_mesh, validate
+    from ...mesh.validate import drop_unreferenced
     from ..cost import check_mesh_fits
 
     where = f"system.file {spec['file']}" if "file" in spec else f"system.geometry {spec['geometry']}"
     try:
         if "file" in spec:
-            return validate(read_mesh(spec["file"]))
+            mesh, note = drop_unreferenced(read_mesh(spec["file"], compact=False))
+            if note and notes is not None:
+                notes.append(f"system.file: {note}")
+            return validate(mesh)
         params = spec.get("params") or {}
         check_mesh_fits(geometry=spec["geometry"], h=spec["h"], params=params)
         return validate(generate(spec["geometry"], spec["h"], **params))
@@ -97,13 +102,14 @@ def _mesh(s: dict, origin, kw: dict):
 
     from ...dynamics import topology
 
-    mesh = scene_mesh(s)
+    notes: list[str] = []
+    mesh = scene_mesh(s, notes)
     for key in ("geometry", "h", "params", "file"):
         s.pop(key, None)
     system = topology.mesh_springs(mesh, **s, **kw)
     if origin is not None:
         system.x0 = system.x0 + np.asarray(origin, float).reshape(1, system.dim)
-    return system, np.asarray(mesh.triangles, dtype=np.int64)
+    return system, np.asarray(mesh.triangles, dtype=np.int64), notes
 
 
 def _rope_size(s) -> SystemSize:
