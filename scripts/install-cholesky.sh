@@ -16,6 +16,6 @@ if ! [ -e /usr/include/suitesparse/cholmod.h ]; then
     $sudo apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq libsuitesparse-dev libopenblas0-pthread >/dev/null
 fi
-python -m pip install -q -e ".[cholesky,pardiso]"
+python -m pip install -q -e ".[cholesky,pardiso,fast]"
 python -c "from femkit.solvers.cholesky import available; assert available(), 'scikit-sparse did not import'; print('install-cholesky.sh: CHOLMOD ready')"
 python -c "from femkit.solvers.pardiso import available; assert available(), 'MKL mkl_rt did not load'; print('install-cholesky.sh: PARDISO ready')"
