@@ -391,14 +391,17 @@ def _one_line(exc: BaseException) -> str:
 def entry() -> None:
     """The ``femkit`` console script and ``python -m femkit``: :func:`main`, then the exit.
 
-    After a stop request that abandoned compiled work in a thread (gmsh's mesher:
-    :func:`femkit.interrupt.run_interruptible`), the process ends at once with ``os._exit``,
-    its output flushed, instead of a normal exit that would tear the library down under it.
+    After a stop request (exit 130 / 143) the process ends at once with ``os._exit``, its
+    output flushed, instead of a normal exit: the request may have abandoned compiled work in a
+    thread (gmsh's mesher: :func:`femkit.interrupt.run_interruptible`) or raised out of a C
+    library's call (:func:`femkit.interrupt.raising`), and the interpreter's teardown would run
+    that library's destructors on its half-done state (a crash: exit -11 instead of 130). What
+    the run keeps is already written and closed (atomic writes) when :func:`main` returns.
     """
     code = main()
     from .interrupt import abandoned_work
 
-    if abandoned_work():
+    if code in (130, 143) or abandoned_work():
         import os
 
         sys.stdout.flush()

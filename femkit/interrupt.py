@@ -35,6 +35,7 @@ never fires by itself. The previous handlers are restored on exit.
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 import threading
 from typing import Iterator
@@ -49,6 +50,7 @@ class StopFlag:
     def __init__(self) -> None:
         self.signum: int | None = None
         self.raising: list[str] = []  # the open raising() blocks, innermost last
+        self.deferred = False  # a raise put off until numba's machinery has returned
 
     def request(self, signum: int = signal.SIGINT) -> None:
         """Ask the running loop to stop after its current unit of work."""
@@ -96,10 +98,15 @@ def stop_on_signals(signals=(signal.SIGINT, signal.SIGTERM)) -> Iterator[StopFla
     _ACTIVE.append(flag)
 
     def handler(signum, frame):
-        if flag and signum == signal.SIGINT:
+        redelivered, flag.deferred = flag.deferred, False
+        if flag and signum == signal.SIGINT and not redelivered:
             raise KeyboardInterrupt
         flag.request(signum)
         if flag.raising:  # inside raising(): stop the work where it is
+            if _inside_numba(frame):  # not inside numba's loader: deliver again shortly
+                flag.deferred = True
+                threading.Timer(0.02, os.kill, (os.getpid(), signum)).start()
+                return
             raise Interrupted(flag, where=f"during {flag.raising[-1]}")
 
     previous = {}
@@ -111,6 +118,18 @@ def stop_on_signals(signals=(signal.SIGINT, signal.SIGTERM)) -> Iterator[StopFla
         _ACTIVE.remove(flag)
         for s, h in previous.items():
             signal.signal(s, h)
+
+
+def _inside_numba(frame) -> bool:
+    """Whether the interrupted Python code is numba's own (compiling a kernel, or loading it
+    from its cache): an exception raised there from a signal handler leaves numba's state
+    half-built and the process crashes later (SIGSEGV instead of exit 130)."""
+    while frame is not None:
+        parts = frame.f_code.co_filename.replace("\\", "/").split("/")
+        if "numba" in parts or "llvmlite" in parts:
+            return True
+        frame = frame.f_back
+    return False
 
 
 class Interrupted(Exception):
