@@ -92,6 +92,20 @@ import numpy as np
 CODES = {"linear": 0, "corotational": 1, "stvk": 2, "stable_neo_hookean": 3}
 
 
+# ---------------------------------------------------------------- deformation gradient
+@numba.njit(cache=True, inline="always")
+def deformation_gradient(x, cells, grads, e, F):  # pragma: no cover - compiled
+    """``F = sum_n x_n grad(phi_n)^T`` of element ``e`` into ``F`` (``grads``: the rest
+    shape-function gradients, i.e. ``Ds Dm^-1``)."""
+    d = F.shape[0]
+    for a in range(d):
+        for b in range(d):
+            acc = 0.0
+            for n in range(cells.shape[1]):
+                acc += x[cells[e, n], a] * grads[e, n, b]
+            F[a, b] = acc
+
+
 # ---------------------------------------------------------------- signed SVD
 @numba.njit(cache=True)
 def det_small(A):  # pragma: no cover - compiled
@@ -463,12 +477,7 @@ def _element_pass(code, x, cells, grads, vol, elems, params, level, project, nod
     base = np.empty((nv * nv, d), dtype=np.int64)
     for t in range(elems.shape[0]):
         e = elems[t]
-        for a in range(d):
-            for b in range(d):
-                acc = 0.0
-                for n in range(nv):
-                    acc += x[cells[e, n], a] * grads[e, n, b]
-                F[a, b] = acc
+        deformation_gradient(x, cells, grads, e, F)
         psi = point(code, F, params, level, P, lam, Q, work, vec)
         v = vol[e]
         energy[e] = v * psi

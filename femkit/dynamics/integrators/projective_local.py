@@ -17,7 +17,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ...solids.compiled import signed_svd
+from ...solids.compiled import deformation_gradient, signed_svd
 
 
 @numba.njit(cache=False)
@@ -36,12 +36,7 @@ def local_step(x, cells, grads, w_rot, w_vol, jmin, jmax, out):  # pragma: no co
     gr = np.empty(d)
     local = 0.0
     for e in range(m):
-        for a in range(d):
-            for b in range(d):
-                acc = 0.0
-                for n in range(nv):
-                    acc += x[cells[e, n], a] * grads[e, n, b]
-                F[a, b] = acc
+        deformation_gradient(x, cells, grads, e, F)
         signed_svd(F, U, s, V, A)
         wr, wv = w_rot[e], w_vol[e]
         J = 1.0
