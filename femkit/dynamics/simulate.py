@@ -175,7 +175,7 @@ def gravity_force(system, x) -> np.ndarray:
     for f in system.forces:
         if getattr(f, "kind", None) == "gravity":
             f.add_force(x, zero, 0.0, out)
-    out[system.pinned] = 0.0
+    out[system.pinned_dofs] = 0.0
     return out
 
 

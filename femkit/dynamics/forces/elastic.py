@@ -82,7 +82,7 @@ class ElasticForce(Force):
 
 class DeadLoad(Force):
     """Constant nodal forces ``f`` ``(n, d)`` (surface tractions of a solid as dead loads,
-    :func:`femkit.solids.traction_forces`); potential ``-f . x`` over the unpinned nodes,
+    :func:`femkit.solids.traction_forces`); potential ``-f . x`` over the unpinned components,
     reported in the ``"gravity"`` bucket (the bucket of constant external forces).
 
     >>> import numpy as np
@@ -106,7 +106,7 @@ class DeadLoad(Force):
         if self.forces.shape != (system.n, system.dim) or not np.all(np.isfinite(self.forces)):
             raise InputError(f"dead load must be finite with shape ({system.n}, {system.dim}), "
                              f"got {self.forces.shape}")
-        self._f = np.where(system.pinned[:, None], 0.0, self.forces)
+        self._f = np.where(system.pinned_dofs, 0.0, self.forces)
 
     def add_force(self, x, v, t, out) -> None:
         out += self._f

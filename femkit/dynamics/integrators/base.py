@@ -123,7 +123,7 @@ class Integrator:
                 f"{self.name}: x and v must have shape {(system.n, system.dim)}, "
                 f"got {x.shape} and {v.shape}"
             )
-        v[system.pinned] = 0.0
+        v[system.pinned_dofs] = 0.0
         if getattr(self, "matrix_free", False):  # refuse a solver that needs the matrix up front
             check_matrix_free(self.name, ctx)
         return StepperState(x, v, float(t))

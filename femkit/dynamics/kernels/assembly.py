@@ -138,7 +138,7 @@ class FreePattern:
 def free_pattern(system, cache: dict) -> FreePattern:
     """The :class:`FreePattern` of ``system`` kept in ``cache`` (a run's ``ctx.cache``), rebuilt
     when the system, its springs or its pinned set are other objects."""
-    key = (system, system.springs, system.pinned)
+    key = (system, system.springs, system.pinned_dofs)
     kept = cache.get("free_pattern")
     if kept is not None and all(a is b for a, b in zip(kept[0], key)):
         return kept[1]
@@ -185,5 +185,5 @@ def assemble_with_forces(pat: FreePattern, system, x, v, t: float, *, diagonal, 
         system.last_shift = mu
         data[pat.diag] += kcoef * mu
         kv += mu * v
-    f[system.pinned] = 0.0
+    f[system.pinned_dofs] = 0.0
     return data, f, kv
