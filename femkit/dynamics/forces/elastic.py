@@ -68,6 +68,17 @@ class ElasticForce(Force):
     def stiffness(self, x, fix=None):
         return self._eval(x, 2, fix == "clamp")[2]
 
+    @property
+    def stored_scale(self) -> float:
+        """``sum (mu + |lam|) vol``: the size of the terms the energy sums before they cancel
+        near rest (the round-off level of the energy is ``eps`` times it)."""
+        return float(sum((m.mu + abs(m.lam)) * self.body.rest.volumes[e].sum()
+                         for e, m in self.body.groups))
+
+    def structure(self):
+        pat = self.body.pattern
+        return pat.indptr, pat.indices
+
     def stiffness_product(self, x, d, fix=None):
         K = self.stiffness(x, fix)
         return (K @ np.asarray(d, dtype=float).reshape(-1)).reshape(self.body.n, self.body.dim)
