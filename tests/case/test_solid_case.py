@@ -51,15 +51,15 @@ def _edit(**changes) -> dict:
     return d
 
 
-def _moved_centre_msh(path: Path) -> None:
-    """A 2x2x2-cube Kuhn mesh of the unit cube whose centre node is moved to z = 1.1, through
-    the faces of the tetrahedra above it: those overlap their neighbours (inverted), whatever
-    vertex order the file gives them."""
+def _moved_centre_msh(path: Path, z: float = 1.1) -> None:
+    """A 2x2x2-cube Kuhn mesh of the unit cube whose centre node is moved to ``z``: at 1.1,
+    through the faces of the tetrahedra above it, which then overlap their neighbours
+    (inverted), whatever vertex order the file gives them; at 1.0, onto those faces (flat)."""
     from femkit.mesh import Mesh, structured_box, write_mesh
 
     m = structured_box(2, 2, 2, (1.0, 1.0, 1.0))
     P = m.points.copy()
-    P[np.argmin(np.linalg.norm(P - 0.5, axis=1))] = [0.5, 0.5, 1.1]
+    P[np.argmin(np.linalg.norm(P - 0.5, axis=1))] = [0.5, 0.5, z]
     write_mesh(path, Mesh(points=P, cells=m.cells, cell_tags=np.full(m.n_cells, 8),
                           boundary_facets=m.boundary_facets, boundary_tags=m.boundary_tags,
                           tag_names={**m.tag_names, "domain": 8}))
@@ -131,14 +131,17 @@ def test_unknown_tag_of_a_mesh_file_is_refused_before_writing(where, tmp_path, c
     assert not out.exists()
 
 
-def test_inverted_input_element_is_named(tmp_path, capsys):
-    _moved_centre_msh(tmp_path / "folded.msh")
+@pytest.mark.parametrize("z,needle", [(1.1, "inverted tetrahedron(s)"),
+                                      (1.0, "degenerate tetrahedron(s) (volume <= 1e-12")],
+                         ids=["inverted", "zero_volume"])
+def test_inverted_or_flat_input_element_is_named(z, needle, tmp_path, capsys):
+    _moved_centre_msh(tmp_path / "folded.msh", z)
     out = tmp_path / "out"
     code = main(["solve", str(_write(tmp_path, _edit(mesh={"file": "folded.msh"}))),
                  "--output", str(out), "--quiet"])
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1, err
-    assert "inverted tetrahedron(s)" in err and "element ids" in err
+    assert needle in err and "element ids" in err
     assert not out.exists()
 
 
