@@ -67,7 +67,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, InstabilityError, StabilityWarning  # StabilityWarning re-exported
+from ..errors import (InputError, InstabilityError, SolverError,  # StabilityWarning re-exported
+                      StabilityWarning)
 from .integrators import Integrator, StepContext, get_integrator
 
 __all__ = ["simulate", "Trajectory", "StabilityWarning", "energy_scale", "gravity_force"]
@@ -175,7 +176,7 @@ def gravity_force(system, x) -> np.ndarray:
     for f in system.forces:
         if getattr(f, "kind", None) == "gravity":
             f.add_force(x, zero, 0.0, out)
-    out[system.pinned] = 0.0
+    out[system.pinned_dofs] = 0.0
     return out
 
 
@@ -270,6 +271,10 @@ def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | 
     ------
     InstabilityError
         Non-finite state or energy growth; ``partial`` is the trajectory up to the last good step.
+    SolverError
+        A step failed (e.g. :class:`~femkit.dynamics.integrators.base.NewtonStepError`, a matrix
+        that is not SPD for ``cholesky``): raised with ``partial`` (the trajectory up to the
+        state the step started from, ``completed`` false) and ``step`` set.
     InputError
         Non-positive ``dt``, ``t_end < t0``, ``record_every < 1``.
     """
@@ -341,7 +346,16 @@ def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | 
                 break
             if watch:
                 raise Interrupted(watch, where=f"at step {step - 1} of {n_steps} of {method}")
-            new = integrator.step(system, state, dt, ctx)
+            try:
+                new = integrator.step(system, state, dt, ctx)
+            except SolverError as exc:   # a failed step (Newton, a linear solve): keep the run so far
+                if last_recorded != step - 1:
+                    rec.add(state.t, state.x, state.v, system.energies(state.x, state.v))
+                exc.step = step
+                exc.partial = rec.build(method, dt, step - 1, time.perf_counter() - start,
+                                        completed=False, reason=f"step {step} failed: {exc}",
+                                        **common)
+                raise
             if not (np.isfinite(new.x).all() and np.isfinite(new.v).all()):
                 fail(step, new.t, math.inf, "non-finite state", state)
             record = step % record_every == 0 or step == n_steps

@@ -3,10 +3,15 @@
 State arrays are node-major ``(n, d)`` float64 (``d`` = 2 or 3); the flat dof index is
 ``i*d + c`` (``x.reshape(-1)``). See ``docs/architecture.md`` and the dynamics contract.
 
-Pinned nodes
-------------
-:meth:`MassSpringSystem.force`, :meth:`~MassSpringSystem.acceleration` and
-:meth:`~MassSpringSystem.potential_gradient` have zero rows on pinned nodes. The matrices
+Pinned nodes and components
+---------------------------
+``pinned`` holds whole nodes (indices or an ``(n,)`` mask) or single components (an ``(n, d)``
+mask: rollers and symmetry planes, a node held in ``x`` only). ``pinned_dofs`` is the ``(n, d)``
+mask of every held component, ``pinned`` the ``(n,)`` mask of the nodes held in every component,
+``free_dofs`` the flat indices of the others. :meth:`MassSpringSystem.force`,
+:meth:`~MassSpringSystem.acceleration` and :meth:`~MassSpringSystem.potential_gradient` are zero
+on every held component (so explicit methods never move one); the implicit methods eliminate
+them from their linear systems through ``free_dofs``. The matrices
 (:meth:`~MassSpringSystem.stiffness_matrix`, :meth:`~MassSpringSystem.damping_matrix`,
 :meth:`~MassSpringSystem.hessian_product`, :meth:`~MassSpringSystem.spring_laplacian`) are the
 full, unconstrained Jacobians; an integrator restricts them to ``free_dofs``
@@ -88,8 +93,9 @@ class MassSpringSystem:
         Dashpot coefficient along each spring; dashpots are evaluated only when non-zero.
     v0 : (n, d) array, optional
         Initial velocities (default zero; pinned rows are set to zero).
-    pinned : index list or (n,) bool mask, optional
-        Particles held fixed.
+    pinned : index list, (n,) bool mask or (n, d) bool mask, optional
+        Particles held fixed (every component), or with an ``(n, d)`` mask the components
+        held fixed (the others move freely: a roller).
     forces : iterable of :class:`~femkit.dynamics.forces.base.Force`
         Declared extra forces (Gravity, ViscousDamping, RayleighDamping, GroundContact,
         SphereContact). Nothing undeclared is computed.
@@ -148,21 +154,26 @@ class MassSpringSystem:
         scale = max(float(self.rest.max()) if s else 0.0, float(np.ptp(x0, axis=0).max()), 1e-300)
         self.length_floor = 1e-12 * scale
 
-        mask = np.zeros(n, dtype=bool)
+        dofs = np.zeros((n, d), dtype=bool)
         if pinned is not None:
             p = np.asarray(pinned)
             if p.dtype == bool:
-                if p.shape != (n,):
-                    raise InputError(f"pinned mask must have shape ({n},), got {p.shape}")
-                mask = p.copy()
+                if p.shape == (n,):
+                    dofs[p] = True
+                elif p.shape == (n, d):
+                    dofs = p.copy()
+                else:
+                    raise InputError(f"pinned mask must have shape ({n},) (whole nodes) or "
+                                     f"({n}, {d}) (components), got {p.shape}")
             elif p.size:
                 if not np.issubdtype(p.dtype, np.integer):
                     raise InputError("pinned must be node indices or a boolean mask")
                 if p.min() < -n or p.max() >= n:
                     raise InputError(f"pinned node indices must lie in [0, {n - 1}]")
-                mask[p.ravel()] = True
-        self.pinned = mask
-        self.free_dofs = np.flatnonzero(np.repeat(~mask, d))
+                dofs[p.ravel()] = True
+        self.pinned_dofs = dofs
+        self.pinned = dofs.all(axis=1)
+        self.free_dofs = np.flatnonzero(~dofs.ravel())
 
         if v0 is None:
             v = np.zeros_like(x0)
@@ -170,7 +181,7 @@ class MassSpringSystem:
             v = np.array(v0, dtype=float)
             if v.shape != x0.shape or not np.all(np.isfinite(v)):
                 raise InputError(f"v0 must be finite with shape {x0.shape}")
-            v[mask] = 0.0
+            v[dofs] = 0.0
         self.v0 = v
 
         # flat scatter indices: per-spring force on i goes to i*d + c, its negative to j*d + c
@@ -202,6 +213,11 @@ class MassSpringSystem:
         if self._pattern is None:
             self._pattern = SpringPattern(self.n, self.dim, self._i, self._j)
         return self._pattern
+
+    @property
+    def partially_pinned(self) -> bool:
+        """Whether some node is held in some components only (a roller)."""
+        return bool(np.any(self.pinned_dofs.any(axis=1) & ~self.pinned))
 
     @property
     def rayleigh(self) -> tuple[float, float]:
@@ -273,7 +289,7 @@ class MassSpringSystem:
         return self._scatter_springs(fs)
 
     def force(self, x, v, t: float = 0.0, *, rayleigh: bool = True) -> np.ndarray:
-        """Total force ``(n, d)``; zero rows on pinned nodes.
+        """Total force ``(n, d)``; zero on pinned components.
 
         ``rayleigh=False`` omits the Rayleigh term (for implicit methods that put
         ``alpha M + beta K`` into their matrix).
@@ -284,7 +300,7 @@ class MassSpringSystem:
         for f in self.forces:
             if rayleigh or not isinstance(f, RayleighDamping):
                 f.add_force(x, v, t, out)
-        out[self.pinned] = 0.0
+        out[self.pinned_dofs] = 0.0
         return out
 
     def constant_force(self) -> np.ndarray:
@@ -298,7 +314,7 @@ class MassSpringSystem:
         for f in self.forces:
             if f.constant:
                 f.add_force(self.x0, zero, 0.0, out)
-        out[self.pinned] = 0.0
+        out[self.pinned_dofs] = 0.0
         return out
 
     @property
@@ -320,22 +336,22 @@ class MassSpringSystem:
         for f in self.forces:
             if not f.constant:
                 f.add_force(x, v, t, out)
-        out[self.pinned] = 0.0
+        out[self.pinned_dofs] = 0.0
         return out
 
     def acceleration(self, x, v, t: float = 0.0, *, rayleigh: bool = True) -> np.ndarray:
-        """``force / mass``, zero on pinned nodes."""
+        """``force / mass``, zero on pinned components."""
         return self.force(x, v, t, rayleigh=rayleigh) / self.mass[:, None]
 
     def potential_gradient(self, x) -> np.ndarray:
         """Gradient of :meth:`potential_energy` = minus the conservative force (springs,
-        gravity, contact); zero rows on pinned nodes."""
+        gravity, contact); zero on pinned components."""
         x = self._state(x)
         out = self.spring_forces(x)
         zero_v = np.zeros_like(x)
         for f in self._conservative:
             f.add_force(x, zero_v, 0.0, out)
-        out[self.pinned] = 0.0
+        out[self.pinned_dofs] = 0.0
         return -out
 
     # ------------------------------------------------------------------ energies

@@ -51,15 +51,15 @@ def _edit(**changes) -> dict:
     return d
 
 
-def _moved_centre_msh(path: Path) -> None:
-    """A 2x2x2-cube Kuhn mesh of the unit cube whose centre node is moved to z = 1.1, through
-    the faces of the tetrahedra above it: those overlap their neighbours (inverted), whatever
-    vertex order the file gives them."""
+def _moved_centre_msh(path: Path, z: float = 1.1) -> None:
+    """A 2x2x2-cube Kuhn mesh of the unit cube whose centre node is moved to ``z``: at 1.1,
+    through the faces of the tetrahedra above it, which then overlap their neighbours
+    (inverted), whatever vertex order the file gives them; at 1.0, onto those faces (flat)."""
     from femkit.mesh import Mesh, structured_box, write_mesh
 
     m = structured_box(2, 2, 2, (1.0, 1.0, 1.0))
     P = m.points.copy()
-    P[np.argmin(np.linalg.norm(P - 0.5, axis=1))] = [0.5, 0.5, 1.1]
+    P[np.argmin(np.linalg.norm(P - 0.5, axis=1))] = [0.5, 0.5, z]
     write_mesh(path, Mesh(points=P, cells=m.cells, cell_tags=np.full(m.n_cells, 8),
                           boundary_facets=m.boundary_facets, boundary_tags=m.boundary_tags,
                           tag_names={**m.tag_names, "domain": 8}))
@@ -80,9 +80,11 @@ BAD = {
     "static_and_integrator": (_edit(integrator="newton", dt=0.1, t_end=1.0),
                               "exclude each other"),
     "neither": (_edit(static=None), "give either 'static: true'"),
-    "roller_in_dynamics": (_edit(static=None, integrator="newton", dt=0.1, t_end=1.0,
-                                 boundaries=[{"tag": "xmin", "type": "roller", "fix": ["x"]}]),
-                           "needs 'static: true'"),
+    "ruinous_time_step": (_edit(static=None, integrator="newton", dt=1e-7, t_end=1.0),
+                          "exceeds the default time budget 1 h; use dt >= "),
+    "explicit_step_above_critical": (_edit(static=None, integrator="velocity_verlet", dt=0.05,
+                                           t_end=1.0),
+                                     "exceeds the critical step"),
     "gravity_2d_on_3d": (_edit(gravity=[0.0, -9.81]), "gravity: needs 3 components"),
     "no_support": (_edit(boundaries=[{"tag": "xmax", "type": "traction",
                                       "traction": [1.0, 0.0, 0.0]}]), "no fixed or roller"),
@@ -129,14 +131,17 @@ def test_unknown_tag_of_a_mesh_file_is_refused_before_writing(where, tmp_path, c
     assert not out.exists()
 
 
-def test_inverted_input_element_is_named(tmp_path, capsys):
-    _moved_centre_msh(tmp_path / "folded.msh")
+@pytest.mark.parametrize("z,needle", [(1.1, "inverted tetrahedron(s)"),
+                                      (1.0, "degenerate tetrahedron(s) (volume <= 1e-12")],
+                         ids=["inverted", "zero_volume"])
+def test_inverted_or_flat_input_element_is_named(z, needle, tmp_path, capsys):
+    _moved_centre_msh(tmp_path / "folded.msh", z)
     out = tmp_path / "out"
     code = main(["solve", str(_write(tmp_path, _edit(mesh={"file": "folded.msh"}))),
                  "--output", str(out), "--quiet"])
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1, err
-    assert "inverted tetrahedron(s)" in err and "element ids" in err
+    assert needle in err and "element ids" in err
     assert not out.exists()
 
 
@@ -174,6 +179,57 @@ def test_newton_failure_keeps_the_earlier_load_steps(tmp_path, capsys):
     assert len(d["residual_history"]) > 1 and len(d["load_steps"]) == 1
     assert (out / "frames" / "frame_00001.vtu").is_file()
     assert not (out / "frames" / "frame_00002.vtu").exists()
+
+
+def _dynamic_collapse(**changes) -> dict:
+    """A StVK cube on rollers (x = 0, y = 0, z = 0) pushed at x = 1 by a dead load of 0.2 E,
+    integrated by Newton's implicit Euler with dt = 0.05, its line search allowed one trial."""
+    return _edit(**{"material__model": "stvk", "material__density": 10.0, "static": None,
+                    "integrator": {"method": "newton", "options": {"max_backtracks": 1}},
+                    "dt": 0.05, "t_end": 1.0,
+                    "boundaries": [{"tag": "xmin", "type": "roller", "fix": ["x"]},
+                                   {"tag": "ymin", "type": "roller", "fix": ["y"]},
+                                   {"tag": "zmin", "type": "roller", "fix": ["z"]},
+                                   {"tag": "xmax", "type": "traction",
+                                    "traction": [-200.0, 0.0, 0.0]}], **changes})
+
+
+def test_newton_failure_in_a_time_step_keeps_the_earlier_frames(tmp_path, capsys):
+    """The first step converges; in the second the full Newton step raises the objective and
+    the residual (the face slams into the collapsing block): the run stops there, its first
+    frames written, ``result.json`` marked failed with the residual history of that step."""
+    out = tmp_path / "out"
+    code = main(["solve", str(_write(tmp_path, _dynamic_collapse())), "--output", str(out),
+                 "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 1
+    assert "newton failed" in err and "from t = 0.05 to 0.1" in err
+    d = json.loads((out / "result.json").read_text())
+    assert d["converged"] is False and d["verdict"] == "newton_failed"
+    assert "line search found no decrease" in d["failure"]
+    assert d["frames"] == 2 and d["times"] == [0.0, pytest.approx(0.05)]
+    assert len(d["residual_history"]) >= 2 and all(r > 0 for r in d["residual_history"])
+    assert (out / "frames" / "frame_00001.vtu").is_file()
+    assert not (out / "frames" / "frame_00002.vtu").exists()
+
+
+def test_rollers_in_a_time_integration_hold_only_their_components(tmp_path):
+    """The same cube on its three rollers, pulled at x = 1: the roller faces slide in their
+    planes (x = 0 face: y and z free) and never leave them; the case equals the library's system
+    with the (n, 3) pin mask."""
+    data = _dynamic_collapse(integrator="newton", t_end=0.2, material__model="stable_neo_hookean")
+    data["boundaries"][3]["traction"] = [100.0, 0.0, 0.0]
+    res = femkit.load_case(_write(tmp_path, data)).run(write=False, quiet=True)
+    assert res.converged
+    X = res.problem.body.rest_positions
+    x = np.array(res.x)
+    for axis in range(3):
+        face = np.isclose(X[:, axis], 0.0)
+        assert np.all(x[:, face, axis] == 0.0)                   # held, bit for bit
+        other = [a for a in range(3) if a != axis]
+        moved = np.abs(x[-1][face][:, other] - X[face][:, other]).max()
+        assert moved > 1e-3                                      # sliding in the plane
+    assert x[-1][:, 0].max() > 1.0 + 1e-3                        # pulled out along x
 
 
 # ----------------------------------------------------------------------------- end to end

@@ -18,9 +18,10 @@ from __future__ import annotations
 import math
 
 from ...cost import Plan, Stage, check_budget, load_constants
+from ...cost.plan import round_down, round_up
 from ..cost import OVERRIDE, geometry_domain
 
-__all__ = ["plan_solid_case", "solid_sizes", "check_solid_fits"]
+__all__ = ["plan_solid_case", "solid_sizes", "check_solid_fits", "check_explicit_step"]
 
 #: cells per h^dim of measure, boundary nodes per h^(dim-1) of boundary measure
 CELLS_PER_MEASURE = {2: 2.3, 3: 5.5}
@@ -79,12 +80,22 @@ def plan_solid_case(case, *, measure: bool = True) -> Plan:
              f"{'static' if spec.static else spec.integrator.method}")
     sizes = {what: cells, "points": points, "unknowns": dofs, "nonzeros": nnz,
              "steps": steps, "frames": frames}
-    return Plan("solid", title, sizes, stages, load_constants()["bytes"]["baseline"],
+
+    def suggest(kind: str, limit: float) -> str:
+        """A time integration too long for a budget: the step and end time that fit."""
+        if spec.static is not None or kind not in ("time", "steps"):
+            return ""
+        k = limit / max(plan.seconds if kind == "time" else steps, 1e-300)
+        return f"dt >= {round_up(spec.dt / k)} or t_end <= {round_down(spec.t_end * k)}"
+
+    plan = Plan("solid", title, sizes, stages, load_constants()["bytes"]["baseline"],
                 assumptions=[
                     f"{CELLS_PER_MEASURE[dim]} x measure / h^{dim} {what} (gmsh)",
                     f"direct factor fill {fill:.0f}x the matrix nonzeros",
                     f"element pass >= {ELEMENTS_PER_SECOND:.0e} elements/s; seconds are an "
                     "order of magnitude (not calibrated on this machine)"])
+    plan.suggest = suggest
+    return plan
 
 
 def check_solid_fits(case) -> None:
@@ -94,3 +105,28 @@ def check_solid_fits(case) -> None:
         return
     check_budget(plan_solid_case(case, measure=False), case.run_options.get("limits"),
                  override=OVERRIDE)
+
+
+def check_explicit_step(case, system) -> None:
+    """Refuse an explicit integration whose step exceeds its critical step on the built mesh:
+    ``dt > bound / omega_max`` (``omega_max`` of ``M^-1 K`` at the start by power iteration,
+    :func:`femkit.dynamics.stability.estimate_omega_max`, which approaches it from below, so a
+    refused step is surely unstable). Such a run only blows up: one line
+    (:class:`~femkit.errors.BudgetExceededError`, exit 2) before anything is written, naming
+    the critical step; ``--force`` runs it anyway."""
+    from ...dynamics.stability import critical_dt, estimate_omega_max
+    from ...errors import BudgetExceededError
+
+    spec = case.spec
+    integrator = spec.integrator.build()
+    if case.run_options.get("force") or integrator.implicit:
+        return
+    omega = float(estimate_omega_max(system, system.x0))
+    dt_crit = float(critical_dt(omega, integrator.stability_bound))
+    if spec.dt > dt_crit:
+        raise BudgetExceededError(
+            f"dt: {spec.dt:g} exceeds the critical step {dt_crit:.4g} of the explicit "
+            f"{integrator.name} on this mesh ({integrator.stability_bound:.4g} / omega_max, "
+            f"omega_max = {omega:.4g}): the run would blow up; use dt <= "
+            f"{round_down(dt_crit)} or an implicit integrator (newton, variational_symplectic) "
+            f"(or {OVERRIDE} to run anyway)", "dt", spec.dt, dt_crit)

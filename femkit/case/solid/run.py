@@ -7,10 +7,16 @@ linear solver -- and builds the frozen :class:`~femkit.case.solid.spec.SolidSpec
 :func:`run_solid` checks the rest (tags of a mesh file, inverted input elements) before anything
 is written. Every such failure is a one-line :class:`~femkit.errors.InputError` (exit 2).
 
-A Newton failure of the static solve (:class:`~femkit.errors.EquilibriumError`) and an unstable
-time integration do not escape :func:`run_solid`: the frames computed before (load steps or
-time steps) are written, ``result.json`` says ``converged: false`` with the failure and, for
-Newton, the residual history; ``femkit solve`` exits 1.
+A Newton failure (:class:`~femkit.errors.EquilibriumError`: of the static solve, or of an
+implicit time step, :class:`~femkit.dynamics.integrators.base.NewtonStepError`), another failed
+step (a linear solve) and an unstable time integration do not escape :func:`run_solid`: the
+frames computed before (load steps or time steps) are written, ``result.json`` says
+``converged: false`` with the failure and, for Newton, the residual history; ``femkit solve``
+exits 1.
+
+Time integration holds every fixed or roller component (per component: rollers slide) at its
+prescribed displacement from ``t = 0`` (:class:`~femkit.dynamics.system.MassSpringSystem`'s
+``(n, d)`` pin mask).
 
 Static runs take load step ``k`` of ``K`` by :func:`femkit.solids.solve_static` from the
 previous equilibrium with ``k/K`` of the loads and prescribed displacements (what
@@ -29,7 +35,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ...errors import (CaseFileError, DegenerateMeshError, EquilibriumError, InputError,
-                       InstabilityError, with_prefix)
+                       InstabilityError, SolverError, with_prefix)
 from ...io.atomic import EARLIER_RUN, check_output_dir
 from ...timing import StageTimer
 from ..frozen import freeze
@@ -57,7 +63,7 @@ def _materials(d) -> dict:
     return out
 
 
-def _boundaries(d, dynamic: bool) -> tuple:
+def _boundaries(d) -> tuple:
     out = []
     for i, b in enumerate(d["boundaries"]):
         where = f"boundaries[{i}]"
@@ -65,12 +71,7 @@ def _boundaries(d, dynamic: bool) -> tuple:
             out.append(Boundary(b["tag"], "traction", traction=tuple(b["traction"])))
             continue
         comps = tuple(COMPONENTS.index(c) for c in b.get("fix", ()))  # () = every component
-        disp = tuple(b.get("displacement", ()))
-        if dynamic and (b["type"] == "roller" or "fix" in b or any(disp)):
-            raise CaseFileError(f"{where}: a {b['type']} condition on some components or with a "
-                                "displacement needs 'static: true' (time integration pins whole "
-                                "nodes at rest)")
-        out.append(Boundary(b["tag"], b["type"], comps, disp))
+        out.append(Boundary(b["tag"], b["type"], comps, tuple(b.get("displacement", ()))))
     return tuple(out)
 
 
@@ -103,7 +104,7 @@ def prepare_solid(case) -> None:
         Unknown material, geometry, integrator, solver (valid names listed).
     CaseFileError
         Unknown boundary tag or region of a geometry, both or neither of ``static`` and
-        ``integrator``, a vector of the wrong dimension, rollers in a dynamic run.
+        ``integrator``, a vector of the wrong dimension.
     """
     d = case.data
     if d.get("name"):
@@ -120,7 +121,7 @@ def prepare_solid(case) -> None:
         raise CaseFileError("give either 'static: true' (equilibrium) or an 'integrator' with "
                             "'dt' and 't_end' (time integration)" if not dynamic else
                             "'static' and 'integrator' exclude each other: give one")
-    boundaries = _boundaries(d, dynamic)
+    boundaries = _boundaries(d)
     dim = _check_geometry_tags(d, boundaries)
     for key in ("gravity", "velocity"):
         if dim is not None and key in d and len(d[key]) != dim:
@@ -225,14 +226,13 @@ def build_mesh(spec: SolidSpec):
 @dataclass
 class SolidProblem:
     """The built problem: mesh, body, Dirichlet data, external nodal loads (traction and
-    gravity, ``(n, d)`` each), fixed nodes (dynamic runs) and the gravity vector."""
+    gravity, ``(n, d)`` each) and the gravity vector."""
 
     mesh: Any
     body: Any
     fixes: list
     traction: np.ndarray
     weight: np.ndarray
-    fixed_nodes: np.ndarray
     gravity: np.ndarray
 
     def dirichlet(self, scale: float = 1.0):
@@ -273,7 +273,7 @@ def build_problem(case) -> SolidProblem:
         material = default
     body = ElasticBody(mesh.points, mesh.cells, material, cell_tags=mesh.cell_tags)
     traction = np.zeros((body.n, d))
-    fixed, fixes = [], []
+    fixes = []
     for i, b in enumerate(spec.boundaries):
         where = f"boundaries[{i}]"
         try:
@@ -286,7 +286,6 @@ def build_problem(case) -> SolidProblem:
                 traction += traction_forces(mesh.points, facets, b.traction)
             else:
                 nodes = np.unique(facets)
-                fixed.append(nodes)
                 disp = np.zeros(d)
                 disp[:len(b.displacement)] = b.displacement
                 if any(c >= d for c in b.components):
@@ -297,8 +296,7 @@ def build_problem(case) -> SolidProblem:
             raise with_prefix(exc, where) from None
     g = np.zeros(d) if spec.gravity is None else np.asarray(spec.gravity, dtype=float)
     weight = body_forces(body, body.density()[:, None] * g[None, :])
-    fixed_nodes = np.unique(np.concatenate(fixed)) if fixed else np.zeros(0, np.int64)
-    problem = SolidProblem(mesh, body, fixes, traction, weight, fixed_nodes, g)
+    problem = SolidProblem(mesh, body, fixes, traction, weight, g)
     problem.dirichlet(1.0)  # a dof prescribed twice with different values: InputError now
     return problem
 
@@ -393,7 +391,8 @@ class SolidResult:
             "tip_displacement": [float(c) for c in self.tip()],
             "volume": {"rest": float(body.rest.volumes.sum()),
                        "final": float((body.rest.volumes * fields["J"]).sum())},
-            "von_mises_max": float(np.nanmax(fields["von_mises"])),
+            "von_mises_max": (float(np.nanmax(fields["von_mises"]))    # None: every element inverted
+                              if np.isfinite(fields["von_mises"]).any() else None),
             "stretch_range": [float(fields["principal_stretches"].min()),
                               float(fields["principal_stretches"].max())],
             "inverted_elements": int(len(inverted)),
@@ -419,7 +418,8 @@ class SolidResult:
                  f"result    max displacement {d['max_displacement']:.6g}, tip "
                  f"[{', '.join(f'{c:.6g}' for c in d['tip_displacement'])}], volume "
                  f"{d['volume']['final'] / d['volume']['rest'] - 1:+.3%}, von Mises max "
-                 f"{d['von_mises_max']:.4g}",
+                 + (f"{d['von_mises_max']:.4g}" if d["von_mises_max"] is not None else
+                    "- (every element inverted)"),
                  f"energy    elastic {e['elastic']:.6g}, kinetic {e['kinetic']:.6g}, gravity "
                  f"{e['gravity']:.6g}, load {e['load']:.6g} (last frame of {d['frames']})",
                  f"verdict   {self.verdict}" + (f": {self.failure}" if self.failure else "")]
@@ -470,6 +470,7 @@ def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
     from ...dynamics.forces.gravity import Gravity
     from ...dynamics.integrators import StepContext
     from ...dynamics.simulate import simulate
+    from .cost import check_explicit_step
 
     spec, body = case.spec, problem.body
     forces = [Gravity(problem.gravity)] if spec.gravity is not None else []
@@ -478,7 +479,15 @@ def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
     v0 = None
     if spec.velocity is not None:
         v0 = np.broadcast_to(np.asarray(spec.velocity, float), (body.n, body.dim)).copy()
-    system = elastic_system(body, v0=v0, pinned=problem.fixed_nodes, forces=forces)
+    # every fixed or roller component is held where its displacement puts it, from t = 0
+    bc = problem.dirichlet(1.0)
+    held = np.zeros(body.ndof, dtype=bool)
+    held[bc.dofs] = True
+    x0 = body.rest_positions.reshape(-1).copy()
+    x0[bc.dofs] += bc.values
+    system = elastic_system(body, x0=x0.reshape(body.n, body.dim), v0=v0,
+                            pinned=held.reshape(body.n, body.dim), forces=forces)
+    check_explicit_step(case, system)    # a step that can only blow up: refused, nothing written
     out: dict = {}
     try:
         traj = simulate(system, spec.integrator.build(), spec.dt, spec.t_end,
@@ -487,6 +496,13 @@ def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
     except InstabilityError as exc:
         traj = exc.partial
         out["failure"] = " ".join(str(exc).split())
+    except SolverError as exc:   # a step failed (Newton, a linear solve): the frames before are kept
+        traj = getattr(exc, "partial", None)
+        if traj is None:
+            raise
+        out["failure"] = " ".join(str(exc).split())
+        out["verdict"] = "newton_failed" if isinstance(exc, EquilibriumError) else "solver_failed"
+        out["residual_history"] = getattr(exc, "residuals", None)
     out.update(times=list(traj.times), x=list(traj.x), v=list(traj.v),
                energies=[frame_energies(problem, x, v) for x, v in zip(traj.x, traj.v)],
                records=[], stats=dict(traj.stats))
@@ -525,7 +541,7 @@ def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = F
                          x=run["x"], v=run["v"], energies=run["energies"],
                          records=run["records"], failure=failure,
                          residual_history=run.get("residual_history"),
-                         verdict="converged" if failure is None else (
+                         verdict="converged" if failure is None else run.get("verdict") or (
                              "newton_failed" if case.spec.static else "unstable"),
                          wall_time=time.perf_counter() - t0, timings=timer.times,
                          stats=run.get("stats", {}))

@@ -37,6 +37,13 @@ class Force:
         """Contribution to ``K = -df/dx`` as a sparse matrix, or ``None``."""
         return None
 
+    def structure(self):
+        """``(indptr, indices)``: the fixed CSR structure (``ndof x ndof``) of every matrix
+        :meth:`stiffness` returns, whose ``data`` is then in this order; ``None`` (the default)
+        when the structure changes (contact) or there is no matrix. The compiled implicit
+        steps (``cholesky``) build it into their pattern once per run."""
+        return None
+
     def stiffness_product(self, x: np.ndarray, d: np.ndarray, fix: str | None = None):
         """``K_force d`` as ``(n, d)`` (matrix-free), or ``None``."""
         return None

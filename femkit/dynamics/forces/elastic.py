@@ -68,6 +68,17 @@ class ElasticForce(Force):
     def stiffness(self, x, fix=None):
         return self._eval(x, 2, fix == "clamp")[2]
 
+    @property
+    def stored_scale(self) -> float:
+        """``sum (mu + |lam|) vol``: the size of the terms the energy sums before they cancel
+        near rest (the round-off level of the energy is ``eps`` times it)."""
+        return float(sum((m.mu + abs(m.lam)) * self.body.rest.volumes[e].sum()
+                         for e, m in self.body.groups))
+
+    def structure(self):
+        pat = self.body.pattern
+        return pat.indptr, pat.indices
+
     def stiffness_product(self, x, d, fix=None):
         K = self.stiffness(x, fix)
         return (K @ np.asarray(d, dtype=float).reshape(-1)).reshape(self.body.n, self.body.dim)
@@ -82,7 +93,7 @@ class ElasticForce(Force):
 
 class DeadLoad(Force):
     """Constant nodal forces ``f`` ``(n, d)`` (surface tractions of a solid as dead loads,
-    :func:`femkit.solids.traction_forces`); potential ``-f . x`` over the unpinned nodes,
+    :func:`femkit.solids.traction_forces`); potential ``-f . x`` over the unpinned components,
     reported in the ``"gravity"`` bucket (the bucket of constant external forces).
 
     >>> import numpy as np
@@ -106,7 +117,7 @@ class DeadLoad(Force):
         if self.forces.shape != (system.n, system.dim) or not np.all(np.isfinite(self.forces)):
             raise InputError(f"dead load must be finite with shape ({system.n}, {system.dim}), "
                              f"got {self.forces.shape}")
-        self._f = np.where(system.pinned[:, None], 0.0, self.forces)
+        self._f = np.where(system.pinned_dofs, 0.0, self.forces)
 
     def add_force(self, x, v, t, out) -> None:
         out += self._f

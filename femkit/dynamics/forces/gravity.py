@@ -17,8 +17,9 @@ class Gravity(Force):
     axis : int
         Vertical axis for a scalar ``g``; default the last coordinate (``y`` in 2D, ``z`` in 3D).
 
-    Energy ``-sum_i m_i g . x_i`` over free (unpinned) nodes: pinned nodes get no force, so
-    their (constant) potential is left out, and ``force = -grad(energy)`` holds row by row.
+    Energy ``-sum_i m_i g . x_i`` over the free (unpinned) components: pinned components get no
+    force, so their (constant) potential is left out, and ``force = -grad(energy)`` holds entry
+    by entry.
 
     >>> import numpy as np
     >>> from femkit.dynamics.system import MassSpringSystem
@@ -44,8 +45,7 @@ class Gravity(Force):
         else:
             vec = as_vector(self.g, d, "gravity vector")
         self.vector = vec
-        w = np.where(system.pinned, 0.0, system.mass)
-        self._weight = w[:, None] * vec[None, :]
+        self._weight = np.where(system.pinned_dofs, 0.0, system.mass[:, None] * vec[None, :])
 
     def add_force(self, x, v, t, out) -> None:
         out += self._weight

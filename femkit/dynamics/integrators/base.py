@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...errors import InputError, StabilityWarning
+from ...errors import EquilibriumError, InputError, StabilityWarning
 from ...solvers.session import LinearSession
 from ...solvers.session import check_matrix_free as _check_matrix_free
 from ...solvers.spec import SolverSpec
@@ -44,6 +44,7 @@ __all__ = [
     "check_matrix_free",
     "check_matrix_free_options",
     "NonlinearConvergenceWarning",
+    "NewtonStepError",
     "note_unconverged",
 ]
 
@@ -123,7 +124,7 @@ class Integrator:
                 f"{self.name}: x and v must have shape {(system.n, system.dim)}, "
                 f"got {x.shape} and {v.shape}"
             )
-        v[system.pinned] = 0.0
+        v[system.pinned_dofs] = 0.0
         if getattr(self, "matrix_free", False):  # refuse a solver that needs the matrix up front
             check_matrix_free(self.name, ctx)
         return StepperState(x, v, float(t))
@@ -159,6 +160,23 @@ class NonlinearConvergenceWarning(StabilityWarning):
     at ``max_iterations`` without meeting its tolerance, so the step is not the method's exact
     step. A :class:`~femkit.errors.StabilityWarning` subclass, so scene runs record it in
     ``result.json``'s ``warnings``."""
+
+
+class NewtonStepError(EquilibriumError):
+    """The Newton iteration of an implicit step failed: its line search found no decrease above
+    the round-off level of the step's objective, and a full Newton step did not lower the
+    residual either (or the objective is not finite along the whole search).
+
+    ``time`` is the time the step was to reach, ``residuals`` the norms of the gradient on the
+    free dofs at every iterate of the failing step (the residual history), ``x`` the state the
+    step started from. :func:`femkit.dynamics.simulate.simulate` attaches the trajectory up to
+    that state as ``partial``.
+    """
+
+    def __init__(self, message: str, time: float, residuals, x=None):
+        self.time = float(time)
+        self.residuals = [float(r) for r in residuals]
+        super().__init__(message, x=x)
 
 
 def note_unconverged(name: str, ctx: StepContext, t: float, max_iterations: int, detail: str) -> None:

@@ -36,7 +36,7 @@ class CentralDifference(KickDriftKick):
         a = system.acceleration(x, v, t, rayleigh=False)
         if rk != 0.0:
             a = a - rk * system.hessian_product(x, v) / system.mass[:, None]
-            a[system.pinned] = 0.0
+            a[system.pinned_dofs] = 0.0
         return a
 
     def start(self, system, x, v, t, dt, ctx):

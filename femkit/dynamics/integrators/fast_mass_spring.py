@@ -35,7 +35,9 @@ Implementation
 factorisation (``femkit.solvers.factorize``: SuperLU, symmetric mode with the ``MMD_AT_PLUS_A``
 ordering for this SPD matrix) serves all ``d`` coordinates, solved as one ``(n_free, d)``
 right-hand-side block in Fortran order (one pass through the factors). Pinned nodes are
-eliminated: their rows are dropped and their fixed positions move to the right-hand side.
+eliminated: their rows are dropped and their fixed positions move to the right-hand side; nodes
+held in some components only (rollers) are eliminated per coordinate
+(:class:`~.component_pins.ComponentSolve`, one more factorisation per distinct held set).
 The local step and ``J d`` are two precomputed sparse matrices: ``G`` (``s x n_free``, the
 spring differences ``x_j - x_i``) and ``G^T diag(k r)``, so ``J d = G^T diag(k r) (dx / |dx|)``
 (lengths floored at ``system.length_floor``).
@@ -78,9 +80,10 @@ import numpy as np
 from ...errors import InputError
 from ...solvers.operators import restrict
 from .base import Integrator, StepContext, StepperState, box_length, check_iteration_options
+from .component_pins import ComponentSolve
 from .registry import register
 
-_KEY_ATTRS = ("mass", "k", "rest", "damping", "springs", "pinned", "forces")
+_KEY_ATTRS = ("mass", "k", "rest", "damping", "springs", "pinned", "pinned_dofs", "forces")
 
 
 def _cache_key(system, dt: float) -> tuple:
@@ -134,9 +137,9 @@ def _spring_rows(system, free: np.ndarray) -> tuple:
 class _Operators:
     """Everything a fast mass-spring step reuses while the cache key holds."""
 
-    factor: object
-    free: np.ndarray
-    pinned: np.ndarray
+    factor: object              # ComponentSolve: per-coordinate elimination of rollers
+    free: np.ndarray            # nodes free in some component
+    pinned: np.ndarray          # nodes held in every component
     m_free: np.ndarray          # (nf, 1)
     G_free: object              # s x nf: x_j - x_i on free nodes
     G_pin: object               # s x np: the pinned nodes' part of x_j - x_i
@@ -213,7 +216,8 @@ class FastMassSpring(Integrator):
         G = system.difference_operators[0]
         G_free = G[:, free].tocsr()
         ops = _Operators(
-            factor=ctx.session.factorize(restrict(A, free)),
+            factor=ComponentSolve(restrict(A, free), system.pinned_dofs[free],
+                                  ctx.session.factorize),
             free=free,
             pinned=pinned,
             m_free=mass[free][:, None],
@@ -234,6 +238,7 @@ class FastMassSpring(Integrator):
         """One local/global iteration as a function ``x_free -> x_free'`` (``x``: a full
         ``(n, d)`` work array whose pinned rows hold the fixed positions)."""
         free = ops.free
+        y_held = x[free]                             # the rollers' held components (fixed)
         variable = system.has_variable_forces
         compiled = ctx.linear_solver.method == "cholesky"
         if compiled:
@@ -267,7 +272,7 @@ class FastMassSpring(Integrator):
                 x[free] = x_free
                 rhs += ops.B_free @ x                # h B x_k (the damping split)
             ctx.count("linear_solves")               # one global solve (all d columns) per sweep
-            return ops.factor.solve(rhs if compiled else np.asfortranarray(rhs))
+            return ops.factor.solve(rhs if compiled else np.asfortranarray(rhs), y_held)
 
         return sweep
 

@@ -118,7 +118,7 @@ class Newmark(Integrator):
                                  f"residual {r:.3e} > tol x force scale = {self.tol * scale:.3e}")
         ctx.stats.setdefault("newton_iterations", []).append(iterations)
         a_new = a_new.reshape(shape)
-        a_new[system.pinned] = 0.0
+        a_new[system.pinned_dofs] = 0.0
         return StepperState(x_new, v_new, state.t + h, {"a": a_new})
 
     def dahlquist_amplification(self, z: complex) -> complex:

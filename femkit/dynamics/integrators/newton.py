@@ -14,8 +14,14 @@ is a descent direction), then backtracks (Armijo, Nocedal & Wright, Numerical Op
 ``x_n``) or after ``max_iterations``; the iteration count of every step is appended to
 ``ctx.stats["newton_iterations"]``, and a step stopped by ``max_iterations`` is counted in
 ``ctx.stats["unconverged_steps"]`` with a :class:`~.base.NonlinearConvergenceWarning` at the
-first one. (A line search that finds no decrease leaves ``x`` in place and ends the step: at
-round-off level that is convergence.)
+first one. Armijo's test allows the round-off level of ``g`` (``64 eps`` times the size of its
+terms, an elastic body's ``sum (mu + |lam|) vol`` among them, as
+:func:`femkit.solids.solve_static` does), so iterates keep converging where differences of ``g``
+drown in rounding. A line search that still finds no decrease takes the full step when it lowers
+the residual ``|grad g|`` on the free dofs, and otherwise -- or when ``g`` is not finite -- the
+step fails: :class:`~.base.NewtonStepError` with the residual history of the step (a
+:class:`~femkit.errors.EquilibriumError`; :func:`~femkit.dynamics.simulate.simulate` attaches
+the trajectory so far).
 
 With the ``direct`` (or ``cholesky``) solver and ``reuse_factorization=True`` (opt-in; the default
 ``False`` factorises every linear system, so ``direct`` means a direct solve) the factorisation of an
@@ -49,10 +55,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, SolverError
 from ...solvers.operators import free_operator, restrict
-from .base import (Integrator, StepContext, StepperState, box_length, check_iteration_options,
-                   check_matrix_free_options, note_unconverged)
+from .base import (Integrator, NewtonStepError, StepContext, StepperState, box_length,
+                   check_iteration_options, check_matrix_free_options, note_unconverged)
 from .registry import register
 
 
@@ -155,26 +161,42 @@ class NewtonImplicitEuler(Integrator):
         y = xn + h * state.v.reshape(-1)
         length = box_length(state.x)
 
+        stored = sum(float(getattr(f, "stored_scale", 0.0)) for f in system.forces)
+
         def g(xf):
+            """The objective and its round-off level (64 eps times the size of its terms)."""
             d, e = xf - y, xf - xn
-            return 0.5 * d @ (m * d) + h * h * system.potential_energy(xf.reshape(shape)) \
-                + 0.5 * h * (e @ c_apply(e))
+            try:
+                en = system.energies(xf.reshape(shape), None)
+            except SolverError:           # an element pass that is not finite there
+                return np.inf, 0.0
+            inertia, damping = 0.5 * d @ (m * d), 0.5 * h * (e @ c_apply(e))
+            value = inertia + h * h * (en["spring"] + en["gravity"] + en["contact"]) + damping
+            size = abs(inertia) + abs(damping) + h * h * (
+                abs(en["spring"]) + abs(en["gravity"]) + abs(en["contact"]) + stored)
+            return value, _ROUNDOFF * size
+
+        def gradient(xf):
+            return m * (xf - y) + h * h * system.potential_gradient(xf.reshape(shape)).reshape(-1) \
+                + h * c_apply(xf - xn)
 
         x = y.copy()
         x[~_free_mask(free, xn.size)] = xn[~_free_mask(free, xn.size)]
-        gx = g(x)
+        gx, noise = g(x)
+        residuals = []
         iterations = 0
         for iterations in range(1, self.max_iterations + 1):
-            grad = m * (x - y) + h * h * system.potential_gradient(x.reshape(shape)).reshape(-1) \
-                + h * c_apply(x - xn)
+            if compiled:  # the matrix first: an elastic body's element pass then serves the gradient
+                data = assemble_with_forces(pat, system, x.reshape(shape), zero_v, state.t,
+                                            diagonal=m, kcoef=h * h, dcoef=0.0, fix=self.fix)[0]
+                data += h * c_data
+            grad = gradient(x)
+            residuals.append(float(np.linalg.norm(grad[free])))
             dx = np.zeros_like(x)
             if self.matrix_free:
                 op, diag = self.newton_operator(system, x.reshape(shape), h, C)
                 dx[free] = ctx.session.solve(op, -grad[free], diagonal=diag)
             elif compiled:
-                data = assemble_with_forces(pat, system, x.reshape(shape), zero_v, state.t,
-                                            diagonal=m, kcoef=h * h, dcoef=0.0, fix=self.fix)[0]
-                data += h * c_data
                 dx[free] = ctx.session.solve_on_pattern(
                     pat.matrix(data), -grad[free], pat,
                     "newton_factor" if self.reuse_factorization else None)
@@ -188,17 +210,25 @@ class NewtonImplicitEuler(Integrator):
             if slope < 0.0:
                 for _ in range(self.max_backtracks):
                     x_try = x + t * dx
-                    g_try = g(x_try)
-                    if g_try <= gx + self.armijo * t * slope:
+                    g_try, noise_try = g(x_try)
+                    if g_try <= gx + self.armijo * t * slope + max(noise, noise_try):
                         break
                     t *= self.shrink
-                else:
-                    x_try, g_try = x, gx
+                else:  # no decrease above round-off: a full step must lower the residual
+                    t, x_try = 1.0, x + dx
+                    g_try, noise_try = g(x_try)
+                    lower = np.isfinite(g_try) and np.linalg.norm(
+                        gradient(x_try)[free]) < (1.0 - self.armijo) * residuals[-1]
+                    if not lower:
+                        self._fail(state, h, iterations, residuals,
+                                   "the line search found no decrease")
             else:  # not a descent direction (no definiteness fix): take the full Newton step
                 x_try = x + dx
-                g_try = g(x_try)
+                g_try, noise_try = g(x_try)
+            if not np.isfinite(g_try):
+                self._fail(state, h, iterations, residuals, "the objective is not finite")
             step_size = t * np.abs(dx).max(initial=0.0)
-            x, gx = x_try, g_try
+            x, gx, noise = x_try, g_try, noise_try
             if step_size <= self.tol * length:
                 converged = True
                 break
@@ -212,8 +242,22 @@ class NewtonImplicitEuler(Integrator):
         v_new = ((x - xn) / h).reshape(shape)
         return StepperState(x_new, v_new, state.t + h)
 
+    def _fail(self, state: StepperState, h: float, iterations: int, residuals: list,
+              why: str) -> None:
+        raise NewtonStepError(
+            f"{self.name}: Newton failed in the step from t = {state.t:.6g} to {state.t + h:.6g} "
+            f"at iteration {iterations}: {why} (residuals "
+            f"{', '.join(f'{r:.3e}' for r in residuals[-6:])})", state.t + h, residuals,
+            state.x.copy())
+
     def dahlquist_amplification(self, z: complex) -> complex:
         return 1.0 / (1.0 - z)
+
+
+#: Armijo's test allows this many ulps of the objective's terms (as the static solver does,
+#: :mod:`femkit.solids.static`): near the minimum the objective stops changing above its
+#: rounding while the gradient is still far from it.
+_ROUNDOFF = 64 * np.finfo(float).eps
 
 
 def _free_mask(free: np.ndarray, ndof: int) -> np.ndarray:

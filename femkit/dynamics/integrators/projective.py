@@ -19,7 +19,7 @@ shear modulus; the other constants of the body's materials are not used (project
 its own energy). The coordinates decouple, so the ``n x n`` matrix ``M + h^2 L`` is factorised
 once per run through the run's linear-solve session (``ctx.session.factorize``: CHOLMOD with the
 ``cholesky`` solver, else SuperLU) and serves all ``d`` coordinates; pinned nodes are eliminated
-as in fast mass-spring.
+as in fast mass-spring (rollers per coordinate, :class:`~.component_pins.ComponentSolve`).
 
 External forces: those flagged constant (gravity) once per step, the others (contact, damping)
 per iteration at velocity ``(x - x_n) / h``, explicitly (not in the matrix).
@@ -42,14 +42,15 @@ import numpy as np
 from ...errors import InputError
 from ...solvers.operators import restrict
 from .base import Integrator, StepContext, StepperState, check_iteration_options
+from .component_pins import ComponentSolve
 from .registry import register
 
 
 @dataclass
 class _Operators:
-    factor: object
-    free: np.ndarray
-    pinned: np.ndarray
+    factor: object             # ComponentSolve (rollers eliminated per coordinate)
+    free: np.ndarray           # nodes free in some component
+    pinned: np.ndarray         # nodes held in every component
     M: np.ndarray              # (n, 1) lumped masses
     A_fp: object               # free x pinned block of M + h^2 L
     w_rot: np.ndarray
@@ -122,7 +123,7 @@ class Projective(Integrator):
                              f"{self.volume_min!r}, {self.volume_max!r}")
 
     def _operators(self, system, dt: float, ctx: StepContext) -> _Operators:
-        key = (float(dt), system, system.mass, system.pinned, system.forces)
+        key = (float(dt), system, system.mass, system.pinned_dofs, system.forces)
         cached = ctx.cache.get("projective")
         if cached is not None and cached[0][0] == key[0] and all(
                 a is b for a, b in zip(cached[0][1:], key[1:])):
@@ -142,7 +143,8 @@ class Projective(Integrator):
         A = (sp.diags(mass) + (dt * dt) * L).tocsr()
         free = np.flatnonzero(~system.pinned)
         pinned = np.flatnonzero(system.pinned)
-        ops = _Operators(ctx.session.factorize(restrict(A, free)), free, pinned, mass[:, None],
+        ops = _Operators(ComponentSolve(restrict(A, free), system.pinned_dofs[free],
+                                        ctx.session.factorize), free, pinned, mass[:, None],
                          A[free][:, pinned].tocsr(), w_rot, w_vol, force, L)
         ctx.cache["projective"] = (key, ops)
         return ops
@@ -159,6 +161,8 @@ class Projective(Integrator):
         t_new = state.t + h
         x = xn + h * state.v
         x[pinned] = xn[pinned]
+        held = xn[free]
+        roller = ~system.pinned_dofs[free] if system.partially_pinned else None
         const = ops.M * x + (h * h) * system.constant_force()
         others = [f for f in system.forces if not f.constant and f is not ops.force]
         jmin, jmax = float(self.volume_min), float(self.volume_max)
@@ -181,10 +185,13 @@ class Projective(Integrator):
                 b -= ops.A_fp @ xn[pinned]
             # residual of the current iterate: A x_k - b(x_k) (h^2 times the gradient of g)
             Ax = ops.M[free] * x[free] + (h * h) * (ops.L @ x)[free]
-            rel = float(np.linalg.norm(Ax - rhs[free]) / max(np.linalg.norm(rhs[free]), 1e-300))
+            res, rn = Ax - rhs[free], rhs[free]
+            if roller is not None:      # a held component has no equation
+                res, rn = res[roller], rn[roller]
+            rel = float(np.linalg.norm(res) / max(np.linalg.norm(rn), 1e-300))
             if k >= int(self.iterations) or (self.tol is not None and rel <= self.tol):
                 break
-            x[free] = ops.factor.solve(np.asfortranarray(b))
+            x[free] = ops.factor.solve(np.asfortranarray(b), held)
             k += 1
         ctx.record("projective_iterations", k)
         ctx.record("projective_residual", rel)

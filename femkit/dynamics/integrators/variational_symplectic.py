@@ -77,7 +77,7 @@ class VariationalSymplectic(Integrator):
         vbar = 2.0 * (q - qn) / h
         x_new = (2.0 * q - qn).reshape(shape)
         v_new = (2.0 * vbar - vn).reshape(shape)
-        v_new[system.pinned] = 0.0
+        v_new[system.pinned_dofs] = 0.0
         return StepperState(x_new, v_new, state.t + h)
 
     def dahlquist_amplification(self, z: complex) -> complex:

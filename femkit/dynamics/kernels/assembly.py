@@ -8,7 +8,8 @@ pinned). A step then only writes values: :meth:`FreePattern.assemble` fills ``da
 diagonal, adds every spring's Hessian (with the definiteness fix) and dashpot blocks in one
 pass (:func:`~femkit.dynamics.kernels.spring_kernels.hessian_values`), and adds the declared
 forces' own matrices (contact stiffness, viscous damping: nodal blocks, inside the pattern) by a
-sorted merge. The pattern never changes, so the Cholesky factorisation reuses one symbolic
+sorted merge, or -- a force with a fixed structure, an elastic solid's Hessian -- by a slot map
+built with the pattern. The pattern never changes, so the Cholesky factorisation reuses one symbolic
 analysis for the whole run (:meth:`femkit.solvers.cholesky.CholeskyFactor.refactor`); a force
 matrix with an entry outside the pattern is reported (``None``), and the caller falls back to the
 general path.
@@ -25,9 +26,11 @@ __all__ = ["FreePattern", "free_pattern"]
 class FreePattern:
     """CSR pattern of the implicit methods' matrices on the free dofs, with the scatter slots.
 
-    The pattern holds every spring's four ``d x d`` blocks and every node's full ``d x d``
+    The pattern holds every spring's four ``d x d`` blocks, every node's full ``d x d``
     diagonal block (so nodal force matrices, e.g. contact stiffness or viscous damping, always
-    fit), restricted to the free dofs.
+    fit) and the fixed structure a declared force states (:meth:`Force.structure
+    <femkit.dynamics.forces.base.Force.structure>`: an elastic body's CSR pattern, whose values
+    are then written by slot, ``force_slots``), restricted to the free dofs.
 
     Attributes
     ----------
@@ -53,15 +56,28 @@ class FreePattern:
         ci, cj = (i[:, None] * d + cq).ravel(), (j[:, None] * d + cq).ravel()
         nodes = np.arange(system.n)
         nr, nc = (nodes[:, None] * d + rp).ravel(), (nodes[:, None] * d + cq).ravel()
+        # declared forces with a fixed matrix structure (an elastic body's CSR pattern)
+        structured = [(k, f.structure()) for k, f in enumerate(system.forces)]
+        structured = [(k, st) for k, st in structured if st is not None]
+        sr = [np.repeat(np.arange(ndof), np.diff(st[0])) for _, st in structured]
+        sc = [np.asarray(st[1], dtype=np.int64) for _, st in structured]
         fmap = np.full(ndof, -1, dtype=np.int64)
         fmap[free] = np.arange(nf)
-        fr = fmap[np.concatenate([ri, rj, ri, rj, nr])]
-        fc = fmap[np.concatenate([ci, cj, cj, ci, nc])]
+        fr = fmap[np.concatenate([ri, rj, ri, rj, nr, *sr])]
+        fc = fmap[np.concatenate([ci, cj, cj, ci, nc, *sc])]
         ok = (fr >= 0) & (fc >= 0)
         uniq, inv = np.unique(fr[ok] * nf + fc[ok], return_inverse=True)
         slot = np.full(fr.size, -1, dtype=np.int64)
         slot[ok] = inv
         self.slots = np.ascontiguousarray(slot[:4 * s * d * d].reshape(4, s, d * d))
+        #: force index -> (entries of its structure inside the free pattern, their data slots)
+        self.force_slots = {}
+        start = 4 * s * d * d + len(nr)
+        for (k, _), rows in zip(structured, sr):
+            part = slot[start:start + len(rows)]
+            inside = np.flatnonzero(part >= 0)
+            self.force_slots[k] = (inside, part[inside])
+            start += len(rows)
         self.diag = np.searchsorted(uniq, np.arange(nf, dtype=np.int64) * (nf + 1))
         self.indices = (uniq % nf).astype(np.int32) if nf else np.zeros(0, np.int32)
         counts = np.bincount(uniq // nf, minlength=nf) if nf else np.zeros(0, np.int64)
@@ -138,7 +154,7 @@ class FreePattern:
 def free_pattern(system, cache: dict) -> FreePattern:
     """The :class:`FreePattern` of ``system`` kept in ``cache`` (a run's ``ctx.cache``), rebuilt
     when the system, its springs or its pinned set are other objects."""
-    key = (system, system.springs, system.pinned)
+    key = (system, system.springs, system.pinned_dofs)
     kept = cache.get("free_pattern")
     if kept is not None and all(a is b for a, b in zip(kept[0], key)):
         return kept[1]
@@ -169,21 +185,29 @@ def assemble_with_forces(pat: FreePattern, system, x, v, t: float, *, diagonal, 
     data, f, kv = pat.assemble(system, x, diagonal=diagonal, kcoef=kcoef, ccoef=dcoef,
                                clamp=clamp, v=v, want_force=True, want_kv=True)
     force_fix = "clamp" if clamp else None
-    for force in system.forces:
+    moving = bool(v.any())
+    for k, force in enumerate(system.forces):
+        Kf = force.stiffness(x, force_fix)    # first: an elastic body's pass keeps its gradient
         if not isinstance(force, RayleighDamping):
             force.add_force(x, v, t, f)
-        Kf = force.stiffness(x, force_fix)
         Df = force.damping(x)
-        for B, coef in ((Kf, kcoef), (Df, dcoef)):
-            if B is not None and not pat.add(data, B, coef):
+        for B, coef, own in ((Kf, kcoef, k in pat.force_slots), (Df, dcoef, False)):
+            if B is None:
+                continue
+            if own:  # the force's declared fixed structure: its values go straight to their slots
+                entries, slots = pat.force_slots[k]
+                if B.nnz != len(force.structure()[1]):
+                    raise SolverError(f"{force!r}: its matrix left the structure it declared")
+                data[slots] += coef * B.data[entries]
+            elif not pat.add(data, B, coef):
                 raise SolverError(f"{force!r}: its matrix has entries outside the nodal blocks "
                                   "of the compiled pattern")
-        if Kf is not None:
+        if Kf is not None and moving:
             kv += (Kf @ v.reshape(-1)).reshape(v.shape)
     if fix == "regularize":
         mu = system.regularization_shift(x)
         system.last_shift = mu
         data[pat.diag] += kcoef * mu
         kv += mu * v
-    f[system.pinned] = 0.0
+    f[system.pinned_dofs] = 0.0
     return data, f, kv
