@@ -94,9 +94,9 @@ def _tip_deflection(mesh, params):
 
 
 SVSE_SCENES.register("hanging_beam", SceneType(
-    schema={**_common(h=[0.05, 0.035, 0.025, 0.0175], reference_h=0.00875, dt=0.02, t_end=1.2,
-                      damping=12.0),
-            "length": {**_POS, "default": 1.0}, "height": {**_POS, "default": 0.1}},
+    schema={**_common(h=[0.05, 0.035, 0.025, 0.0175, 0.0125], reference_h=0.00625, dt=0.02,
+                      t_end=1.2, damping=12.0),
+            "length": {**_POS, "default": 0.4}, "height": {**_POS, "default": 0.1}},
     geometry=lambda p: ("rectangle", dict(x0=0.0, y0=0.0, x1=float(p["length"]),
                                           y1=float(p["height"]))),
     pinned=lambda mesh, p: _side_nodes(mesh, "left"),

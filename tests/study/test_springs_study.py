@@ -38,7 +38,7 @@ def test_quick_study_writes_its_figures_and_numbers(quick):
         assert (out / "figures" / f).stat().st_size > 10_000
     data = json.loads((out / "results.json").read_text())
     methods = {r["method"] for r in data["records"]}
-    assert len(methods) == 4 and len(data["records"]) == 4 * (3 + 2)
+    assert len(methods) == 5 and len(data["records"]) == 5 * (3 + 2)
     for r in data["records"]:
         assert r["completed"] and r["seconds"] > 0
         for key in ("value", "value_error", "trajectory_error", "area_change_peak", "area_error"):
