@@ -44,7 +44,7 @@ import numpy as np
 
 from ..registry import Registry
 
-__all__ = ["SpringLayout", "SPRING_LAYOUTS", "van_gelder", "interior_edge_quads", "plane_strain_modulus"]
+__all__ = ["SpringLayout", "SPRING_LAYOUTS", "van_gelder", "plane_strain_modulus"]
 
 
 @dataclass(frozen=True)
@@ -100,15 +100,6 @@ def van_gelder(points, springs, areas, modulus: float) -> np.ndarray:
     p = np.asarray(points, dtype=float)
     d = p[springs[:, 1]] - p[springs[:, 0]]
     return float(modulus) * np.asarray(areas, float) / np.einsum("ij,ij->i", d, d)
-
-
-def interior_edge_quads(points, triangles):
-    """``(cross springs (q, 2), quadrilateral areas (q,))``: for every interior edge the pair of
-    vertices opposite it and the area of its two triangles."""
-    edges, summed, first, second = _edge_areas(points, triangles)
-    inner = second >= 0
-    cross = np.sort(np.stack([first[inner], second[inner]], axis=1), axis=1)
-    return cross.astype(np.intp), summed[inner]
 
 
 def _edges(mesh, modulus: float):

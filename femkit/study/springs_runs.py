@@ -67,10 +67,10 @@ def build_system(method: MethodSpec, mesh, pinned, forces, E: float, nu: float, 
     from .spring_layouts import SPRING_LAYOUTS, plane_strain_modulus
 
     if method.springs:
+        from ..dynamics.topology import mesh_springs
+
         springs, k = SPRING_LAYOUTS.get(method.layout).build(mesh, plane_strain_modulus(E, nu))
-        tri = mesh.triangles
-        mass = np.bincount(tri.ravel(), weights=np.repeat(density * mesh.areas() / 3.0, 3),
-                           minlength=mesh.n_points)
+        mass = mesh_springs(mesh, k=1.0, density=density).mass   # the one lumping rule
         return MassSpringSystem(mesh.points.copy(), mass, springs, k, pinned=pinned,
                                 forces=list(forces)), len(springs)
     body = ElasticBody(mesh.points, mesh.triangles, material(method.material, E=E, nu=nu,
