@@ -17,7 +17,7 @@ from typing import Any, Mapping
 
 __all__ = ["StudySpec", "PoissonSource", "LevelsSpec", "PoissonStudySpec", "AdaptiveStudySpec", "DynamicsScene",
            "DynamicsReference", "DynamicsStudySpec", "StabilityStudySpec", "ClothReference",
-           "ClothStudySpec", "SolidLoadStudySpec"]
+           "ClothStudySpec", "SolidLoadStudySpec", "SpringsStudySpec"]
 
 
 @dataclass(frozen=True)
@@ -274,3 +274,22 @@ class SolidLoadStudySpec(StudySpec):
         return cls(**cls.common(d), base_case=str(d["base_case"]), materials=tuple(d["materials"]),
                    scale=float(d["scale"]), load_steps=int(d["load_steps"]),
                    case_overrides=_plain(d.get("case_overrides") or {}))
+
+
+@dataclass(frozen=True)
+class SpringsStudySpec(StudySpec):
+    """``kind: springs_vs_elements`` (defaults: :func:`femkit.study.springs_elements.
+    springs_schema`): the material, each scene's parameters (defaults of its
+    :data:`~femkit.study.springs_scenes.SVSE_SCENES` entry filled), the methods
+    (:class:`~femkit.study.springs_runs.MethodSpec`) and the reference method."""
+
+    material: Mapping
+    scenes: Mapping                 # scene name -> its parameters
+    methods: tuple
+    reference: Any
+
+    @classmethod
+    def from_data(cls, d: Mapping, methods, reference) -> "SpringsStudySpec":
+        return cls(**cls.common(d), material=_plain(d["material"]),
+                   scenes=_plain({k: dict(v) for k, v in d["scenes"].items()}),
+                   methods=tuple(methods), reference=reference)
