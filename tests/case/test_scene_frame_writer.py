@@ -194,3 +194,27 @@ def test_output_removed_mid_run_is_one_line_and_leaves_nothing(tmp_path):
     assert sorted(q.name for q in tmp_path.iterdir()) == ["out", "scene.yaml"]  # no *.tmp-*
     assert (tmp_path / "out" / "result.json").read_text() == before
     assert json.loads(before)["frames"] == 11
+
+
+def test_simulate_hands_every_recorded_frame_to_on_record():
+    """``on_record(k, t, x, v)`` sees exactly the recorded frames, in order, as kept copies (an
+    unstable run included: its last good state is the last frame)."""
+    from femkit.dynamics.simulate import simulate
+    from femkit.dynamics.topology import single_spring
+    from femkit.errors import InstabilityError
+
+    seen = []
+    traj = simulate(single_spring(), "newmark", 1e-2, 0.25, record_every=3,
+                    on_record=lambda k, t, x, v: seen.append((k, t, x, v)))
+    assert [k for k, *_ in seen] == list(range(len(traj.times)))
+    for k, t, x, v in seen:
+        assert t == traj.times[k]
+        np.testing.assert_array_equal(x, traj.x[k])
+        np.testing.assert_array_equal(v, traj.v[k])
+    seen.clear()
+    with pytest.raises(InstabilityError) as info:
+        simulate(single_spring(k=1e6), "explicit_euler", 1e-2, 5.0, check_stability=False,
+                 on_record=lambda k, t, x, v: seen.append((k, t)))
+    partial = info.value.partial
+    assert [k for k, _ in seen] == list(range(len(partial.times)))
+    assert [t for _, t in seen] == list(partial.times)
