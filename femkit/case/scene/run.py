@@ -6,7 +6,9 @@ preconditioner names against their registries, integrator options, mesh geometry
 expressions, output cadence), so bad input fails before anything is computed or written;
 :func:`run_scene` builds the system with *only the declared forces*, runs
 :func:`femkit.dynamics.simulate.simulate` and writes the outputs atomically
-(:mod:`femkit.case.scene.output`).
+(:mod:`femkit.case.scene.output`): the frames by a writer thread while the simulation runs
+(:class:`~femkit.case.scene.output.FrameStream`, off the run's critical path), the other files
+after it, all into the output directory's temporary place, moved into place at the end.
 
 Stability: an :class:`~femkit.errors.InstabilityError` does not escape :func:`run_scene`. The
 trajectory up to the last good step is written, ``result.json`` says ``"verdict":
