@@ -54,3 +54,4 @@ def test_signal_while_writing_frames_keeps_a_consistent_marked_output(tmp_path, 
     assert times[-1] == pytest.approx(result["t_reached"])   # the state at the stop is the last
     last = meshio.read(out / "frames" / frames[-1])             # every kept frame is whole
     assert last.points.shape == (SCENE["system"]["n"], 3) and np.isfinite(last.points).all()
+    assert "final.png" not in {p.name for p in out.iterdir()}  # no plotting after a stop

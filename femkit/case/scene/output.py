@@ -190,6 +190,7 @@ def _write_outputs(result, tmp: Path, stream: FrameStream | None) -> None:
     traj, system, tri = result.trajectory, result.system, result.triangles
     files: list[str] = []
     stop = active_flag()
+    stopped = bool(stop)   # a stop request answered: the pictures (seconds of plotting) are skipped
     if stop:  # the simulation itself was stopped: write every frame it recorded
         stop = None
     if opts.vtu:
@@ -208,10 +209,10 @@ def _write_outputs(result, tmp: Path, stream: FrameStream | None) -> None:
     if opts.energy_csv:
         write_energy_csv(tmp / "energy.csv", traj)
         files.append("energy.csv")
-    if opts.png and not stop:
+    if opts.png and not stop and not stopped:
         write_final_png(tmp / "final.png", system, traj, result.case.name, triangles=tri)
         files.append("final.png")
-    if opts.gif and not stop:
+    if opts.gif and not stop and not stopped:
         write_gif(tmp / "animation.gif", system, traj, result.case.name, triangles=tri)
         files.append("animation.gif")
     files.append("result.json")
