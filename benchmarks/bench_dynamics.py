@@ -38,6 +38,12 @@ the NumPy spring passes (the baseline), ``cholesky`` (CHOLMOD) and ``cholesky`` 
 ``options: {engine: pardiso}`` (MKL PARDISO, when the extra ``femkit[pardiso]`` is installed),
 plus symplectic Euler against Taichi's own demo. ``--engines``: the numeric refactorisation
 alone per engine and ordering on the Baraff-Witkin matrices (:func:`engine_rows`).
+
+The whole command (``--liu [ENGINE]``, issue 19): the bundled ``cases/scenes/liu_cloth.yaml`` on
+``cholesky`` (engine ``cholmod`` by default, or ``cholespy``) with its default outputs (a frame
+every 2 steps, energy.csv, result.json), run as a user runs it (``femkit solve``, a fresh
+process each), against the kernel's frame time on the identical system (built from the same
+file) measured in this process, in the same run (:func:`liu_rows`).
 """
 
 from __future__ import annotations
@@ -430,8 +436,126 @@ def engine_rows() -> None:
                   f"{fl / 1e6 if fl else float('nan'):7.0f} {fl / t / 1e9 if fl else float('nan'):7.2f}")
 
 
+LIU_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "cases", "scenes",
+                        "liu_cloth.yaml")
+
+
+def _cpu(who) -> float:
+    import resource
+
+    r = resource.getrusage(who)
+    return r.ru_utime + r.ru_stime
+
+
+def _solve_scene(overrides: list[str], out: str) -> dict:
+    """``femkit solve`` of the Liu scene in a fresh process: its result.json, the process's wall
+    time (start to exit) and CPU time (user + system, all its threads)."""
+    import json
+    import resource
+    import subprocess
+
+    cmd = [sys.executable, "-m", "femkit.cli", "solve", LIU_CASE, "--quiet", "--output", out]
+    for o in overrides:
+        cmd += ["--set", o]
+    c0, t0 = _cpu(resource.RUSAGE_CHILDREN), time.perf_counter()
+    subprocess.run(cmd, check=True, capture_output=True, text=True)
+    wall, cpu = time.perf_counter() - t0, _cpu(resource.RUSAGE_CHILDREN) - c0
+    with open(os.path.join(out, "result.json")) as fh:
+        res = json.load(fh)
+    res.update(process_wall=wall, process_cpu=cpu)
+    return res
+
+
+def _kernel_frame(engine: str, repeats: int) -> tuple[float, float]:
+    """The kernel: median wall seconds of one fast mass-spring frame on the scene's own system
+    (after a warm-up frame, as :func:`_time_steps` measures), and its mean CPU seconds."""
+    import resource
+
+    from femkit.case import load_case
+    from femkit.case.scene.run import build_system
+
+    case = load_case(LIU_CASE, linear_solver__method="cholesky",
+                     linear_solver__options={"engine": engine})
+    system, _ = build_system(case)
+    ctx = StepContext(SolverSpec("cholesky", options={"engine": engine}))
+    integ = case.spec.integrator.build()
+    h = case.spec.dt
+    s = integ.step(system, integ.start(system, system.x0, system.v0, 0.0, h, ctx), h, ctx)
+    times = []
+    c0 = _cpu(resource.RUSAGE_SELF)
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        s = integ.step(system, s, h, ctx)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), (_cpu(resource.RUSAGE_SELF) - c0) / repeats
+
+
+def liu_rows(engine: str = "cholmod", rounds: int = 3) -> None:
+    """Issue 19: the Liu scene through ``femkit solve`` against its kernel, in one run.
+
+    Per round: the kernel's median frame (20 frames in this process), then ``femkit solve`` of
+    the scene as bundled (60 steps, ``t_end = 2``) and of the same scene run three times as long
+    (``t_end = 6``, 180 steps), each a fresh process with the default outputs. The marginal
+    per-step wall of the whole command is the difference of the two processes' wall times (start
+    to exit) over the 120 extra steps: everything a step costs (the step, energies and checks,
+    the frame handed to the writer thread, waiting for it, the files) without the one-time costs
+    (start-up, imports, factorisation, loading the compiled kernels), which are printed apart.
+    The same difference of the processes' CPU time (all threads: the writer's work counted
+    even when another core did it) is printed against the kernel's CPU time per frame: on a
+    machine shared with other jobs the wall times swing by 2x from round to round, the CPU
+    times by a few percent. Medians over ``rounds`` rounds; goal: marginal per-step wall <= 1.15
+    x the kernel's frame."""
+    import tempfile
+
+    sets = ["linear_solver.method=cholesky", f"linear_solver.options={{engine: {engine}}}"]
+    kernel, kcpu, marginal, mcpu, stage, whole, walls, frames = [], [], [], [], [], [], [], []
+    last = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for r in range(rounds):
+            kw, kc = _kernel_frame(engine, 20)
+            kernel.append(kw)
+            kcpu.append(kc)
+            a = _solve_scene(sets, os.path.join(tmp, f"a{r}"))
+            b = _solve_scene(sets + ["t_end=6"], os.path.join(tmp, f"b{r}"))
+            extra = b["steps"] - a["steps"]
+            marginal.append((b["process_wall"] - a["process_wall"]) / extra)
+            mcpu.append((b["process_cpu"] - a["process_cpu"]) / extra)
+            stage.append((b["timings"]["simulate"] - a["timings"]["simulate"]) / extra)
+            whole.append(a["timings"]["simulate"] / a["steps"])
+            walls.append(a["process_wall"])
+            frames.append(a["frames"])
+            last = a["timings"]
+    k, m = statistics.median(kernel), statistics.median(marginal)
+    kc, mc = statistics.median(kcpu), statistics.median(mcpu)
+
+    def rounds_of(values):
+        return ", ".join(f"{1e3 * t:.1f}" for t in values)
+
+    print(f"Liu 81x81 cloth (cases/scenes/liu_cloth.yaml), fast_mass_spring 10 it, cholesky "
+          f"(engine {engine}), default outputs ({frames[0]} frames of 60 steps); "
+          f"OPENBLAS_NUM_THREADS={os.environ['OPENBLAS_NUM_THREADS']}; medians of {rounds} rounds; "
+          f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    print(f"{'':58s} {'wall ms':>8s} {'CPU ms':>8s}   rounds (wall)")
+    print(f"{'kernel frame (bench_dynamics, in this process)':58s} {1e3 * k:8.1f} {1e3 * kc:8.1f}"
+          f"   {rounds_of(kernel)}")
+    print(f"{'femkit solve, marginal per step (processes, 180 - 60)':58s} {1e3 * m:8.1f} "
+          f"{1e3 * mc:8.1f}   {rounds_of(marginal)}")
+    print(f"{'femkit solve, marginal simulate stage per step':58s} "
+          f"{1e3 * statistics.median(stage):8.1f}")
+    print(f"{'femkit solve, simulate stage / steps (60, one-time incl.)':58s} "
+          f"{1e3 * statistics.median(whole):8.1f}")
+    print(f"femkit solve, 60 steps: process wall {statistics.median(walls):.2f} s; stages of the "
+          "last: " + ", ".join(f"{n} {v:.3f} s" for n, v in last.items()))
+    print(f"ratio femkit solve per step / kernel frame: wall {m / k:.3f}, CPU {mc / kc:.3f}  "
+          "(goal <= 1.15)")
+
 if __name__ == "__main__":
-    if "--engines" in sys.argv:
+    if "--liu" in sys.argv:
+        i = sys.argv.index("--liu")
+        eng = sys.argv[i + 1] if len(sys.argv) > i + 1 and not sys.argv[i + 1].startswith("-") \
+            else "cholmod"
+        liu_rows(eng, rounds=1 if "--quick" in sys.argv else 3)
+    elif "--engines" in sys.argv:
         engine_rows()
     elif "--compiled" in sys.argv:
         compiled_rows(quick="--quick" in sys.argv)

@@ -184,8 +184,9 @@ import json, resource, subprocess, sys, time
 t0 = time.perf_counter()
 p = subprocess.run(sys.argv[1:], capture_output=True, text=True)
 wall = time.perf_counter() - t0
+ru = resource.getrusage(resource.RUSAGE_CHILDREN)
 print(json.dumps({"code": p.returncode, "wall": wall, "stdout": p.stdout, "stderr": p.stderr[-3000:],
-                  "peak_mb": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024}))
+                  "peak_mb": ru.ru_maxrss / 1024, "cpu": ru.ru_utime + ru.ru_stime}))
 """
 
 
@@ -199,10 +200,11 @@ def measure(cmd: list[str], cwd: str, env: dict) -> dict:
     return r
 
 
-def femkit_row(name: str, k: int, tmp: Path, env: dict) -> dict:
+def femkit_row(name: str, k: int, tmp: Path, env: dict, quiet: bool = True) -> dict:
     case = tmp / f"{name}_{k}.yaml"
     case.write_text(CASE.format(name=f"{name}_{k}", h=H0, k=k, solver=SOLVERS[name]))
-    r = measure([sys.executable, "-m", "femkit.cli", "solve", str(case), "--quiet"], str(tmp), env)
+    r = measure([sys.executable, "-m", "femkit.cli", "solve", str(case)] + ["--quiet"] * quiet,
+                str(tmp), env)
     res = json.loads((tmp / f"out_{name}_{k}" / "result.json").read_text())
     r.update(dofs=res["dofs"], stages=res["timings"], errors=res["errors"], inside=res.get("wall") or {})
     return r
@@ -263,24 +265,31 @@ def pipeline(levels: list[int]) -> None:
 
 
 def cold(k: int) -> None:
-    """First run after install (empty numba cache) against the second, fmg case."""
+    """First run after install (empty numba cache) against the second, fmg case; and the first
+    run after ``femkit warmup`` on another empty cache. Wall times and CPU times (user + system:
+    on a machine shared with other jobs the wall times swing, the CPU times much less)."""
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
         env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp / "numba-cache"))
-        first = femkit_row("fmg", k, tmp, env)
+        first = femkit_row("fmg", k, tmp, env, quiet=False)  # what the terminal says
         second = femkit_row("fmg", k, tmp, env)
         print(f"\n=== fmg, h = {H0} refined {k} times, {first['dofs']:,} unknowns: empty compile "
-              "cache, then warm ===")
+              f"cache, then warm (load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} "
+              "cores) ===")
         for label, r in (("first (cold cache)", first), ("second (warm)", second)):
-            print(f"{label:20s} wall {r['wall']:6.2f} s  {_stages(r['stages'])}")
-        print(f"ratio first / warm: {first['wall'] / second['wall']:.2f}  (goal <= 2); the first "
-              f"run's compile stage {first['stages'].get('compile', 0.0):.2f} s")
+            print(f"{label:20s} wall {r['wall']:6.2f} s  CPU {r['cpu']:6.2f} s  {_stages(r['stages'])}")
+        said = [line for line in first["stdout"].splitlines() if "compil" in line]
+        print("the first run said: " + " / ".join(said))
+        print(f"ratio first / warm: wall {first['wall'] / second['wall']:.2f}, CPU "
+              f"{first['cpu'] / second['cpu']:.2f}  (goal <= 2); the first run's compile stage "
+              f"{first['stages'].get('compile', 0.0):.2f} s")
         warm = tmp / "numba-warmup"
         wenv = dict(os.environ, NUMBA_CACHE_DIR=str(warm))
         t = measure([sys.executable, "-m", "femkit.cli", "warmup"], str(tmp), wenv)
         after = femkit_row("fmg", k, tmp, wenv)
-        print(f"'femkit warmup' on an empty cache: {t['wall']:.2f} s; the first solve after it "
-              f"{after['wall']:.2f} s = {after['wall'] / second['wall']:.2f}x the warm run")
+        print(f"'femkit warmup' on an empty cache: wall {t['wall']:.2f} s, CPU {t['cpu']:.2f} s; "
+              f"the first solve after it: wall {after['wall']:.2f} s = {after['wall'] / second['wall']:.2f}x "
+              f"the warm run, CPU {after['cpu']:.2f} s = {after['cpu'] / second['cpu']:.2f}x")
 
 
 def main(argv=None) -> None:

@@ -137,8 +137,9 @@ def _list_summary(v: list) -> dict:
 
 
 class _Recorder:
-    def __init__(self, system):
+    def __init__(self, system, on_record=None):
         self.system = system
+        self.on_record = on_record
         self.times, self.xs, self.vs, self.mom = [], [], [], []
         self.energies = {k: [] for k in _ENERGY_KEYS}
 
@@ -149,6 +150,8 @@ class _Recorder:
         self.mom.append(self.system.momentum(v))
         for k in _ENERGY_KEYS:
             self.energies[k].append(e[k])
+        if self.on_record is not None:  # the copies just kept: never modified afterwards
+            self.on_record(len(self.times) - 1, float(t), self.xs[-1], self.vs[-1])
 
     def build(self, method, dt, steps, wall, **kw) -> Trajectory:
         n, d = self.system.n, self.system.dim
@@ -230,7 +233,8 @@ class _GrowthMonitor:
 def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | None = None,
              record_every: int = 1, energy_growth_limit: float = 100.0,
              check_stability: bool = True, check_every: int = 10, progress=False,
-             stop=None, x0=None, v0=None, t0: float = 0.0, **integrator_options) -> Trajectory:
+             stop=None, x0=None, v0=None, t0: float = 0.0, on_record=None,
+             **integrator_options) -> Trajectory:
     """Integrate ``system`` from ``t0`` to ``t_end`` with fixed step ``dt``.
 
     Parameters
@@ -262,6 +266,10 @@ def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | 
         ``stop``, a stop request of an enclosing :func:`femkit.interrupt.stop_on_signals` block
         raises :class:`~femkit.interrupt.Interrupted` (a study's run keeps nothing partial).
     x0, v0, t0 : initial state (default the system's ``x0``, ``v0`` and 0).
+    on_record : callable, optional
+        ``on_record(k, t, x, v)`` at each recorded frame ``k`` (0, 1, ...), with the recorded
+        copies of the state (read-only for the callee): how a caller writes frames while the
+        run goes on (a scene's writer thread) instead of after it.
 
     Returns
     -------
@@ -309,7 +317,7 @@ def simulate(system, integrator, dt: float, t_end: float, *, ctx: StepContext | 
     x_init = system.x0 if x0 is None else x0
     v_init = system.v0 if v0 is None else v0
     state = integrator.start(system, x_init, v_init, t0, dt, ctx)
-    rec = _Recorder(system)
+    rec = _Recorder(system, on_record)
     e0 = system.energies(state.x, state.v)
     scale = energy_scale(system, state.x, state.v, e0)
     monitor = _GrowthMonitor(e0["total"], scale, float(energy_growth_limit))

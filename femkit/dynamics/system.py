@@ -363,8 +363,15 @@ class MassSpringSystem:
     def energies(self, x, v) -> dict:
         """``dict(kinetic, spring, gravity, contact, total)`` (``v=None`` gives kinetic 0)."""
         x = self._state(x)
-        _, l, _ = self._geometry(x)
-        out = {"kinetic": 0.0, "spring": spring_energy(l, self.k, self.rest), "gravity": 0.0, "contact": 0.0}
+        if self.n_springs >= COMPILED_SPRINGS:  # one compiled pass, no (s, d) temporaries
+            from .kernels.spring_kernels import spring_energy as compiled_energy
+
+            spring = float(compiled_energy(np.ascontiguousarray(x), self._i, self._j, self.k,
+                                           self.rest, self.length_floor))
+        else:
+            _, l, _ = self._geometry(x)
+            spring = spring_energy(l, self.k, self.rest)
+        out = {"kinetic": 0.0, "spring": spring, "gravity": 0.0, "contact": 0.0}
         if v is not None:
             v = self._state(v, "v")
             out["kinetic"] = float(0.5 * np.einsum("n,nd,nd->", self.mass, v, v))

@@ -147,3 +147,128 @@ def write_parallel_index(path: str | os.PathLike, first_piece: str | os.PathLike
     for p in pieces:
         ET.SubElement(grid, "Piece", Source=p)
     return _atomic_xml(Path(path), tree=ET.ElementTree(vtk))
+
+
+# ----------------------------------------------------------------------------- frame series
+__all__ += ["VtuFrames"]
+
+#: VTK cell type numbers of the meshio cell types a frame series writes (VTK's vtkCellType.h).
+_VTK_TYPES = {"vertex": 1, "line": 3, "triangle": 5, "quad": 9, "tetra": 10, "hexahedron": 12,
+              "wedge": 13, "pyramid": 14}
+_VTK_NAMES = {"f8": "Float64", "f4": "Float32", "i8": "Int64", "i4": "Int32", "u1": "UInt8"}
+
+
+def _little(a: np.ndarray) -> np.ndarray:
+    """``a`` as a C-contiguous little-endian array of one of the VTK types written here."""
+    a = np.asarray(a)
+    kind = a.dtype.kind + str(a.dtype.itemsize)
+    if kind not in _VTK_NAMES:
+        a = a.astype(np.int64 if a.dtype.kind in "iub" else np.float64)
+        kind = a.dtype.kind + str(a.dtype.itemsize)
+    return np.ascontiguousarray(a, dtype=np.dtype("<" + kind))
+
+
+class VtuFrames:
+    """``.vtu`` files of a time series whose cells never change (a scene's frames), written at
+    disk speed: VTK's XML format with the arrays as *raw appended* binary (``<AppendedData
+    encoding="raw">``, UInt64 block headers; Kitware, "VTK File Formats", section "XML File
+    Formats"), no base64 and no compression. The connectivity, offsets and types are encoded
+    once; each frame writes its XML header and then its arrays straight from memory. ParaView
+    and meshio read these files like any ``.vtu``.
+
+    ``cells`` is ``[(meshio type, (k, nv) ints), ...]`` as for :func:`write_cells`;
+    :meth:`write` takes the points ``(n, d)``, ``point_data`` ``{name: (n,) or (n, c)}`` and
+    ``cell_data`` ``{name: [one array per block]}``.
+    """
+
+    def __init__(self, cells: Sequence[tuple[str, np.ndarray]]):
+        unknown = [kind for kind, _ in cells if kind not in _VTK_TYPES]
+        if unknown:
+            raise MeshError(f"frame series: cell type {unknown[0]!r} not supported; valid: "
+                            f"{', '.join(_VTK_TYPES)}")
+        blocks = [(kind, np.asarray(conn)) for kind, conn in cells]
+        self.rows = [len(c) for _, c in blocks]
+        self.n_cells = sum(self.rows)
+        conn = [c.reshape(len(c), -1) for _, c in blocks]
+        sizes = np.concatenate([np.full(len(c), c.shape[1], dtype=np.int64) for c in conn]) \
+            if conn else np.zeros(0, dtype=np.int64)
+        # Int32 connectivity and offsets while they fit (VTK reads either): a third less to write
+        top = max([sum(c.size for c in conn)] + [int(c.max()) + 1 for c in conn if c.size])
+        index = np.int32 if top < 2 ** 31 else np.int64
+        self._topology = (
+            _little(np.concatenate([c.ravel() for c in conn]).astype(index) if conn
+                    else np.zeros(0, index)),
+            _little(np.cumsum(sizes).astype(index)),
+            _little(np.concatenate([np.full(len(c), _VTK_TYPES[k], dtype=np.uint8)
+                                    for (k, _), c in zip(blocks, conn)])
+                    if conn else np.zeros(0, np.uint8)))
+        self._layout: tuple | None = None
+        self._header = b""
+
+    def _xml(self, n_points: int, point: list, cell: list) -> bytes:
+        offset = 0
+
+        def array(a: np.ndarray, name: str, components: int | None) -> str:
+            nonlocal offset
+            comp = "" if components is None else f' NumberOfComponents="{components}"'
+            tag = (f'<DataArray type="{_VTK_NAMES[a.dtype.str[1:]]}" Name="{name}"{comp} '
+                   f'format="appended" offset="{offset}"/>')
+            offset += 8 + a.nbytes
+            return tag
+
+        conn, offs, types = self._topology
+        lines = ['<?xml version="1.0"?>',
+                 '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
+                 'header_type="UInt64">', "<UnstructuredGrid>",
+                 f'<Piece NumberOfPoints="{n_points}" NumberOfCells="{self.n_cells}">',
+                 "<Points>", array(point[0][1], "Points", 3), "</Points>",
+                 "<Cells>", array(conn, "connectivity", None), array(offs, "offsets", None),
+                 array(types, "types", None), "</Cells>", "<PointData>"]
+        lines += [array(a, name, a.shape[1] if a.ndim == 2 else None) for name, a in point[1:]]
+        lines += ["</PointData>", "<CellData>"]
+        lines += [array(a, name, a.shape[1] if a.ndim == 2 else None) for name, a in cell]
+        lines += ["</CellData>", "</Piece>", "</UnstructuredGrid>",
+                  '<AppendedData encoding="raw">', "_"]
+        return "\n".join(lines).encode("ascii")
+
+    def write(self, path: str | os.PathLike, points: np.ndarray, *,
+              point_data: dict | None = None, cell_data: dict | None = None) -> Path:
+        """Write one frame to ``path`` (its directory must exist).
+
+        Raises
+        ------
+        MeshError
+            A data array whose row count does not match, or the file cannot be written
+            (the operating system's reason).
+        """
+        pts = _little(pad3(points))
+        point = [("Points", pts)]
+        for name, a in (point_data or {}).items():
+            a = _little(a)
+            if a.shape[0] != len(pts):
+                raise MeshError(f"point_data {name!r} has {a.shape[0]} rows, the frame has "
+                                f"{len(pts)} points")
+            point.append((name, a))
+        cell = []
+        for name, per_block in (cell_data or {}).items():
+            rows = [np.shape(a)[0] for a in per_block]
+            if rows != self.rows:
+                raise MeshError(f"cell_data {name!r} has {rows} rows per block, the cell blocks "
+                                f"have {self.rows}")
+            cell.append((name, _little(np.concatenate([np.asarray(a) for a in per_block]))))
+        layout = tuple((name, a.dtype.str, a.shape) for name, a in point + cell)
+        if layout != self._layout:
+            self._layout, self._header = layout, self._xml(len(pts), point, cell)
+        conn, offs, types = self._topology
+        arrays = [pts, conn, offs, types] + [a for _, a in point[1:]] + [a for _, a in cell]
+        try:
+            with open(path, "wb") as fh:
+                fh.write(self._header)
+                for a in arrays:
+                    fh.write(np.uint64(a.nbytes).tobytes())
+                    fh.write(memoryview(a).cast("B"))
+                fh.write(b"\n</AppendedData>\n</VTKFile>\n")
+        except OSError as exc:
+            raise MeshError(f"cannot write frame {os.fspath(path)}: "
+                            f"{exc.strerror or exc}") from None
+        return Path(path)

@@ -37,7 +37,9 @@ def test_first_run_compiles_in_its_own_stage_then_never_again(tmp_path):
     cache = tmp_path / "numba-cache"
     first = _run(["solve", "case.yaml"], tmp_path, cache)
     timings = json.loads((tmp_path / "out" / "result.json").read_text())["timings"]
-    assert "compiling kernels (first run, cached afterwards)..." in first
+    assert ("compiling kernels (first run, cached afterwards): mesh edges, P1 assembly, "
+            "geometric multigrid..." in first)
+    assert "compiled in " in first
     assert timings["compile"] > 0 and list(timings)[:2] == ["compile", "mesh"]
     second = _run(["solve", "case.yaml"], tmp_path, cache)
     assert "compiling" not in second
@@ -59,3 +61,22 @@ def test_warmup_fills_the_cache(tmp_path):
     empty = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                            env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "other")))
     assert empty.stdout.strip() == "False"
+
+
+def test_a_run_without_multigrid_compiles_no_multigrid_kernel(tmp_path):
+    """The families a run needs: pcg + jacobi compiles edges and assembly, not multigrid."""
+    from femkit.case.poisson.warmup import families
+
+    assert families(True) == ("mesh edges", "P1 assembly", "geometric multigrid")
+    assert families(False) == ("mesh edges", "P1 assembly")
+    probe = ("from femkit.case.poisson.warmup import warm_up, kernels_cached; "
+             "warm_up(print, multigrid=False); "
+             "print(kernels_cached(('mesh edges', 'P1 assembly')), "
+             "kernels_cached(('geometric multigrid',)))")
+    res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache")),
+                         timeout=900)
+    assert res.returncode == 0, res.stderr
+    lines = res.stdout.strip().splitlines()
+    assert lines[0] == "compiling kernels (first run, cached afterwards): mesh edges, P1 assembly..."
+    assert lines[-1] == "True False"

@@ -200,3 +200,27 @@ def test_multigrid_levels_are_scipy_galerkin_products_down_to_a_1x1_level():
         np.testing.assert_allclose(mg.levels[lvl].inv_diag, mg.omega / C.diagonal(), rtol=1e-15)
     x = mg.vcycle(np.ones(sys.A.shape[0]))
     assert np.all(np.isfinite(x)) and x @ np.ones(sys.A.shape[0]) > 0
+
+
+@pytest.mark.parametrize("name", ["dense-coarse", "hierarchy"])
+@pytest.mark.parametrize("capacity", [1, 7, 10 ** 6], ids=["cap1", "cap7", "cap1e6"])
+def test_galerkin_output_growth_is_invisible(name, capacity):
+    """The compiled pass stops at a row that does not fit and the buffers grow between calls:
+    whatever the starting capacity, the same arrays (and rows longer than 32 entries, sorted by
+    the Shell sort, in canonical order as SciPy's)."""
+    from femkit.solvers.preconditioners import _gmg_kernels
+    from femkit.solvers.preconditioners.gmg import _kernel_index
+
+    A, P = _case(name)
+    A, P = A.tocsr(), P.tocsr()
+    PT = transpose_csr(P)
+    args = [a for M in (PT, A, P) for a in (_kernel_index(M.indptr), _kernel_index(M.indices),
+                                              M.data)]
+    ref = _gmg_kernels.galerkin(*args, A.nnz * 4)
+    got = _gmg_kernels.galerkin(*args, capacity)
+    for a, b in zip(got, ref):
+        np.testing.assert_array_equal(a, b)
+    C, diag = galerkin_product(A, P)
+    _assert_matches_scipy(A, P, C, diag)
+    if name == "dense-coarse":
+        assert np.diff(C.indptr).max() > 32

@@ -273,9 +273,12 @@ def _compile_stage(case: Case, mesh, stage, echo) -> None:
     ``compile`` stage (not inside assembly and solve), saying so on the terminal (``echo``)."""
     from .warmup import must_compile, warm_up
 
-    if must_compile(mesh, case.solver.needs_hierarchy):
+    multigrid = case.solver.needs_hierarchy
+    if must_compile(mesh, multigrid):
         with stage("compile"):
-            warm_up(echo)
+            seconds = warm_up(echo, multigrid)
+        if echo is not None:
+            echo(f"compiled in {seconds:.1f} s (stage 'compile'; the next runs load them)")
 
 
 def _solve(case: Case, system, stop, **mg):

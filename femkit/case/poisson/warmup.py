@@ -1,13 +1,18 @@
 """Compile the Poisson pipeline's kernels ahead: ``femkit warmup``, or the first large run.
 
-femkit's compiled kernels (numba, ``cache=True``: assembly, edges, geometric multigrid) are
-compiled on their first call after an install and loaded from the on-disk cache afterwards. A
-first solve would otherwise pay that compile (tens of seconds on a loaded machine) inside its
-assembly and solve stages. :func:`warm_up` compiles them on a tiny fmg problem instead, with the
-size thresholds that choose the compiled paths lowered for its duration, so every kernel and
-every argument type a large run uses is in the cache afterwards; :func:`kernels_cached` says
-whether that already happened (the run prints ``compiling kernels (first run, cached
-afterwards)...`` and books the time as its own ``compile`` stage when not).
+femkit's compiled kernels (numba, ``cache=True``: mesh edges, P1 assembly, geometric multigrid)
+are compiled on their first call after an install and loaded from the on-disk cache afterwards.
+A first solve would otherwise pay that compile inside its mesh, assembly and solve stages.
+:func:`warm_up` compiles them on a tiny problem instead, with the size thresholds that choose the
+compiled paths lowered for its duration, so every kernel and every argument type a large run
+uses is in the cache afterwards; :func:`kernels_cached` says whether that already happened (the
+run prints ``compiling kernels (first run, cached afterwards): mesh edges, P1 assembly,
+geometric multigrid...`` naming what it compiles, books the time as its own ``compile`` stage
+and prints how long it took).
+
+Only the families a run needs are compiled (:data:`FAMILIES`): a run without multigrid compiles
+no multigrid kernel. One tiny fmg run compiles every multigrid kernel that pcg + gmg calls too
+(the same V-cycle, the same argument types), so the warm-up runs one case, not one per solver.
 """
 
 from __future__ import annotations
@@ -16,16 +21,19 @@ import importlib
 import time
 from typing import Callable
 
-__all__ = ["warm_up", "kernels_cached", "needs_kernels", "must_compile", "COMPILE_MESSAGE"]
+__all__ = ["warm_up", "kernels_cached", "needs_kernels", "must_compile", "families", "FAMILIES",
+           "COMPILE_MESSAGE"]
 
-COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)..."
+COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)"
 
-#: (module, name) of one kernel of each compiled family; when all are in the on-disk cache the
-#: kernels were compiled before (a warm-up compiles every family at once).
-_PROBES = (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
-           ("femkit.mesh._edges_kernel", "unique_edges"),
-           ("femkit.solvers.preconditioners._gmg_kernels", "galerkin"),
-           ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps"))
+#: Each compiled family of the Poisson pipeline: (module, name) of its kernels that a warm-up
+#: leaves in numba's on-disk cache (when all are there, the family was compiled before).
+FAMILIES = {
+    "mesh edges": (("femkit.mesh._edges_kernel", "unique_edges"),),
+    "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness")),
+    "geometric multigrid": (("femkit.solvers.preconditioners._gmg_kernels", "_galerkin_rows"),
+                            ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps")),
+}
 
 #: The module constants that choose the compiled paths by size (lowered during a warm-up).
 _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiffness", "NUMBA_THRESHOLD"),
@@ -42,6 +50,12 @@ _TINY = {
 }
 
 
+def families(multigrid: bool) -> tuple[str, ...]:
+    """The compiled families a run uses: all of them with geometric multigrid, else edges and
+    assembly."""
+    return tuple(FAMILIES) if multigrid else ("mesh edges", "P1 assembly")
+
+
 def needs_kernels(mesh, multigrid: bool) -> bool:
     """True when a run on ``mesh`` (None: not built yet) calls compiled kernels: a mesh above the
     smallest size threshold, or geometric multigrid (``multigrid``: fmg, or pcg + gmg)."""
@@ -55,31 +69,33 @@ def needs_kernels(mesh, multigrid: bool) -> bool:
     return mesh.n_cells >= min(NUMBA_THRESHOLD, EDGES)
 
 
-def kernels_cached() -> bool:
-    """True when every compiled family is in numba's on-disk cache (``NUMBA_CACHE_DIR`` or the
-    package's ``__pycache__``)."""
+def kernels_cached(names: tuple[str, ...] | None = None) -> bool:
+    """True when every kernel of the families ``names`` (default: all of :data:`FAMILIES`) is in
+    numba's on-disk cache (``NUMBA_CACHE_DIR`` or the package's ``__pycache__``)."""
     import os
 
-    for module, name in _PROBES:
-        cache = getattr(importlib.import_module(module), name)._cache
-        path = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
-        if path is None or not os.path.exists(path):
-            return False
+    for family in (tuple(FAMILIES) if names is None else names):
+        for module, name in FAMILIES[family]:
+            cache = getattr(importlib.import_module(module), name)._cache
+            path = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
+            if path is None or not os.path.exists(path):
+                return False
     return True
 
 
-def warm_up(echo: Callable[[str], object] | None = None) -> float:
-    """Compile (or load) every kernel of the Poisson pipeline on a tiny fmg problem; seconds taken.
+def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True) -> float:
+    """Compile (or load) the kernels of the Poisson pipeline on a tiny problem; seconds taken.
 
-    The compiled paths are forced for its duration (the size thresholds set to 0, restored
-    after), and gmg-preconditioned CG runs too, so the argument types of a large run are the
-    ones compiled.
+    ``multigrid``: the tiny problem runs fmg (every family), else pcg + jacobi (edges and
+    assembly only). The compiled paths are forced for its duration (the size thresholds set to
+    0, restored after), so the argument types of a large run are the ones compiled. ``echo``
+    receives one line naming the families compiled.
     """
     from ..load import case_from_dict
 
     global _ACTIVE
     if echo is not None:
-        echo(COMPILE_MESSAGE)
+        echo(f"{COMPILE_MESSAGE}: {', '.join(families(multigrid))}...")
     t0 = time.perf_counter()
     saved = [(importlib.import_module(m), name) for m, name in _THRESHOLDS]
     values = [getattr(mod, name) for mod, name in saved]
@@ -87,9 +103,8 @@ def warm_up(echo: Callable[[str], object] | None = None) -> float:
     try:
         for mod, name in saved:
             setattr(mod, name, 0)
-        for solver in ({"method": "fmg"}, {"method": "pcg", "preconditioner": "gmg"}):
-            case = case_from_dict(dict(_TINY, solver=solver))
-            case.run(write=False, quiet=True)
+        solver = {"method": "fmg"} if multigrid else {"method": "pcg", "preconditioner": "jacobi"}
+        case_from_dict(dict(_TINY, solver=solver)).run(write=False, quiet=True)
     finally:
         _ACTIVE = False
         for (mod, name), value in zip(saved, values):
@@ -97,11 +112,12 @@ def warm_up(echo: Callable[[str], object] | None = None) -> float:
     return time.perf_counter() - t0
 
 
-#: True while :func:`warm_up` runs its tiny cases (which must not warm up again).
+#: True while :func:`warm_up` runs its tiny case (which must not warm up again).
 _ACTIVE = False
 
 
 def must_compile(mesh, multigrid: bool) -> bool:
     """True before the first run after an install whose ``mesh`` (with geometric multigrid when
     ``multigrid``) will call kernels that are not compiled yet (not inside a warm-up)."""
-    return not _ACTIVE and needs_kernels(mesh, multigrid) and not kernels_cached()
+    return (not _ACTIVE and needs_kernels(mesh, multigrid)
+            and not kernels_cached(families(multigrid)))

@@ -2,15 +2,18 @@
 
 :func:`write_scene_outputs` builds the whole output directory under a temporary name and moves
 it into place only when every file is written (:func:`femkit.io.atomic.atomic_directory`).
+Under ``femkit solve`` the frames are written while the simulation runs (:class:`FrameStream`:
+a writer thread fed by the simulation's ``on_record``, off the run's critical path) into that
+temporary directory; the other files follow when the run ends.
 
 Frames: one ``frames/frame_NNNNN.vtu`` per recorded step (points padded to 3D; cells are the
 springs as ``line`` cells, plus the ``triangle`` cells of cloth and mesh systems; point data
 ``velocity`` (3D) and ``pinned``; cell data ``stretch`` = length / rest - 1 on springs, 0 on
-triangles) and ``scene.pvd`` listing them with their times (ParaView opens the ``.pvd`` as a
+triangles; VTK XML with raw appended binary arrays, uncompressed: :class:`femkit.mesh.vtk.VtuFrames`) and ``scene.pvd`` listing them with their times (ParaView opens the ``.pvd`` as a
 time series). ``xdmf: true`` writes ``scene.xdmf`` + ``scene.h5`` (meshio's time-series writer).
 
 Matplotlib and Pillow (pictures: :mod:`femkit.case.scene.plot`) are imported only when a PNG
-or GIF is asked for; meshio only when frames are written.
+or GIF is asked for; meshio only for XDMF.
 """
 
 from __future__ import annotations
@@ -22,11 +25,12 @@ import numpy as np
 
 from ...interrupt import active_flag
 from ...io.atomic import EARLIER_RUN, atomic_directory
+from ...io.background import BackgroundWriter
 from ...io.writers import write_csv, write_json
-from ...mesh.vtk import pad3, write_cells, write_collection
+from ...mesh.vtk import VtuFrames, pad3, write_collection
 from .plot import write_final_png, write_gif
 
-__all__ = ["write_scene_outputs", "write_frames_vtu", "write_frames_xdmf", "write_pvd",
+__all__ = ["write_scene_outputs", "FrameStream", "write_frames_vtu", "write_frames_xdmf", "write_pvd",
            "write_energy_csv", "energy_columns", "RESULT_KEYS"]
 
 #: Top-level keys of a scene's result.json.
@@ -44,30 +48,71 @@ def _frame_cells(system, triangles) -> list[tuple[str, np.ndarray]]:
     return cells
 
 
+class FrameStream:
+    """A run's frames, written while it runs: ``add`` is :func:`~femkit.dynamics.simulate.simulate`'s
+    ``on_record``; each frame becomes ``directory/subdir/frame_NNNNN.vtu`` (the stretch computed
+    and the file written by :class:`femkit.mesh.vtk.VtuFrames`) in a writer thread
+    (:class:`femkit.io.background.BackgroundWriter`: bounded queue, errors raised in the run's
+    thread). ``background=False`` writes each frame at once in the caller's thread: the same
+    bytes. Use it as a context manager: leaving on an exception drops the queued frames and
+    waits for the one being written."""
+
+    def __init__(self, directory: str | os.PathLike, system, triangles=None, *,
+                 subdir: str = "frames", background: bool = True, depth: int = 8):
+        self.directory = Path(directory)
+        self.subdir = subdir
+        (self.directory / subdir).mkdir(parents=True, exist_ok=True)
+        cells = _frame_cells(system, triangles)
+        self._vtu = VtuFrames(cells)
+        self._i = np.ascontiguousarray(system.springs[:, 0])
+        self._j = np.ascontiguousarray(system.springs[:, 1])
+        self._rest = np.asarray(system.rest, dtype=float)
+        self._zeros = [np.zeros(len(c)) for _, c in cells[1:]]
+        self._pinned = np.asarray(system.pinned).astype(np.int32)
+        self.names: list[str] = []
+        self.writer = BackgroundWriter(depth, "femkit frame writer", background)
+
+    def add(self, k: int, t: float, x: np.ndarray, v: np.ndarray) -> None:
+        """Queue frame ``k`` (state ``x``, ``v`` at time ``t``; not modified afterwards)."""
+        name = f"{self.subdir}/frame_{k:05d}.vtu"
+        self.writer.submit(self._write, self.directory / name, x, v)
+        self.names.append(name)
+
+    def _write(self, path: Path, x: np.ndarray, v: np.ndarray) -> None:
+        dx = np.take(x, self._j, axis=0)
+        dx -= np.take(x, self._i, axis=0)
+        stretch = np.sqrt(np.einsum("sd,sd->s", dx, dx)) / self._rest - 1.0
+        self._vtu.write(path, x, cell_data={"stretch": [stretch, *self._zeros]},
+                        point_data={"velocity": pad3(v), "pinned": self._pinned})
+
+    def close(self, stop=None) -> list[str]:
+        """Wait for the queued frames; the relative names of those written, in order.
+
+        ``stop`` (a :class:`~femkit.interrupt.StopFlag`) checked while waiting: once set, the
+        frames not yet started are dropped (those written so far are kept and returned)."""
+        return self.names[:self.writer.close(stop)]
+
+    def __enter__(self) -> "FrameStream":
+        return self
+
+    def __exit__(self, kind, value, tb) -> None:
+        if kind is not None:
+            self.writer.cancel()
+
+
 def write_frames_vtu(directory: str | os.PathLike, system, traj, triangles=None,
                      subdir: str = "frames", stop=None) -> list[str]:
-    """One ``.vtu`` per recorded frame in ``directory/subdir`` (femkit's one VTK writer,
-    :func:`femkit.mesh.vtk.write_cells`); returns their relative names.
+    """One ``.vtu`` per recorded frame of ``traj`` in ``directory/subdir``, written now (the
+    frames of :class:`FrameStream`, same bytes); returns their relative names.
 
     ``stop`` (a :class:`~femkit.interrupt.StopFlag`) is checked before each frame: once set,
     the frames written so far are returned (a Ctrl-C while frames are written is answered)."""
-    d = Path(directory)
-    cells = _frame_cells(system, triangles)
-    i, j = system.springs[:, 0], system.springs[:, 1]
-    names = []
-    for k in range(len(traj.times)):
-        if stop:
-            break
-        x = traj.x[k]
-        stretch = [np.linalg.norm(x[j] - x[i], axis=1) / system.rest - 1.0]
-        if len(cells) > 1:
-            stretch.append(np.zeros(len(cells[1][1])))
-        name = f"{subdir}/frame_{k:05d}.vtu"
-        write_cells(d / name, x, cells, cell_data={"stretch": stretch},
-                    point_data={"velocity": pad3(traj.v[k]),
-                                "pinned": system.pinned.astype(np.int32)})
-        names.append(name)
-    return names
+    with FrameStream(directory, system, triangles, subdir=subdir, background=False) as frames:
+        for k in range(len(traj.times)):
+            if stop:
+                break
+            frames.add(k, float(traj.times[k]), traj.x[k], traj.v[k])
+        return frames.close()
 
 
 def write_pvd(path: str | os.PathLike, times: Sequence[float], files: Sequence[str]) -> Path:
@@ -122,37 +167,54 @@ def write_energy_csv(path: str | os.PathLike, traj) -> Path:
 
 # ----------------------------------------------------------------------------- all
 
-def write_scene_outputs(result, directory: str | os.PathLike) -> Path:
-    """Write every requested output of ``result`` (a SceneResult) into ``directory`` atomically."""
-    opts = result.case.spec.output
-    traj, system, tri = result.trajectory, result.system, result.triangles
+def write_scene_outputs(result, directory: str | os.PathLike, *, into: Path | None = None,
+                        frames: FrameStream | None = None) -> Path:
+    """Write every requested output of ``result`` (a SceneResult) into ``directory`` atomically.
+
+    ``into``: the temporary directory of an :func:`~femkit.io.atomic.atomic_directory` the
+    caller holds open (its run's), where ``frames`` (a :class:`FrameStream`) has been writing
+    the frames during the run; the remaining files go there and the caller moves it into place.
+    Without it the directory is built here, frames included."""
     final = Path(directory).resolve()
     result.output_dir = final
+    if into is not None:
+        _write_outputs(result, Path(into), frames)
+        return final
+    with atomic_directory(final, EARLIER_RUN) as tmp:
+        _write_outputs(result, tmp, None)
+    return final
+
+
+def _write_outputs(result, tmp: Path, stream: FrameStream | None) -> None:
+    opts = result.case.spec.output
+    traj, system, tri = result.trajectory, result.system, result.triangles
     files: list[str] = []
     stop = active_flag()
+    stopped = bool(stop)   # a stop request answered: the pictures (seconds of plotting) are skipped
     if stop:  # the simulation itself was stopped: write every frame it recorded
         stop = None
-    with atomic_directory(final, EARLIER_RUN) as tmp:
-        if opts.vtu:
+    if opts.vtu:
+        if stream is None:
             frames = write_frames_vtu(tmp, system, traj, tri, stop=stop)
-            write_pvd(tmp / "scene.pvd", traj.times[:len(frames)], frames)
-            files += ["scene.pvd", *frames]
-            if stop:  # stopped while writing frames: keep those, skip the pictures
-                result.output_stop = stop.name
-                result.frames_written = len(frames)
-        if opts.xdmf and not stop:
-            write_frames_xdmf(tmp / "scene.xdmf", system, traj, tri)
-            files += ["scene.xdmf", "scene.h5"]
-        if opts.energy_csv:
-            write_energy_csv(tmp / "energy.csv", traj)
-            files.append("energy.csv")
-        if opts.png and not stop:
-            write_final_png(tmp / "final.png", system, traj, result.case.name, triangles=tri)
-            files.append("final.png")
-        if opts.gif and not stop:
-            write_gif(tmp / "animation.gif", system, traj, result.case.name, triangles=tri)
-            files.append("animation.gif")
-        files.append("result.json")
-        result.files = files
-        write_json(tmp / "result.json", result.to_dict())
-    return final
+        else:  # written during the run: wait for the last ones (a stop request is answered)
+            frames = stream.close(stop)
+        write_pvd(tmp / "scene.pvd", traj.times[:len(frames)], frames)
+        files += ["scene.pvd", *frames]
+        if stop:  # stopped while writing frames: keep those, skip the pictures
+            result.output_stop = stop.name
+            result.frames_written = len(frames)
+    if opts.xdmf and not stop:
+        write_frames_xdmf(tmp / "scene.xdmf", system, traj, tri)
+        files += ["scene.xdmf", "scene.h5"]
+    if opts.energy_csv:
+        write_energy_csv(tmp / "energy.csv", traj)
+        files.append("energy.csv")
+    if opts.png and not stop and not stopped:
+        write_final_png(tmp / "final.png", system, traj, result.case.name, triangles=tri)
+        files.append("final.png")
+    if opts.gif and not stop and not stopped:
+        write_gif(tmp / "animation.gif", system, traj, result.case.name, triangles=tri)
+        files.append("animation.gif")
+    files.append("result.json")
+    result.files = files
+    write_json(tmp / "result.json", result.to_dict())

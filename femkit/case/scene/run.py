@@ -6,7 +6,9 @@ preconditioner names against their registries, integrator options, mesh geometry
 expressions, output cadence), so bad input fails before anything is computed or written;
 :func:`run_scene` builds the system with *only the declared forces*, runs
 :func:`femkit.dynamics.simulate.simulate` and writes the outputs atomically
-(:mod:`femkit.case.scene.output`).
+(:mod:`femkit.case.scene.output`): the frames by a writer thread while the simulation runs
+(:class:`~femkit.case.scene.output.FrameStream`, off the run's critical path), the other files
+after it, all into the output directory's temporary place, moved into place at the end.
 
 Stability: an :class:`~femkit.errors.InstabilityError` does not escape :func:`run_scene`. The
 trajectory up to the last good step is written, ``result.json`` says ``"verdict":
@@ -23,6 +25,7 @@ Each stage is a public function (:func:`build_system`, :func:`build_integrator`,
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import math
 import os
@@ -48,7 +51,7 @@ from ...errors import (
     UnknownNameError,
     with_prefix,
 )
-from ...io.atomic import EARLIER_RUN, check_output_dir
+from ...io.atomic import EARLIER_RUN, atomic_directory, check_output_dir
 from ...progress import Progress
 from ...solvers.defaults import DEFAULT_METHOD
 from ...timing import StageTimer
@@ -59,7 +62,7 @@ from ..load import Case
 from ..names import check_geometry_spec, resolve_file
 from ..specs import IntegratorSpec, limits_spec, solver_spec
 from .forces import FORCES
-from .output import write_scene_outputs
+from .output import FrameStream, write_scene_outputs
 from .spec import OutputSpec, SceneSpec, StabilitySpec, record_every
 from .systems import SYSTEMS, system_size
 
@@ -464,8 +467,9 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
         ``converged`` is false when the run became unstable; the results up to the last good
         step are still written, marked ``"verdict": "unstable"``.
     """
+    final = Path(output_dir or case.spec.output.dir).resolve()
     if write:  # refuse a bad output location before any work (never replaces user files)
-        check_output_dir(output_dir or case.spec.output.dir, EARLIER_RUN)
+        check_output_dir(final, EARLIER_RUN)
     check_scene_fits(case, system_size(case.spec.system))  # before anything is allocated
     out = echo or print
     timer = StageTimer()
@@ -482,37 +486,46 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
 
     caught: list[str] = []
     instability = None
-    with timer("simulate"), warnings.catch_warnings(record=True) as wlist:
-        warnings.simplefilter("always", StabilityWarning)
-        try:
-            traj = simulate(system, integrator, case.spec.dt, case.spec.t_end, ctx=ctx,
-                            record_every=every, energy_growth_limit=st.energy_growth_limit,
-                            check_stability=st.check, check_every=st.check_every,
-                            progress=progress, stop=stop)
-        except InstabilityError as exc:
-            instability = exc
-            traj = exc.partial
-        for w in wlist:
-            if issubclass(w.category, StabilityWarning):
-                caught.append(" ".join(str(w.message).split()))
-            else:
-                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    with contextlib.ExitStack() as outputs:
+        # the output directory is built under a temporary name while the run goes on: frames
+        # are written by a writer thread as they are recorded, the rest after the run; an
+        # error anywhere removes it (nothing half-written), the earlier run stays
+        tmp = outputs.enter_context(atomic_directory(final, EARLIER_RUN)) if write else None
+        frames = None
+        if write and case.spec.output.vtu:
+            frames = outputs.enter_context(FrameStream(tmp, system, triangles))
+        with timer("simulate"), warnings.catch_warnings(record=True) as wlist:
+            warnings.simplefilter("always", StabilityWarning)
+            try:
+                traj = simulate(system, integrator, case.spec.dt, case.spec.t_end, ctx=ctx,
+                                record_every=every, energy_growth_limit=st.energy_growth_limit,
+                                check_stability=st.check, check_every=st.check_every,
+                                progress=progress, stop=stop,
+                                on_record=None if frames is None else frames.add)
+            except InstabilityError as exc:
+                instability = exc
+                traj = exc.partial
+            for w in wlist:
+                if issubclass(w.category, StabilityWarning):
+                    caught.append(" ".join(str(w.message).split()))
+                else:
+                    warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
-    omega = None
-    if st.check and traj.omega_max is None and system.n_springs:
-        omega = float(estimate_omega_max(system, iters=200))
-    result = SceneResult(case=case, system=system, integrator=integrator, trajectory=traj,
-                         triangles=triangles, instability=instability, every=every,
-                         wall_time=time.perf_counter() - t0, timings=timer.times, omega_max=omega,
-                         warnings=caught)
-    if not quiet:
-        for w in caught:
-            print(f"femkit: warning: {w}", file=sys.stderr)
-    if write:
-        with timer("output"):
-            write_scene_outputs(result, output_dir or case.spec.output.dir)
-        # wall_time stays "build + simulate" as result.json and docs/scenes.md say; the output
-        # stage has its own entry in the timings
+        omega = None
+        if st.check and traj.omega_max is None and system.n_springs:
+            omega = float(estimate_omega_max(system, iters=200))
+        result = SceneResult(case=case, system=system, integrator=integrator, trajectory=traj,
+                             triangles=triangles, instability=instability, every=every,
+                             wall_time=time.perf_counter() - t0, timings=timer.times,
+                             omega_max=omega, warnings=caught)
+        if not quiet:
+            for w in caught:
+                print(f"femkit: warning: {w}", file=sys.stderr)
+        if write:
+            # wall_time stays "build + simulate" as result.json and docs/scenes.md say; the
+            # output stage (the last frames, the other files) has its own entry in the timings
+            with timer("output"):
+                write_scene_outputs(result, final, into=tmp, frames=frames)
     if instability is not None:
         print(f"femkit: unstable: {result.failure}", file=sys.stderr)
     if not quiet:

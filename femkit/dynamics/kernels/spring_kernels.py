@@ -79,7 +79,7 @@ def spring_forces(x, si, sj, k, rest, floor, out):  # pragma: no cover - compile
                 out[j, 1] -= f * w1
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def local_global_rhs(xf, x, si, sj, fi, fj, kr, floor, scale, const, out):  # pragma: no cover - compiled
     """Fast mass-spring local step and its right-hand side in one pass: ``out = const + scale J d``
     with, for every spring, the projection ``d_s = L_s (x_i - x_j) / |x_i - x_j|`` (``kr = k L``);
@@ -139,6 +139,27 @@ def local_global_rhs(xf, x, si, sj, fi, fj, kr, floor, scale, const, out):  # pr
                 out[a, c] -= f * w[c]
             if b >= 0:
                 out[b, c] += f * w[c]
+
+
+@numba.njit(cache=True, nogil=True)
+def spring_energy(x, si, sj, k, rest, floor):  # pragma: no cover - compiled
+    """``sum_s 1/2 k_s (l_s - L_s)^2`` in one pass (``l`` floored at ``floor``, as the NumPy
+    path floors it); without the GIL, so a writer thread runs meanwhile."""
+    d = x.shape[1]
+    total = 0.0
+    for s in range(si.shape[0]):
+        i = si[s]
+        j = sj[s]
+        s2 = 0.0
+        for c in range(d):
+            w = x[j, c] - x[i, c]
+            s2 += w * w
+        ln = math.sqrt(s2)
+        if ln < floor:
+            ln = floor
+        e = ln - rest[s]
+        total += k[s] * e * e
+    return 0.5 * total
 
 
 @numba.njit(cache=True)

@@ -51,7 +51,9 @@ def gs_forward_zero(indptr, indices, data, inv_diag, b, x, sweeps):  # pragma: n
             if j < i:
                 acc -= data[t] * x[j]
         x[i] = acc * inv_diag[i]
-    gs_sweeps(indptr, indices, data, inv_diag, b, x, sweeps - 1, True)
+    for _ in range(sweeps - 1):  # the remaining forward sweeps (not a call of gs_sweeps with a
+        for i in range(n):       # literal True: numba compiled that as a second specialisation)
+            _relax(indptr, indices, data, inv_diag, b, x, i)
 
 
 @numba.njit(cache=True)
@@ -111,10 +113,22 @@ def transpose(indptr, indices, data, n_cols):  # pragma: no cover - compiled
 @numba.njit(cache=True, inline="always")
 def _sort_row(cols, m):  # pragma: no cover - compiled
     """Sort ``cols[:m]`` in place: insertion sort for the short rows of a coarse operator
-    (about 7 entries for P1 triangles), numpy's sort for long ones (a general ``P`` may give any
-    row length)."""
+    (about 7 entries for P1 triangles), Shell's sort with Knuth's gaps 1, 4, 13, ... for long
+    ones (a general ``P`` may give any row length; Knuth, TAOCP vol. 3, 5.2.1). Not numpy's
+    sort: its compilation alone took 15-25 s of a first run's 18 s compile stage."""
     if m > 32:
-        cols[:m] = np.sort(cols[:m])
+        gap = 1
+        while gap < m // 3:
+            gap = 3 * gap + 1
+        while gap > 0:
+            for q in range(gap, m):
+                c = cols[q]
+                p = q
+                while p >= gap and cols[p - gap] > c:
+                    cols[p] = cols[p - gap]
+                    p -= gap
+                cols[p] = c
+            gap //= 3
         return
     for q in range(1, m):
         c = cols[q]
@@ -125,9 +139,8 @@ def _sort_row(cols, m):  # pragma: no cover - compiled
         cols[p + 1] = c
 
 
-@numba.njit(cache=True)
 def galerkin(pt_indptr, pt_indices, pt_data, a_indptr, a_indices, a_data,
-             p_indptr, p_indices, p_data, capacity):  # pragma: no cover - compiled
+             p_indptr, p_indices, p_data, capacity):
     """``C = P^T A P`` and its diagonal, row by row (Gustavson's row-wise product).
 
     ``P^T`` (the CSR of :func:`transpose`), ``A`` and ``P`` are CSR triples; ``P`` is
@@ -136,20 +149,42 @@ def galerkin(pt_indptr, pt_indices, pt_data, a_indptr, a_indices, a_data,
     (so neither array is cleared between rows). The touched columns are then sorted and exact
     zeros dropped, as SciPy's product drops them: ``C`` is canonical CSR (sorted, no duplicates;
     duplicates in the inputs are summed). Work: ``sum_k nnz(P_k:) sum_(j in A_k:) nnz(P_j:)``, one
-    pass; the output grows by doubling from ``capacity`` entries and is returned as views of its
-    buffers. Column indices keep ``p_indices``' dtype, ``indptr`` is int64.
+    pass; the output starts at ``capacity`` entries and grows by doubling here, between calls of
+    the compiled pass (:func:`_galerkin_rows`, which stops at a row that does not fit: growing
+    arrays inside the compiled loop made its compilation 4x slower, 11 s of a first run), and is
+    returned as views of its buffers. Column indices keep ``p_indices``' dtype, ``indptr`` is
+    int64.
     """
     nc = pt_indptr.shape[0] - 1
     c_indptr = np.empty(nc + 1, np.int64)
+    c_indptr[0] = 0
     c_indices = np.empty(max(capacity, 1), p_indices.dtype)
     c_data = np.empty(max(capacity, 1), np.float64)
     diag = np.zeros(nc)
     acc = np.empty(nc)      # acc[c] is set when row i first touches c (marker[c] != i)
     marker = np.full(nc, -1, np.int64)
     cols = np.empty(nc, np.int64)
-    pos = 0
-    c_indptr[0] = 0
-    for i in range(nc):
+    row = pos = 0
+    while True:
+        row, pos, need = _galerkin_rows(pt_indptr, pt_indices, pt_data, a_indptr, a_indices,
+                                        a_data, p_indptr, p_indices, p_data, row, pos, c_indptr,
+                                        c_indices, c_data, diag, acc, marker, cols)
+        if row == nc:
+            return c_indptr, c_indices[:pos], c_data[:pos], diag
+        grown = max(2 * c_data.shape[0], pos + need)
+        c_indices = np.concatenate([c_indices[:pos], np.empty(grown - pos, c_indices.dtype)])
+        c_data = np.concatenate([c_data[:pos], np.empty(grown - pos)])
+
+
+@numba.njit(cache=True)
+def _galerkin_rows(pt_indptr, pt_indices, pt_data, a_indptr, a_indices, a_data,
+                   p_indptr, p_indices, p_data, row, pos, c_indptr, c_indices, c_data, diag,
+                   acc, marker, cols):  # pragma: no cover - compiled
+    """Rows ``row, row + 1, ...`` of :func:`galerkin`, written from entry ``pos`` on, until the
+    last row or a row whose entries do not fit in ``c_data``; returns ``(next row, pos, entries
+    of that row)`` (the row is left untouched, its markers cleared, so it is redone)."""
+    nc = pt_indptr.shape[0] - 1
+    for i in range(row, nc):
         m = 0
         for s in range(pt_indptr[i], pt_indptr[i + 1]):
             k = pt_indices[s]
@@ -166,14 +201,11 @@ def galerkin(pt_indptr, pt_indices, pt_data, a_indptr, a_indices, a_data,
                         acc[c] = wa * p_data[u]
                     else:
                         acc[c] += wa * p_data[u]
-        _sort_row(cols, m)
         if pos + m > c_data.shape[0]:
-            grown = max(2 * c_data.shape[0], pos + m)
-            new_indices = np.empty(grown, c_indices.dtype)
-            new_data = np.empty(grown, np.float64)
-            new_indices[:pos] = c_indices[:pos]
-            new_data[:pos] = c_data[:pos]
-            c_indices, c_data = new_indices, new_data
+            for q in range(m):
+                marker[cols[q]] = -1
+            return i, pos, m
+        _sort_row(cols, m)
         for q in range(m):
             c = cols[q]
             v = acc[c]
@@ -184,4 +216,4 @@ def galerkin(pt_indptr, pt_indices, pt_data, a_indptr, a_indices, a_data,
                 if c == i:
                     diag[i] = v
         c_indptr[i + 1] = pos
-    return c_indptr, c_indices[:pos], c_data[:pos], diag
+    return nc, pos, 0
