@@ -16,9 +16,11 @@ import importlib
 import time
 from typing import Callable
 
-__all__ = ["warm_up", "kernels_cached", "needs_kernels", "must_compile", "COMPILE_MESSAGE"]
+__all__ = ["warm_up", "kernels_cached", "needs_kernels", "must_compile", "compile_expressions",
+           "expressions_cached", "COMPILE_MESSAGE", "EXPRESSIONS_MESSAGE"]
 
 COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)..."
+EXPRESSIONS_MESSAGE = "compiling the case's expressions (first run, cached afterwards)..."
 
 #: (module, name) of one kernel of each compiled family; when all are in the on-disk cache the
 #: kernels were compiled before (a warm-up compiles every family at once).
@@ -29,7 +31,8 @@ _PROBES = (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffn
 
 #: The module constants that choose the compiled paths by size (lowered during a warm-up).
 _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiffness", "NUMBA_THRESHOLD"),
-               ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"))
+               ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"),
+               ("femkit.fem.fused.kernels", "NUMBA_THRESHOLD"))
 
 _TINY = {
     "problem": "poisson", "name": "warmup",
@@ -105,3 +108,67 @@ def must_compile(mesh, multigrid: bool) -> bool:
     """True before the first run after an install whose ``mesh`` (with geometric multigrid when
     ``multigrid``) will call kernels that are not compiled yet (not inside a warm-up)."""
     return not _ACTIVE and needs_kernels(mesh, multigrid) and not kernels_cached()
+
+
+def _passes(kernels, dim: int) -> list[str]:
+    """The fused passes (:mod:`femkit.fem.fused.templates`) a run on a ``dim``-D mesh calls."""
+    names = []
+    if kernels.exact is not None:
+        names += ["triangle_pass" if dim == 2 else "simplex_pass", "nodal_pass"]
+    if kernels.source is not None and (kernels.exact is None or not kernels.module.HAS_SOURCE):
+        names.append("source_pass")
+    return names
+
+
+def expressions_cached(kernels, dim: int) -> bool:
+    """True when every fused pass of ``kernels`` a ``dim``-D run calls is in numba's cache."""
+    import os
+
+    for name in _passes(kernels, dim):
+        cache = getattr(kernels.module, name)._cache
+        path = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
+        if path is None or not os.path.exists(path):
+            return False
+    return True
+
+
+def _compile_passes(kernels, mesh) -> None:
+    """Call each pass a run on ``mesh`` calls once, on two cells of the same array types."""
+    import numpy as np
+
+    from ...fem.quadrature import rule_for_degree
+
+    d = mesh.dim
+    points = np.vstack([np.zeros(d), np.eye(d), np.ones((1, d))])
+    cells = np.array([np.arange(d + 1), np.arange(1, d + 2)], dtype=mesh.cells.dtype)
+    rule = rule_for_degree(5, d)
+    bary, weights = np.ascontiguousarray(rule.points), np.ascontiguousarray(rule.weights)
+    u, out = np.zeros(len(points)), [np.empty(2) for _ in range(3)]
+    mod = kernels.module
+    for name in _passes(kernels, d):
+        if name == "triangle_pass":
+            mod.triangle_pass(points, cells, bary, weights, u, *out)
+        elif name == "simplex_pass":
+            mod.simplex_pass(points, cells, bary, weights, u, np.zeros((2, d)), np.ones(2), *out)
+        elif name == "nodal_pass":
+            mod.nodal_pass(points, u)
+        else:
+            mod.source_pass(points, cells, bary, weights, np.ones(2), out[0])
+
+
+def compile_expressions(case, mesh, stage, echo: Callable[[str], object] | None = None) -> None:
+    """Give the case's expressions their compiled kernels (:mod:`femkit.case.compiled_expressions`);
+    when ``mesh`` is large enough for them and they are not in the cache yet, compile them now in
+    the ``compile`` stage, saying so (``echo``)."""
+    from ...fem.fused import NUMBA_THRESHOLD
+    from ..compiled_expressions import case_kernels
+
+    kernels = case_kernels(case)
+    if kernels is None or _ACTIVE or mesh.n_cells < NUMBA_THRESHOLD or kernels.dim > mesh.dim:
+        return
+    if expressions_cached(kernels, mesh.dim):
+        return
+    with stage("compile"):
+        if echo is not None:
+            echo(EXPRESSIONS_MESSAGE)
+        _compile_passes(kernels, mesh)
