@@ -7,6 +7,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 import yaml
@@ -59,3 +60,57 @@ def test_warmup_fills_the_cache(tmp_path):
     empty = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                            env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "other")))
     assert empty.stdout.strip() == "False"
+    # the expressions of the bundled fmg case (the only bundled mesh large enough to compile them)
+    fmg = ("from femkit.case import load_case; from femkit.case.compiled_expressions import "
+           "case_kernels; from femkit.case.poisson.warmup import expressions_cached; "
+           f"print(expressions_cached(case_kernels(load_case({str(FMG_CASE)!r})), 2))")
+    res = subprocess.run([sys.executable, "-c", fmg], env=dict(os.environ), capture_output=True,
+                         text=True)
+    assert res.stdout.strip() == "True", res.stderr
+
+
+FMG_CASE = Path(__file__).resolve().parents[2] / "cases" / "poisson_fmg_unit_square.yaml"
+
+
+def test_the_warm_up_case_compiles_the_bundled_fmg_cases_expressions():
+    """Same trees, one generated module: what ``femkit warmup`` compiles is what the case runs."""
+    from femkit.case import case_from_dict, load_case
+    from femkit.case.compiled_expressions import case_kernels
+    from femkit.case.poisson.warmup import _TINY
+
+    tiny = case_kernels(case_from_dict(dict(_TINY)))
+    assert case_kernels(load_case(FMG_CASE)).module is tiny.module
+
+
+EXPRESSIONS_RUN = """
+import sys
+import femkit.fem.fused.kernels as k
+from femkit.case import case_from_dict
+k.NUMBA_THRESHOLD = 0          # this small mesh takes the compiled path, as a large one would
+case = case_from_dict({case!r})
+result = case.run(write=False, quiet=False)
+print("timings", sorted(result.timings))
+"""
+
+
+@pytest.mark.slow
+def test_first_use_of_new_expressions_compiles_in_the_compile_stage(tmp_path):
+    """Expressions never compiled before: the run says so and books a ``compile`` stage before
+    the mesh is used; the next process loads them from the cache (nothing said, no stage)."""
+    from femkit.case.poisson.warmup import EXPRESSIONS_MESSAGE
+
+    case = dict(CASE, solver={"method": "pcg", "preconditioner": "amg"},
+                source="3*pi**2*sin(pi*x)*sin(pi*y) + 0.25",
+                exact={"u": "1.5*sin(pi*x)*sin(pi*y)",
+                       "grad": ["1.5*pi*cos(pi*x)*sin(pi*y)", "1.5*pi*sin(pi*x)*cos(pi*y)"]})
+    env = dict(os.environ, FEMKIT_CACHE_DIR=str(tmp_path / "femkit"),
+               NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    outs = []
+    for _ in range(2):
+        proc = subprocess.run([sys.executable, "-c", EXPRESSIONS_RUN.format(case=case)], cwd=tmp_path,
+                              env=env, capture_output=True, text=True, timeout=900)
+        assert proc.returncode == 0, proc.stderr
+        outs.append(proc.stdout)
+    assert EXPRESSIONS_MESSAGE in outs[0] and "'compile'" in outs[0]
+    assert "compiling" not in outs[1] and "'compile'" not in outs[1]
+    assert list((tmp_path / "femkit" / "expressions").glob("femkit_expr_*.py"))

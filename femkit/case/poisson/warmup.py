@@ -27,12 +27,15 @@ EXPRESSIONS_MESSAGE = "compiling the case's expressions (first run, cached after
 _PROBES = (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
            ("femkit.mesh._edges_kernel", "unique_edges"),
            ("femkit.solvers.preconditioners._gmg_kernels", "galerkin"),
-           ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps"))
+           ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps"),
+           ("femkit.fem.estimators._kernels", "residual_edges"))
 
 #: The module constants that choose the compiled paths by size (lowered during a warm-up).
 _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiffness", "NUMBA_THRESHOLD"),
                ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"),
-               ("femkit.fem.fused.kernels", "NUMBA_THRESHOLD"))
+               ("femkit.fem.fused.kernels", "NUMBA_THRESHOLD"),
+               ("femkit.fem.estimators.geometry", "NUMBA_THRESHOLD"),
+               ("femkit.fem.estimators.residual", "NUMBA_THRESHOLD"))
 
 _TINY = {
     "problem": "poisson", "name": "warmup",
@@ -160,11 +163,11 @@ def compile_expressions(case, mesh, stage, echo: Callable[[str], object] | None 
     """Give the case's expressions their compiled kernels (:mod:`femkit.case.compiled_expressions`);
     when ``mesh`` is large enough for them and they are not in the cache yet, compile them now in
     the ``compile`` stage, saying so (``echo``)."""
-    from ...fem.fused import NUMBA_THRESHOLD
+    from ...fem.fused import kernels as fused
     from ..compiled_expressions import case_kernels
 
     kernels = case_kernels(case)
-    if kernels is None or _ACTIVE or mesh.n_cells < NUMBA_THRESHOLD or kernels.dim > mesh.dim:
+    if kernels is None or _ACTIVE or mesh.n_cells < fused.NUMBA_THRESHOLD or kernels.dim > mesh.dim:
         return
     if expressions_cached(kernels, mesh.dim):
         return

@@ -12,7 +12,7 @@ integral on the spot. The passes are used by :func:`femkit.fem.error_norms`,
 - the callables opt in: each has the kernels as its ``fused`` attribute, and the kernels stand
   for exactly these callables (``kernels.exact is exact``, ``kernels.source is f``; the gradient
   callable's ``fused`` is the same kernels);
-- the mesh has at least :data:`NUMBA_THRESHOLD` cells (a small mesh is not worth a compile) and
+- the mesh has at least :data:`.kernels.NUMBA_THRESHOLD` cells (a small mesh is not worth a compile) and
   the functions use no coordinate beyond its dimension.
 
 Otherwise, and whenever a pass meets a non-finite value or a degenerate cell, the NumPy path
@@ -22,8 +22,8 @@ order of the sums over points and vertices; tests/fem/test_fused.py).
 
 from __future__ import annotations
 
-from .kernels import NUMBA_THRESHOLD, FusedKernels, kernels_for
+from .kernels import FusedKernels, kernels_for
 from .passes import error_sums, nodal_error, source_norm_sq
 
-__all__ = ["NUMBA_THRESHOLD", "FusedKernels", "kernels_for", "error_sums", "nodal_error",
+__all__ = ["FusedKernels", "kernels_for", "error_sums", "nodal_error",
            "source_norm_sq"]
