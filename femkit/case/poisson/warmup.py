@@ -8,6 +8,11 @@ size thresholds that choose the compiled paths lowered for its duration, so ever
 every argument type a large run uses is in the cache afterwards; :func:`kernels_cached` says
 whether that already happened (the run prints ``compiling kernels (first run, cached
 afterwards)...`` and books the time as its own ``compile`` stage when not).
+
+A case's expressions are compiled too (:mod:`femkit.case.compiled_expressions`, one module per
+set of trees): :func:`compile_expressions` does it in the ``compile`` stage of the first run that
+meets them on a large mesh, saying so; the warm-up's tiny case has the trees of the bundled fmg
+case, so ``femkit warmup`` compiles those.
 """
 
 from __future__ import annotations
@@ -16,26 +21,20 @@ import importlib
 import time
 from typing import Callable
 
-__all__ = ["warm_up", "kernels_cached", "needs_kernels", "must_compile", "compile_expressions",
-           "expressions_cached", "COMPILE_MESSAGE", "EXPRESSIONS_MESSAGE"]
+__all__ = ["warm_up", "kernels_cached", "needs_kernels", "must_compile", "COMPILE_MESSAGE"]
 
 COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)..."
-EXPRESSIONS_MESSAGE = "compiling the case's expressions (first run, cached afterwards)..."
 
 #: (module, name) of one kernel of each compiled family; when all are in the on-disk cache the
 #: kernels were compiled before (a warm-up compiles every family at once).
 _PROBES = (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
            ("femkit.mesh._edges_kernel", "unique_edges"),
            ("femkit.solvers.preconditioners._gmg_kernels", "galerkin"),
-           ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps"),
-           ("femkit.fem.estimators._kernels", "residual_edges"))
+           ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps"))
 
 #: The module constants that choose the compiled paths by size (lowered during a warm-up).
 _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiffness", "NUMBA_THRESHOLD"),
-               ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"),
-               ("femkit.fem.fused.kernels", "NUMBA_THRESHOLD"),
-               ("femkit.fem.estimators.geometry", "NUMBA_THRESHOLD"),
-               ("femkit.fem.estimators.residual", "NUMBA_THRESHOLD"))
+               ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"))
 
 _TINY = {
     "problem": "poisson", "name": "warmup",
@@ -46,6 +45,19 @@ _TINY = {
               "grad": ["pi * cos(pi * x) * sin(pi * y)", "pi * sin(pi * x) * cos(pi * y)"]},
     "solver": {"method": "fmg"},
 }
+
+
+#: The errors and estimate stages' compiled passes: the residual estimator's (a family of the
+#: warm-up), and the size thresholds of those and of a case's compiled expressions.
+_PROBES += (("femkit.fem.estimators._kernels", "residual_edges"),)
+_THRESHOLDS += (("femkit.fem.fused.kernels", "NUMBA_THRESHOLD"),
+                ("femkit.fem.estimators.geometry", "NUMBA_THRESHOLD"),
+                ("femkit.fem.estimators.residual", "NUMBA_THRESHOLD"))
+
+__all__ += ["compile_expressions", "expressions_cached", "EXPRESSIONS_MESSAGE"]
+
+#: Said when a run compiles its case's expressions (:func:`compile_expressions`).
+EXPRESSIONS_MESSAGE = "compiling the case's expressions (first run, cached afterwards)..."
 
 
 def needs_kernels(mesh, multigrid: bool) -> bool:
