@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import ast
 import inspect
+from functools import partial
 from typing import Sequence
 
 from .numba_source import COORDINATES, point_function
@@ -56,23 +57,29 @@ def module_text(exact=None, gradient: Sequence = (), source=None, *, fuse_source
 
 def expression_kernels(exact=None, gradient: Sequence = (), source=None, *,
                        fuse_source: bool = True):
-    """:class:`~femkit.fem.fused.FusedKernels` of these expressions (the module is generated
-    now and loaded, from the cache when it is there, on first use); None when there is nothing to
+    """:class:`~femkit.fem.fused.FusedKernels` of these expressions (the module is generated and
+    loaded, from the cache when it is there, on first use); None when there is nothing to
     evaluate. Attaches the kernels to the expressions (their ``fused``)."""
-    from ...codegen import load_generated
-    from ...fem.fused import FusedKernels, templates
+    from ...fem.fused.kernels import FusedKernels
 
     if exact is None and source is None:
         return None
     members = [e for e in (exact, *gradient, source) if e is not None]
-    text = module_text(exact, gradient, source, fuse_source=fuse_source)
-    salt = inspect.getsource(templates)
     dim = max([2] + [i + 1 for e in members for i, v in enumerate(e.variables) if v in e.used])
-    kernels = FusedKernels(lambda: load_generated(text, "femkit_expr", "expressions", salt),
+    kernels = FusedKernels(partial(_load, exact, tuple(gradient), source, fuse_source),
                            exact=exact, source=source, gradient=tuple(gradient), dim=dim)
     for e in members:
         e.fused = kernels
     return kernels
+
+
+def _load(exact, gradient, source, fuse_source):
+    """The generated module (numba is imported here, on first use: a small run never needs it)."""
+    from ...codegen import load_generated
+    from ...fem.fused import templates
+
+    text = module_text(exact, gradient, source, fuse_source=fuse_source)
+    return load_generated(text, "femkit_expr", "expressions", inspect.getsource(templates))
 
 
 def case_kernels(case):

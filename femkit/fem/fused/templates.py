@@ -9,10 +9,13 @@ inlined: one visit of each quadrature point evaluates every function and adds it
 integral, and no array of point values is ever formed.
 
 Rounding: the physical point is ``sum_a lambda_a X_a`` summed vertex by vertex, as
-:meth:`femkit.fem.quadrature.TriangleRule.physical_points` does, and the triangle's area and
-gradient are the formulas of :func:`femkit.fem._elements.triangle_geometry` and
-:func:`~femkit.fem._elements.p1_gradients`, operation for operation; only the order of the sums
-over the points and vertices (a BLAS product in the NumPy path) may differ, at round-off.
+:meth:`femkit.fem.quadrature.TriangleRule.physical_points` does; ``u_h`` at the point is summed
+with fused multiply-adds, as OpenBLAS's product ``u[cells] @ bary.T`` of the NumPy path does
+(another BLAS may round it differently, by an ulp); the triangle's area and gradient are the
+formulas of :func:`femkit.fem._elements.triangle_geometry` and
+:func:`~femkit.fem._elements.p1_gradients`, operation for operation. Only the sum over the
+points (a BLAS matrix-vector product in the NumPy path) is in another order: an element's
+integral may differ in its last bit, the norms agree to round-off.
 """
 
 from __future__ import annotations
