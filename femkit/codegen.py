@@ -23,7 +23,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Iterable
 
-__all__ = ["cache_dir", "load_generated", "copied_kernels", "generated_path"]
+__all__ = ["cache_dir", "load_generated", "copied_kernels", "function_sources", "generated_path"]
 
 _LOADED: dict[str, ModuleType] = {}
 
