@@ -207,6 +207,9 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         mesh, hierarchy = build_mesh_levels(case)
     check_stop("mesh")
     _compile_stage(case, mesh, stage, say)  # a large mesh without multigrid
+    from .warmup import compile_expressions
+
+    compile_expressions(case, mesh, stage, say)  # the case's expressions (errors, estimate)
     grad = exact_gradient(case)
     run = est = None
     if case.spec.adaptive:
@@ -271,13 +274,11 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
 def _compile_stage(case: Case, mesh, stage, echo) -> None:
     """The first run after an install compiles the kernels it needs ahead, in its own
     ``compile`` stage (not inside assembly and solve), saying so on the terminal (``echo``)."""
-    from .warmup import compile_expressions, must_compile, warm_up
+    from .warmup import must_compile, warm_up
 
     if must_compile(mesh, case.solver.needs_hierarchy):
         with stage("compile"):
             warm_up(echo)
-    if mesh is not None:  # the case's expressions, for the error norms and the estimator
-        compile_expressions(case, mesh, stage, echo)
 
 
 def _solve(case: Case, system, stop, **mg):
