@@ -23,7 +23,8 @@ APPLICATION = ("case", "study", "cli")
 #: What the library must never import: the application and the cost model (planned above it).
 ABOVE_THE_LIBRARY = APPLICATION + ("cost",)
 #: Shared leaves any layer may import; they import only one another.
-LEAVES = ("errors", "registry", "timing", "validation", "_version", "progress", "interrupt")
+LEAVES = ("errors", "registry", "timing", "validation", "_version", "progress", "interrupt",
+          "codegen")
 
 
 def _modules(layer: str) -> list[Path]:

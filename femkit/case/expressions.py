@@ -44,7 +44,7 @@ import numpy as np
 
 from ..errors import ExpressionError
 
-__all__ = ["compile_expression", "Expression", "FUNCTIONS", "CONSTANTS", "MAX_LENGTH"]
+__all__ = ["compile_expression", "Expression", "Gradient", "FUNCTIONS", "CONSTANTS", "MAX_LENGTH"]
 
 #: Functions an expression may call: name -> (numpy function, number of arguments).
 FUNCTIONS: dict[str, tuple[Callable, int]] = {
@@ -111,7 +111,8 @@ class Expression:
     """
 
     def __init__(self, source: str, variables: tuple[str, ...], fn: Callable,
-                 is_constant: bool, check_finite: bool, used: frozenset = frozenset()):
+                 is_constant: bool, check_finite: bool, used: frozenset = frozenset(),
+                 tree: ast.expr | None = None, names: Mapping[str, float] | None = None):
         self.source = source
         self.variables = variables
         self._fn = fn
@@ -119,6 +120,13 @@ class Expression:
         self.used = frozenset(used)
         self.check_finite = check_finite
         self.label = ""  # where the expression comes from (e.g. "source"), used in messages
+        #: The checked tree the closures were built from (a number: one ``ast.Constant``) and
+        #: the values of the named constants it may use: what the compiled form is generated from.
+        self.tree = tree
+        self.names = dict(names or {})
+        #: Compiled kernels evaluating this expression with others (:mod:`femkit.fem.fused`),
+        #: set by :mod:`femkit.case.compiled_expressions`; None: NumPy only.
+        self.fused = None
 
     def __call__(self, *args):
         # Trailing variables the expression does not use may be left out: an expression of
@@ -147,6 +155,30 @@ class Expression:
 
     def __repr__(self) -> str:
         return f"Expression({self.source!r}, variables={self.variables})"
+
+
+class Gradient:
+    """The components of a gradient, each an :class:`Expression`, as one callable
+    ``(x, y[, z]) -> (d/dx, d/dy[, d/dz])``.
+
+    ``fused`` is the compiled kernels the components share (:mod:`femkit.fem.fused`), or None.
+    """
+
+    def __init__(self, parts: Sequence[Expression]):
+        self.parts = tuple(parts)
+
+    def __call__(self, *xyz):
+        return tuple(g(*xyz) for g in self.parts)
+
+    @property
+    def fused(self):
+        kernels = self.parts[0].fused if self.parts else None
+        same = kernels is not None and len(kernels.gradient) == len(self.parts) and all(
+            a is b for a, b in zip(kernels.gradient, self.parts))
+        return kernels if same else None
+
+    def __repr__(self) -> str:
+        return f"Gradient({', '.join(repr(g.source) for g in self.parts)})"
 
 
 def _fail(text: str, node: ast.AST | None, what: str, variables, constants) -> ExpressionError:
@@ -195,7 +227,8 @@ def compile_expression(text, variables: Sequence[str] = ("x", "y"),
         value = float(text)
         if not math.isfinite(value):
             raise ExpressionError(f"expression value {text!r} is not finite")
-        return Expression(repr(text), variables, lambda env, v=value: v, True, check_finite)
+        return Expression(repr(text), variables, lambda env, v=value: v, True, check_finite,
+                          tree=ast.Constant(value))
     source = text.strip()
     if not source:
         raise ExpressionError("expression is empty")
@@ -215,7 +248,7 @@ def compile_expression(text, variables: Sequence[str] = ("x", "y"),
     except RecursionError:
         raise ExpressionError(f"expression {source!r} is nested too deeply") from None
     expr = Expression(source, variables, fn, not (used & set(variables)), check_finite,
-                      frozenset(used & set(variables)))
+                      frozenset(used & set(variables)), tree=tree.body, names=names)
     if expr.is_constant and check_finite:
         expr(*([0.0] * len(variables)))  # a constant that is NaN/inf fails at load time
     return expr

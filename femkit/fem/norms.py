@@ -3,6 +3,9 @@
 ``L2 = ||u - u_h||``, ``H1_semi = ||grad(u - u_h)||`` (needs ``grad_exact``), both by a
 quadrature rule of degree ``order`` per element (default 5: Dunavant 7 points, so the
 quadrature error is far below the discretisation error), and ``max_nodal = max_i |u(x_i) - u_i|``.
+Callables that bring compiled kernels (:mod:`femkit.fem.fused`: a case file's expressions on a
+large mesh) are integrated in one compiled pass over the points, the others by NumPy block by
+block.
 
 >>> import numpy as np
 >>> from femkit.mesh import Mesh
@@ -22,6 +25,7 @@ import numpy as np
 from ..errors import InputError
 from ._elements import p1_gradients, select_elements, simplex_gradients, triangle_geometry
 from .coefficients import evaluate_callable
+from .fused import error_sums, kernels_for, nodal_error
 from .quadrature import blocks, rule_for_degree
 
 
@@ -61,6 +65,34 @@ def error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | Non
     rule = rule_for_degree(order, mesh.dim)
     root = (lambda v: v) if squared else np.sqrt
     idx = select_elements(mesh, elements)
+    kernels = None if idx is not None else kernels_for(mesh, exact=exact, grad_exact=grad_exact)
+    sums = None if kernels is None else error_sums(mesh, u, rule, kernels)
+    if sums is not None:  # every point visited once for every integral, compiled
+        l2_sq, h1_sq = sums[0], (sums[1] if grad_exact is not None else None)
+        tri = None
+    else:
+        l2_sq, h1_sq, tri = _error_sums(mesh, u, exact, grad_exact, rule, idx)
+    l2 = float(root(np.sum(l2_sq)))
+    big = None if kernels is None else nodal_error(mesh, u, exact)
+    if big is None:
+        nodes = slice(None) if elements is None else np.unique(tri)
+        pts = mesh.points[nodes]
+        nodal = u[nodes] - evaluate_callable(exact, *pts.T, name="exact")
+        big = float(np.max(np.abs(nodal))) if nodal.size else 0.0
+    out = {"L2": l2, "H1_semi": None, "max_nodal": big}
+    if h1_sq is not None:
+        out["H1_semi"] = float(root(np.sum(h1_sq)))
+        if idx is None:
+            _remember_gradient_error(mesh, u, grad_exact, rule, h1_sq)
+    for k, v in out.items():
+        if v is not None and not np.isfinite(v):
+            raise InputError(f"error norm {k} is not finite (exact solution or u not finite)")
+    return out
+
+
+def _error_sums(mesh, u, exact, grad_exact, rule, idx):
+    """Per element ``int (u - u_h)^2`` and ``int |grad(u - u_h)|^2`` (None without
+    ``grad_exact``) by NumPy, block by block, and the elements' vertices."""
     geometry = triangle_geometry(mesh, idx) if mesh.dim == 2 else simplex_gradients(mesh, idx)
     tri = geometry[-1]
     l2_sq = np.empty(len(tri))
@@ -72,19 +104,7 @@ def error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | Non
         l2_sq[s] = part[1] * ((diff * diff) @ rule.weights)
         if h1_sq is not None:
             h1_sq[s] = _gradient_error_sq(mesh, u, grad_exact, rule, part, xy)
-    l2 = float(root(np.sum(l2_sq)))
-    nodes = slice(None) if elements is None else np.unique(tri)
-    pts = mesh.points[nodes]
-    nodal = u[nodes] - evaluate_callable(exact, *pts.T, name="exact")
-    out = {"L2": l2, "H1_semi": None, "max_nodal": float(np.max(np.abs(nodal))) if nodal.size else 0.0}
-    if h1_sq is not None:
-        out["H1_semi"] = float(root(np.sum(h1_sq)))
-        if idx is None:
-            _remember_gradient_error(mesh, u, grad_exact, rule, h1_sq)
-    for k, v in out.items():
-        if v is not None and not np.isfinite(v):
-            raise InputError(f"error norm {k} is not finite (exact solution or u not finite)")
-    return out
+    return l2_sq, h1_sq, tri
 
 
 #: The last per-element ``int_T |grad(u - u_h)|^2`` of each mesh (weakly keyed, so it goes with
@@ -109,6 +129,10 @@ def _gradient_error_all(mesh, u, grad_exact, rule) -> np.ndarray:
         hit = None
     if hit is not None and hit[1] is grad_exact and hit[2] == rule.name and np.array_equal(hit[0], u):
         return hit[3]
+    kernels = kernels_for(mesh, grad_exact=grad_exact)
+    sums = None if kernels is None else error_sums(mesh, u, rule, kernels)
+    if sums is not None:
+        return sums[1]
     geometry = triangle_geometry(mesh, None) if mesh.dim == 2 else simplex_gradients(mesh, None)
     sq = np.empty(len(geometry[-1]))
     for s in blocks(len(sq)):

@@ -7,6 +7,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 import yaml
@@ -38,7 +39,7 @@ def test_first_run_compiles_in_its_own_stage_then_never_again(tmp_path):
     first = _run(["solve", "case.yaml"], tmp_path, cache)
     timings = json.loads((tmp_path / "out" / "result.json").read_text())["timings"]
     assert ("compiling kernels (first run, cached afterwards): mesh edges, P1 assembly, "
-            "geometric multigrid..." in first)
+            "geometric multigrid, error estimate..." in first)
     assert "compiled in " in first
     assert timings["compile"] > 0 and list(timings)[:2] == ["compile", "mesh"]
     second = _run(["solve", "case.yaml"], tmp_path, cache)
@@ -61,14 +62,21 @@ def test_warmup_fills_the_cache(tmp_path):
     empty = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                            env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "other")))
     assert empty.stdout.strip() == "False"
+    # the expressions of the bundled fmg case (the only bundled mesh large enough to compile them)
+    fmg = ("from femkit.case import load_case; from femkit.case.compiled_expressions import "
+           "case_kernels; from femkit.case.poisson.warmup import expressions_cached; "
+           f"print(expressions_cached(case_kernels(load_case({str(FMG_CASE)!r})), 2))")
+    res = subprocess.run([sys.executable, "-c", fmg], env=dict(os.environ), capture_output=True,
+                         text=True)
+    assert res.stdout.strip() == "True", res.stderr
 
 
 def test_a_run_without_multigrid_compiles_no_multigrid_kernel(tmp_path):
     """The families a run needs: pcg + jacobi compiles edges and assembly, not multigrid."""
     from femkit.case.poisson.warmup import families
 
-    assert families(True) == ("mesh edges", "P1 assembly", "geometric multigrid")
-    assert families(False) == ("mesh edges", "P1 assembly")
+    assert families(True) == ("mesh edges", "P1 assembly", "geometric multigrid", "error estimate")
+    assert families(False) == ("mesh edges", "P1 assembly", "error estimate")
     probe = ("from femkit.case.poisson.warmup import warm_up, kernels_cached; "
              "warm_up(print, multigrid=False); "
              "print(kernels_cached(('mesh edges', 'P1 assembly')), "
@@ -78,5 +86,52 @@ def test_a_run_without_multigrid_compiles_no_multigrid_kernel(tmp_path):
                          timeout=900)
     assert res.returncode == 0, res.stderr
     lines = res.stdout.strip().splitlines()
-    assert lines[0] == "compiling kernels (first run, cached afterwards): mesh edges, P1 assembly..."
+    assert lines[0] == "compiling kernels (first run, cached afterwards): mesh edges, P1 assembly, error estimate..."
     assert lines[-1] == "True False"
+
+
+FMG_CASE = Path(__file__).resolve().parents[2] / "cases" / "poisson_fmg_unit_square.yaml"
+
+
+def test_the_warm_up_case_compiles_the_bundled_fmg_cases_expressions():
+    """Same trees, one generated module: what ``femkit warmup`` compiles is what the case runs."""
+    from femkit.case import case_from_dict, load_case
+    from femkit.case.compiled_expressions import case_kernels
+    from femkit.case.poisson.warmup import _TINY
+
+    tiny = case_kernels(case_from_dict(dict(_TINY)))
+    assert case_kernels(load_case(FMG_CASE)).module is tiny.module
+
+
+EXPRESSIONS_RUN = """
+import sys
+import femkit.fem.fused.kernels as k
+from femkit.case import case_from_dict
+k.NUMBA_THRESHOLD = 0          # this small mesh takes the compiled path, as a large one would
+case = case_from_dict({case!r})
+result = case.run(write=False, quiet=False)
+print("timings", sorted(result.timings))
+"""
+
+
+@pytest.mark.slow
+def test_first_use_of_new_expressions_compiles_in_the_compile_stage(tmp_path):
+    """Expressions never compiled before: the run says so and books a ``compile`` stage before
+    the mesh is used; the next process loads them from the cache (nothing said, no stage)."""
+    from femkit.case.poisson.warmup import EXPRESSIONS_MESSAGE
+
+    case = dict(CASE, solver={"method": "pcg", "preconditioner": "amg"},
+                source="3*pi**2*sin(pi*x)*sin(pi*y) + 0.25",
+                exact={"u": "1.5*sin(pi*x)*sin(pi*y)",
+                       "grad": ["1.5*pi*cos(pi*x)*sin(pi*y)", "1.5*pi*sin(pi*x)*cos(pi*y)"]})
+    env = dict(os.environ, FEMKIT_CACHE_DIR=str(tmp_path / "femkit"),
+               NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    outs = []
+    for _ in range(2):
+        proc = subprocess.run([sys.executable, "-c", EXPRESSIONS_RUN.format(case=case)], cwd=tmp_path,
+                              env=env, capture_output=True, text=True, timeout=900)
+        assert proc.returncode == 0, proc.stderr
+        outs.append(proc.stdout)
+    assert EXPRESSIONS_MESSAGE in outs[0] and "'compile'" in outs[0]
+    assert "compiling" not in outs[1] and "'compile'" not in outs[1]
+    assert list((tmp_path / "femkit" / "expressions").glob("femkit_expr_*.py"))

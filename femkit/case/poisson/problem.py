@@ -244,13 +244,10 @@ def exact_gradient(case: Case):
     gz)`` on tetrahedra), or None."""
     if "exact.grad[0]" not in case.functions:
         return None
-    parts = [case.functions[f"exact.grad[{i}]"] for i in range(len(VARIABLES))
-             if f"exact.grad[{i}]" in case.functions]
+    from ..expressions import Gradient
 
-    def grad(*xyz):
-        return tuple(g(*xyz) for g in parts)
-
-    return grad
+    return Gradient([case.functions[f"exact.grad[{i}]"] for i in range(len(VARIABLES))
+                     if f"exact.grad[{i}]" in case.functions])
 
 
 def compute_errors(case: Case, problem, u: np.ndarray, *, order: int = 5) -> dict | None:

@@ -207,6 +207,9 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         mesh, hierarchy = build_mesh_levels(case)
     check_stop("mesh")
     _compile_stage(case, mesh, stage, say)  # a large mesh without multigrid
+    from .warmup import compile_expressions
+
+    compile_expressions(case, mesh, stage, say)  # the case's expressions (errors, estimate)
     grad = exact_gradient(case)
     run = est = None
     if case.spec.adaptive:

@@ -13,6 +13,11 @@ and prints how long it took).
 Only the families a run needs are compiled (:data:`FAMILIES`): a run without multigrid compiles
 no multigrid kernel. One tiny fmg run compiles every multigrid kernel that pcg + gmg calls too
 (the same V-cycle, the same argument types), so the warm-up runs one case, not one per solver.
+
+A case's expressions are compiled too (:mod:`femkit.case.compiled_expressions`, one module per
+set of trees): :func:`compile_expressions` does it in the ``compile`` stage of the first run that
+meets them on a large mesh, saying so; the warm-up's tiny case has the trees of the bundled fmg
+case, so ``femkit warmup`` compiles those.
 """
 
 from __future__ import annotations
@@ -51,9 +56,24 @@ _TINY = {
 
 
 def families(multigrid: bool) -> tuple[str, ...]:
-    """The compiled families a run uses: all of them with geometric multigrid, else edges and
-    assembly."""
-    return tuple(FAMILIES) if multigrid else ("mesh edges", "P1 assembly")
+    """The compiled families a run uses: all of them with geometric multigrid, else edges,
+    assembly and the error estimate."""
+    if multigrid:
+        return tuple(FAMILIES)
+    return tuple(f for f in FAMILIES if f != "geometric multigrid")
+
+
+#: The errors and estimate stages' compiled passes: the residual estimator's (a family of the
+#: warm-up), and the size thresholds of those and of a case's compiled expressions.
+FAMILIES["error estimate"] = (("femkit.fem.estimators._kernels", "residual_edges"),)
+_THRESHOLDS += (("femkit.fem.fused.kernels", "NUMBA_THRESHOLD"),
+                ("femkit.fem.estimators.geometry", "NUMBA_THRESHOLD"),
+                ("femkit.fem.estimators.residual", "NUMBA_THRESHOLD"))
+
+__all__ += ["compile_expressions", "expressions_cached", "EXPRESSIONS_MESSAGE"]
+
+#: Said when a run compiles its case's expressions (:func:`compile_expressions`).
+EXPRESSIONS_MESSAGE = "compiling the case's expressions (first run, cached afterwards)..."
 
 
 def needs_kernels(mesh, multigrid: bool) -> bool:
@@ -121,3 +141,67 @@ def must_compile(mesh, multigrid: bool) -> bool:
     ``multigrid``) will call kernels that are not compiled yet (not inside a warm-up)."""
     return (not _ACTIVE and needs_kernels(mesh, multigrid)
             and not kernels_cached(families(multigrid)))
+
+
+def _passes(kernels, dim: int) -> list[str]:
+    """The fused passes (:mod:`femkit.fem.fused.templates`) a run on a ``dim``-D mesh calls."""
+    names = []
+    if kernels.exact is not None:
+        names += ["triangle_pass" if dim == 2 else "simplex_pass", "nodal_pass"]
+    if kernels.source is not None and (kernels.exact is None or not kernels.module.HAS_SOURCE):
+        names.append("source_pass")
+    return names
+
+
+def expressions_cached(kernels, dim: int) -> bool:
+    """True when every fused pass of ``kernels`` a ``dim``-D run calls is in numba's cache."""
+    import os
+
+    for name in _passes(kernels, dim):
+        cache = getattr(kernels.module, name)._cache
+        path = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
+        if path is None or not os.path.exists(path):
+            return False
+    return True
+
+
+def _compile_passes(kernels, mesh) -> None:
+    """Call each pass a run on ``mesh`` calls once, on two cells of the same array types."""
+    import numpy as np
+
+    from ...fem.quadrature import rule_for_degree
+
+    d = mesh.dim
+    points = np.vstack([np.zeros(d), np.eye(d), np.ones((1, d))])
+    cells = np.array([np.arange(d + 1), np.arange(1, d + 2)], dtype=mesh.cells.dtype)
+    rule = rule_for_degree(5, d)
+    bary, weights = np.ascontiguousarray(rule.points), np.ascontiguousarray(rule.weights)
+    u, out = np.zeros(len(points)), [np.empty(2) for _ in range(3)]
+    mod = kernels.module
+    for name in _passes(kernels, d):
+        if name == "triangle_pass":
+            mod.triangle_pass(points, cells, bary, weights, u, *out)
+        elif name == "simplex_pass":
+            mod.simplex_pass(points, cells, bary, weights, u, np.zeros((2, d)), np.ones(2), *out)
+        elif name == "nodal_pass":
+            mod.nodal_pass(points, u)
+        else:
+            mod.source_pass(points, cells, bary, weights, np.ones(2), out[0])
+
+
+def compile_expressions(case, mesh, stage, echo: Callable[[str], object] | None = None) -> None:
+    """Give the case's expressions their compiled kernels (:mod:`femkit.case.compiled_expressions`);
+    when ``mesh`` is large enough for them and they are not in the cache yet, compile them now in
+    the ``compile`` stage, saying so (``echo``)."""
+    from ...fem.fused import kernels as fused
+    from ..compiled_expressions import case_kernels
+
+    kernels = case_kernels(case)
+    if kernels is None or _ACTIVE or mesh.n_cells < fused.NUMBA_THRESHOLD or kernels.dim > mesh.dim:
+        return
+    if expressions_cached(kernels, mesh.dim):
+        return
+    with stage("compile"):
+        if echo is not None:
+            echo(EXPRESSIONS_MESSAGE)
+        _compile_passes(kernels, mesh)

@@ -9,6 +9,7 @@ import numpy as np
 
 from .._elements import p1_gradients, simplex_gradients, triangle_geometry
 from ..coefficients import element_coefficient
+from ..sparsity import NUMBA_THRESHOLD
 
 
 @dataclass(frozen=True)
@@ -53,8 +54,17 @@ def element_fields(mesh, u: np.ndarray, kappa) -> ElementFields:
         count = np.bincount(tf.ravel(), minlength=len(face_nodes))
         grad = np.einsum("ma,mad->md", u[tets], grads)
         return ElementFields(grads, volume, grad, kap, face_nodes, tf, count)
-    e, area, signed, tri = triangle_geometry(mesh, None)
-    grad = p1_gradients(e, signed, u[tri])
+    if mesh.n_cells >= NUMBA_THRESHOLD:  # one compiled pass, the same numbers
+        from ._kernels import triangle_fields
+
+        m = mesh.n_cells
+        e, area, grad = np.empty((m, 3, 2)), np.empty(m), np.empty((m, 2))
+        if triangle_fields(np.ascontiguousarray(mesh.points, dtype=np.float64),
+                           np.ascontiguousarray(mesh.triangles), u, e, area, grad):
+            triangle_geometry(mesh, None)  # names the degenerate triangles
+    else:
+        e, area, signed, tri = triangle_geometry(mesh, None)
+        grad = p1_gradients(e, signed, u[tri])
     edge_nodes, te = edges(mesh)
     count = np.bincount(te.ravel(), minlength=len(edge_nodes))
     return ElementFields(e, area, grad, kap, edge_nodes, te, count)

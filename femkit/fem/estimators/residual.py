@@ -38,7 +38,9 @@ from typing import Sequence
 import numpy as np
 
 from ..coefficients import evaluate_callable
+from ..fused import source_norm_sq
 from ..quadrature import blocks, rule_for_degree
+from ..sparsity import NUMBA_THRESHOLD
 from .base import ESTIMATORS, ErrorEstimate
 from .geometry import element_fields
 
@@ -51,12 +53,32 @@ def _source_norm_sq(mesh, f, area: np.ndarray) -> np.ndarray:
     """``||f||_T^2`` per element (7-point rule of degree 5 for a callable ``f``)."""
     if callable(f):
         rule = rule_for_degree(5)
+        fused = source_norm_sq(mesh, f, area, rule)  # compiled (or kept from the error pass)
+        if fused is not None:
+            return fused
         out = np.empty(len(area))
         for s in blocks(len(area)):  # (block, 7) values at a time: in cache, bounded memory
             fv = evaluate_callable(f, *rule.physical_points(mesh, mesh.triangles[s]), name="f")
             out[s] = area[s] * ((fv * fv) @ rule.weights)
         return out
     return area * float(f) ** 2
+
+
+def _edge_terms(fl, n_edges: int, c_jump: float):
+    """``(lens, qlen, jump)``: edge lengths (m, 3), outward normal flux times length (m, 3) and
+    the interior edges' jump term of each element."""
+    e, te = fl.e, fl.tri_edges
+    lens = np.hypot(e[..., 0], e[..., 1])                  # (m, 3)
+    # outward normal flux kappa grad u_h . n times the edge length, per (element, local edge):
+    # for a counter-clockwise triangle the outward normal of e = (ex, ey) is (ey, -ex) / |e|
+    sigma = fl.kappa[:, None] * fl.grad
+    qlen = sigma[:, None, 0] * e[..., 1] - sigma[:, None, 1] * e[..., 0]          # (m, 3)
+    jump_len = np.bincount(te.ravel(), weights=qlen.ravel(), minlength=n_edges)   # [flux] * |E|
+    kmax = np.zeros(n_edges)
+    np.maximum.at(kmax, te.ravel(), np.repeat(fl.kappa, 3))
+    # h_E ||J||_E^2 / kappa_E with ||J||_E^2 = J^2 h_E and J = jump_len / h_E: jump_len^2 / kappa_E
+    eta_edge = np.where(fl.edge_count == 2, jump_len ** 2 / kmax, 0.0)
+    return lens, qlen, 0.5 * c_jump ** 2 * eta_edge[te].sum(axis=1)
 
 
 @ESTIMATORS.register("residual")
@@ -93,24 +115,16 @@ def residual_estimator(mesh, u: np.ndarray, *, kappa=1.0, f=0.0, neumann: Sequen
         parts = residual_terms_3d(mesh, fl, f, neumann, dirichlet_nodes, c_volume, c_jump)
         return ErrorEstimate("residual", np.sqrt(sum(parts.values())), parts)
     e, te, count = fl.e, fl.tri_edges, fl.edge_count
-    lens = np.hypot(e[..., 0], e[..., 1])                  # (m, 3)
+    n_edges = len(fl.edge_nodes)
+    if mesh.n_cells >= NUMBA_THRESHOLD:  # the same numbers in one compiled pass
+        from ._kernels import residual_edges
+
+        lens, qlen, jump = residual_edges(e, fl.grad, fl.kappa, te, count, n_edges,
+                                          0.5 * c_jump ** 2)
+    else:
+        lens, qlen, jump = _edge_terms(fl, n_edges, c_jump)
     h_T = lens.max(axis=1)
     volume = c_volume ** 2 * h_T ** 2 * _source_norm_sq(mesh, f, fl.area) / fl.kappa
-
-    # outward normal flux kappa grad u_h . n times the edge length, per (element, local edge):
-    # for a counter-clockwise triangle the outward normal of e = (ex, ey) is (ey, -ex) / |e|
-    sigma = fl.kappa[:, None] * fl.grad
-    qlen = sigma[:, None, 0] * e[..., 1] - sigma[:, None, 1] * e[..., 0]          # (m, 3)
-    n_edges = len(fl.edge_nodes)
-    jump_len = np.bincount(te.ravel(), weights=qlen.ravel(), minlength=n_edges)   # [flux] * |E|
-    kmax = np.zeros(n_edges)
-    np.maximum.at(kmax, te.ravel(), np.repeat(fl.kappa, 3))
-    edge_len = np.zeros(n_edges)
-    edge_len[te.ravel()] = lens.ravel()
-    interior = count == 2
-    # h_E ||J||_E^2 / kappa_E with ||J||_E^2 = J^2 h_E and J = jump_len / h_E: jump_len^2 / kappa_E
-    eta_edge = np.where(interior, jump_len ** 2 / kmax, 0.0)
-    jump = 0.5 * c_jump ** 2 * eta_edge[te].sum(axis=1)
 
     # boundary edges: Neumann mismatch unless both ends are Dirichlet nodes
     bnd = np.flatnonzero(count == 1)

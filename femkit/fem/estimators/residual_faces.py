@@ -20,6 +20,7 @@ from typing import Sequence
 import numpy as np
 
 from ..coefficients import evaluate_callable
+from ..fused import source_norm_sq
 from ..quadrature import get_rule, rule_for_degree
 
 
@@ -27,6 +28,9 @@ def _source_norm_sq(mesh, f, volume: np.ndarray) -> np.ndarray:
     """``||f||_T^2`` per tetrahedron (degree-5 rule for a callable ``f``)."""
     if callable(f):
         rule = rule_for_degree(5, 3)
+        fused = source_norm_sq(mesh, f, volume, rule)  # compiled (or kept from the error pass)
+        if fused is not None:
+            return fused
         fv = evaluate_callable(f, *rule.physical_points(mesh, mesh.cells), name="f")
         return volume * ((fv * fv) @ rule.weights)
     return volume * float(f) ** 2

@@ -21,27 +21,19 @@ nor compilation.
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
 import inspect
-import os
-import sys
-import tempfile
 from pathlib import Path
 from types import ModuleType
 from typing import Sequence
 
+from ...codegen import cache_dir as _cache_dir, copied_kernels as _copied_kernels, load_generated
+
 __all__ = ["energy_module", "energy_source", "cache_dir"]
-
-
-_LOADED: dict[str, ModuleType] = {}
 
 
 def cache_dir() -> Path:
     """Where generated energy modules live (``FEMKIT_CACHE_DIR`` or ``~/.cache/femkit``)."""
-    root = os.environ.get("FEMKIT_CACHE_DIR") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "femkit")
-    return Path(root) / "energies"
+    return _cache_dir("energies")
 
 
 def _energy_function(name: str, W, d: int, n_params: int) -> str:
@@ -79,18 +71,9 @@ def _energy_function(name: str, W, d: int, n_params: int) -> str:
 
 def copied_kernels(module) -> list[str]:
     """Names of the compiled functions of ``module`` that reach ``stretch_energy`` through their
-    calls (read from each function's code object): these are copied into a generated module, so
-    that they resolve the generated energy; the others are imported."""
-    funcs = {n: f.py_func for n, f in vars(module).items() if hasattr(f, "py_func")}
-    calls = {n: set(f.__code__.co_names) & set(funcs) for n, f in funcs.items()}
-    reach = {"stretch_energy"}
-    grew = True
-    while grew:
-        new = {n for n, c in calls.items() if c & reach} - reach
-        reach |= new
-        grew = bool(new)
-    reach.discard("stretch_energy")
-    return sorted(reach, key=lambda n: funcs[n].__code__.co_firstlineno)
+    calls: these are copied into a generated module, so that they resolve the generated energy;
+    the others are imported (:func:`femkit.codegen.copied_kernels`)."""
+    return _copied_kernels(module, ("stretch_energy",))
 
 
 def energy_source(W, stretches: Sequence, constants: Sequence) -> str:
@@ -131,22 +114,4 @@ def energy_module(W, stretches: Sequence, constants: Sequence) -> ModuleType:
     from .. import compiled
 
     text = energy_source(W, stretches, constants)
-    key = hashlib.sha256((text + inspect.getsource(compiled)).encode()).hexdigest()[:20]
-    mod = _LOADED.get(key)
-    if mod is not None:
-        return mod
-    folder = cache_dir()
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"femkit_energy_{key}.py"
-    if not path.exists() or path.read_text() != text:
-        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.replace(tmp, path)          # atomic: parallel test workers may write the same file
-    name = f"femkit_energy_{key}"
-    spec = importlib.util.spec_from_file_location(name, path)
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[name] = mod
-    spec.loader.exec_module(mod)
-    _LOADED[key] = mod
-    return mod
+    return load_generated(text, "femkit_energy", "energies", inspect.getsource(compiled))

@@ -1,0 +1,91 @@
+"""Generated Python modules: written once to femkit's cache directory and imported from there.
+
+femkit turns some user input into numba source (an elastic energy's derivatives, the
+expressions of a case file). The text of such a module is written to ``FEMKIT_CACHE_DIR`` (else
+``~/.cache/femkit``) under a name that hashes the text (and whatever else it depends on, the
+``salt``), then imported; numba's ``cache=True`` keeps its machine code beside it, so a later
+process pays neither the generation nor the compilation. A generated module reuses compiled
+template functions of a library module by copying their source in (:func:`copied_kernels`):
+their globals then resolve to the generated definitions.
+
+Standard library only: any layer may import it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import inspect
+import os
+import sys
+import tempfile
+from pathlib import Path
+from types import ModuleType
+from typing import Iterable
+
+__all__ = ["cache_dir", "load_generated", "copied_kernels", "function_sources", "generated_path"]
+
+_LOADED: dict[str, ModuleType] = {}
+
+
+def cache_dir(kind: str) -> Path:
+    """Where generated modules of ``kind`` live (``FEMKIT_CACHE_DIR`` or ``~/.cache/femkit``)."""
+    root = os.environ.get("FEMKIT_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "femkit")
+    return Path(root) / kind
+
+
+def _name(text: str, prefix: str, salt: str) -> str:
+    return f"{prefix}_{hashlib.sha256((text + salt).encode()).hexdigest()[:20]}"
+
+
+def generated_path(text: str, prefix: str, kind: str, salt: str = "") -> Path:
+    """The file :func:`load_generated` writes ``text`` to (whether or not it exists yet)."""
+    return cache_dir(kind) / f"{_name(text, prefix, salt)}.py"
+
+
+def load_generated(text: str, prefix: str, kind: str, salt: str = "") -> ModuleType:
+    """The module whose source is ``text``: written once to :func:`cache_dir` (``kind``) under
+    ``<prefix>_<hash of text + salt>.py``, imported once per process.
+
+    ``salt`` is what the module depends on beyond its own text (e.g. the source of the module it
+    imports its shared kernels from: numba's cache would not notice an edited callee).
+    """
+    name = _name(text, prefix, salt)
+    mod = _LOADED.get(name)
+    if mod is not None:
+        return mod
+    path = generated_path(text, prefix, kind, salt)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not path.exists() or path.read_text() != text:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        os.replace(tmp, path)          # atomic: parallel test workers may write the same file
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[name] = mod
+    spec.loader.exec_module(mod)
+    _LOADED[name] = mod
+    return mod
+
+
+def copied_kernels(module: ModuleType, roots: Iterable[str]) -> list[str]:
+    """Names of the compiled functions of ``module`` that reach one of ``roots`` through their
+    calls (read from each function's code object), in source order: a generated module copies
+    their source, so that they resolve its own definitions of ``roots``; it imports the others."""
+    funcs = {n: f.py_func for n, f in vars(module).items() if hasattr(f, "py_func")}
+    calls = {n: set(f.__code__.co_names) & set(funcs) for n, f in funcs.items()}
+    reach = set(roots)
+    grew = True
+    while grew:
+        new = {n for n, c in calls.items() if c & reach} - reach
+        reach |= new
+        grew = bool(new)
+    reach -= set(roots)
+    return sorted(reach, key=lambda n: funcs[n].__code__.co_firstlineno)
+
+
+def function_sources(module: ModuleType, names: Iterable[str]) -> list[str]:
+    """The source text of each function ``names`` of ``module`` (decorators included)."""
+    return [inspect.getsource(getattr(module, n)).rstrip() for n in names]

@@ -1,0 +1,159 @@
+"""The fused, compiled passes give the NumPy path's numbers: error norms, the residual estimate
+and the energy error to 1e-12 relative, with expressions of a case file compiled by the case layer;
+a non-finite value or a degenerate cell is reported by the NumPy path exactly as before."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import femkit.fem.fused.kernels as fused_kernels
+from femkit.case.compiled_expressions import expression_kernels
+from femkit.case.expressions import Gradient, compile_expression
+from femkit.errors import DegenerateMeshError, ExpressionError
+from femkit.fem import energy_error, error_norms
+from femkit.fem.estimators import residual_estimator
+from femkit.fem.fused import kernels_for
+from femkit.mesh import Mesh, structured_mesh
+
+from ._tets import perturbed_box
+
+V = ("x", "y", "z")
+
+#: (u, gradient components, f) as a case file gives them
+SETS = {
+    "sin-2d": ("sin(pi * x) * sin(pi * y)",
+               ["pi * cos(pi * x) * sin(pi * y)", "pi * sin(pi * x) * cos(pi * y)"],
+               "2 * pi**2 * sin(pi * x) * sin(pi * y)"),
+    "exp-poly-2d": ("exp(x) * y**2 + x", ["exp(x) * y**2 + 1", "2 * y * exp(x)"],
+                    "-(exp(x) * y**2 + 2 * exp(x))"),
+    "singular-no-gradient": ("hypot(x, y)**(2/3) * sin(2/3 * mod(arctan2(y, x), 2*pi))", [], "0"),
+    "where-constants": ("where(x < 0.5, k * x**2, k / 4 + (x - 0.5))", [], "c * x * y"),
+    "sin-3d": ("sin(pi*x) * sin(pi*y) * sin(pi*z)",
+               ["pi*cos(pi*x)*sin(pi*y)*sin(pi*z)", "pi*sin(pi*x)*cos(pi*y)*sin(pi*z)",
+                "pi*sin(pi*x)*sin(pi*y)*cos(pi*z)"], "3*pi**2*sin(pi*x)*sin(pi*y)*sin(pi*z)"),
+}
+
+
+def _mesh(name):
+    if name.endswith("3d"):
+        return perturbed_box(4)
+    m = structured_mesh(12, 12)
+    rng = np.random.default_rng(3)
+    p = m.points.copy()
+    inner = ((p > 1e-9) & (p < 1 - 1e-9)).all(axis=1)
+    p[inner] += 0.02 * rng.uniform(-1, 1, (int(inner.sum()), 2))
+    return Mesh(p, m.triangles)
+
+
+def _functions(name, fuse_source=True):
+    u, grad, f = SETS[name]
+    consts = {"k": 2.0, "c": 3.0}
+    exact = compile_expression(u, V, consts)
+    parts = [compile_expression(g, V, consts, check_finite=False) for g in grad]
+    source = compile_expression(f, V, consts)
+    kernels = expression_kernels(exact, parts, source, fuse_source=fuse_source)
+    return exact, (Gradient(parts) if parts else None), source, kernels
+
+
+def _numpy_and_fused(monkeypatch, run):
+    """``run()`` by the NumPy path, then by the compiled one."""
+    monkeypatch.setattr(fused_kernels, "NUMBA_THRESHOLD", 10 ** 12)
+    reference = run()
+    monkeypatch.setattr(fused_kernels, "NUMBA_THRESHOLD", 0)
+    return reference, run()
+
+
+@pytest.mark.parametrize("name", list(SETS))
+def test_errors_estimate_and_energy_error_match_the_numpy_path(name, monkeypatch):
+    mesh = _mesh(name)
+    exact, grad, f, kernels = _functions(name)
+    assert kernels.module.HAS_SOURCE
+    pts = mesh.points.T
+    u = exact(*pts) + 1e-3 * np.sin(3 * pts[0] + 2 * pts[1])     # a discrete solution's error
+
+    def run():
+        errs = error_norms(mesh, u, exact, grad)
+        est = residual_estimator(mesh, u, kappa=2.0, f=f, dirichlet_nodes=np.arange(0))
+        energy = energy_error(mesh, u, grad, 2.0, per_element=True) if grad is not None else None
+        return errs, est, energy
+
+    (e0, s0, g0), (e1, s1, g1) = _numpy_and_fused(monkeypatch, run)
+    assert kernels_for(mesh, exact=exact, grad_exact=grad) is kernels
+    for key in ("L2", "H1_semi", "max_nodal"):
+        if e0[key] is None:
+            assert e1[key] is None and grad is None
+        else:
+            assert e1[key] == pytest.approx(e0[key], rel=1e-12, abs=0), key
+    np.testing.assert_allclose(s1.indicators, s0.indicators, rtol=1e-12, atol=0)
+    assert s1.energy == pytest.approx(s0.energy, rel=1e-12)
+    if grad is not None:
+        np.testing.assert_allclose(g1, g0, rtol=1e-12, atol=0)
+
+
+def test_the_source_alone_is_compiled_for_the_estimator(monkeypatch):
+    """No exact solution (or a source not fused into the error pass): its own compiled pass."""
+    mesh = _mesh("sin-2d")
+    _, _, f, kernels = _functions("exp-poly-2d", fuse_source=False)
+    assert not kernels.module.HAS_SOURCE
+    u = np.cos(mesh.points[:, 0])
+    s0, s1 = _numpy_and_fused(monkeypatch, lambda: residual_estimator(mesh, u, f=f))
+    np.testing.assert_allclose(s1.parts["volume"], s0.parts["volume"], rtol=1e-12, atol=0)
+
+
+def test_kernels_are_used_only_for_the_callables_they_stand_for(monkeypatch):
+    monkeypatch.setattr(fused_kernels, "NUMBA_THRESHOLD", 0)
+    mesh = _mesh("sin-2d")
+    exact, grad, f, kernels = _functions("sin-2d")
+    other = compile_expression("sin(pi * x) * sin(pi * y)", V)     # same text, not attached
+    assert kernels_for(mesh, exact=exact, grad_exact=grad, source=f) is kernels
+    assert kernels_for(mesh, exact=other, grad_exact=grad) is None
+    assert kernels_for(mesh, exact=exact, grad_exact=lambda x, y: (x, y)) is None
+    assert kernels_for(mesh, exact=f) is None                          # the source is not u
+    box = perturbed_box(2)
+    assert kernels_for(box, exact=exact) is kernels                    # u(x, y) on a 3D mesh: fine
+    assert kernels_for(box, exact=exact, grad_exact=grad) is None      # but 3 gradient components
+    swapped = Gradient(list(reversed(grad.parts)))
+    assert swapped.fused is None and kernels_for(mesh, exact=exact, grad_exact=swapped) is None
+    monkeypatch.setattr(fused_kernels, "NUMBA_THRESHOLD", mesh.n_cells + 1)
+    assert kernels_for(mesh, exact=exact) is None                      # small mesh: NumPy
+
+
+def test_non_finite_values_and_degenerate_cells_are_reported_as_by_numpy(monkeypatch):
+    mesh = _mesh("sin-2d")
+    exact = compile_expression("log(x)", V)                           # -inf on x = 0
+    exact.label = "exact.u"
+    expression_kernels(exact)
+    u = np.zeros(mesh.n_points)
+    messages = []
+    for threshold in (10 ** 12, 0):
+        monkeypatch.setattr(fused_kernels, "NUMBA_THRESHOLD", threshold)
+        with pytest.raises(ExpressionError) as info:
+            error_norms(mesh, u, exact)
+        messages.append(str(info.value))
+    assert messages[0] == messages[1] and "exact.u: expression 'log(x)' gave non-finite" in messages[0]
+    flat = Mesh(np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [0.0, 1.0]]),
+                np.array([[0, 1, 2], [0, 1, 3]]))
+    ok = compile_expression("x + y", V)
+    expression_kernels(ok)
+    with pytest.raises(DegenerateMeshError, match="1 triangle"):
+        error_norms(flat, np.zeros(4), ok)
+
+
+@pytest.mark.parametrize("kappa", [1.0, "regions"], ids=["kappa-1", "kappa-per-region"])
+def test_compiled_residual_estimator_gives_the_same_bits(kappa, monkeypatch):
+    """The estimator's element and edge terms compiled (large meshes) equal NumPy's exactly."""
+    import femkit.fem.estimators.geometry as geometry
+    import femkit.fem.estimators.residual as residual
+
+    mesh = _mesh("sin-2d")
+    k = np.where(mesh.centroids()[:, 0] < 0.5, 1.0, 1e3) if kappa == "regions" else kappa
+    u = np.sin(3 * mesh.points[:, 0]) * mesh.points[:, 1]
+    bottom = np.flatnonzero(mesh.points[:, 1] < 1e-12)
+    results = []
+    for threshold in (10 ** 12, 0):
+        monkeypatch.setattr(geometry, "NUMBA_THRESHOLD", threshold)
+        monkeypatch.setattr(residual, "NUMBA_THRESHOLD", threshold)
+        results.append(residual_estimator(mesh, u, kappa=k, f=1.0, dirichlet_nodes=bottom))
+    for part in ("volume", "jump", "neumann"):
+        np.testing.assert_array_equal(results[1].parts[part], results[0].parts[part])
