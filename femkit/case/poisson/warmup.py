@@ -23,6 +23,7 @@ COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)..."
 #: (module, name) of one kernel of each compiled family; when all are in the on-disk cache the
 #: kernels were compiled before (a warm-up compiles every family at once).
 _PROBES = (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
+           ("femkit.fem._kernels", "_stiffness_rows"), ("femkit.fem._kernels", "_eliminate"),
            ("femkit.mesh._edges_kernel", "cell_edges"),
            ("femkit.mesh._quality_kernel", "triangle_quality"),
            ("femkit.mesh._refine_kernel", "red_children"),
@@ -32,7 +33,8 @@ _PROBES = (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffn
 #: The module constants that choose the compiled paths by size (lowered during a warm-up).
 _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiffness", "NUMBA_THRESHOLD"),
                ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"),
-               ("femkit.mesh.quality", "NUMBA_THRESHOLD"), ("femkit.mesh.refine", "NUMBA_THRESHOLD"))
+               ("femkit.mesh.quality", "NUMBA_THRESHOLD"), ("femkit.mesh.refine", "NUMBA_THRESHOLD"),
+               ("femkit.fem.dirichlet", "NUMBA_THRESHOLD"))
 
 _TINY = {
     "problem": "poisson", "name": "warmup",
