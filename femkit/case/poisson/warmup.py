@@ -28,13 +28,15 @@ _PROBES = (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffn
            ("femkit.mesh._quality_kernel", "triangle_quality"),
            ("femkit.mesh._refine_kernel", "red_children"),
            ("femkit.solvers.preconditioners._gmg_kernels", "galerkin"),
+           ("femkit.solvers._symmetry_kernel", "row_sums"),
            ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps"))
 
 #: The module constants that choose the compiled paths by size (lowered during a warm-up).
 _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiffness", "NUMBA_THRESHOLD"),
                ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"),
                ("femkit.mesh.quality", "NUMBA_THRESHOLD"), ("femkit.mesh.refine", "NUMBA_THRESHOLD"),
-               ("femkit.fem.dirichlet", "NUMBA_THRESHOLD"))
+               ("femkit.fem.dirichlet", "NUMBA_THRESHOLD"),
+               ("femkit.solvers.checks", "SYMMETRY_NUMBA_THRESHOLD"))
 
 _TINY = {
     "problem": "poisson", "name": "warmup",
