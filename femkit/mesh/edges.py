@@ -59,6 +59,15 @@ def edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     return hit
 
 
+def forget_edges(mesh: Mesh) -> None:
+    """Drop ``mesh``'s cached edges (a coarser level of a hierarchy needs them only while it
+    is refined; :func:`edges` computes them again if asked)."""
+    try:
+        _CACHE.pop(mesh, None)
+    except TypeError:
+        pass
+
+
 def _edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     n = max(mesh.n_points, 1)
     k = 3 if mesh.dim == 2 else 6

@@ -31,6 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError
+from .edges import forget_edges
 from .mesh import Mesh
 from .refine import refine_once
 
@@ -164,6 +165,7 @@ class MeshHierarchy:
         for _ in range(int(levels)):
             n_c = mesh.n_points
             fine, edge_nodes = refine_once(mesh)
+            forget_edges(mesh)  # kept only through edge_nodes, which P needs
             P = prolongation(n_c, edge_nodes)
             inj = np.arange(n_c, dtype=np.int64)
             if renumber != "none":

@@ -107,3 +107,10 @@ def test_compiled_quality_is_the_numpy_quality(monkeypatch, make):
             assert got[k] == ref[k], k
         else:
             assert got[k] == pytest.approx(ref[k], rel=1e-13, abs=0), k
+
+
+def test_hierarchy_keeps_no_edges_of_its_coarser_levels():
+    """The coarser levels' edges are needed only while they are refined (memory of a large run)."""
+    H = MeshHierarchy.from_refinement(_tagged_skewed(5), 2)
+    assert all(m not in edges_module._CACHE for m in H.meshes[:-1])
+    assert np.array_equal(edges(H.meshes[0])[0], edges(_tagged_skewed(5))[0])  # recomputed on demand
