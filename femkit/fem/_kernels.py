@@ -10,6 +10,18 @@ import numba
 import numpy as np
 
 
+@numba.njit(cache=True, inline="always")
+def _insert_sorted(indices, s, end, j):  # pragma: no cover - compiled
+    """Insert column ``j`` into the sorted run ``indices[s:end]`` (insertion sort: rows are
+    short); returns the new end."""
+    q = end
+    while q > s and indices[q - 1] > j:
+        indices[q] = indices[q - 1]
+        q -= 1
+    indices[q] = j
+    return end + 1
+
+
 @numba.njit(cache=True)
 def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  # pragma: no cover - compiled
     """Node-wise P1 pattern: row i = sorted unique vertices of the elements around node i.
@@ -61,12 +73,7 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
                 j = verts[k, b]
                 if stamp[j] != i:
                     stamp[j] = i
-                    q = nnz
-                    while q > s and indices[q - 1] > j:
-                        indices[q] = indices[q - 1]
-                        q -= 1
-                    indices[q] = j
-                    nnz += 1
+                    nnz = _insert_sorted(indices, s, nnz, j)
         for q in range(s, nnz):
             pos[indices[q]] = q
         for k in range(start[i], start[i + 1]):
@@ -132,12 +139,7 @@ def _pattern_cells(tri, n, indices, slots):  # pragma: no cover - compiled
                 j = verts[k, b]
                 if stamp[j] != i:
                     stamp[j] = i
-                    q = nnz
-                    while q > s and indices[q - 1] > j:
-                        indices[q] = indices[q - 1]
-                        q -= 1
-                    indices[q] = j
-                    nnz += 1
+                    nnz = _insert_sorted(indices, s, nnz, j)
         for q in range(s, nnz):
             pos[indices[q]] = q
         for k in range(start[i], start[i + 1]):
@@ -352,6 +354,7 @@ def warm_up() -> None:
     _, nnz, _, _ = _pattern(tri, 4, ind, slots, pts, np.ones(1), True, True)
     _stiffness(tri, pts, np.zeros(1, np.int64), False, np.ones(1), True, slots, nnz)
     _load_barycentric(tri, pts, np.zeros(1, np.int64), False, np.ones(1), True, 4)
+    _stiffness_rows(tri, 4, pts, np.ones(1), True, np.empty(6, np.int32))
     tet = np.array([[0, 1, 2, 3]], dtype=np.int64)
     p3 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
     ind3 = np.empty(4 + 12, np.int32)
@@ -359,3 +362,156 @@ def warm_up() -> None:
     _, nnz3 = _pattern_cells(tet, 4, ind3, slots3)
     _stiffness_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, slots3, nnz3)
     _load_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, 4)
+
+
+@numba.njit(cache=True)
+def _stiffness_rows(tri, n, points, kappa, scalar_kappa, inc):  # pragma: no cover - compiled
+    """The P1 stiffness as CSR, row by row, without a slot map: ``(indptr, indices, data, bad)``.
+
+    A node -> element incidence list (counting sort: elements in increasing order around each
+    node) is the only buffer besides the output. Row ``i`` is the sorted set of the vertices of
+    its elements; each element adds its local row ``a`` (``i`` its vertex ``a``), so every entry
+    is summed over its elements in increasing element order: the same sums, in the same order,
+    as the element-order scatter of :func:`_pattern` / :func:`_stiffness` (bit for bit). The
+    price is each element's geometry computed once per vertex; the memory is ``3 m`` element
+    ids instead of the (m, 9) slot map and the (3 m, 3) vertex copies. ``inc`` is the ``3 m``
+    buffer of the incidences; ``indices`` get its dtype. ``bad`` counts degenerate triangles
+    (then ``data`` is incomplete).
+    """
+    m = tri.shape[0]
+    start = np.zeros(n + 1, np.int64)
+    for e in range(m):
+        for a in range(3):
+            start[tri[e, a] + 1] += 1
+    for i in range(n):
+        start[i + 1] += start[i]
+    fill = start[:-1].copy()
+    for e in range(m):
+        for a in range(3):
+            i = tri[e, a]
+            inc[fill[i]] = e
+            fill[i] += 1
+    # pass 1: the row lengths (distinct neighbours, a stamp array)
+    stamp = np.full(n, -1, np.int64)
+    indptr = np.zeros(n + 1, np.int64)
+    for i in range(n):
+        c = 0
+        for k in range(start[i], start[i + 1]):
+            e = inc[k]
+            for b in range(3):
+                j = tri[e, b]
+                if stamp[j] != i:
+                    stamp[j] = i
+                    c += 1
+        indptr[i + 1] = indptr[i] + c
+    nnz = indptr[n]
+    indices = np.empty(nnz, inc.dtype)
+    data = np.zeros(nnz)
+    pos = np.empty(n, np.int64)
+    stamp[:] = -1
+    bad = 0
+    # pass 2: sorted columns (insertion sort: rows are short), then the local rows summed
+    for i in range(n):
+        s = indptr[i]
+        q_end = s
+        for k in range(start[i], start[i + 1]):
+            e = inc[k]
+            for b in range(3):
+                j = tri[e, b]
+                if stamp[j] != i:
+                    stamp[j] = i
+                    q_end = _insert_sorted(indices, s, q_end, j)
+        for q in range(s, q_end):
+            pos[indices[q]] = q
+        for k in range(start[i], start[i + 1]):
+            e = inc[k]
+            i0, i1, i2, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(tri, points, e)
+            if not (area > 0.0 and area < np.inf):
+                bad += 1
+                continue
+            sc = (kappa[0] if scalar_kappa else kappa[e]) / (4.0 * area)
+            if i0 == i:
+                exa, eya = ex0, ey0
+            elif i1 == i:
+                exa, eya = ex1, ey1
+            else:
+                exa, eya = ex2, ey2
+            data[pos[i0]] += sc * (exa * ex0 + eya * ey0)
+            data[pos[i1]] += sc * (exa * ex1 + eya * ey1)
+            data[pos[i2]] += sc * (exa * ex2 + eya * ey2)
+    return indptr, indices, data, bad
+
+
+def stiffness_rows_kernel(mesh, kappa):
+    """``(indptr, indices, data)`` of the stiffness of a whole triangle mesh, built row by row
+    without a slot map (:func:`_stiffness_rows`), or None if some triangle is degenerate."""
+    m, n = mesh.n_cells, mesh.n_points
+    inc = np.empty(3 * m, np.int32 if max(3 * m, 8 * n) < np.iinfo(np.int32).max else np.int64)
+    indptr, indices, data, bad = _stiffness_rows(mesh.cells, n, mesh.points, *_values(kappa), inc)
+    return None if bad else (indptr, indices, data)
+
+
+@numba.njit(cache=True)
+def _eliminate(indptr, indices, data, is_fixed, g_full, F, out_indptr, out_indices, out_data, b):  # pragma: no cover - compiled
+    """``A = K[free, free]`` and ``b = F[free] - K[free, :] g`` in one pass over ``K``'s rows.
+
+    The entries of the free rows in the free columns are copied in their order (renumbered
+    columns), so ``A`` is what SciPy's ``K[free][:, free]`` gives for sorted ``K``; the lifting
+    sums ``K_ij g_j`` over the whole row in its order, as SciPy's product does (``g`` is 0 at
+    the free nodes). ``out_*`` may be ``K``'s own arrays (the copy only moves entries forward:
+    elimination in place). Returns ``nnz(A)``.
+    """
+    n = is_fixed.shape[0]
+    col = np.empty(n, np.int64)
+    c = 0
+    for j in range(n):
+        if is_fixed[j]:
+            col[j] = -1
+        else:
+            col[j] = c
+            c += 1
+    r = 0
+    q = 0
+    t = indptr[0]
+    out_indptr[0] = 0
+    for i in range(n):
+        # indptr[i] may be overwritten already (in place): the row starts where the last ended
+        s, t = t, indptr[i + 1]
+        if is_fixed[i]:
+            continue
+        acc = 0.0
+        for p in range(s, t):
+            j = indices[p]
+            v = data[p]
+            acc += v * g_full[j]
+            cj = col[j]
+            if cj >= 0:
+                out_indices[q] = cj
+                out_data[q] = v
+                q += 1
+        b[r] = F[i] - acc
+        r += 1
+        out_indptr[r] = q
+    return q
+
+
+def eliminate_kernel(K, F, is_fixed, g_full, overwrite: bool):
+    """``(A, b)`` of Dirichlet elimination by :func:`_eliminate`; with ``overwrite`` ``A``
+    takes over ``K``'s arrays (``K`` is left invalid)."""
+    import scipy.sparse as sp
+
+    n = K.shape[0]
+    n_free = n - int(is_fixed.sum())
+    if overwrite:
+        out_indptr, out_indices, out_data = K.indptr, K.indices, K.data
+    else:
+        out_indptr = np.empty(n_free + 1, K.indptr.dtype)
+        out_indices = np.empty_like(K.indices)
+        out_data = np.empty_like(K.data)
+    b = np.empty(n_free)
+    nnz = _eliminate(K.indptr, K.indices, K.data, is_fixed, g_full, F, out_indptr, out_indices,
+                     out_data, b)
+    A = sp.csr_matrix((out_data[:nnz], out_indices[:nnz], out_indptr[:n_free + 1]),
+                      shape=(n_free, n_free), copy=not overwrite)
+    A.has_sorted_indices = True
+    return A, b

@@ -83,7 +83,12 @@ def dirichlet_values(mesh, nodes, g: Values) -> np.ndarray:
     return vals
 
 
-def apply_dirichlet(K, F, nodes, values) -> DirichletSystem:
+#: Systems with at least this many rows are reduced by one compiled pass over ``K``
+#: (:func:`femkit.fem._kernels.eliminate_kernel`: the same ``A`` and ``b`` as SciPy's indexing).
+NUMBA_THRESHOLD = 100_000
+
+
+def apply_dirichlet(K, F, nodes, values, *, overwrite: bool = False) -> DirichletSystem:
     """Eliminate the Dirichlet nodes from ``K u = F``.
 
     Parameters
@@ -94,6 +99,10 @@ def apply_dirichlet(K, F, nodes, values) -> DirichletSystem:
         Dirichlet nodes (duplicates allowed if their values agree).
     values : float or array of len(nodes) (of ``mask.sum()`` for a mask)
         ``g`` at ``nodes`` (use :func:`dirichlet_values` for a callable); must be finite.
+    overwrite : bool
+        Let ``A`` take over ``K``'s arrays (elimination in place, no second matrix in memory);
+        ``K`` must not be used afterwards. Only for a CSR ``K`` of float64 with sorted indices
+        from :data:`NUMBA_THRESHOLD` rows on; otherwise ignored.
 
     Returns
     -------
@@ -105,6 +114,7 @@ def apply_dirichlet(K, F, nodes, values) -> DirichletSystem:
         Shapes that do not match, node ids out of range or not integers, non-finite values,
         a node given twice with different values.
     """
+    given = K
     K = sp.csr_matrix(K)
     n = K.shape[0]
     F = np.asarray(F, dtype=np.float64)
@@ -129,6 +139,15 @@ def apply_dirichlet(K, F, nodes, values) -> DirichletSystem:
     is_fixed = np.zeros(n, dtype=bool)
     is_fixed[fixed] = True
     free = np.flatnonzero(~is_fixed)
+    if n >= NUMBA_THRESHOLD and K.has_sorted_indices and K.dtype == np.float64:
+        from ._kernels import eliminate_kernel
+
+        g_full = np.zeros(n)
+        g_full[fixed] = g
+        # in place only on the caller's own CSR arrays (sp.csr_matrix(K) shares them)
+        in_place = overwrite and sp.issparse(given) and given.format == "csr"
+        A, b = eliminate_kernel(K, F, is_fixed, g_full, in_place)
+        return DirichletSystem(A=A, b=b, free=free, fixed=fixed, values=g, n=n)
     K_free = K[free]
     A = K_free[:, free].tocsr()
     A.sort_indices()

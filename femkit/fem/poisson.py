@@ -329,18 +329,21 @@ class PoissonProblem:
         """Seconds per stage of the last assembly and solve."""
         return self._timer.times
 
-    def assemble_matrices(self) -> tuple:
+    def assemble_matrices(self, *, keep_pattern: bool = True) -> tuple:
         """Stiffness ``K`` and load ``F`` (source + Neumann fluxes) on the whole mesh.
 
         The Neumann part alone is kept as :attr:`neumann_load` (the pure-Neumann compatibility
-        check needs it). Stage times go to :attr:`timings`.
+        check needs it). Stage times go to :attr:`timings`. ``keep_pattern=False``: a one-off
+        assembly that builds and caches no sparsity pattern on a large triangle mesh
+        (:func:`assemble_stiffness`'s ``keep_pattern``; the same ``K``).
         """
         self._timer = StageTimer()
         t = self._timer
         with t("pattern"):
-            pattern = SparsityPattern.for_mesh(self.mesh)
+            pattern = (SparsityPattern.for_mesh(self.mesh) if keep_pattern
+                       else SparsityPattern.cached(self.mesh))
         with t("stiffness"):
-            K = assemble_stiffness(self.mesh, self.kappa, pattern=pattern)
+            K = assemble_stiffness(self.mesh, self.kappa, pattern=pattern, keep_pattern=keep_pattern)
         with t("load"):
             F = assemble_load(self.mesh, self.f, rule=self.load_rule)
         with t("neumann"):
@@ -364,10 +367,11 @@ class PoissonProblem:
             F_flux += assemble_neumann(self.mesh, tags, h)
         return F_flux
 
-    def reduce(self, K, F, method: str = "direct") -> DirichletSystem | NullspaceSystem:
+    def reduce(self, K, F, method: str = "direct", *, overwrite: bool = False) -> DirichletSystem | NullspaceSystem:
         """The system a solver gets: Dirichlet nodes eliminated (SPD), or, pure Neumann, the
         compatibility checked and the constant fixed (:func:`pure_neumann_system`; ``method``
-        says whether a direct solver will be used)."""
+        says whether a direct solver will be used). ``overwrite``: the Dirichlet elimination
+        may reuse ``K``'s arrays (:func:`apply_dirichlet`; ``K`` is not to be used after)."""
         with self._timer("dirichlet"):
             if self.nullspace is not None:
                 w = node_weights(self.mesh)
@@ -379,7 +383,7 @@ class PoissonProblem:
                                                   compatibility=info)
             else:
                 fixed, values = self.dirichlet_data()
-                self.system = apply_dirichlet(K, F, fixed, values)
+                self.system = apply_dirichlet(K, F, fixed, values, overwrite=overwrite)
         return self.system
 
     def assemble(self, method: str = "direct") -> DirichletSystem | NullspaceSystem:

@@ -11,46 +11,68 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def unique_edges(lo, hi, n):  # pragma: no cover - compiled
-    """Unique ``(lo, hi)`` pairs in lexicographic order and the position of each input pair.
+def cell_edges(cells, local, n):  # pragma: no cover - compiled
+    """Unique edges of ``cells`` in lexicographic order and the edge of each local edge.
 
-    A counting sort by ``lo`` (O(N), no comparison sort of the N keys), then an insertion sort
-    by ``hi`` inside each ``lo`` bucket (a node has ~6 edges): the same order and inverse as
-    ``np.unique(lo * n + hi, return_inverse=True)``.
+    ``local`` (k, 2) lists the local edges of a cell (:data:`femkit.mesh.mesh.LOCAL_EDGES`).
+    Reads ``cells`` directly (no (m, k, 2) copy, no separate min / max arrays): a counting sort
+    of the m k local edges by their lower node (O(m k), no comparison sort of the keys), then an
+    insertion sort by the higher node inside each bucket (a node has ~6 edges in 2D, ~14 in 3D).
+    Returns ``(edge_nodes (E, 2), cell_edges (m, k))``, the same arrays as
+    ``np.unique(lo * n + hi, return_inverse=True)`` gives.
     """
-    k = lo.shape[0]
+    m = cells.shape[0]
+    k = local.shape[0]
+    total = m * k
     start = np.zeros(n + 1, np.int64)
-    for i in range(k):
-        start[lo[i] + 1] += 1
+    for e in range(m):
+        for j in range(k):
+            a, b = cells[e, local[j, 0]], cells[e, local[j, 1]]
+            start[min(a, b) + 1] += 1
     for v in range(n):
         start[v + 1] += start[v]
-    order = np.empty(k, np.int64)
     fill = start[:-1].copy()
-    for i in range(k):
-        v = lo[i]
-        order[fill[v]] = i
-        fill[v] += 1
-    edge_lo = np.empty(k, np.int64)
-    edge_hi = np.empty(k, np.int64)
-    inverse = np.empty(k, np.int64)
+    bucket_hi = np.empty(total, np.int64)
+    bucket_id = np.empty(total, np.int64)
+    for e in range(m):
+        for j in range(k):
+            a, b = cells[e, local[j, 0]], cells[e, local[j, 1]]
+            lo, hi = min(a, b), max(a, b)
+            q = fill[lo]
+            fill[lo] = q + 1
+            bucket_hi[q] = hi
+            bucket_id[q] = e * k + j
     count = 0
     for v in range(n):
-        s, e = start[v], start[v + 1]
-        for a in range(s + 1, e):  # insertion sort of the bucket by hi
-            j = order[a]
-            key = hi[j]
+        s, t = start[v], start[v + 1]
+        for a in range(s + 1, t):  # insertion sort of the bucket by hi
+            h, i = bucket_hi[a], bucket_id[a]
             b = a
-            while b > s and hi[order[b - 1]] > key:
-                order[b] = order[b - 1]
+            while b > s and bucket_hi[b - 1] > h:
+                bucket_hi[b] = bucket_hi[b - 1]
+                bucket_id[b] = bucket_id[b - 1]
                 b -= 1
-            order[b] = j
-        last = -1
-        for a in range(s, e):
-            j = order[a]
-            if hi[j] != last:
-                last = hi[j]
-                edge_lo[count] = v
-                edge_hi[count] = last
+            bucket_hi[b] = h
+            bucket_id[b] = i
+        for a in range(s, t):
+            if a == s or bucket_hi[a] != bucket_hi[a - 1]:
                 count += 1
-            inverse[j] = count - 1
-    return edge_lo[:count], edge_hi[:count], inverse
+    edge_nodes = np.empty((count, 2), np.int64)  # exactly sized: no (m k, 2) buffer
+    inverse = np.empty((m, k), np.int64)
+    count = 0
+    for v in range(n):
+        for a in range(start[v], start[v + 1]):
+            if a == start[v] or bucket_hi[a] != bucket_hi[a - 1]:
+                edge_nodes[count, 0] = v
+                edge_nodes[count, 1] = bucket_hi[a]
+                count += 1
+            i = bucket_id[a]
+            inverse[i // k, i % k] = count - 1
+    return edge_nodes, inverse
+
+
+def warm_up() -> None:
+    """Compile (or load from the on-disk cache) the kernel for triangles and tetrahedra."""
+    from .mesh import LOCAL_EDGES
+
+    cell_edges(np.array([[0, 1, 2], [0, 2, 3]], np.int64), LOCAL_EDGES[3], 4)

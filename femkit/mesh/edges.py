@@ -59,16 +59,24 @@ def edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     return hit
 
 
+def forget_edges(mesh: Mesh) -> None:
+    """Drop ``mesh``'s cached edges (a coarser level of a hierarchy needs them only while it
+    is refined; :func:`edges` computes them again if asked)."""
+    try:
+        _CACHE.pop(mesh, None)
+    except TypeError:
+        pass
+
+
 def _edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     n = max(mesh.n_points, 1)
     k = 3 if mesh.dim == 2 else 6
+    if mesh.n_cells >= NUMBA_THRESHOLD:
+        from ._edges_kernel import cell_edges
+
+        return cell_edges(mesh.cells, LOCAL_EDGES[mesh.cells.shape[1]], n)
     loc = _local_edges(mesh.cells).reshape(-1, 2)
     lo, hi = loc.min(axis=1), loc.max(axis=1)
-    if mesh.n_cells >= NUMBA_THRESHOLD:
-        from ._edges_kernel import unique_edges
-
-        elo, ehi, inverse = unique_edges(lo, hi, n)
-        return np.stack([elo, ehi], axis=1), inverse.reshape(-1, k)
     keys, inverse = np.unique(lo * n + hi, return_inverse=True)
     edge_nodes = np.stack([keys // n, keys % n], axis=1)
     return edge_nodes, inverse.reshape(-1, k).astype(np.int64)

@@ -31,6 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError
+from .edges import forget_edges
 from .mesh import Mesh
 from .refine import refine_once
 
@@ -92,9 +93,16 @@ def interleave_permutation(n_coarse: int, edge_nodes: np.ndarray) -> np.ndarray:
     node ``j``; old ids as :func:`femkit.mesh.refine` numbers them). A stable merge of two sorted
     sequences, O(n); the children of a coarse triangle stay contiguous, so elements need no sort.
     """
-    key = np.concatenate([np.arange(n_coarse, dtype=np.int64),
-                          np.asarray(edge_nodes[:, 0], dtype=np.int64)])
-    return np.argsort(key, kind="stable")
+    lo = np.asarray(edge_nodes[:, 0], dtype=np.int64)
+    # the merge needs no sort: coarse node v goes after v nodes and the edges of lower nodes
+    # (edges are sorted by their lower node), edge e after its lower node and the e edges before
+    below = np.zeros(n_coarse + 1, dtype=np.int64)
+    np.cumsum(np.bincount(lo, minlength=n_coarse), out=below[1:])
+    inv = np.concatenate([np.arange(n_coarse, dtype=np.int64) + below[:-1],
+                          lo + 1 + np.arange(len(lo), dtype=np.int64)])
+    perm = np.empty_like(inv)
+    perm[inv] = np.arange(len(inv), dtype=np.int64)
+    return perm
 
 
 @dataclass(frozen=True, eq=False)
@@ -157,6 +165,7 @@ class MeshHierarchy:
         for _ in range(int(levels)):
             n_c = mesh.n_points
             fine, edge_nodes = refine_once(mesh)
+            forget_edges(mesh)  # kept only through edge_nodes, which P needs
             P = prolongation(n_c, edge_nodes)
             inj = np.arange(n_c, dtype=np.int64)
             if renumber != "none":

@@ -108,6 +108,8 @@ def quality(mesh: Mesh) -> dict:
         return _quality_3d(mesh)
     from .edges import edges
 
+    if mesh.n_cells >= NUMBA_THRESHOLD:
+        return _quality_compiled(mesh)
     area = mesh.areas()
     aspect = np.empty(mesh.n_cells)
     h_max, h_min, a_min, a_max = -np.inf, np.inf, np.nan, np.nan
@@ -145,3 +147,27 @@ def quality(mesh: Mesh) -> dict:
 
 #: Triangles per block of :func:`quality` (its (block, 3, 2) temporaries stay small).
 _BLOCK = 1 << 16
+
+#: Triangle meshes with at least this many cells get their numbers from one compiled pass
+#: (:mod:`femkit.mesh._quality_kernel`: no temporaries; the same formulas, equal to round-off).
+NUMBA_THRESHOLD = 200_000
+
+
+def _quality_compiled(mesh: Mesh) -> dict:
+    from ._quality_kernel import mean_edge_length, triangle_quality
+    from .edges import edges
+
+    h_max, h_min, a_min, a_max, asp_max, asp_sum, area = triangle_quality(mesh.points, mesh.triangles)
+    edge_nodes, _ = edges(mesh)  # shared with the estimator (cached per mesh)
+    return {
+        "n_points": mesh.n_points,
+        "n_triangles": mesh.n_triangles,
+        "h_max": float(h_max),
+        "h_min": float(h_min),
+        "h_mean": float(mean_edge_length(mesh.points, edge_nodes)),
+        "min_angle": float(a_min),
+        "max_angle": float(a_max),
+        "max_aspect_ratio": float(asp_max),
+        "mean_aspect_ratio": float(asp_sum / max(mesh.n_cells, 1)),
+        "area": float(area),
+    }

@@ -22,6 +22,10 @@ import numpy as np
 from .edges import boundary_edge_ids, edge_ids, edges
 from .mesh import Mesh
 
+#: Triangle meshes with at least this many cells are refined by compiled passes
+#: (:mod:`femkit.mesh._refine_kernel`; the same arrays as the NumPy path).
+NUMBA_THRESHOLD = 50_000
+
 # Local vertices of a tetrahedron during refinement: v0..v3, then the midpoints of its edges in
 # :data:`~femkit.mesh.edges.LOCAL_EDGES` order, m01 m02 m03 m12 m13 m23 (ids 4..9).
 _CORNERS = np.array([[0, 4, 5, 6], [4, 1, 7, 8], [5, 7, 2, 9], [6, 8, 9, 3]])
@@ -46,18 +50,23 @@ def refine_once(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
         return _refine_tetrahedra(mesh)
     n = mesh.n_points
     edge_nodes, tri_edges = edges(mesh)
-    mid = mesh.points[edge_nodes].mean(axis=1)
-    points = np.vstack([mesh.points, mid])
     t = mesh.triangles
-    m0, m1, m2 = (n + tri_edges[:, k] for k in range(3))
-    v0, v1, v2 = t[:, 0], t[:, 1], t[:, 2]
-    # children are counter-clockwise when the parent is; the four of a parent are contiguous
-    children = np.stack([
-        np.stack([v0, m2, m1], axis=1),
-        np.stack([m2, v1, m0], axis=1),
-        np.stack([m1, m0, v2], axis=1),
-        np.stack([m0, m1, m2], axis=1),
-    ], axis=1).reshape(-1, 3)
+    if len(t) >= NUMBA_THRESHOLD:  # the same arrays from two compiled passes
+        from ._refine_kernel import red_children, with_midpoints
+
+        points = with_midpoints(mesh.points, edge_nodes)
+        children = red_children(t, tri_edges, n)
+    else:
+        points = np.vstack([mesh.points, mesh.points[edge_nodes].mean(axis=1)])
+        m0, m1, m2 = (n + tri_edges[:, k] for k in range(3))
+        v0, v1, v2 = t[:, 0], t[:, 1], t[:, 2]
+        # children are counter-clockwise when the parent is; the four of a parent are contiguous
+        children = np.stack([
+            np.stack([v0, m2, m1], axis=1),
+            np.stack([m2, v1, m0], axis=1),
+            np.stack([m1, m0, v2], axis=1),
+            np.stack([m0, m1, m2], axis=1),
+        ], axis=1).reshape(-1, 3)
     cell_tags = np.repeat(mesh.cell_tags, 4)
 
     be = mesh.boundary_edges

@@ -60,7 +60,8 @@ def permute_nodes(mesh: Mesh, perm: np.ndarray, *, sort_elements: bool = True) -
     """
     perm = np.asarray(perm, dtype=np.int64)
     n = mesh.n_points
-    if perm.shape != (n,) or not np.array_equal(np.sort(perm), np.arange(n)):
+    if perm.shape != (n,) or (n and (perm.min() < 0 or perm.max() >= n
+                                     or not np.all(np.bincount(perm, minlength=n) == 1))):
         raise MeshError(f"perm must be a permutation of 0..{n - 1} (got shape {perm.shape})")
     inv = np.empty(n, dtype=np.int64)
     inv[perm] = np.arange(n)

@@ -18,6 +18,7 @@ section "Parallel XML files" and "Collection files"). meshio and the XML modules
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 from typing import Sequence
 
@@ -25,8 +26,8 @@ import numpy as np
 
 from ..errors import MeshError
 
-__all__ = ["write_cells", "write_collection", "write_parallel_index", "pad3", "COMPRESSIONS",
-           "DEFAULT_COMPRESSION"]
+__all__ = ["write_cells", "write_collection", "write_parallel_index", "pad3", "vtu_header",
+           "COMPRESSIONS", "DEFAULT_COMPRESSION"]
 
 #: Compression of the binary arrays of a ``.vtu`` file (VTK's ``compressor`` attribute):
 #: ``none`` writes at disk speed (about 2x the bytes of ``zlib``), ``zlib`` is VTK's usual
@@ -76,9 +77,16 @@ def write_cells(path: str | os.PathLike, points: np.ndarray, cells: Sequence[tup
         if rows != [len(c) for _, c in blocks]:
             raise MeshError(f"cell_data {name!r} has {rows} rows per block, the cell blocks have "
                             f"{[len(c) for _, c in blocks]}")
+    Path(p).parent.mkdir(parents=True, exist_ok=True)
+    fmt = file_format or Path(p).suffix.lower().lstrip(".")
+    if fmt == "vtu" and COMPRESSIONS[compression] is None and binary is not False:
+        try:
+            _write_vtu_raw(p, pts, blocks, point_data or {}, cell_data or {})
+        except OSError as exc:
+            raise MeshError(f"cannot write mesh file {p}: {type(exc).__name__}: {exc}") from None
+        return Path(p)
     import meshio
 
-    Path(p).parent.mkdir(parents=True, exist_ok=True)
     out = meshio.Mesh(pts, blocks, point_data=point_data or {}, cell_data=cell_data or {},
                       field_data=field_data or {})
     kwargs = {} if binary is None else {"binary": binary}
@@ -89,6 +97,127 @@ def write_cells(path: str | os.PathLike, points: np.ndarray, cells: Sequence[tup
     except Exception as exc:  # meshio raises plain exceptions of many kinds
         raise MeshError(f"cannot write mesh file {p}: {type(exc).__name__}: {exc}") from None
     return Path(p)
+
+
+#: VTK's names of the array types the writer stores.
+_VTK_TYPES = {np.dtype(t): name for t, name in (
+    (np.float64, "Float64"), (np.float32, "Float32"), (np.int8, "Int8"), (np.int16, "Int16"),
+    (np.int32, "Int32"), (np.int64, "Int64"), (np.uint8, "UInt8"), (np.uint16, "UInt16"),
+    (np.uint32, "UInt32"), (np.uint64, "UInt64"))}
+
+#: Rows of the padded (n, 3) points converted per write (bounded temporary).
+_ROWS = 1 << 20
+
+
+def _native(a: np.ndarray) -> np.ndarray:
+    a = np.asarray(a)
+    if a.dtype == bool:
+        a = a.astype(np.uint8)
+    return np.ascontiguousarray(a.astype(a.dtype.newbyteorder("="), copy=False))
+
+
+def _write_vtu_raw(path: str, points: np.ndarray, blocks: list, point_data: dict,
+                   cell_data: dict) -> None:
+    """An uncompressed ``.vtu`` with its arrays appended raw after the XML (VTK's
+    ``<AppendedData encoding="raw">``, UInt64 size headers): the bytes of each array go to the
+    file as they are in memory (no base64 text, no concatenated copies), so it is written at
+    disk speed. ParaView and meshio read it; :func:`vtu_header` parses its XML part."""
+    arrays = []          # (section, name, vtk type, components, [pieces], total bytes)
+
+    def add(section, name, pieces, comps=None):
+        pieces = [_native(a) for a in pieces]
+        dtypes = {a.dtype for a in pieces}
+        if len(dtypes) > 1:
+            common = np.result_type(*dtypes)
+            pieces = [a.astype(common) for a in pieces]
+        dtype = pieces[0].dtype
+        if dtype not in _VTK_TYPES:
+            raise MeshError(f"cannot write {section} array {name!r} of type {dtype} to a .vtu file")
+        arrays.append((section, name, _VTK_TYPES[dtype], comps, pieces,
+                       sum(a.nbytes for a in pieces)))
+
+    conn = [_native(c) for _, c in blocks]
+    idx = np.result_type(*[c.dtype for c in conn]) if conn else np.dtype(np.int64)
+    add("Cells", "connectivity", [c.astype(idx, copy=False).ravel() for c in conn])
+    ends, offsets = 0, []
+    for c in conn:
+        offsets.append(ends + c.shape[1] * np.arange(1, len(c) + 1, dtype=idx))
+        ends += c.size
+    add("Cells", "offsets", offsets)
+    add("Cells", "types", [np.full(len(c), _vtk_cell_type(kind), np.uint8)
+                           for (kind, _), c in zip(blocks, conn)])
+    for name, a in point_data.items():
+        a = np.asarray(a)
+        add("PointData", name, [a], a.shape[1] if a.ndim == 2 else None)
+    for name, per_block in cell_data.items():
+        a0 = np.asarray(per_block[0])
+        add("CellData", name, list(per_block), a0.shape[1] if a0.ndim == 2 else None)
+
+    head = 8  # UInt64 size header of each appended array
+    offset = 3 * len(points) * 8 + head
+    declared = {"Cells": [], "PointData": [], "CellData": []}
+    for section, name, vtype, comps, _, nbytes in arrays:
+        nc = f' NumberOfComponents="{comps}"' if comps else ""
+        declared[section].append(f'<DataArray type="{vtype}" Name="{_attr(name)}"{nc} '
+                                 f'format="appended" offset="{offset}"/>')
+        offset += nbytes + head
+    order = "LittleEndian" if sys.byteorder == "little" else "BigEndian"
+    xml = ['<?xml version="1.0"?>',
+           f'<VTKFile type="UnstructuredGrid" version="1.0" byte_order="{order}" '
+           'header_type="UInt64">',
+           "<UnstructuredGrid>",
+           f'<Piece NumberOfPoints="{len(points)}" NumberOfCells="{sum(len(c) for c in conn)}">',
+           '<Points>\n<DataArray type="Float64" Name="Points" NumberOfComponents="3" '
+           'format="appended" offset="0"/>\n</Points>']
+    for section in ("Cells", "PointData", "CellData"):
+        if declared[section] or section == "Cells":
+            xml += [f"<{section}>", *declared[section], f"</{section}>"]
+    xml += ["</Piece>", "</UnstructuredGrid>", '<AppendedData encoding="raw">', "_"]
+    with open(path, "wb") as f:
+        f.write("\n".join(xml).encode())
+        f.write(np.uint64(3 * len(points) * 8).tobytes())
+        pts = np.asarray(points, dtype=np.float64)
+        for lo in range(0, len(pts), _ROWS):  # padded to 3D a block at a time
+            f.write(memoryview(pad3(pts[lo:lo + _ROWS])).cast("B"))
+        for *_, pieces, nbytes in arrays:
+            f.write(np.uint64(nbytes).tobytes())
+            for a in pieces:
+                f.write(memoryview(a).cast("B"))
+        f.write(b"\n</AppendedData>\n</VTKFile>\n")
+
+
+#: VTK's cell type numbers of the cells femkit writes (others: meshio's table).
+_CELL_TYPES = {"vertex": 1, "line": 3, "triangle": 5, "quad": 9, "tetra": 10, "hexahedron": 12}
+
+
+def _vtk_cell_type(kind: str) -> int:
+    if kind in _CELL_TYPES:
+        return _CELL_TYPES[kind]
+    from meshio._vtk_common import meshio_to_vtk_type
+
+    try:
+        return meshio_to_vtk_type[kind]
+    except KeyError:
+        raise MeshError(f"unknown cell type {kind!r} for a .vtu file") from None
+
+
+def _attr(text: str) -> str:
+    from xml.sax.saxutils import quoteattr
+
+    return quoteattr(str(text))[1:-1]
+
+
+def vtu_header(path: str | os.PathLike):
+    """The XML of a ``.vtu`` file without its appended raw data, as an ElementTree root
+    (the whole file when it has no raw section)."""
+    import xml.etree.ElementTree as ET
+
+    with open(path, "rb") as f:
+        head = f.read(1 << 20)
+    cut = head.find(b"<AppendedData")
+    if cut < 0:
+        return ET.parse(path).getroot()
+    return ET.fromstring(head[:cut] + b"</VTKFile>")
 
 
 def _atomic_xml(path: Path, text: str | None = None, tree=None) -> Path:
@@ -117,9 +246,7 @@ def write_collection(path: str | os.PathLike, times: Sequence[float], files: Seq
 def _declarations(piece: Path) -> dict[str, list[dict]]:
     """``{"PointData": [...], "CellData": [...], "Points": [...]}``: the DataArray attributes
     (type, Name, NumberOfComponents) of a ``.vtu`` piece."""
-    import xml.etree.ElementTree as ET
-
-    root = ET.parse(piece).getroot()
+    root = vtu_header(piece)
     grid = root.find("UnstructuredGrid/Piece")
     out = {}
     for section in ("PointData", "CellData", "Points"):

@@ -38,8 +38,8 @@ def test_first_run_compiles_in_its_own_stage_then_never_again(tmp_path):
     cache = tmp_path / "numba-cache"
     first = _run(["solve", "case.yaml"], tmp_path, cache)
     timings = json.loads((tmp_path / "out" / "result.json").read_text())["timings"]
-    assert ("compiling kernels (first run, cached afterwards): mesh edges, P1 assembly, "
-            "geometric multigrid, error estimate..." in first)
+    assert ("compiling kernels (first run, cached afterwards): mesh passes, P1 assembly, "
+            "solver checks, geometric multigrid, error estimate..." in first)
     assert "compiled in " in first
     assert timings["compile"] > 0 and list(timings)[:2] == ["compile", "mesh"]
     second = _run(["solve", "case.yaml"], tmp_path, cache)
@@ -75,18 +75,20 @@ def test_a_run_without_multigrid_compiles_no_multigrid_kernel(tmp_path):
     """The families a run needs: pcg + jacobi compiles edges and assembly, not multigrid."""
     from femkit.case.poisson.warmup import families
 
-    assert families(True) == ("mesh edges", "P1 assembly", "geometric multigrid", "error estimate")
-    assert families(False) == ("mesh edges", "P1 assembly", "error estimate")
-    probe = ("from femkit.case.poisson.warmup import warm_up, kernels_cached; "
+    assert families(True) == ("mesh passes", "P1 assembly", "solver checks", "geometric multigrid",
+                              "error estimate")
+    assert families(False) == ("mesh passes", "P1 assembly", "solver checks", "error estimate")
+    probe = ("from femkit.case.poisson.warmup import warm_up, kernels_cached, families; "
              "warm_up(print, multigrid=False); "
-             "print(kernels_cached(('mesh edges', 'P1 assembly')), "
+             "print(kernels_cached(families(False)), "
              "kernels_cached(('geometric multigrid',)))")
     res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                          env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache")),
                          timeout=900)
     assert res.returncode == 0, res.stderr
     lines = res.stdout.strip().splitlines()
-    assert lines[0] == "compiling kernels (first run, cached afterwards): mesh edges, P1 assembly, error estimate..."
+    assert lines[0] == ("compiling kernels (first run, cached afterwards): mesh passes, "
+                        "P1 assembly, solver checks, error estimate...")
     assert lines[-1] == "True False"
 
 

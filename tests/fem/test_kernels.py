@@ -105,3 +105,25 @@ def test_first_assembly_degenerate_triangle_named():
     with pytest.raises(DegenerateMeshError) as info:
         assemble_stiffness(mesh, backend="numba")
     assert info.value.element_ids == [1]
+
+
+@pytest.mark.parametrize("kappa", [2.5, "per-element"])
+def test_one_off_assembly_is_the_fused_matrix_bit_for_bit_and_caches_nothing(make_square, kappa):
+    """``keep_pattern=False`` builds K row by row (no slot map): the same sums in the same
+    order as the element-order scatter, so the same matrix bit for bit, and no pattern cached."""
+    mesh = _scrambled(make_square)
+    kap = 2.5 if kappa == 2.5 else np.linspace(1, 3, mesh.n_triangles)
+    K = assemble_stiffness(mesh, kap, backend="numba", keep_pattern=False)
+    assert SparsityPattern.cached(mesh) is None
+    K_ref = assemble_stiffness(mesh, kap, backend="numba")
+    assert SparsityPattern.cached(mesh) is not None
+    assert np.array_equal(K.indptr, K_ref.indptr) and np.array_equal(K.indices, K_ref.indices)
+    assert np.array_equal(K.data, K_ref.data)
+    assert K.indices.dtype == K_ref.indices.dtype and K.indptr.dtype == K_ref.indptr.dtype
+
+
+def test_one_off_assembly_names_a_degenerate_triangle():
+    mesh = Mesh(np.array([[0, 0], [1, 0], [0, 1], [2, 0]], float), [[0, 1, 2], [0, 1, 3]])
+    with pytest.raises(DegenerateMeshError) as info:
+        assemble_stiffness(mesh, backend="numba", keep_pattern=False)
+    assert info.value.element_ids == [1]

@@ -17,7 +17,8 @@ from ...errors import CaseFileError, ExpressionError, InputError
 from ..load import Case
 from ..names import with_prefix
 
-__all__ = ["VARIABLES", "check_dimension", "build_mesh", "build_mesh_levels", "multigrid_inputs", "multigrid_overrides",
+__all__ = ["VARIABLES", "check_dimension", "build_mesh", "build_mesh_levels", "multigrid_inputs",
+           "multigrid_overrides", "level_system",
            "element_kappa", "poisson_problem", "is_pure_neumann", "exact_gradient",
            "compute_errors", "CaseResult", "nullspace_facts"]
 
@@ -143,8 +144,30 @@ def multigrid_inputs(case: Case, hierarchy, system) -> dict:
         return {}
     levels = None
     if spec.method == "fmg" and not is_pure_neumann(case):
-        levels = [poisson_problem(case, m).assemble(spec.method) for m in hierarchy.meshes[:-1]]
+        levels = [level_system(case, m, spec.method) for m in hierarchy.meshes[:-1]]
     return multigrid_overrides(spec, hierarchy, system.free, levels)
+
+
+def level_system(case: Case, mesh, method: str):
+    """A coarser level's system for ``fmg``, which takes its right-hand side and Dirichlet
+    values (its operator is the Galerkin product of the finer one's, built by the solver).
+
+    With homogeneous Dirichlet data the lifting ``K[free, fixed] g`` is zero, so ``b`` is
+    the load on the free nodes and no stiffness matrix is assembled (``A`` is None): the same
+    ``b``, bit for bit, as the full assembly gives. Otherwise the level is assembled whole.
+    """
+    from ...fem import assemble_load
+    from ...fem.dirichlet import DirichletSystem
+
+    problem = poisson_problem(case, mesh)
+    fixed, values = problem.dirichlet_data()
+    if np.any(values != 0):
+        return problem.assemble(method)
+    F = assemble_load(mesh, problem.f, rule=problem.load_rule) + problem.neumann_vector()
+    is_fixed = np.zeros(mesh.n_points, dtype=bool)
+    is_fixed[fixed] = True
+    return DirichletSystem(A=None, b=F[~is_fixed], free=np.flatnonzero(~is_fixed), fixed=fixed,
+                           values=values, n=mesh.n_points)
 
 
 def multigrid_overrides(spec, hierarchy, free, levels=None) -> dict:

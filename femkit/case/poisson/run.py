@@ -219,13 +219,14 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
             run = solve_adaptive(case, mesh)
         mesh, problem, u, res, est = run.mesh, run.problem, run.u, run.result, run.estimate
         system = problem.system
+        dofs, nnz = int(system.A.shape[0]), int(system.A.nnz)
     else:
         problem = poisson_problem(case, mesh)
         with raising("assembly"), stage("assembly"):
-            K, F = problem.assemble_matrices()
+            K, F = problem.assemble_matrices(keep_pattern=False)  # a one-off: no slot map kept
         check_stop("assembly")
         with raising("the boundary conditions"), stage("boundary"):
-            system = problem.reduce(K, F, case.solver.method)
+            system = problem.reduce(K, F, case.solver.method, overwrite=True)  # K is dropped
         del K, F  # the reduced system is what the later stages use
         check_stop("boundary")
         with raising("assembly"), stage("assembly"):  # the coarser levels' systems (fmg only)
@@ -234,6 +235,8 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
             res = _solve(case, system, stop, **mg)
             u = system.expand(res.x)
         del mg, hierarchy  # the coarser levels and their operators: not needed after the solve
+        dofs, nnz = int(system.A.shape[0]), int(system.A.nnz)
+        system.A = None  # nor is the matrix (the errors and the estimate work on the mesh)
         report.done("solve")
     # after a complete solve a signal during the errors or the estimate stops at once (nothing
     # written); after an interrupted solve they run to write its last iterate
@@ -250,9 +253,9 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         with stage("estimate"):
             estimate, effectivity, est = estimate_facts(case, problem, u, grad, est)
     result = CaseResult(case=case, mesh=mesh, u=u, kappa=problem.kappa, solve=res, errors=errors,
-                        timings=stage.times, quality=q, dofs=int(system.A.shape[0]),
+                        timings=stage.times, quality=q, dofs=dofs,
                         n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
-                        nnz=int(system.A.nnz), nullspace=nullspace_facts(system),
+                        nnz=nnz, nullspace=nullspace_facts(system),
                         error_estimate=estimate, effectivity=effectivity, indicators=est.indicators,
                         adaptive=adaptive_facts(run) if run is not None else None,
                         interrupted=stop.name if res.reason == "interrupted" else None,

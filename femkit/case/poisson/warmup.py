@@ -1,12 +1,13 @@
 """Compile the Poisson pipeline's kernels ahead: ``femkit warmup``, or the first large run.
 
-femkit's compiled kernels (numba, ``cache=True``: mesh edges, P1 assembly, geometric multigrid)
+femkit's compiled kernels (numba, ``cache=True``: mesh passes, P1 assembly,
+solver checks, geometric multigrid, error estimate)
 are compiled on their first call after an install and loaded from the on-disk cache afterwards.
 A first solve would otherwise pay that compile inside its mesh, assembly and solve stages.
 :func:`warm_up` compiles them on a tiny problem instead, with the size thresholds that choose the
 compiled paths lowered for its duration, so every kernel and every argument type a large run
 uses is in the cache afterwards; :func:`kernels_cached` says whether that already happened (the
-run prints ``compiling kernels (first run, cached afterwards): mesh edges, P1 assembly,
+run prints ``compiling kernels (first run, cached afterwards): mesh passes, P1 assembly,
 geometric multigrid...`` naming what it compiles, books the time as its own ``compile`` stage
 and prints how long it took).
 
@@ -34,15 +35,22 @@ COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)"
 #: Each compiled family of the Poisson pipeline: (module, name) of its kernels that a warm-up
 #: leaves in numba's on-disk cache (when all are there, the family was compiled before).
 FAMILIES = {
-    "mesh edges": (("femkit.mesh._edges_kernel", "unique_edges"),),
-    "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness")),
+    "mesh passes": (("femkit.mesh._edges_kernel", "cell_edges"),
+                    ("femkit.mesh._quality_kernel", "triangle_quality"),
+                    ("femkit.mesh._refine_kernel", "red_children")),
+    "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
+                    ("femkit.fem._kernels", "_stiffness_rows"), ("femkit.fem._kernels", "_eliminate")),
+    "solver checks": (("femkit.solvers._symmetry_kernel", "row_sums"),),
     "geometric multigrid": (("femkit.solvers.preconditioners._gmg_kernels", "_galerkin_rows"),
                             ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps")),
 }
 
 #: The module constants that choose the compiled paths by size (lowered during a warm-up).
 _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiffness", "NUMBA_THRESHOLD"),
-               ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"))
+               ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"),
+               ("femkit.mesh.quality", "NUMBA_THRESHOLD"), ("femkit.mesh.refine", "NUMBA_THRESHOLD"),
+               ("femkit.fem.dirichlet", "NUMBA_THRESHOLD"),
+               ("femkit.solvers.checks", "SYMMETRY_NUMBA_THRESHOLD"))
 
 _TINY = {
     "problem": "poisson", "name": "warmup",
@@ -125,6 +133,9 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True)
             setattr(mod, name, 0)
         solver = {"method": "fmg"} if multigrid else {"method": "pcg", "preconditioner": "jacobi"}
         case_from_dict(dict(_TINY, solver=solver)).run(write=False, quiet=True)
+        from ...fem._kernels import warm_up as assembly_kernels
+
+        assembly_kernels()  # the cached-pattern assembly, which a one-off run does not call
     finally:
         _ACTIVE = False
         for (mod, name), value in zip(saved, values):

@@ -1,0 +1,116 @@
+"""The compiled passes of the mesh stage (red refinement, quality numbers, the hierarchy's
+interleaved numbering) give what their NumPy definitions give: refined meshes and hierarchies
+array for array, quality numbers to round-off."""
+
+from __future__ import annotations
+
+import importlib
+
+import numpy as np
+import pytest
+
+from femkit.mesh import Mesh, MeshHierarchy, refine, structured_mesh
+from femkit.mesh.edges import edges
+
+refine_module = importlib.import_module("femkit.mesh.refine")
+quality_module = importlib.import_module("femkit.mesh.quality")
+edges_module = importlib.import_module("femkit.mesh.edges")
+
+MESH_ARRAYS = ("points", "cells", "cell_tags", "boundary_facets", "boundary_tags")
+
+
+def _tagged_skewed(n=9, draw=5):
+    """A structured square with wobbled interior nodes, two cell tags, a tagged boundary and
+    its nodes and triangles in random order (no structure the kernels could lean on)."""
+    base = structured_mesh(n, n)
+    rng = np.random.default_rng(draw)
+    pts = base.points + 0.02 * np.sin(5 * base.points[:, ::-1]) * (base.points * (1 - base.points))
+    perm = rng.permutation(base.n_points)
+    inv = np.empty_like(perm)
+    inv[perm] = np.arange(len(perm))
+    order = rng.permutation(base.n_cells)
+    tags = np.where(base.centroids()[:, 0] < 0.5, 1, 2)[order]
+    return Mesh(pts[perm], inv[base.triangles][order], cell_tags=tags,
+                boundary_facets=inv[base.boundary_facets], boundary_tags=base.boundary_tags,
+                tag_names=dict(base.tag_names))
+
+
+def _numpy_paths(monkeypatch):
+    for mod in (refine_module, quality_module, edges_module):
+        monkeypatch.setattr(mod, "NUMBA_THRESHOLD", 10 ** 12)
+
+
+def _compiled_paths(monkeypatch):
+    for mod in (refine_module, quality_module, edges_module):
+        monkeypatch.setattr(mod, "NUMBA_THRESHOLD", 0)
+
+
+@pytest.mark.parametrize("levels", [1, 3], ids=["one-level", "three-levels"])
+def test_compiled_refinement_is_the_numpy_refinement(monkeypatch, levels):
+    mesh = _tagged_skewed()
+    _numpy_paths(monkeypatch)
+    ref = refine(mesh, levels)
+    _compiled_paths(monkeypatch)
+    got = refine(Mesh(mesh.points, mesh.cells, mesh.cell_tags, mesh.boundary_facets,
+                      mesh.boundary_tags, mesh.tag_names), levels)
+    for name in MESH_ARRAYS:
+        a, b = getattr(got, name), getattr(ref, name)
+        assert a.dtype == b.dtype and np.array_equal(a, b), name
+
+
+@pytest.mark.parametrize("renumber", ["none", "rcm"])
+def test_compiled_hierarchy_is_the_numpy_hierarchy(monkeypatch, renumber):
+    mesh = _tagged_skewed(7)
+    _numpy_paths(monkeypatch)
+    ref = MeshHierarchy.from_refinement(mesh, 2, renumber=renumber)
+    _compiled_paths(monkeypatch)
+    got = MeshHierarchy.from_refinement(Mesh(mesh.points, mesh.cells, mesh.cell_tags,
+                                             mesh.boundary_facets, mesh.boundary_tags,
+                                             mesh.tag_names), 2, renumber=renumber)
+    for a, b in zip(got.meshes, ref.meshes):
+        for name in MESH_ARRAYS:
+            assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    for P, Q in zip(got.prolongations, ref.prolongations):
+        assert (P != Q).nnz == 0 and P.shape == Q.shape
+    for a, b in zip(got.injections, ref.injections):
+        assert np.array_equal(a, b)
+
+
+def test_interleaved_numbering_is_the_stable_merge():
+    """The O(n) numbering equals its definition: a stable sort of coarse ids and edge lower nodes."""
+    hierarchy = importlib.import_module("femkit.mesh.hierarchy")
+    mesh = _tagged_skewed()
+    edge_nodes, _ = edges(mesh)
+    key = np.concatenate([np.arange(mesh.n_points), edge_nodes[:, 0]])
+    assert np.array_equal(hierarchy.interleave_permutation(mesh.n_points, edge_nodes),
+                          np.argsort(key, kind="stable"))
+
+
+def _degenerate_one():
+    """A mesh with one zero-area triangle (a repeated vertex): NaN angles, infinite aspect."""
+    m = _tagged_skewed(5)
+    cells = m.cells.copy()
+    cells[0, 2] = cells[0, 1]
+    return Mesh(m.points, cells)
+
+
+@pytest.mark.parametrize("make", [_tagged_skewed, _degenerate_one], ids=["skewed", "degenerate"])
+def test_compiled_quality_is_the_numpy_quality(monkeypatch, make):
+    mesh = make()
+    _numpy_paths(monkeypatch)
+    ref = quality_module.quality(mesh)
+    _compiled_paths(monkeypatch)
+    got = quality_module.quality(Mesh(mesh.points, mesh.cells))
+    assert got.keys() == ref.keys()
+    for k in ref:
+        if np.isinf(ref[k]):
+            assert got[k] == ref[k], k
+        else:
+            assert got[k] == pytest.approx(ref[k], rel=1e-13, abs=0), k
+
+
+def test_hierarchy_keeps_no_edges_of_its_coarser_levels():
+    """The coarser levels' edges are needed only while they are refined (memory of a large run)."""
+    H = MeshHierarchy.from_refinement(_tagged_skewed(5), 2)
+    assert all(m not in edges_module._CACHE for m in H.meshes[:-1])
+    assert np.array_equal(edges(H.meshes[0])[0], edges(_tagged_skewed(5))[0])  # recomputed on demand
