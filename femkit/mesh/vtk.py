@@ -1,9 +1,12 @@
 """femkit's one VTK writer: points, cell blocks and data to ``.vtu`` (or any meshio format),
 and the two XML index files ParaView opens over several ``.vtu`` files.
 
-* :func:`write_cells` is the one call of meshio's writer: a Poisson solution
-  (:func:`femkit.mesh.write_mesh`), a scene's frames (springs as ``line`` cells, cloth
-  triangles) and each rank's piece of a distributed solution all go through it;
+* :func:`write_cells` writes a Poisson solution (:func:`femkit.mesh.write_mesh`) and each
+  rank's piece of a distributed solution: an uncompressed ``.vtu`` with its arrays appended
+  raw (at disk speed), other formats and compressions through meshio;
+* :class:`VtuFrames` writes a scene's frames (springs as ``line`` cells, cloth triangles), the
+  cells encoded once; both ``.vtu`` writers share :func:`_appended_header` and
+  :func:`_write_appended`;
 * :func:`write_collection` writes a ``.pvd`` time series (``<Collection>`` of ``.vtu`` files
   with their times);
 * :func:`write_parallel_index` writes a ``.pvtu`` index of per-rank pieces, its array
@@ -110,9 +113,13 @@ _ROWS = 1 << 20
 
 
 def _native(a: np.ndarray) -> np.ndarray:
+    """``a`` as a C-contiguous native-order array of one of VTK's types (booleans as UInt8,
+    other types as Int64 or Float64)."""
     a = np.asarray(a)
     if a.dtype == bool:
         a = a.astype(np.uint8)
+    elif a.dtype.newbyteorder("=") not in _VTK_TYPES:
+        a = a.astype(np.int64 if a.dtype.kind in "iu" else np.float64)
     return np.ascontiguousarray(a.astype(a.dtype.newbyteorder("="), copy=False))
 
 
@@ -153,41 +160,62 @@ def _write_vtu_raw(path: str, points: np.ndarray, blocks: list, point_data: dict
         a0 = np.asarray(per_block[0])
         add("CellData", name, list(per_block), a0.shape[1] if a0.ndim == 2 else None)
 
-    head = 8  # UInt64 size header of each appended array
-    offset = 3 * len(points) * 8 + head
-    declared = {"Cells": [], "PointData": [], "CellData": []}
+    pts = np.asarray(points, dtype=np.float64)
+
+    def padded():  # padded to 3D a block at a time (bounded temporary)
+        for lo in range(0, len(pts), _ROWS):
+            yield pad3(pts[lo:lo + _ROWS])
+
+    declared = {"Points": [("Points", "Float64", 3, 3 * len(pts) * 8)],
+                "Cells": [], "PointData": [], "CellData": []}
     for section, name, vtype, comps, _, nbytes in arrays:
-        nc = f' NumberOfComponents="{comps}"' if comps else ""
-        declared[section].append(f'<DataArray type="{vtype}" Name="{_attr(name)}"{nc} '
-                                 f'format="appended" offset="{offset}"/>')
-        offset += nbytes + head
+        declared[section].append((name, vtype, comps, nbytes))
+    header = _appended_header(len(pts), sum(len(c) for c in conn), declared)
+    with open(path, "wb") as f:
+        _write_appended(f, header, [(3 * len(pts) * 8, padded())]
+                        + [(nbytes, pieces) for *_, pieces, nbytes in arrays])
+
+
+def _appended_header(n_points: int, n_cells: int, declared: dict) -> bytes:
+    """The XML part of a ``.vtu`` whose arrays are appended raw (VTK's ``<AppendedData
+    encoding="raw">``, UInt64 size headers; Kitware, "VTK File Formats", "XML File Formats").
+    ``declared``: ``{section: [(name, VTK type, components or None, bytes), ...]}`` for the
+    sections ``Points``, ``Cells``, ``PointData``, ``CellData``, in the order written."""
+    offset = 0
     order = "LittleEndian" if sys.byteorder == "little" else "BigEndian"
     xml = ['<?xml version="1.0"?>',
            f'<VTKFile type="UnstructuredGrid" version="1.0" byte_order="{order}" '
            'header_type="UInt64">',
            "<UnstructuredGrid>",
-           f'<Piece NumberOfPoints="{len(points)}" NumberOfCells="{sum(len(c) for c in conn)}">',
-           '<Points>\n<DataArray type="Float64" Name="Points" NumberOfComponents="3" '
-           'format="appended" offset="0"/>\n</Points>']
-    for section in ("Cells", "PointData", "CellData"):
-        if declared[section] or section == "Cells":
-            xml += [f"<{section}>", *declared[section], f"</{section}>"]
+           f'<Piece NumberOfPoints="{n_points}" NumberOfCells="{n_cells}">']
+    for section in ("Points", "Cells", "PointData", "CellData"):
+        if not declared.get(section) and section not in ("Points", "Cells"):
+            continue
+        xml.append(f"<{section}>")
+        for name, vtype, comps, nbytes in declared.get(section, ()):
+            nc = f' NumberOfComponents="{comps}"' if comps else ""
+            xml.append(f'<DataArray type="{vtype}" Name="{_attr(name)}"{nc} '
+                       f'format="appended" offset="{offset}"/>')
+            offset += nbytes + 8  # + the UInt64 size header
+        xml.append(f"</{section}>")
     xml += ["</Piece>", "</UnstructuredGrid>", '<AppendedData encoding="raw">', "_"]
-    with open(path, "wb") as f:
-        f.write("\n".join(xml).encode())
-        f.write(np.uint64(3 * len(points) * 8).tobytes())
-        pts = np.asarray(points, dtype=np.float64)
-        for lo in range(0, len(pts), _ROWS):  # padded to 3D a block at a time
-            f.write(memoryview(pad3(pts[lo:lo + _ROWS])).cast("B"))
-        for *_, pieces, nbytes in arrays:
-            f.write(np.uint64(nbytes).tobytes())
-            for a in pieces:
-                f.write(memoryview(a).cast("B"))
-        f.write(b"\n</AppendedData>\n</VTKFile>\n")
+    return "\n".join(xml).encode()
+
+
+def _write_appended(f, header: bytes, arrays: list) -> None:
+    """Write ``header`` (:func:`_appended_header`) and each ``(bytes, pieces)`` of ``arrays``:
+    its UInt64 size, then the pieces' memory as it is (no copy, no encoding)."""
+    f.write(header)
+    for nbytes, pieces in arrays:
+        f.write(np.uint64(nbytes).tobytes())
+        for a in pieces:
+            f.write(memoryview(np.ascontiguousarray(a)).cast("B"))
+    f.write(b"\n</AppendedData>\n</VTKFile>\n")
 
 
 #: VTK's cell type numbers of the cells femkit writes (others: meshio's table).
-_CELL_TYPES = {"vertex": 1, "line": 3, "triangle": 5, "quad": 9, "tetra": 10, "hexahedron": 12}
+_CELL_TYPES = {"vertex": 1, "line": 3, "triangle": 5, "quad": 9, "tetra": 10, "hexahedron": 12,
+               "wedge": 13, "pyramid": 14}
 
 
 def _vtk_cell_type(kind: str) -> int:
@@ -279,22 +307,6 @@ def write_parallel_index(path: str | os.PathLike, first_piece: str | os.PathLike
 # ----------------------------------------------------------------------------- frame series
 __all__ += ["VtuFrames"]
 
-#: VTK cell type numbers of the meshio cell types a frame series writes (VTK's vtkCellType.h).
-_VTK_TYPES = {"vertex": 1, "line": 3, "triangle": 5, "quad": 9, "tetra": 10, "hexahedron": 12,
-              "wedge": 13, "pyramid": 14}
-_VTK_NAMES = {"f8": "Float64", "f4": "Float32", "i8": "Int64", "i4": "Int32", "u1": "UInt8"}
-
-
-def _little(a: np.ndarray) -> np.ndarray:
-    """``a`` as a C-contiguous little-endian array of one of the VTK types written here."""
-    a = np.asarray(a)
-    kind = a.dtype.kind + str(a.dtype.itemsize)
-    if kind not in _VTK_NAMES:
-        a = a.astype(np.int64 if a.dtype.kind in "iub" else np.float64)
-        kind = a.dtype.kind + str(a.dtype.itemsize)
-    return np.ascontiguousarray(a, dtype=np.dtype("<" + kind))
-
-
 class VtuFrames:
     """``.vtu`` files of a time series whose cells never change (a scene's frames), written at
     disk speed: VTK's XML format with the arrays as *raw appended* binary (``<AppendedData
@@ -309,10 +321,10 @@ class VtuFrames:
     """
 
     def __init__(self, cells: Sequence[tuple[str, np.ndarray]]):
-        unknown = [kind for kind, _ in cells if kind not in _VTK_TYPES]
+        unknown = [kind for kind, _ in cells if kind not in _CELL_TYPES]
         if unknown:
             raise MeshError(f"frame series: cell type {unknown[0]!r} not supported; valid: "
-                            f"{', '.join(_VTK_TYPES)}")
+                            f"{', '.join(_CELL_TYPES)}")
         blocks = [(kind, np.asarray(conn)) for kind, conn in cells]
         self.rows = [len(c) for _, c in blocks]
         self.n_cells = sum(self.rows)
@@ -323,40 +335,25 @@ class VtuFrames:
         top = max([sum(c.size for c in conn)] + [int(c.max()) + 1 for c in conn if c.size])
         index = np.int32 if top < 2 ** 31 else np.int64
         self._topology = (
-            _little(np.concatenate([c.ravel() for c in conn]).astype(index) if conn
+            _native(np.concatenate([c.ravel() for c in conn]).astype(index) if conn
                     else np.zeros(0, index)),
-            _little(np.cumsum(sizes).astype(index)),
-            _little(np.concatenate([np.full(len(c), _VTK_TYPES[k], dtype=np.uint8)
+            _native(np.cumsum(sizes).astype(index)),
+            _native(np.concatenate([np.full(len(c), _CELL_TYPES[k], dtype=np.uint8)
                                     for (k, _), c in zip(blocks, conn)])
                     if conn else np.zeros(0, np.uint8)))
         self._layout: tuple | None = None
         self._header = b""
 
     def _xml(self, n_points: int, point: list, cell: list) -> bytes:
-        offset = 0
-
-        def array(a: np.ndarray, name: str, components: int | None) -> str:
-            nonlocal offset
-            comp = "" if components is None else f' NumberOfComponents="{components}"'
-            tag = (f'<DataArray type="{_VTK_NAMES[a.dtype.str[1:]]}" Name="{name}"{comp} '
-                   f'format="appended" offset="{offset}"/>')
-            offset += 8 + a.nbytes
-            return tag
+        def declare(items):
+            return [(name, _VTK_TYPES[a.dtype], a.shape[1] if a.ndim == 2 else None, a.nbytes)
+                    for name, a in items]
 
         conn, offs, types = self._topology
-        lines = ['<?xml version="1.0"?>',
-                 '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
-                 'header_type="UInt64">', "<UnstructuredGrid>",
-                 f'<Piece NumberOfPoints="{n_points}" NumberOfCells="{self.n_cells}">',
-                 "<Points>", array(point[0][1], "Points", 3), "</Points>",
-                 "<Cells>", array(conn, "connectivity", None), array(offs, "offsets", None),
-                 array(types, "types", None), "</Cells>", "<PointData>"]
-        lines += [array(a, name, a.shape[1] if a.ndim == 2 else None) for name, a in point[1:]]
-        lines += ["</PointData>", "<CellData>"]
-        lines += [array(a, name, a.shape[1] if a.ndim == 2 else None) for name, a in cell]
-        lines += ["</CellData>", "</Piece>", "</UnstructuredGrid>",
-                  '<AppendedData encoding="raw">', "_"]
-        return "\n".join(lines).encode("ascii")
+        return _appended_header(n_points, self.n_cells, {
+            "Points": [("Points", "Float64", 3, point[0][1].nbytes)],
+            "Cells": declare([("connectivity", conn), ("offsets", offs), ("types", types)]),
+            "PointData": declare(point[1:]), "CellData": declare(cell)})
 
     def write(self, path: str | os.PathLike, points: np.ndarray, *,
               point_data: dict | None = None, cell_data: dict | None = None) -> Path:
@@ -368,10 +365,10 @@ class VtuFrames:
             A data array whose row count does not match, or the file cannot be written
             (the operating system's reason).
         """
-        pts = _little(pad3(points))
+        pts = _native(pad3(points))
         point = [("Points", pts)]
         for name, a in (point_data or {}).items():
-            a = _little(a)
+            a = _native(a)
             if a.shape[0] != len(pts):
                 raise MeshError(f"point_data {name!r} has {a.shape[0]} rows, the frame has "
                                 f"{len(pts)} points")
@@ -382,7 +379,7 @@ class VtuFrames:
             if rows != self.rows:
                 raise MeshError(f"cell_data {name!r} has {rows} rows per block, the cell blocks "
                                 f"have {self.rows}")
-            cell.append((name, _little(np.concatenate([np.asarray(a) for a in per_block]))))
+            cell.append((name, _native(np.concatenate([np.asarray(a) for a in per_block]))))
         layout = tuple((name, a.dtype.str, a.shape) for name, a in point + cell)
         if layout != self._layout:
             self._layout, self._header = layout, self._xml(len(pts), point, cell)
@@ -390,11 +387,7 @@ class VtuFrames:
         arrays = [pts, conn, offs, types] + [a for _, a in point[1:]] + [a for _, a in cell]
         try:
             with open(path, "wb") as fh:
-                fh.write(self._header)
-                for a in arrays:
-                    fh.write(np.uint64(a.nbytes).tobytes())
-                    fh.write(memoryview(a).cast("B"))
-                fh.write(b"\n</AppendedData>\n</VTKFile>\n")
+                _write_appended(fh, self._header, [(a.nbytes, [a]) for a in arrays])
         except OSError as exc:
             raise MeshError(f"cannot write frame {os.fspath(path)}: "
                             f"{exc.strerror or exc}") from None
