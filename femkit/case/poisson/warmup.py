@@ -25,11 +25,13 @@ COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)..."
 _PROBES = (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
            ("femkit.mesh._edges_kernel", "unique_edges"),
            ("femkit.solvers.preconditioners._gmg_kernels", "galerkin"),
-           ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps"))
+           ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps"),
+           ("femkit.solvers._check_kernels", "asymmetry_sums"))
 
 #: The module constants that choose the compiled paths by size (lowered during a warm-up).
 _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiffness", "NUMBA_THRESHOLD"),
-               ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"))
+               ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"),
+               ("femkit.solvers.checks", "SYMMETRY_NUMBA_NNZ"))
 
 _TINY = {
     "problem": "poisson", "name": "warmup",
