@@ -21,6 +21,7 @@ CASES = {
     "nonsymmetric": lambda: _random(3000, 8, 0),
     "symmetric": lambda: (_random(3000, 8, 1) + _random(3000, 8, 1).T).tocsr(),
     "one-sided pattern": lambda: sp.triu(_random(3000, 8, 2), k=1, format="csr"),
+    "lower pattern": lambda: sp.tril(_random(3000, 8, 5), format="csr"),
     "perturbed by 1e-9": lambda: (_random(3000, 8, 3) + _random(3000, 8, 3).T
                                   + 1e-9 * _random(3000, 8, 4)).tocsr(),
     "zero": lambda: sp.csr_matrix((3000, 3000)),
@@ -37,7 +38,7 @@ def test_compiled_asymmetry_equals_the_sparse_algebra(name, monkeypatch):
     assert got == pytest.approx(ref, rel=1e-12, abs=1e-300)
     if name == "symmetric":
         assert got == 0.0
-    if name in ("nonsymmetric", "one-sided pattern"):
+    if name in ("nonsymmetric", "one-sided pattern", "lower pattern"):
         assert got > 0.5
 
 
