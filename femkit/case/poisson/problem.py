@@ -135,19 +135,20 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
 
 def multigrid_inputs(case: Case, hierarchy, system) -> dict:
     """What geometric multigrid needs at solve time, as :meth:`SolverSpec.solve` overrides:
-    the hierarchy and the free nodes; for ``fmg`` with Dirichlet conditions also the reduced
-    systems of the coarser meshes (their own right-hand sides and Dirichlet values, see
-    :func:`femkit.solvers.fmg.fmg`). Empty for every other solver."""
+    the hierarchy and the free nodes; for ``fmg`` with Dirichlet conditions also the finest
+    level's Dirichlet values, from which fmg builds the coarser levels' consistent problems
+    algebraically (:func:`femkit.solvers.fmg.fmg`; no assembly on the coarser meshes). Empty for
+    every other solver."""
     spec = case.solver
     if not spec.needs_hierarchy:
         return {}
-    levels = None
+    dirichlet = None
     if spec.method == "fmg" and not is_pure_neumann(case):
-        levels = [poisson_problem(case, m).assemble(spec.method) for m in hierarchy.meshes[:-1]]
-    return multigrid_overrides(spec, hierarchy, system.free, levels)
+        dirichlet = system.expand(np.zeros(len(system.free)))
+    return multigrid_overrides(spec, hierarchy, system.free, dirichlet=dirichlet)
 
 
-def multigrid_overrides(spec, hierarchy, free, levels=None) -> dict:
+def multigrid_overrides(spec, hierarchy, free, levels=None, *, dirichlet=None) -> dict:
     """The :meth:`SolverSpec.solve` overrides of geometric multigrid: ``{"options": ...}`` for
     ``method: fmg`` (with the coarser levels' own systems ``levels`` when given),
     ``{"preconditioner_options": ...}`` for ``preconditioner: gmg``, ``{}`` otherwise. The one
@@ -159,6 +160,8 @@ def multigrid_overrides(spec, hierarchy, free, levels=None) -> dict:
         return {"preconditioner_options": mg}
     if levels is not None:
         mg["levels"] = list(levels)
+    if dirichlet is not None:
+        mg["dirichlet"] = dirichlet
     return {"options": mg}
 
 
