@@ -139,6 +139,91 @@ def solve(H, repeat: int) -> None:
     print(f"fmg / best pyamg: {t_fmg / best:.3f} (goal <= 0.2)")
 
 
+CASE = """problem: poisson
+name: bench3d
+mesh: {{geometry: kuhn_cube, h: {h}, refine: {k}}}
+source: "-(1 + 0.25 + 0.09) * exp(x + 0.5*y - 0.3*z)"
+boundary:
+  dirichlet: [{{tags: [boundary], value: "exp(x + 0.5*y - 0.3*z)"}}]
+exact:
+  u: "exp(x + 0.5*y - 0.3*z)"
+  grad: ["exp(x + 0.5*y - 0.3*z)", "0.5*exp(x + 0.5*y - 0.3*z)", "-0.3*exp(x + 0.5*y - 0.3*z)"]
+solver: {{method: fmg}}
+output: {{vtu: false, plot: false}}
+"""
+
+PEER = """
+import numpy as np, pyamg, skfem
+from skfem.helpers import dot, grad
+d = np.load({mesh!r})
+m = skfem.MeshTet(d["points"].T.copy(), d["cells"].T.copy())
+del d
+basis = skfem.Basis(m, skfem.ElementTetP1(), intorder=1)
+u = lambda x, y, z: np.exp(x + 0.5 * y - 0.3 * z)
+A = skfem.BilinearForm(lambda u, v, w: dot(grad(u), grad(v))).assemble(basis)
+b = skfem.LinearForm(lambda v, w: -1.34 * u(*w.x) * v).assemble(basis)
+D = basis.get_dofs().all()
+g = basis.zeros()
+g[D] = u(*m.p[:, D])
+Ai, bi, xi, I = skfem.condense(A, b, x=g, D=D)
+x = pyamg.smoothed_aggregation_solver(Ai).solve(bi, tol=1e-6, accel="cg")
+g[I] = x
+err = skfem.Functional(lambda w: (w["uh"] - u(*w.x)) ** 2).assemble(
+    skfem.Basis(m, skfem.ElementTetP1(), intorder=4), uh=g)
+print("L2", np.sqrt(err))
+"""
+
+
+def peak_rss(cmd: list[str], limit_gb: float | None) -> tuple[float, float, int, str]:
+    """Wall seconds, peak RSS (GB, ``/usr/bin/time -v``), exit code and the output's last line
+    of ``cmd`` in a fresh process (``ulimit -v`` when ``limit_gb`` is given)."""
+    import shlex
+    import subprocess
+
+    line = " ".join(shlex.quote(c) for c in cmd)
+    if limit_gb:
+        line = f"ulimit -v {int(limit_gb * 2**20)}; {line}"
+    t0 = time.perf_counter()
+    out = subprocess.run(["bash", "-c", f"/usr/bin/time -v {line}"], capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    rss = [ln for ln in out.stderr.splitlines() if "Maximum resident set size" in ln]
+    gb = int(rss[0].split()[-1]) / 2**20 if rss else float("nan")
+    text = (out.stdout.strip().splitlines() or [""])[-1]
+    if out.returncode:
+        text = (out.stderr.strip().splitlines() or [""])[-2 if rss else -1][:160]
+    return wall, gb, out.returncode, text
+
+
+def memory(coarse: int, levels: int, limit_gb: float | None) -> None:
+    """Peak memory of ``femkit solve`` on the cube case against scikit-fem + pyamg on its mesh."""
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    from femkit.mesh import MeshHierarchy, generate
+
+    tmp = Path(tempfile.mkdtemp(prefix="bench3d-"))
+    case = tmp / "cube.yaml"
+    case.write_text(CASE.format(h=repr(1.0 / coarse), k=levels))
+    fine = MeshHierarchy.from_refinement(generate("kuhn_cube", 1.0 / coarse), levels,
+                                         renumber="rcm").finest
+    np.savez(tmp / "mesh.npz", points=fine.points, cells=fine.cells)
+    print(f"memory: kuhn_cube h = 1/{coarse} refined {levels} times: {fine.n_points} nodes, "
+          f"{fine.n_cells} tetrahedra (the peer reads the same mesh from .npz, untimed)")
+    del fine
+    env_py = sys.executable
+    rows = [("femkit solve", [env_py, "-m", "femkit.cli", "solve", str(case), "-o", str(tmp / "out")]),
+            ("skfem + pyamg SA", [env_py, "-c", PEER.format(mesh=str(tmp / "mesh.npz"))])]
+    for name, cmd in rows:
+        wall, gb, rc, text = peak_rss(cmd, limit_gb)
+        result = tmp / "out" / "result.json"
+        if name.startswith("femkit") and result.exists():
+            import json
+
+            text = f"L2 {json.loads(result.read_text())['errors']['L2']!r}; {text}"
+        print(f"{name:18s} {wall:7.1f} s  peak RSS {gb:6.2f} GB  exit {rc}  {text}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--coarse", type=int, default=3)
@@ -146,10 +231,17 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--no-solve", action="store_true", help="assembly only")
     ap.add_argument("--no-assembly", action="store_true", help="solve only")
+    ap.add_argument("--memory", action="store_true",
+                    help="only the peak memory of femkit solve against scikit-fem + pyamg")
+    ap.add_argument("--limit-gb", type=float, default=None,
+                    help="address-space limit of each --memory process (ulimit -v)")
     ap.add_argument("--numbering", choices=("rcm", "none"), default="rcm",
                     help="rcm (default): as femkit solve numbers tetrahedral hierarchies; "
                          "none: the refinement's own (coarse nodes first)")
     args = ap.parse_args()
+    if args.memory:
+        memory(args.coarse, args.levels, args.limit_gb)
+        return
     from femkit.mesh import MeshHierarchy, structured_box
 
     t, H = timed(lambda: MeshHierarchy.from_refinement(
