@@ -108,7 +108,7 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
         backend = "numba" if count >= NUMBA_THRESHOLD else "numpy"
     if pattern is None:
         pattern = SparsityPattern.cached(mesh)
-        if pattern is None and backend == "numba" and idx is None and mesh.dim == 2:
+        if pattern is None and backend == "numba" and idx is None:
             # first assembly on a large mesh: pattern, slots and stiffness in one pass
             pattern, data = SparsityPattern.with_stiffness(mesh, _kernel_coefficient(mesh, kappa, None))
             if data is not None:
