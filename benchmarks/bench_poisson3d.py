@@ -1,19 +1,33 @@
 """3D Poisson benchmark: P1 tetrahedra, femkit against scikit-fem (assembly) and pyamg (solve).
 
-Run by hand:  python benchmarks/bench_poisson3d.py [--coarse 3] [--levels 5] [--repeat 3] [--no-solve]
+Run by hand::
+
+    python benchmarks/bench_poisson3d.py [--coarse 3] [--levels 5] [--repeat 3] [--no-solve]
+                                         [--no-assembly] [--numbering rcm|none]
+    python benchmarks/bench_poisson3d.py --memory [--coarse 3] [--levels 5] [--limit-gb 16]
 
 The mesh is ``structured_box(c, c, c)`` refined ``levels`` times by Bey's red refinement (the
 Kuhn box of ``c 2^levels`` cells per side; c = 3, levels = 5: 97^3 = 912,673 nodes, 5.3M
-tetrahedra, the ~1M-unknown target). BLAS and numba threads are pinned to 1. Printed:
+tetrahedra, the ~1M-unknown target; c = 5: 161^3 = 4.17M nodes, 24.6M tetrahedra), numbered as
+``femkit solve`` numbers tetrahedral hierarchies (reverse Cuthill-McKee, midpoints next to their
+edges; ``--numbering none``: the refinement's own). BLAS and numba threads are pinned to 1. Printed:
 
 - assembly: ``skfem`` = ``Basis(MeshTet, ElementTetP1(), intorder=1)`` + ``asm(laplace)`` +
   ``asm(unit load)``; ``fk first`` = ``assemble_stiffness`` + ``assemble_load`` on a new mesh
   object (CSR pattern built in the call; numba compile excluded: cached on disk); medians of
   interleaved runs, and the ratio;
 - solve to the discretisation error of ``u = exp(x + y/2 - 3z/10)`` (Dirichlet data = u):
-  ``fmg`` on the nested boxes (its own stopping rule), then pyamg Ruge-Stueben and smoothed
-  aggregation (``solve(accel="cg")``) with the tolerance lowered by 10x until their L2 error is
-  within 1 % of fmg's; wall times in seconds and in units of one SpMV ``A @ x`` of the same run.
+  ``fmg`` on the nested boxes given the Dirichlet values (as ``femkit solve`` calls it; its own
+  stopping rule; the time includes its set-up: symmetry check, transfers, Galerkin products),
+  then pyamg Ruge-Stueben and smoothed aggregation (set-up + ``solve(accel="cg")``) with the
+  tolerance lowered by 10x until their L2 error is within 1 % of fmg's; wall times in seconds and
+  in units of one SpMV ``A @ x`` (SciPy CSR, medians taken around the fmg runs);
+- ``--memory``: peak RSS (``/usr/bin/time -v``) of ``python -m femkit.cli solve`` on the same cube
+  case (kuhn_cube h = 1/c, ``refine: levels``, fmg, errors, no VTU/PNG) and of the peer job on
+  the identical mesh read from ``.npz`` (scikit-fem ``MeshTet`` + ``ElementTetP1`` assembly,
+  ``condense``, pyamg smoothed aggregation CG to 1e-6, the L2 error), each a fresh process;
+  ``--limit-gb`` caps each one's address space (``ulimit -v``) so a peer that cannot fit fails
+  instead of taking the machine.
 """
 
 from __future__ import annotations
