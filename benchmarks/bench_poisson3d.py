@@ -194,11 +194,11 @@ def peak_rss(cmd: list[str], limit_gb: float | None) -> tuple[float, float, int,
     import shlex
     import subprocess
 
-    line = " ".join(shlex.quote(c) for c in cmd)
+    line = "/usr/bin/time -v " + " ".join(shlex.quote(c) for c in cmd)
     if limit_gb:
         line = f"ulimit -v {int(limit_gb * 2**20)}; {line}"
     t0 = time.perf_counter()
-    out = subprocess.run(["bash", "-c", f"/usr/bin/time -v {line}"], capture_output=True, text=True)
+    out = subprocess.run(["bash", "-c", line], capture_output=True, text=True)
     wall = time.perf_counter() - t0
     rss = [ln for ln in out.stderr.splitlines() if "Maximum resident set size" in ln]
     gb = int(rss[0].split()[-1]) / 2**20 if rss else float("nan")
