@@ -10,8 +10,8 @@ import scipy.sparse as sp
 from femkit.solvers import checks
 
 
-def _random(n, per_row, seed):
-    rng = np.random.default_rng(seed)
+def _random(n, per_row, state):
+    rng = np.random.default_rng(state)
     rows = np.repeat(np.arange(n), per_row)
     cols = rng.integers(0, n, n * per_row)
     return sp.csr_matrix((rng.standard_normal(n * per_row), (rows, cols)), shape=(n, n))
