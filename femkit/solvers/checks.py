@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from .defaults import DEFAULT_RTOL
 
+import sys
 import time
 from dataclasses import dataclass
 from typing import Any, Callable
@@ -181,14 +182,17 @@ def check_tolerances(rtol: float, atol: float) -> None:
 
 
 #: Sparse matrices with at least this many entries are checked by one compiled pass (each
-#: entry's partner found by bisection in its row: about 2 SpMV) instead of forming ``A - A^T``
-#: (a transposition and a sparse difference: ~40 SpMV on a 3D P1 matrix).
+#: row's lower part walked by a pointer: 2-4 SpMV) instead of forming ``A - A^T`` (a
+#: transposition and a sparse difference: 15-40 SpMV on a 3D P1 matrix) when numba is loaded
+#: already (a compiled assembly or multigrid ran), else from 10x this size: importing numba for
+#: the check alone would add ~100 MB to a mid-size run that needs no other kernel.
 SYMMETRY_NUMBA_NNZ = 200_000
 
 
 def asymmetry(A) -> float:
     """``||A - A^T||_inf / ||A||_inf`` for a sparse or dense matrix (0 for a zero matrix)."""
-    if sp.issparse(A) and A.format == "csr" and A.nnz >= SYMMETRY_NUMBA_NNZ:
+    if sp.issparse(A) and A.format == "csr" and A.nnz >= SYMMETRY_NUMBA_NNZ and (
+            "numba" in sys.modules or A.nnz >= 10 * SYMMETRY_NUMBA_NNZ):
         from ._check_kernels import asymmetry_sums
 
         if not A.has_canonical_format:
