@@ -100,10 +100,11 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
 
 
 @numba.njit(cache=True)
-def _pattern_cells(tri, n, indices, slots):  # pragma: no cover - compiled
-    """:func:`_pattern` for cells of any width ``w`` (tetrahedra: 4), without the fused
-    stiffness: the same three passes, loops over ``w`` (the triangle kernel keeps its
-    unrolled copies, which are faster). Returns ``(indptr, nnz)``."""
+def _pattern_cells(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  # pragma: no cover - compiled
+    """:func:`_pattern` for cells of any width ``w`` (tetrahedra: 4): the same three passes,
+    loops over ``w`` (the triangle kernel keeps its unrolled copies, which are faster). With
+    ``with_data`` (tetrahedra) the stiffness is summed in the element-order pass that writes the
+    slots, while the element's slots are in cache. Returns ``(indptr, nnz, data, bad)``."""
     m = tri.shape[0]
     w = tri.shape[1]
     # 1. node -> incidences, by counting sort; each incidence carries the element's vertices.
@@ -147,19 +148,29 @@ def _pattern_cells(tri, n, indices, slots):  # pragma: no cover - compiled
                 verts[k, b] = pos[verts[k, b]]
         indptr[i + 1] = nnz
     # 3. slots in element order: entry (e, a, b) is position b of incidence (e, a)
+    data = np.zeros(nnz if with_data else 0)
+    g = np.empty((4, 3))
+    bad = 0
     for e in range(m):
         for a in range(w):
             k = where[w * e + a]
             for b in range(w):
                 slots[e, w * a + b] = verts[k, b]
-    return indptr, nnz
+        if with_data:
+            vol6 = abs(_tetrahedron(tri, points, e, g))
+            if not (vol6 > 0.0 and vol6 < np.inf):
+                bad += 1
+                continue
+            _add_tet_stiffness(data, slots, e, g, (kappa[0] if scalar_kappa else kappa[e]) / (6.0 * vol6))
+    return indptr, nnz, data, bad
 
 
 def pattern_kernel(tri: np.ndarray, n: int, points: np.ndarray | None = None, kappa=None):
     """CSR ``indptr``, ``indices``, the (m, w * w) slot map of the P1 pattern (compiled; ``w``
     = 3 for triangles, 4 for tetrahedra) and, for triangles when ``points`` and ``kappa`` (a
     float or one value per element) are given, the CSR data of the stiffness summed in the
-    same pass (None if some triangle is degenerate; else None too when not asked).
+    same pass, for tetrahedra likewise (None if some element is degenerate; else None too when
+    not asked).
 
     ``indices`` and ``slots`` are int32 when the entry count allows it (half the memory
     traffic of int64), else int64.
@@ -171,13 +182,11 @@ def pattern_kernel(tri: np.ndarray, n: int, points: np.ndarray | None = None, ka
     dtype = np.int32 if bound < np.iinfo(np.int32).max else np.int64
     indices = np.empty(bound, dtype)
     slots = np.empty((m, w * w), dtype)
-    with_data = points is not None and kappa is not None and w == 3
-    pts = np.ascontiguousarray(points, dtype=np.float64) if with_data else np.zeros((0, 2))
+    with_data = points is not None and kappa is not None and w in (3, 4)
+    pts = np.ascontiguousarray(points, dtype=np.float64) if with_data else np.zeros((0, w - 1))
     kap, scalar = _values(kappa if with_data else 1.0)
-    if w != 3:
-        indptr, nnz = _pattern_cells(tri, n, indices, slots)
-        return indptr, indices[:nnz].copy(), slots, None
-    indptr, nnz, data, bad = _pattern(tri, n, indices, slots, pts, kap, scalar, with_data)
+    kernel = _pattern if w == 3 else _pattern_cells
+    indptr, nnz, data, bad = kernel(tri, n, indices, slots, pts, kap, scalar, with_data)
     return indptr, indices[:nnz].copy(), slots, (data if with_data and not bad else None)
 
 
@@ -305,14 +314,19 @@ def _stiffness_tet(tets, points, idx, use_idx, kappa, scalar_kappa, slots, nnz):
         if not (vol6 > 0.0 and vol6 < np.inf):
             bad += 1
             continue
-        s = (kappa[0] if scalar_kappa else kappa[k]) / (6.0 * vol6)
-        for a in range(4):
-            for b in range(a, 4):
-                v = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
-                data[slots[e, 4 * a + b]] += v
-                if b != a:
-                    data[slots[e, 4 * b + a]] += v
+        _add_tet_stiffness(data, slots, e, g, (kappa[0] if scalar_kappa else kappa[k]) / (6.0 * vol6))
     return data, bad
+
+
+@numba.njit(cache=True, inline="always")
+def _add_tet_stiffness(data, slots, e, g, s):  # pragma: no cover - compiled
+    """``data[slots[e, 4 a + b]] += s (g_a . g_b)``: element e's local matrix into CSR data."""
+    for a in range(4):
+        for b in range(a, 4):
+            v = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
+            data[slots[e, 4 * a + b]] += v
+            if b != a:
+                data[slots[e, 4 * b + a]] += v
 
 
 @numba.njit(cache=True)
@@ -359,7 +373,7 @@ def warm_up() -> None:
     p3 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
     ind3 = np.empty(4 + 12, np.int32)
     slots3 = np.empty((1, 16), np.int32)
-    _, nnz3 = _pattern_cells(tet, 4, ind3, slots3)
+    _, nnz3, _, _ = _pattern_cells(tet, 4, ind3, slots3, p3, np.ones(1), True, True)
     _stiffness_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, slots3, nnz3)
     _load_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, 4)
 

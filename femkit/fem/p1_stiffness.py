@@ -124,7 +124,7 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
                                   shape=(mesh.n_points, mesh.n_points), copy=False)
                 K.has_sorted_indices = True
                 return K
-        if pattern is None and backend == "numba" and idx is None and mesh.dim == 2:
+        if pattern is None and backend == "numba" and idx is None:
             # first assembly on a large mesh: pattern, slots and stiffness in one pass
             pattern, data = SparsityPattern.with_stiffness(mesh, _kernel_coefficient(mesh, kappa, None))
             if data is not None:

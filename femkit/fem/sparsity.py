@@ -99,11 +99,12 @@ class SparsityPattern:
         for ``kappa`` (a float or one value per element) in one compiled pass.
 
         This is the first assembly on a large mesh: the element-order pass that writes the
-        slot map sums the local matrices too.  ``data`` is None if a triangle is degenerate.
+        slot map sums the local matrices too (triangles and tetrahedra).  ``data`` is None if
+        an element is degenerate.
         """
         from ._kernels import pattern_kernel
 
-        indptr, indices, slots, data = pattern_kernel(mesh.triangles, mesh.n_points, mesh.points, kappa)
+        indptr, indices, slots, data = pattern_kernel(mesh.cells, mesh.n_points, mesh.points, kappa)
         pat = cls._from_arrays(mesh.n_points, indptr, indices, slots)
         _CACHE[mesh] = pat
         return pat, data

@@ -79,7 +79,8 @@ def _restrict_free(P: sp.csr_matrix, rows: np.ndarray, cols: np.ndarray) -> sp.c
     new_cols[np.repeat(starts - (np.cumsum(lens) - lens), lens) + np.arange(lens.sum())] = -1
     dropped = np.flatnonzero(new_cols < 0)
     counts = np.diff(P.indptr)
-    np.subtract.at(counts, np.searchsorted(P.indptr, dropped, side="right") - 1, 1)
+    counts -= np.bincount(np.searchsorted(P.indptr, dropped, side="right") - 1,
+                          minlength=n_rows).astype(counts.dtype, copy=False)
     indptr = np.zeros(len(rows) + 1, dtype=idx)
     np.cumsum(counts[row_kept], out=indptr[1:])
     keep = np.ones(P.nnz, dtype=bool)

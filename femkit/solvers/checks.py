@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from .defaults import DEFAULT_RTOL
 
+import sys
 import time
 from dataclasses import dataclass
 from typing import Any, Callable
@@ -180,19 +181,25 @@ def check_tolerances(rtol: float, atol: float) -> None:
         )
 
 
-#: Square CSR matrices with at least this many entries (sorted, canonical) are measured by one
-#: compiled pass (:mod:`femkit.solvers._symmetry_kernel`) instead of SciPy's ``A - A.T``.
-SYMMETRY_NUMBA_THRESHOLD = 1_000_000
+#: Sparse matrices with at least this many entries are checked by one compiled pass (each
+#: row's lower part walked by a pointer: 2-4 SpMV) instead of forming ``A - A^T`` (a
+#: transposition and a sparse difference: 15-40 SpMV on a 3D P1 matrix) when numba is loaded
+#: already (a compiled assembly or multigrid ran), else from 10x this size: importing numba for
+#: the check alone would add ~100 MB to a mid-size run that needs no other kernel.
+SYMMETRY_NUMBA_NNZ = 200_000
 
 
 def asymmetry(A) -> float:
     """``||A - A^T||_inf / ||A||_inf`` for a sparse or dense matrix (0 for a zero matrix)."""
-    if (sp.issparse(A) and A.format == "csr" and A.nnz >= SYMMETRY_NUMBA_THRESHOLD
-            and A.shape[0] == A.shape[1] and A.has_canonical_format and np.isrealobj(A.data)):
-        from ._symmetry_kernel import row_sums
+    if sp.issparse(A) and A.format == "csr" and A.nnz >= SYMMETRY_NUMBA_NNZ and (
+            "numba" in sys.modules or A.nnz >= 10 * SYMMETRY_NUMBA_NNZ):
+        from ._check_kernels import asymmetry_sums
 
-        num, den = row_sums(A.indptr, A.indices, np.asarray(A.data, dtype=np.float64))
-        return float(num) / float(den) if den > 0 else 0.0
+        if not A.has_canonical_format:
+            A = A.copy()
+            A.sum_duplicates()      # sorted, unique indices: what the bisection needs
+        num, den = asymmetry_sums(A.indptr, A.indices, A.data)
+        return num / den if den > 0 else 0.0
     if sp.issparse(A):
         D = (A - A.T).tocsr()
         num = float(np.max(np.asarray(abs(D).sum(axis=1)))) if D.nnz else 0.0

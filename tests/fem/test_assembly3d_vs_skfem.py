@@ -55,6 +55,36 @@ def test_stiffness_equals_scikit_fem(mesh, backend, kappa):
     assert _rel(K, K_ref) < 1e-12
 
 
+@pytest.mark.parametrize("kappa", ["one", "expression"])
+def test_fused_first_call_equals_scikit_fem(kappa):
+    """A first compiled assembly on a fresh mesh builds the pattern and sums the stiffness in
+    one pass (per-element kappa indexed by element in that pass)."""
+    m = perturbed_box(3, state=4)
+    from femkit.fem.sparsity import SparsityPattern
+
+    assert SparsityPattern.cached(m) is None
+    mine = 1.0 if kappa == "one" else (lambda x, y, z: 1.0 + x * y + z ** 2)
+    c = m.centroids()
+    values = np.ones(m.n_cells) if kappa == "one" else 1.0 + c[:, 0] * c[:, 1] + c[:, 2] ** 2
+    basis = _basis(m)
+    K_ref = _laplace.assemble(basis, kappa=basis.with_element(skfem.ElementTetP0()).interpolate(values))
+    K = assemble_stiffness(m, mine, backend="numba")
+    assert SparsityPattern.cached(m) is not None
+    assert _rel(K, K_ref) < 1e-12
+
+
+def test_fused_first_call_refuses_a_flat_tetrahedron():
+    from femkit.errors import DegenerateMeshError
+    from femkit.mesh import Mesh
+
+    m = perturbed_box(2, state=5)
+    pts = m.points.copy()
+    a, b, c, d = m.cells[0]
+    pts[d] = pts[a] + 0.5 * (pts[b] - pts[a]) + 0.25 * (pts[c] - pts[a])   # coplanar with a, b, c
+    with pytest.raises(DegenerateMeshError):
+        assemble_stiffness(Mesh(pts, m.cells), backend="numba")
+
+
 def test_first_numba_assembly_builds_the_same_pattern():
     m = perturbed_box(2, state=9)
     K1 = assemble_stiffness(m, backend="numba")        # pattern built by the compiled kernel

@@ -64,17 +64,66 @@ def test_gmg_preconditioned_cg_on_tetrahedra(hierarchy):
     assert np.abs(res.x - ref.x).max() <= 1e-8 * np.abs(ref.x).max()
 
 
-def test_fmg_within_1_2_of_the_discrete_error_on_every_level(hierarchy):
+@pytest.mark.parametrize("coarse", ["restricted", "dirichlet data", "level systems"])
+def test_fmg_within_1_2_of_the_discrete_error_on_every_level(hierarchy, coarse):
     ratios = []
-    for levels in range(2, 6):
+    for levels in range(2, 7):
         sub = _sub(hierarchy, levels)
         mesh = sub.finest
         sys = _system(mesh, f=source, g=exact)
-        res = solve(sys.A, sys.b, method="fmg", hierarchy=sub, free=sys.free)
+        extra = {}
+        if coarse == "dirichlet data":
+            extra["dirichlet"] = sys.expand(np.zeros(len(sys.free)))
+        elif coarse == "level systems":
+            extra["levels"] = [_system(m, f=source, g=exact) for m in sub.meshes[:-1]]
+        res = solve(sys.A, sys.b, method="fmg", hierarchy=sub, free=sys.free, **extra)
         disc = solve(sys.A, sys.b, method="direct").x
         e_fmg = error_norms(mesh, sys.expand(res.x), exact)["L2"]
         e_disc = error_norms(mesh, sys.expand(disc), exact)["L2"]
         assert res.converged and res.method == "fmg"
+        if coarse != "restricted":
+            # consistent coarse problems: the estimate is trusted and stops every level after
+            # at most two V-cycles (plain restriction falls back on the residual rule)
+            assert res.info["stopped_by"] == "discretisation-error estimate"
+            assert max(res.info["cycles_per_level"]) <= 2
         ratios.append(e_fmg / e_disc)
-    print("fmg / discrete L2 error by level:", np.round(ratios, 4).tolist())
+    print(f"fmg ({coarse}) / discrete L2 error by level:", np.round(ratios, 4).tolist())
     assert max(ratios) <= 1.2
+
+
+def test_fmg_dirichlet_data_gives_the_level_systems_coarse_problems(hierarchy):
+    """The algebraic coarse right-hand side equals the Galerkin projection of the finer problem
+    with the injected Dirichlet values: with the same Dirichlet data on both levels (a linear g,
+    interpolated exactly along the boundary) it is the reduced coarse system's own ``b`` when
+    the coarse load is the restricted fine load."""
+    sub = _sub(hierarchy, 3)
+    g = lambda x, y, z: 1.0 + 2.0 * x - y + 0.5 * z  # noqa: E731
+    fine, coarse_mesh = sub.finest, sub.meshes[1]
+    K, F = assemble_stiffness(fine), assemble_load(fine, source)
+    nodes = boundary_nodes(fine)
+    sys = apply_dirichlet(K, F, nodes, g(*fine.points[nodes].T))
+    P = sub.prolongations[1]
+    Kc, Fc = (P.T @ K @ P).tocsr(), P.T @ F
+    cn = boundary_nodes(coarse_mesh)
+    ref = apply_dirichlet(Kc, Fc, cn, g(*coarse_mesh.points[cn].T))
+    from femkit.solvers.fmg import _coarse_dirichlet
+    from femkit.solvers.preconditioners.gmg import Multigrid
+
+    mg = Multigrid(sys.A, sub, free=sys.free)
+    gl = _coarse_dirichlet(mg, sys.expand(np.zeros(len(sys.free))))
+    w = sub.prolongate(gl[1], 1)[sys.free]
+    b_c = mg.restrictions[1] @ (sys.b - sys.A @ w)
+    assert np.abs(b_c - ref.b).max() <= 1e-12 * np.abs(ref.b).max()
+
+
+def test_fmg_refuses_levels_and_dirichlet_together_and_a_wrong_length(hierarchy):
+    from femkit.errors import InputError
+
+    sub = _sub(hierarchy, 3)
+    sys = _system(sub.finest)
+    full = sys.expand(np.zeros(len(sys.free)))
+    with pytest.raises(InputError, match="not both"):
+        solve(sys.A, sys.b, method="fmg", hierarchy=sub, free=sys.free, dirichlet=full,
+              levels=[_system(m) for m in sub.meshes[:-1]])
+    with pytest.raises(InputError, match="one value per node"):
+        solve(sys.A, sys.b, method="fmg", hierarchy=sub, free=sys.free, dirichlet=full[:-1])

@@ -136,9 +136,11 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
 
 def multigrid_inputs(case: Case, hierarchy, system) -> dict:
     """What geometric multigrid needs at solve time, as :meth:`SolverSpec.solve` overrides:
-    the hierarchy and the free nodes; for ``fmg`` with Dirichlet conditions also the reduced
-    systems of the coarser meshes (their own right-hand sides and Dirichlet values, see
-    :func:`femkit.solvers.fmg.fmg`). Empty for every other solver."""
+    the hierarchy and the free nodes; for ``fmg`` with Dirichlet conditions also the coarser
+    levels' own right-hand sides (:func:`level_system`: the load alone when the Dirichlet data are
+    zero). Empty for every other solver. (fmg's ``dirichlet=`` option builds the coarser problems
+    from the finest level's Dirichlet values alone; the pipeline keeps the assembled loads, whose
+    results it has always given.)"""
     spec = case.solver
     if not spec.needs_hierarchy:
         return {}
@@ -170,7 +172,7 @@ def level_system(case: Case, mesh, method: str):
                            values=values, n=mesh.n_points)
 
 
-def multigrid_overrides(spec, hierarchy, free, levels=None) -> dict:
+def multigrid_overrides(spec, hierarchy, free, levels=None, *, dirichlet=None) -> dict:
     """The :meth:`SolverSpec.solve` overrides of geometric multigrid: ``{"options": ...}`` for
     ``method: fmg`` (with the coarser levels' own systems ``levels`` when given),
     ``{"preconditioner_options": ...}`` for ``preconditioner: gmg``, ``{}`` otherwise. The one
@@ -182,6 +184,8 @@ def multigrid_overrides(spec, hierarchy, free, levels=None) -> dict:
         return {"preconditioner_options": mg}
     if levels is not None:
         mg["levels"] = list(levels)
+    if dirichlet is not None:
+        mg["dirichlet"] = dirichlet
     return {"options": mg}
 
 

@@ -40,7 +40,7 @@ FAMILIES = {
                     ("femkit.mesh._refine_kernel", "red_children")),
     "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
                     ("femkit.fem._kernels", "_stiffness_rows"), ("femkit.fem._kernels", "_eliminate")),
-    "solver checks": (("femkit.solvers._symmetry_kernel", "row_sums"),),
+    "solver checks": (("femkit.solvers._check_kernels", "asymmetry_sums"),),
     "geometric multigrid": (("femkit.solvers.preconditioners._gmg_kernels", "_galerkin_rows"),
                             ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps")),
 }
@@ -50,7 +50,7 @@ _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiff
                ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"),
                ("femkit.mesh.quality", "NUMBA_THRESHOLD"), ("femkit.mesh.refine", "NUMBA_THRESHOLD"),
                ("femkit.fem.dirichlet", "NUMBA_THRESHOLD"),
-               ("femkit.solvers.checks", "SYMMETRY_NUMBA_THRESHOLD"))
+               ("femkit.solvers.checks", "SYMMETRY_NUMBA_NNZ"))
 
 _TINY = {
     "problem": "poisson", "name": "warmup",
