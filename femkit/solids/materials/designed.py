@@ -109,12 +109,15 @@ class EnergyMaterial(StretchMaterial):
         key = (self.energy, names)
         mod = _KERNELS.get(key)
         if mod is None:
-            import sympy
-
             from ..energy.codegen import energy_module
 
-            mod = energy_module(_symbolic(self.energy, names), sympy.symbols("s1:4"),
-                                [sympy.Symbol(k) for k in names])
+            def build():
+                import sympy
+
+                return [(_symbolic(self.energy, names), sympy.symbols("s1:4"),
+                         [sympy.Symbol(k) for k in names])]
+
+            mod = energy_module(f"{self.energy!r} ({', '.join(names)})", build)
             _KERNELS[key] = mod
         return mod
 
