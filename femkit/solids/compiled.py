@@ -370,7 +370,14 @@ def point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no cover - c
 
 
 # ---------------------------------------------------------------- element pass
-@numba.njit(cache=True)
+#: floating-point licences of the element pass: contraction to FMA, reassociation, reciprocals,
+#: signless zeros -- results move by rounding only (~1e-14 relative, checked by the tests against
+#: the point function and the NumPy reference); no NaN/inf assumptions (``nnan``/``ninf`` are left
+#: out: a non-finite energy must still reach the caller's check)
+FASTMATH = {"contract", "reassoc", "arcp", "nsz"}
+
+
+@numba.njit(cache=True, fastmath=FASTMATH)
 def element_pass(code, x, cells, grads, vol, elems, params, level, project,
                  node_slots, node_indptr, energy, grad, data, neg, stress):  # pragma: no cover - compiled
     """The element pass of material number ``code`` (:func:`point`).
