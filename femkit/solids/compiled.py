@@ -328,6 +328,16 @@ def _frame(code, F, params, level, P, lam, work, vec, d):  # pragma: no cover - 
 
 
 @numba.njit(cache=True)
+def frame(code, F, params, level, P, lam, work, vec):  # pragma: no cover - compiled
+    """:func:`_frame` with the size a constant. A function of its own, not inlined into the
+    element pass: numba types it once for both sizes and both callers, which keeps the element
+    pass's compilation short (LLVM may still inline the machine code)."""
+    if F.shape[0] == 3:
+        return _frame(code, F, params, level, P, lam, work, vec, 3)
+    return _frame(code, F, params, level, P, lam, work, vec, 2)
+
+
+@numba.njit(cache=True)
 def _modes(work, Q):  # pragma: no cover - compiled
     """The ``d^2`` unit modes ``Q[k]`` (``d x d``, in F-space) of a frame ``U, V, E``:
     ``U diag(E[:, k]) V^T``, then per pair ``(u_i v_j^T +- u_j v_i^T) / sqrt 2``."""
@@ -360,10 +370,7 @@ def point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no cover - c
     ``dP/dF`` (``lam``, ``Q[k]`` the unit ``d x d`` mode in F-space). Returns ``psi``.
     ``work`` ``(6, d, d)`` and ``vec`` ``(2, d)`` are scratch (no allocation per element).
     """
-    if F.shape[0] == 3:
-        psi = _frame(code, F, params, level, P, lam, work, vec, 3)
-    else:
-        psi = _frame(code, F, params, level, P, lam, work, vec, 2)
+    psi = frame(code, F, params, level, P, lam, work, vec)
     if level >= 2:
         _modes(work, Q)
     return psi
@@ -422,7 +429,7 @@ def _element_pass(code, x, cells, grads, vol, elems, params, level, project, nod
     for t in range(elems.shape[0]):
         e = elems[t]
         deformation_gradient(x, cells, grads, e, F)
-        psi = _frame(code, F, params, level, P, lam, work, vec, d)
+        psi = frame(code, F, params, level, P, lam, work, vec)
         v = vol[e]
         energy[e] = v * psi
         if level < 1:

@@ -136,7 +136,13 @@ def energy_source(energies: Sequence) -> str:
               f"from femkit.solids.compiled import {', '.join(sorted(shared))}", *funcs, "", "",
               *_dispatch(len(energies)), ""]
     for name in copied:
-        parts += ["", inspect.getsource(getattr(compiled, name)).rstrip(), ""]
+        src = inspect.getsource(getattr(compiled, name)).rstrip()
+        if f"def {name}(" not in src:   # the file was edited after this process imported it
+            from ...errors import MaterialError
+
+            raise MaterialError(f"{compiled.__file__} changed since it was imported; restart to "
+                                "generate kernels from it")
+        parts += ["", src, ""]
     return "\n".join(parts)
 
 
