@@ -123,11 +123,11 @@ class Material:
     def kernels(self):
         """The module of compiled kernels evaluating this material (``point``,
         ``element_pass``, ``stretch_energy``), generated from energy expressions
-        (:mod:`femkit.solids.energy.codegen`): one module for all built-ins
-        (:func:`.builtin.builtin_kernels`), one per material designed by its energy."""
-        from .builtin import builtin_kernels
-
-        return builtin_kernels()
+        (:mod:`femkit.solids.energy.codegen`): one module for all built-ins (given to every
+        registered class by :func:`.registry.register_material`), one per material designed by
+        its energy (:class:`.designed.EnergyMaterial`)."""
+        raise MaterialError(f"{self.name}: neither a registered material nor designed by its "
+                            "energy, so it has no compiled kernels")
 
 
 @dataclass(frozen=True)

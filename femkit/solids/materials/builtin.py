@@ -19,33 +19,33 @@ __all__ = ["builtin_kernels", "builtin_recipe", "stretch_builtins"]
 CONSTANTS = ("mu", "lam")
 
 
-def stretch_builtins() -> list:
-    """The registered material classes written as energies, in the order of their ``code``
-    (1, 2, ...: the numbers of the generated ``stretch_energy``)."""
+def stretch_builtins(classes) -> list:
+    """The material ``classes`` written as energies in the order of their ``code`` (1, 2, ...:
+    the numbers of the generated ``stretch_energy``)."""
     from ...errors import MaterialError
-    from .registry import MATERIALS
 
-    classes = [MATERIALS.get(n) for n in MATERIALS.names()]
-    out = sorted((c for c in classes if getattr(c, "energy_expression", None) is not None),
-                 key=lambda c: c.code)
+    out = sorted(classes, key=lambda c: c.code)
     if [c.code for c in out] != list(range(1, len(out) + 1)):
         raise MaterialError("the built-in stretch materials must be numbered 1, 2, ... by their "
                             f"code, got {[(c.name, c.code) for c in out]}")
     return out
 
 
-def builtin_recipe() -> str:
-    """The built-in energies as text (the key of their generated module)."""
+def builtin_recipe(classes) -> str:
+    """The energies of ``classes`` as text (the key of their generated module)."""
     return "\n".join(f"{c.name}: {c.energy_expression!r} ({', '.join(CONSTANTS)})"
-                     for c in stretch_builtins())
+                     for c in stretch_builtins(classes))
 
 
-_MODULE = []
+_MODULE: dict = {}
 
 
-def builtin_kernels():
-    """The generated module of the built-in materials (loaded once per process)."""
-    if not _MODULE:
+def builtin_kernels(classes):
+    """The generated module of the built-in material ``classes`` (the registry's entries written
+    as energies; :func:`femkit.solids.materials.registry._builtin_kernels`), loaded once per
+    process."""
+    recipe = builtin_recipe(classes)
+    if recipe not in _MODULE:
         from ..energy.codegen import energy_module
 
         def build():
@@ -54,7 +54,7 @@ def builtin_kernels():
             s = sympy.symbols("s1:4")
             consts = [sympy.Symbol(k) for k in CONSTANTS]
             return [(c.energy_expression.symbolic(CONSTANTS), s, consts)
-                    for c in stretch_builtins()]
+                    for c in stretch_builtins(classes)]
 
-        _MODULE.append(energy_module(builtin_recipe(), build))
-    return _MODULE[0]
+        _MODULE[recipe] = energy_module(recipe, build)
+    return _MODULE[recipe]
