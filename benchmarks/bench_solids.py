@@ -28,16 +28,23 @@ from the three finest, the Richardson-extrapolated deflection, and Timoshenko's
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
+# the hand-written formulas of the NumPy baseline are the tests' reference
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "solids"))
+
 
 def numpy_gradient_hessian(body, x, mu, lam):
-    """Vectorised NumPy: stable neo-Hookean gradient and projected Hessian (CSR data)."""
+    """Vectorised NumPy: stable neo-Hookean gradient and projected Hessian (CSR data), from the
+    hand-written formulas the tests check femkit against (tests/solids/_reference.py)."""
+    from _reference import hand, principal_modes
+
     r = body.rest
     d = body.dim
-    lam = lam + mu                                            # the energy's lambda'
     F = np.einsum("mna,mnb->mab", x[r.cells], r.gradients)
     U, s, Vt = np.linalg.svd(F)
     V = np.swapaxes(Vt, 1, 2).copy()
@@ -45,32 +52,13 @@ def numpy_gradient_hessian(body, x, mu, lam):
         neg = np.linalg.det(M) < 0
         M[neg, :, -1] *= -1
         s[neg, -1] *= -1
-    J = s.prod(axis=1)
-    c = J[:, None] / np.where(s == 0, 1e-300, s)              # dJ/ds_i
-    a = lam * (J - 1) - mu
-    g = mu * s + a[:, None] * c
-    Hs = lam * c[:, :, None] * c[:, None, :] + mu * np.eye(d)
-    for i in range(d):
-        for j in range(d):
-            if i != j:
-                k = 3 - i - j
-                Hs[:, i, j] += a * s[:, k]
+    _, g, Hs = hand("stable_neo_hookean", s, mu, lam)
     P = np.einsum("mai,mi,mbi->mab", U, g, V)
     vol = r.volumes
     grad = np.zeros_like(x)
     np.add.at(grad, r.cells, vol[:, None, None] * np.einsum("mab,mnb->mna", P, r.gradients))
-    w, E = np.linalg.eigh(Hs)
-    lams, modes = [w[:, k] for k in range(d)], [np.einsum("mai,mi,mbi->mab", U, E[:, :, k], V) for k in range(d)]
-    r2 = 1 / np.sqrt(2)
-    for i in range(d):
-        for j in range(i + 1, d):
-            lams.append((g[:, i] - g[:, j]) / (s[:, i] - s[:, j]))
-            lams.append((g[:, i] + g[:, j]) / (s[:, i] + s[:, j]))
-            p = np.einsum("ma,mb->mab", U[:, :, i], V[:, :, j])
-            q = np.einsum("ma,mb->mab", U[:, :, j], V[:, :, i])
-            modes += [r2 * (p + q), r2 * (p - q)]
-    L = np.maximum(np.stack(lams, axis=1), 0.0)               # (m, d^2)
-    Q = np.stack(modes, axis=1)                                # (m, d^2, d, d)
+    L, Q = principal_modes(U, s, V, g, Hs)
+    L = np.maximum(L, 0.0)
     W = np.einsum("mkab,mnb->mkna", Q, r.gradients).reshape(len(F), d * d, -1)
     He = np.einsum("m,mk,mki,mkj->mij", vol, L, W, W)          # (m, 12, 12)
     pat = body.pattern

@@ -266,7 +266,8 @@ def _add_warmup(sub) -> None:
     p = sub.add_parser(
         "warmup", help="compile femkit's kernels now (once after an install; cached afterwards)",
         description=("Compile the compiled (numba) kernels of the Poisson pipeline (assembly, "
-                     "edges, geometric multigrid) on a tiny problem, so the first real "
+                     "edges, geometric multigrid) on a tiny problem, and generate and compile "
+                     "the elastic solids' built-in material kernels, so the first real "
                      "'femkit solve' does not pay for it. Without it that first large run "
                      "compiles them itself, in a stage named 'compile'."))
     p.set_defaults(handler=_run_warmup)
@@ -274,8 +275,9 @@ def _add_warmup(sub) -> None:
 
 def _run_warmup(args) -> int:
     from .case.poisson.warmup import warm_up
+    from .solids.warmup import warm_up as warm_up_solids
 
-    print(f"kernels ready in {warm_up(print):.1f} s")
+    print(f"kernels ready in {warm_up(print) + warm_up_solids():.1f} s")
     return EXIT_OK
 
 

@@ -21,9 +21,9 @@ import sys
 import tempfile
 from pathlib import Path
 from types import ModuleType
-from typing import Iterable
+from typing import Callable, Iterable
 
-__all__ = ["cache_dir", "load_generated", "copied_kernels", "function_sources", "generated_path"]
+__all__ = ["cache_dir", "load_generated", "load_named", "copied_kernels", "function_sources", "generated_path"]
 
 _LOADED: dict[str, ModuleType] = {}
 
@@ -51,17 +51,27 @@ def load_generated(text: str, prefix: str, kind: str, salt: str = "") -> ModuleT
     ``salt`` is what the module depends on beyond its own text (e.g. the source of the module it
     imports its shared kernels from: numba's cache would not notice an edited callee).
     """
-    name = _name(text, prefix, salt)
+    return load_named(_name(text, prefix, salt), kind, lambda: text, rewrite=True)
+
+
+def load_named(name: str, kind: str, make_text: Callable[[], str], *,
+               rewrite: bool = False) -> ModuleType:
+    """The generated module ``name`` of :func:`cache_dir` (``kind``), imported once per process;
+    its text is made by ``make_text()`` only when the file is missing (or differs, with
+    ``rewrite``), so a caller whose ``name`` already hashes everything the text depends on loads
+    a cached module without generating it. Written atomically."""
     mod = _LOADED.get(name)
     if mod is not None:
         return mod
-    path = generated_path(text, prefix, kind, salt)
+    path = cache_dir(kind) / f"{name}.py"
     path.parent.mkdir(parents=True, exist_ok=True)
-    if not path.exists() or path.read_text() != text:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.replace(tmp, path)          # atomic: parallel test workers may write the same file
+    if not path.exists() or rewrite:
+        text = make_text()
+        if not path.exists() or path.read_text() != text:
+            fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+            with os.fdopen(fd, "w") as fh:
+                fh.write(text)
+            os.replace(tmp, path)      # atomic: parallel test workers may write the same file
     spec = importlib.util.spec_from_file_location(name, path)
     mod = importlib.util.module_from_spec(spec)
     sys.modules[name] = mod
@@ -72,11 +82,12 @@ def load_generated(text: str, prefix: str, kind: str, salt: str = "") -> ModuleT
 
 def copied_kernels(module: ModuleType, roots: Iterable[str]) -> list[str]:
     """Names of the compiled functions of ``module`` that reach one of ``roots`` through their
-    calls (read from each function's code object), in source order: a generated module copies
+    calls (read from each function's code object; a root need not be defined in ``module``), in
+    source order: a generated module copies
     their source, so that they resolve its own definitions of ``roots``; it imports the others."""
     funcs = {n: f.py_func for n, f in vars(module).items() if hasattr(f, "py_func")}
-    calls = {n: set(f.__code__.co_names) & set(funcs) for n, f in funcs.items()}
     reach = set(roots)
+    calls = {n: set(f.__code__.co_names) & (set(funcs) | reach) for n, f in funcs.items()}
     grew = True
     while grew:
         new = {n for n, c in calls.items() if c & reach} - reach

@@ -2,9 +2,10 @@
 
 numba's on-disk cache is invalidated only by the source file of the cached function itself, not
 by the files of the compiled functions it calls: kernels spread over several files would keep
-running stale code after an edit. So the signed SVD, the stretch energies, the linear point
-function, the SVD-derivative eigensystem and the element pass live together here (sections
-below), and materials refer to their energy by number (``code``).
+running stale code after an edit. So the signed SVD, the linear point function, the
+SVD-derivative eigensystem and the element pass live together here (sections below), and the
+generated modules that compile them with the energies (:mod:`femkit.solids.energy.codegen`) carry
+this file's hash in their name; materials refer to their energy by number (``code``).
 
 Element pass
 ------------
@@ -21,19 +22,17 @@ Signed SVD
 ----------
 The invertible SVD of one small matrix, compiled (Irving, Teran & Fedkiw 2004).
 
-Stretch energies
-----------------
-The built-in energies of the principal stretches (signed, ``d`` = 2 or 3).
-
-* co-rotational: ``W = mu sum (s_i - 1)^2 + lam/2 (sum (s_i - 1))^2``, i.e.
-  ``mu |F - R|^2 + lam/2 tr(R^T F - I)^2`` (Mueller & Gross 2004; Sifakis & Barbic 2012);
-* St. Venant-Kirchhoff: ``W = mu |E|^2 + lam/2 tr(E)^2``, ``E = (F^T F - I)/2``, i.e.
-  ``mu/4 sum (s_i^2 - 1)^2 + lam/8 (sum (s_i^2 - 1))^2``;
-* stable neo-Hookean (Smith, de Goes & Kim 2018, their eq. 13 without the constant; Kim &
-  Eberle 2022, "Dynamic deformables", section 6): ``W = mu/2 (I_C - d) - mu (J - 1) +
-  lam'/2 (J - 1)^2`` with ``I_C = sum s_i^2``, ``J = prod s_i`` and ``lam' = lam + mu``, which
-  makes its Hessian at rest the linear-elasticity tensor with ``(mu, lam)``; finite and smooth
-  through inversion (``J <= 0``).
+Energies
+--------
+No energy is written here. Every stretch material -- the built-ins (co-rotational, StVK,
+stable neo-Hookean: :mod:`femkit.solids.materials.registry`) and the ones a user designs -- is
+an expression of the principal stretches whose derivatives are generated and printed as numba
+functions by :mod:`femkit.solids.energy.codegen`. The functions below that call
+``stretch_energy`` (:func:`_stretch_frame`, :func:`point`, :func:`element_pass`) are templates:
+the generator copies their source into the module it writes, next to the generated
+``stretch_energy(code, s, params, grad, hess) -> W`` (``dW/ds`` into ``grad``,
+``d^2W/ds^2`` into ``hess``), and that module's copies are the ones compiled and run; called
+from here they would not compile.
 
 Linear material
 ---------------
@@ -44,7 +43,8 @@ Linear (small-strain) elasticity as a point function of ``F``.
 on the symmetric off-diagonal modes and the eigenpairs of ``2 mu I + lam 1 1^T`` on the diagonal
 ones. Not rotation invariant: a rigid rotation by ``theta`` has ``eps = (cos theta - 1) I`` and so
 spurious energy and forces of order ``theta^2`` (measured in ``tests/solids``; docs/methods.md).
-Its number in the element pass is 0 (:func:`point`).
+Its number in the element pass is 0 (:func:`point`); it shares the modes of the principal frame
+with ``U = V = I``.
 
 SVD derivative
 --------------
@@ -73,11 +73,10 @@ accuracy, ``1e-8`` with ``tol = 1e-8``.
 Projection to positive semi-definite (Teran et al. 2005): every eigenvalue clamped at 0, which
 makes the element Hessian ``vol g^T (dP/dF) g`` PSD as well.
 
-A material supplies one compiled function ``energy(s, params, grad, hess) -> W`` (writes
-``dW/ds`` into ``grad`` and ``d^2W/ds^2`` into ``hess``), listed by number in
-:func:`femkit.solids.compiled.stretch_energy` (a dispatch on an integer keeps every
-kernel cached on disk: numba does not cache functions taking other compiled functions as
-arguments); :func:`stretch_point` evaluates the point quantities the element pass needs.
+A material's energy is ``stretch_energy(code, s, params, grad, hess)`` of the generated module
+(a dispatch on an integer keeps every kernel cached on disk: numba does not cache functions
+taking other compiled functions as arguments); :func:`_stretch_frame` evaluates the point
+quantities the element pass needs.
 """
 
 from __future__ import annotations
@@ -86,11 +85,6 @@ import math
 
 import numba
 import numpy as np
-
-#: energy number of each built-in stretch material (0 is the linear material's point function;
-#: the material classes carry it as ``code``)
-CODES = {"linear": 0, "corotational": 1, "stvk": 2, "stable_neo_hookean": 3}
-
 
 # ---------------------------------------------------------------- deformation gradient
 @numba.njit(cache=True, inline="always")
@@ -155,20 +149,22 @@ def _sym_eig(A, V, d):  # pragma: no cover - compiled
                     t = -t
                 c = 1.0 / math.sqrt(t * t + 1.0)
                 sn = t * c
-                for k in range(d):                       # A <- A J
-                    akp, akq = A[k, p], A[k, q]
-                    A[k, p] = c * akp - sn * akq
-                    A[k, q] = sn * akp + c * akq
-                for k in range(d):                       # A <- J^T A
-                    apk, aqk = A[p, k], A[q, k]
-                    A[p, k] = c * apk - sn * aqk
-                    A[q, k] = sn * apk + c * aqk
+                # A <- J^T A J touches rows/columns p, q only (Golub & Van Loan, sym.schur2)
+                A[p, p] -= t * apq
+                A[q, q] += t * apq
+                A[p, q] = 0.0
+                A[q, p] = 0.0
+                for r in range(d):
+                    if r != p and r != q:
+                        arp, arq = A[r, p], A[r, q]
+                        A[r, p] = c * arp - sn * arq
+                        A[p, r] = A[r, p]
+                        A[r, q] = sn * arp + c * arq
+                        A[q, r] = A[r, q]
                 for k in range(d):                       # V <- V J
                     vkp, vkq = V[k, p], V[k, q]
                     V[k, p] = c * vkp - sn * vkq
                     V[k, q] = sn * vkp + c * vkq
-                A[p, q] = 0.0
-                A[q, p] = 0.0
 
 
 @numba.njit(cache=True)
@@ -237,91 +233,14 @@ def _signed_svd(F, U, s, V, A, d):  # pragma: no cover - compiled
             U[a, b], U[b, a] = U[b, a], U[a, b]
 
 
-# ---------------------------------------------------------------- stretch energies
-@numba.njit(cache=True)
-def corotational_energy(s, params, grad, hess):  # pragma: no cover - compiled
-    mu, lam = params[0], params[1]
-    d = s.shape[0]
-    tr = 0.0
-    W = 0.0
-    for i in range(d):
-        tr += s[i] - 1.0
-        W += mu * (s[i] - 1.0) ** 2
-    W += 0.5 * lam * tr * tr
-    for i in range(d):
-        grad[i] = 2.0 * mu * (s[i] - 1.0) + lam * tr
-        for j in range(d):
-            hess[i, j] = lam + (2.0 * mu if i == j else 0.0)
-    return W
-
-
-@numba.njit(cache=True)
-def stvk_energy(s, params, grad, hess):  # pragma: no cover - compiled
-    mu, lam = params[0], params[1]
-    d = s.shape[0]
-    S = 0.0
-    W = 0.0
-    for i in range(d):
-        e = s[i] * s[i] - 1.0
-        S += e
-        W += 0.25 * mu * e * e
-    W += 0.125 * lam * S * S
-    for i in range(d):
-        e = s[i] * s[i] - 1.0
-        grad[i] = mu * e * s[i] + 0.5 * lam * S * s[i]
-        for j in range(d):
-            hess[i, j] = lam * s[i] * s[j]
-        hess[i, i] += mu * (3.0 * s[i] * s[i] - 1.0) + 0.5 * lam * S
-    return W
-
-
-@numba.njit(cache=True)
-def stable_neo_hookean_energy(s, params, grad, hess):  # pragma: no cover - compiled
-    mu, lam = params[0], params[1] + params[0]
-    d = s.shape[0]
-    J = 1.0
-    IC = 0.0
-    for i in range(d):
-        J *= s[i]
-        IC += s[i] * s[i]
-    W = 0.5 * mu * (IC - d) - mu * (J - 1.0) + 0.5 * lam * (J - 1.0) ** 2
-    a = lam * (J - 1.0) - mu                     # dW/dJ
-    for i in range(d):
-        ci = 1.0                                  # dJ/ds_i, the product of the others
-        for k in range(d):
-            if k != i:
-                ci *= s[k]
-        grad[i] = mu * s[i] + a * ci
-        for j in range(d):
-            cj = 1.0
-            for k in range(d):
-                if k != j:
-                    cj *= s[k]
-            cij = 0.0                             # d^2J / ds_i ds_j
-            if i != j:
-                cij = 1.0
-                for k in range(d):
-                    if k != i and k != j:
-                        cij *= s[k]
-            hess[i, j] = lam * ci * cj + a * cij + (mu if i == j else 0.0)
-    return W
-
-
-@numba.njit(cache=True)
-def stretch_energy(code, s, params, grad, hess):  # pragma: no cover - compiled
-    """The energy number ``code`` (:data:`CODES`)."""
-    if code == 1:
-        return corotational_energy(s, params, grad, hess)
-    if code == 2:
-        return stvk_energy(s, params, grad, hess)
-    return stable_neo_hookean_energy(s, params, grad, hess)
-
-
 # ---------------------------------------------------------------- linear material
-@numba.njit(cache=True)
-def linear_point(F, params, level, P, lam, Q, work, vec):  # pragma: no cover - compiled
+@numba.njit(cache=True, inline="always")
+def _linear_frame(F, params, level, P, lam, work, vec, d):  # pragma: no cover - compiled
+    """The linear material in the form of :func:`_stretch_frame`: ``U = V = I`` (its modes are
+    those of the principal frame of the identity), ``lam``: the eigenvalues of
+    ``2 mu I + lam 1 1^T`` (eigenvectors ``E``), then per pair ``2 mu`` (symmetric) and ``0``
+    (skew: an infinitesimal rotation)."""
     mu, la = params[0], params[1]
-    d = F.shape[0]
     tr = 0.0
     for a in range(d):
         tr += F[a, a] - 1.0
@@ -334,29 +253,20 @@ def linear_point(F, params, level, P, lam, Q, work, vec):  # pragma: no cover - 
                 P[a, b] = 2.0 * mu * eps + (la * tr if a == b else 0.0)
     if level < 2:
         return psi
-    H, E = work[4], work[5]
+    U, V, A, E = work[0], work[1], work[2], work[4]
     for i in range(d):
         for j in range(d):
-            H[i, j] = la + (2.0 * mu if i == j else 0.0)
-    sym_eig(H, E)
-    for k in range(d * d):
-        for a in range(d):
-            for b in range(d):
-                Q[k, a, b] = 0.0
+            U[i, j] = 1.0 if i == j else 0.0
+            V[i, j] = U[i, j]
+            A[i, j] = la + (2.0 * mu if i == j else 0.0)
+    _sym_eig(A, E, d)
     for k in range(d):
-        lam[k] = H[k, k]
-        for i in range(d):
-            Q[k, i, i] = E[i, k]
-    r2 = 1.0 / math.sqrt(2.0)
+        lam[k] = A[k, k]
     k = d
     for i in range(d):
         for j in range(i + 1, d):
             lam[k] = 2.0 * mu
-            Q[k, i, j] = r2
-            Q[k, j, i] = r2
             lam[k + 1] = 0.0
-            Q[k + 1, i, j] = r2
-            Q[k + 1, j, i] = -r2
             k += 2
     return psi
 
@@ -367,22 +277,12 @@ REPEATED_TOL = 1e-8
 _R2 = 1.0 / math.sqrt(2.0)
 
 
-@numba.njit(cache=True)
-def stretch_point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no cover - compiled
-    """The point function of the stretch energy number ``code``
-    (:func:`femkit.solids.compiled.stretch_energy`).
-
-    ``level`` 0 energy only, 1 also the stress ``P`` (``d x d``), 2 also the ``d^2`` eigenpairs of
-    ``dP/dF`` (``lam``, ``Q[k]`` the unit ``d x d`` mode in F-space). Returns ``psi``.
-    ``work`` ``(6, d, d)`` and ``vec`` ``(2, d)`` are scratch (no allocation per element).
-    """
-    if F.shape[0] == 3:
-        return _stretch_point(code, F, params, level, P, lam, Q, work, vec, 3)
-    return _stretch_point(code, F, params, level, P, lam, Q, work, vec, 2)
-
-
 @numba.njit(cache=True, inline="always")
-def _stretch_point(code, F, params, level, P, lam, Q, work, vec, d):  # pragma: no cover - compiled
+def _stretch_frame(code, F, params, level, P, lam, work, vec, d):  # pragma: no cover - compiled
+    """Energy ``psi`` of the stretch energy number ``code``; ``level >= 1`` also the stress ``P``,
+    ``level 2`` the principal frame of ``dP/dF``: ``U = work[0]``, ``V = work[1]``, the
+    eigenvectors ``E = work[4]`` of the stretch Hessian and the ``d^2`` eigenvalues ``lam`` (the
+    ``d`` of ``E``, then the shear and twist of each pair ``i < j``; module docstring)."""
     U, V, A, H, E = work[0], work[1], work[2], work[3], work[4]
     s, g = vec[0], vec[1]
     _signed_svd(F, U, s, V, A, d)
@@ -407,6 +307,43 @@ def _stretch_point(code, F, params, level, P, lam, Q, work, vec, d):  # pragma: 
     _sym_eig(A, E, d)                  # eigenpairs of the stretch Hessian (H kept for the limits)
     for k in range(d):
         lam[k] = A[k, k]
+    k = d
+    for i in range(d):
+        for j in range(i + 1, d):
+            gap = REPEATED_TOL * (abs(s[i]) + abs(s[j]))
+            dm = s[i] - s[j]
+            dp = s[i] + s[j]
+            lam[k] = (g[i] - g[j]) / dm if abs(dm) > gap else H[i, i] - H[i, j]
+            lam[k + 1] = (g[i] + g[j]) / dp if abs(dp) > gap else H[i, i] + H[i, j]
+            k += 2
+    return psi
+
+
+@numba.njit(cache=True, inline="always")
+def _frame(code, F, params, level, P, lam, work, vec, d):  # pragma: no cover - compiled
+    """:func:`_linear_frame` (``code`` 0) or :func:`_stretch_frame`."""
+    if code == 0:
+        return _linear_frame(F, params, level, P, lam, work, vec, d)
+    return _stretch_frame(code, F, params, level, P, lam, work, vec, d)
+
+
+@numba.njit(cache=True)
+def frame(code, F, params, level, P, lam, work, vec):  # pragma: no cover - compiled
+    """:func:`_frame` with the size a constant. A function of its own, not inlined into the
+    element pass: numba types it once for both sizes and both callers, which keeps the element
+    pass's compilation short (LLVM may still inline the machine code)."""
+    if F.shape[0] == 3:
+        return _frame(code, F, params, level, P, lam, work, vec, 3)
+    return _frame(code, F, params, level, P, lam, work, vec, 2)
+
+
+@numba.njit(cache=True)
+def _modes(work, Q):  # pragma: no cover - compiled
+    """The ``d^2`` unit modes ``Q[k]`` (``d x d``, in F-space) of a frame ``U, V, E``:
+    ``U diag(E[:, k]) V^T``, then per pair ``(u_i v_j^T +- u_j v_i^T) / sqrt 2``."""
+    U, V, E = work[0], work[1], work[4]
+    d = U.shape[0]
+    for k in range(d):
         for a in range(d):
             for b in range(d):
                 acc = 0.0
@@ -416,11 +353,6 @@ def _stretch_point(code, F, params, level, P, lam, Q, work, vec, d):  # pragma: 
     k = d
     for i in range(d):
         for j in range(i + 1, d):
-            gap = REPEATED_TOL * (abs(s[i]) + abs(s[j]))
-            dm = s[i] - s[j]
-            dp = s[i] + s[j]
-            lam[k] = (g[i] - g[j]) / dm if abs(dm) > gap else H[i, i] - H[i, j]
-            lam[k + 1] = (g[i] + g[j]) / dp if abs(dp) > gap else H[i, i] + H[i, j]
             for a in range(d):
                 for b in range(d):
                     p = U[a, i] * V[b, j]
@@ -428,19 +360,31 @@ def _stretch_point(code, F, params, level, P, lam, Q, work, vec, d):  # pragma: 
                     Q[k, a, b] = _R2 * (p + q)
                     Q[k + 1, a, b] = _R2 * (p - q)
             k += 2
+
+
+@numba.njit(cache=True)
+def point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no cover - compiled
+    """Point function of material number ``code`` (0 linear, else the stretch energy ``code``).
+
+    ``level`` 0 energy only, 1 also the stress ``P`` (``d x d``), 2 also the ``d^2`` eigenpairs of
+    ``dP/dF`` (``lam``, ``Q[k]`` the unit ``d x d`` mode in F-space). Returns ``psi``.
+    ``work`` ``(6, d, d)`` and ``vec`` ``(2, d)`` are scratch (no allocation per element).
+    """
+    psi = frame(code, F, params, level, P, lam, work, vec)
+    if level >= 2:
+        _modes(work, Q)
     return psi
 
 
 # ---------------------------------------------------------------- element pass
-@numba.njit(cache=True)
-def point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no cover - compiled
-    """Point function of material number ``code``: 0 linear, else the stretch energy ``code``."""
-    if code == 0:
-        return linear_point(F, params, level, P, lam, Q, work, vec)
-    return stretch_point(code, F, params, level, P, lam, Q, work, vec)
+#: floating-point licences of the element pass: contraction to FMA, reassociation, reciprocals,
+#: signless zeros -- results move by rounding only (~1e-14 relative, checked by the tests against
+#: the point function and the NumPy reference); no NaN/inf assumptions (``nnan``/``ninf`` are left
+#: out: a non-finite energy must still reach the caller's check)
+FASTMATH = {"contract", "reassoc", "arcp", "nsz"}
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FASTMATH)
 def element_pass(code, x, cells, grads, vol, elems, params, level, project,
                  node_slots, node_indptr, energy, grad, data, neg, stress):  # pragma: no cover - compiled
     """The element pass of material number ``code`` (:func:`point`).
@@ -463,22 +407,29 @@ def element_pass(code, x, cells, grads, vol, elems, params, level, project,
 @numba.njit(cache=True, inline="always")
 def _element_pass(code, x, cells, grads, vol, elems, params, level, project, node_slots,
                   node_indptr, energy, grad, data, neg, stress, d):  # pragma: no cover - compiled
-    """The body of :func:`element_pass` for dimension ``d`` (a constant after inlining)."""
+    """The body of :func:`element_pass` for dimension ``d`` (a constant after inlining).
+
+    The Hessian in the principal frame, without forming the modes ``Q_k``: with
+    ``h_n = V^T g_n`` the mode vector on vertex ``n`` is ``w_k[n] = Q_k g_n = U M_k h_n``, i.e.
+    ``sum_i u_i E_ik h_ni`` for the ``d`` stretch modes and ``(u_i h_nj +- u_j h_ni) / sqrt 2`` for
+    a pair's shear and twist. Only the vertices ``1 .. d`` are computed: ``g_0 = -sum g_n``, so the
+    blocks of vertex 0 are minus the sums of the others' (rows of zero sum)."""
     nv = d + 1
     dd = d * d
+    nd = d * d                          # dofs of vertices 1..d
     F = np.empty((d, d))
     P = np.zeros((d, d))
     lam = np.zeros(dd)
-    Q = np.zeros((dd, d, d))
-    w = np.empty((nv * d, dd))          # w[i, k]: mode k at dof i (contiguous in k)
-    wl = np.empty((nv * d, dd))         # lam[k] w[i, k]
     work = np.zeros((6, d, d))
     vec = np.zeros((2, d))
-    base = np.empty((nv * nv, d), dtype=np.int64)
+    h = np.empty((d, d))                # h[n-1, i] = (V^T g_n)_i
+    w = np.empty((nd, dd))              # w[i, k]: mode k at dof i of vertices 1..d
+    wl = np.empty((nd, dd))             # vol lam[k] w[i, k]
+    B = np.empty((nv * d, nv * d))      # the element Hessian
     for t in range(elems.shape[0]):
         e = elems[t]
         deformation_gradient(x, cells, grads, e, F)
-        psi = point(code, F, params, level, P, lam, Q, work, vec)
+        psi = frame(code, F, params, level, P, lam, work, vec)
         v = vol[e]
         energy[e] = v * psi
         if level < 1:
@@ -496,42 +447,79 @@ def _element_pass(code, x, cells, grads, vol, elems, params, level, project, nod
                 grad[node, a] += v * acc
         if level < 2:
             continue
+        U, V, E = work[0], work[1], work[4]
         g2 = 0.0
         for n in range(nv):
             for b in range(d):
                 g2 += grads[e, n, b] * grads[e, n, b]
+        for n in range(d):
+            for i in range(d):
+                acc = 0.0
+                for b in range(d):
+                    acc += V[b, i] * grads[e, n + 1, b]
+                h[n, i] = acc
         ng = 0.0
         na = 0                          # the modes kept (a clamped one adds nothing)
-        for k in range(dd):
+        for k in range(d):
             if lam[k] < 0.0:
                 ng -= lam[k]
                 if project:
                     continue
-            for n in range(nv):
+            for n in range(d):
                 for a in range(d):
                     acc = 0.0
-                    for b in range(d):
-                        acc += Q[k, a, b] * grads[e, n, b]
+                    for i in range(d):
+                        acc += U[a, i] * E[i, k] * h[n, i]
                     w[n * d + a, na] = acc
                     wl[n * d + a, na] = v * lam[k] * acc
             na += 1
+        k = d
+        for i in range(d):
+            for j in range(i + 1, d):
+                for sign in range(2):
+                    lk = lam[k + sign]
+                    if lk < 0.0:
+                        ng -= lk
+                        if project:
+                            continue
+                    sg = _R2 if sign == 0 else -_R2
+                    for n in range(d):
+                        for a in range(d):
+                            acc = _R2 * U[a, i] * h[n, j] + sg * U[a, j] * h[n, i]
+                            w[n * d + a, na] = acc
+                            wl[n * d + a, na] = v * lk * acc
+                    na += 1
+                k += 2
         neg[e] = v * ng * g2
-        # CSR position of entry (n, a), (m, c): see BlockPattern
+        # vertices 1..d: B[d + i, d + j] = sum_k wl[i, k] w[j, k] (symmetric)
+        for i in range(nd):
+            for j in range(i, nd):
+                acc = 0.0
+                for kk in range(na):
+                    acc += wl[i, kk] * w[j, kk]
+                B[d + i, d + j] = acc
+                B[d + j, d + i] = acc
+        # vertex 0: minus the column sums of the blocks of vertices 1..d, then the corner
+        for j in range(nd):
+            for a in range(d):
+                acc = 0.0
+                for n in range(d):
+                    acc -= B[d + n * d + a, d + j]
+                B[a, d + j] = acc
+                B[d + j, a] = acc
+        for a in range(d):
+            for c in range(d):
+                acc = 0.0
+                for m in range(d):
+                    acc -= B[a, d + m * d + c]
+                B[a, c] = acc
+        # scatter the (d+1)^2 blocks: CSR position of entry (n, a), (m, c), see BlockPattern
         for n in range(nv):
             r = cells[e, n]
             r0 = node_indptr[r]
-            width = node_indptr[r + 1] - r0
+            row = d * (node_indptr[r + 1] - r0)
             for m in range(nv):
-                off = node_slots[e, n * nv + m] - r0
+                pos = dd * r0 + (node_slots[e, n * nv + m] - r0) * d
                 for a in range(d):
-                    base[n * nv + m, a] = dd * r0 + a * d * width + off * d
-        for i in range(nv * d):
-            n, a = i // d, i % d
-            for j in range(i, nv * d):
-                m, c = j // d, j % d
-                acc = 0.0
-                for k in range(na):
-                    acc += wl[i, k] * w[j, k]
-                data[base[n * nv + m, a] + c] += acc
-                if j != i:
-                    data[base[m * nv + n, c] + a] += acc
+                    for c in range(d):
+                        data[pos + a * row + c] += B[n * d + a, m * d + c]

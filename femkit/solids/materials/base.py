@@ -5,14 +5,15 @@ principal stretches ``W(s_1, .., s_d)`` (Xu, Sin, Zhu & Barbic 2015); forces and
 follow from the SVD derivative (:mod:`femkit.solids.compiled`) with only ``dW/ds`` and
 ``d^2W/ds^2``. So a material here *is* that function and its constants:
 
-* :class:`StretchMaterial` subclasses name a numba-compiled
-  ``energy(s, params, grad, hess) -> W`` (``params`` = :meth:`Material.params`) by its number
-  ``code`` in :func:`femkit.solids.compiled.stretch_energy` (:mod:`femkit.solids.compiled`,
-  imported only when evaluated); a material designed by its
-  energy (written by a user, derivatives generated symbolically) is one more such function, the
-  element kernels are shared.
+* :class:`StretchMaterial` subclasses carry that function as an expression: the built-ins
+  (:mod:`.registry`) as ``energy_expression``, a material designed by a user (:mod:`.designed`)
+  as its ``energy``. Derivatives are generated symbolically and compiled into numba kernels by
+  one path (:mod:`femkit.solids.energy.codegen`; the built-ins share one module,
+  :mod:`.builtin`); the material names its energy there by number, ``code``, and the element
+  kernels (SVD, SVD derivative, projection, assembly: :mod:`femkit.solids.compiled`) are shared.
 * The linear (small-strain) material is not a function of the stretches (not rotation
-  invariant); it brings its own point function of ``F`` (:mod:`.linear`).
+  invariant); its point function of ``F`` is :func:`femkit.solids.compiled._linear_frame`
+  (``code`` 0).
 
 Constants are the Lame moduli ``mu``, ``lam`` of the material *linearised at rest*: at ``F = I``
 every material's Hessian is the linear-elasticity tensor with these moduli. Plane strain in 2D:
@@ -121,17 +122,18 @@ class Material:
 
     def kernels(self):
         """The module of compiled kernels evaluating this material (``point``,
-        ``element_pass``, ``stretch_energy``): :mod:`femkit.solids.compiled` for the
-        hand-written ones, a generated module for a material designed by its energy."""
-        from .. import compiled
-
-        return compiled
+        ``element_pass``, ``stretch_energy``), generated from energy expressions
+        (:mod:`femkit.solids.energy.codegen`): one module for all built-ins (given to every
+        registered class by :func:`.registry.register_material`), one per material designed by
+        its energy (:class:`.designed.EnergyMaterial`)."""
+        raise MaterialError(f"{self.name}: neither a registered material nor designed by its "
+                            "energy, so it has no compiled kernels")
 
 
 @dataclass(frozen=True)
 class StretchMaterial(Material):
-    """A material given by its energy of the principal stretches (number ``code`` of
-    :func:`femkit.solids.compiled.stretch_energy`)."""
+    """A material given by its energy of the principal stretches (number ``code`` of the
+    ``stretch_energy`` of its generated kernels, :meth:`Material.kernels`)."""
 
 
     def stretch_derivatives(self, s) -> tuple[float, np.ndarray, np.ndarray]:

@@ -4,9 +4,9 @@
 (:class:`femkit.solids.energy.Energy`): checked at construction (finite and stress-free at rest,
 stable, symmetric; :meth:`~femkit.solids.energy.Energy.check}`), its Lame-equivalent moduli at
 rest become the record's ``mu``, ``lam``, and its kernels are generated and compiled
-(:mod:`femkit.solids.energy.codegen`) on first evaluation. The built-in stretch materials carry
-their energy the same way (``energy_expression``); :func:`designed` builds the generated twin
-of one (the test of the generator: both agree to rounding).
+(:mod:`femkit.solids.energy.codegen`) on first evaluation. The built-in stretch materials are
+written the same way (``energy_expression``, compiled together: :mod:`.builtin`);
+:func:`designed` gives one's expression as a user's energy, with a module of its own.
 
 >>> m = EnergyMaterial.from_energy({"f": "mu*(s-1)**2", "h": "lam/2*(J-1)**2"},
 ...                                {"mu": 1.0, "lam": 2.0})
@@ -109,19 +109,22 @@ class EnergyMaterial(StretchMaterial):
         key = (self.energy, names)
         mod = _KERNELS.get(key)
         if mod is None:
-            import sympy
-
             from ..energy.codegen import energy_module
 
-            mod = energy_module(_symbolic(self.energy, names), sympy.symbols("s1:4"),
-                                [sympy.Symbol(k) for k in names])
+            def build():
+                import sympy
+
+                return [(_symbolic(self.energy, names), sympy.symbols("s1:4"),
+                         [sympy.Symbol(k) for k in names])]
+
+            mod = energy_module(f"{self.energy!r} ({', '.join(names)})", build)
             _KERNELS[key] = mod
         return mod
 
 
 def designed(material: Material) -> EnergyMaterial:
-    """The generated twin of a built-in stretch material: its ``energy_expression`` with its
-    ``mu``, ``lam`` and density."""
+    """A built-in stretch material's ``energy_expression`` as a user's energy, with its ``mu``,
+    ``lam`` and density (its own generated module, not the built-ins' shared one)."""
     expr = getattr(type(material), "energy_expression", None)
     if expr is None:
         raise MaterialError(f"material {material.name!r} is not written as an energy of the "

@@ -15,12 +15,22 @@ __all__ = ["MATERIALS", "LinearElastic", "Corotational", "StVenantKirchhoff",
 MATERIALS: Registry = Registry("material")
 
 
+def _builtin_kernels(self):
+    """The built-in materials' generated module (:func:`.builtin.builtin_kernels` of the
+    registered classes written as energies, in the order of their ``code``)."""
+    from .builtin import builtin_kernels
+
+    classes = [MATERIALS.get(n) for n in MATERIALS.names()]
+    return builtin_kernels([c for c in classes if getattr(c, "energy_expression", None) is not None])
+
+
 def register_material(name: str):
     """Class decorator: register a material class as ``name`` and set its ``name`` attribute
     (the name is written once, here)."""
 
     def decorator(cls):
         cls.name = name
+        cls.kernels = _builtin_kernels
         return MATERIALS.register(name, cls)
 
     return decorator

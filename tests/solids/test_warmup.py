@@ -1,0 +1,42 @@
+"""``femkit warmup`` generates and compiles the built-in materials' kernels: afterwards a fresh
+process evaluates a body from the cache -- numba loads every kernel it calls (no compile) and
+SymPy is never imported."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+PROBE = """
+import json, sys
+import numpy as np
+from femkit.solids import ElasticBody, material
+X = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+mat = material("stvk", mu=1.0, lam=2.0)
+ElasticBody(X, [[0, 1, 2, 3]], mat).evaluate(1.2 * X, 2, project=True)
+mod = mat.kernels()
+stats = mod.element_pass.stats
+print(json.dumps({"hits": sum(stats.cache_hits.values()), "misses": sum(stats.cache_misses.values()),
+                  "sympy": "sympy" in sys.modules}))
+"""
+
+
+@pytest.mark.slow
+def test_warmup_compiles_the_builtin_materials_once(tmp_path):
+    from femkit.solids.warmup import warm_up  # noqa: F401  (importable without side effects)
+
+    env = dict(os.environ, FEMKIT_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("NUMBA_CACHE_DIR", None)
+    run = subprocess.run([sys.executable, "-c", "from femkit.solids.warmup import warm_up; warm_up()"],
+                         env=env, capture_output=True, text=True, timeout=1500)
+    assert run.returncode == 0, run.stderr
+    assert list((tmp_path / "cache" / "energies").glob("femkit_energy_*.py"))
+    probe = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True, text=True,
+                           timeout=600)
+    assert probe.returncode == 0, probe.stderr
+    out = json.loads(probe.stdout.strip().splitlines()[-1])
+    assert out == {"hits": 1, "misses": 0, "sympy": False}
