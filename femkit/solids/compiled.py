@@ -100,6 +100,21 @@ def deformation_gradient(x, cells, grads, e, F):  # pragma: no cover - compiled
             F[a, b] = acc
 
 
+@numba.njit(cache=True, inline="always")
+def add_nodal_forces(out, cells, grads, e, P, scale):  # pragma: no cover - compiled
+    """``out[node_n] += scale P grad(phi_n)`` for each vertex ``n`` of element ``e``: a stress-like
+    ``(d, d)`` matrix ``P`` turned into nodal vectors (the transpose of
+    :func:`deformation_gradient`)."""
+    d = P.shape[0]
+    for n in range(cells.shape[1]):
+        node = cells[e, n]
+        for a in range(d):
+            acc = 0.0
+            for b in range(d):
+                acc += P[a, b] * grads[e, n, b]
+            out[node, a] += scale * acc
+
+
 # ---------------------------------------------------------------- signed SVD
 @numba.njit(cache=True)
 def det_small(A):  # pragma: no cover - compiled
@@ -438,13 +453,7 @@ def _element_pass(code, x, cells, grads, vol, elems, params, level, project, nod
             for a in range(d):
                 for b in range(d):
                     stress[e, a, b] = P[a, b]
-        for n in range(nv):
-            node = cells[e, n]
-            for a in range(d):
-                acc = 0.0
-                for b in range(d):
-                    acc += P[a, b] * grads[e, n, b]
-                grad[node, a] += v * acc
+        add_nodal_forces(grad, cells, grads, e, P, v)
         if level < 2:
             continue
         U, V, E = work[0], work[1], work[4]

@@ -17,14 +17,14 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ...solids.compiled import deformation_gradient, signed_svd
+from ...solids.compiled import add_nodal_forces, deformation_gradient, signed_svd
 
 
 @numba.njit(cache=False)
 def local_step(x, cells, grads, w_rot, w_vol, jmin, jmax, out):  # pragma: no cover - compiled
     """Add ``w_rot[e] D_e^T R_e + w_vol[e] D_e^T B_e`` into ``out`` ``(n, d)`` for every element
     (``D_e x = F_e``); returns ``sum_e (w_rot |F - R|^2 + w_vol |F - B|^2) / 2``."""
-    m, nv = cells.shape
+    m = cells.shape[0]
     d = x.shape[1]
     F = np.empty((d, d))
     U = np.empty((d, d))
@@ -79,11 +79,5 @@ def local_step(x, cells, grads, w_rot, w_vol, jmin, jmax, out):  # pragma: no co
                     band += U[a, i] * sp[i] * V[b, i]
                 local += 0.5 * (wr * (F[a, b] - rot) ** 2 + wv * (F[a, b] - band) ** 2)
                 T[a, b] = wr * rot + wv * band
-        for n in range(nv):
-            node = cells[e, n]
-            for a in range(d):
-                acc = 0.0
-                for b in range(d):
-                    acc += T[a, b] * grads[e, n, b]
-                out[node, a] += acc
+        add_nodal_forces(out, cells, grads, e, T, 1.0)
     return local
