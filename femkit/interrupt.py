@@ -79,7 +79,7 @@ def exit_code(flag: StopFlag) -> int:
 
 
 _ACTIVE: list[StopFlag] = []
-_WORKERS: list[threading.Thread] = []  # threads of run_interruptible, alive or done
+_WORKERS: list[threading.Event] = []  # "finished" events of run_interruptible's workers
 
 
 def active_flag() -> StopFlag | None:
@@ -228,23 +228,29 @@ def run_interruptible(fn, *args, what: str, on_abandon=None, poll: float = 0.05,
     if flag:
         raise Interrupted(flag, where=f"before {what}")
     box: dict = {}
+    done = threading.Event()  # the worker's own "finished": see below
 
     def work():
         try:
             box["value"] = fn(*args, **kwargs)
         except BaseException as exc:  # relayed to the waiting thread
             box["error"] = exc
+        finally:
+            done.set()
 
     worker = threading.Thread(target=work, name=f"femkit {what}", daemon=True)
-    _WORKERS.append(worker)
+    _WORKERS.append(done)
     worker.start()
+    # Wait on an Event, not Thread.join: a signal handler raising inside join() makes CPython
+    # (3.11, bpo-45274's fix) release the worker's state lock and mark the *running* worker as
+    # stopped, so is_alive() would lie and the caller would clean up under it (gmsh finalised
+    # under its running mesher: SIGSEGV instead of exit 130).
     try:
-        while worker.is_alive():
-            worker.join(poll)
-            if flag and worker.is_alive():
+        while not done.wait(poll):
+            if flag:
                 raise Interrupted(flag, where=f"during {what}")
     except BaseException:  # Interrupted, or KeyboardInterrupt from a second Ctrl-C
-        if worker.is_alive() and on_abandon is not None:
+        if not done.is_set() and on_abandon is not None:
             on_abandon()
         raise
     if "error" in box:
@@ -256,4 +262,4 @@ def abandoned_work() -> bool:
     """Whether a stop request left a :func:`run_interruptible` worker running. The command line
     then ends the process with ``os._exit`` after flushing its output: a normal interpreter exit
     would run the C library's global destructors under its still-running thread (a crash)."""
-    return any(w.is_alive() for w in _WORKERS)
+    return any(not done.is_set() for done in _WORKERS)
