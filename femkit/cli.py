@@ -269,7 +269,10 @@ def _add_warmup(sub) -> None:
                      "edges, geometric multigrid) on a tiny problem, and generate and compile "
                      "the elastic solids' built-in material kernels, so the first real "
                      "'femkit solve' does not pay for it. Without it that first large run "
-                     "compiles them itself, in a stage named 'compile'."))
+                     "compiles them itself, in a stage named 'compile'. Also writes the "
+                     "bytecode (.pyc) of femkit's own modules, which Python does not write "
+                     "itself under PYTHONDONTWRITEBYTECODE or a read-only install, so each "
+                     "command does not compile them from source again."))
     p.set_defaults(handler=_run_warmup)
 
 
@@ -278,7 +281,40 @@ def _run_warmup(args) -> int:
     from .solids.warmup import warm_up as warm_up_solids
 
     print(f"kernels ready in {warm_up(print) + warm_up_solids():.1f} s")
+    written, failed = byte_compile()
+    print(f"bytecode of femkit's {written} modules written"
+          + (f" ({failed} could not be written: a read-only install)" if failed else ""))
     return EXIT_OK
+
+
+def byte_compile(root: str | None = None) -> tuple[int, int]:
+    """Write the bytecode (``__pycache__/*.pyc``) of every module under ``root`` (default: the
+    installed femkit package); ``(modules written or up to date, modules that failed)``.
+
+    Python reads a ``.pyc`` whenever it is up to date with its source, but writes none under
+    ``PYTHONDONTWRITEBYTECODE=1`` or where it cannot write: each process then compiles every
+    femkit module it imports from source again (about 0.2 s of a ``femkit solve``).
+    :mod:`py_compile` writes regardless of that variable. A source edited later makes its
+    ``.pyc`` stale (its recorded modification time differs), and Python ignores it.
+    """
+    import os
+    import py_compile
+    from importlib.util import cache_from_source
+
+    base = root if root is not None else os.path.dirname(os.path.abspath(__file__))
+    written = failed = 0
+    for folder, dirs, files in os.walk(base):
+        dirs[:] = sorted(d for d in dirs if d != "__pycache__" and not d.startswith("."))
+        for name in sorted(files):
+            if not name.endswith(".py"):
+                continue
+            source = os.path.join(folder, name)
+            try:
+                py_compile.compile(source, cfile=cache_from_source(source), doraise=True)
+                written += 1
+            except (py_compile.PyCompileError, OSError):
+                failed += 1
+    return written, failed
 
 
 def _add_study(sub) -> None:
@@ -393,23 +429,82 @@ def _one_line(exc: BaseException) -> str:
 def entry() -> None:
     """The ``femkit`` console script and ``python -m femkit``: :func:`main`, then the exit.
 
-    After a stop request (exit 130 / 143) the process ends at once with ``os._exit``, its
-    output flushed, instead of a normal exit: the request may have abandoned compiled work in a
-    thread (gmsh's mesher: :func:`femkit.interrupt.run_interruptible`) or raised out of a C
-    library's call (:func:`femkit.interrupt.raising`), and the interpreter's teardown would run
-    that library's destructors on its half-done state (a crash: exit -11 instead of 130). What
-    the run keeps is already written and closed (atomic writes) when :func:`main` returns.
+    The process ends with :func:`_exit_now` rather than the interpreter's own teardown, which
+    clears a thousand modules (numba, llvmlite, scipy) and their objects one by one: 0.25-0.4 s
+    after the results of a solve are written, doing nothing the user can see. What that teardown
+    does that matters is done first, in CPython's order: the non-daemon threads are joined, the
+    ``atexit`` handlers run, and stdout and stderr are flushed. What the run keeps is already
+    written and closed (atomic writes) when :func:`main` returns.
+
+    After a stop request (exit 130 / 143) the process ends at once, its output flushed but no
+    thread joined: the request may have abandoned compiled work in a thread (gmsh's mesher:
+    :func:`femkit.interrupt.run_interruptible`) or raised out of a C library's call
+    (:func:`femkit.interrupt.raising`), and waiting for it, or the library's destructors run on
+    its half-done state, would hang or crash (exit -11 instead of 130).
     """
+    _defer_unused_imports()
     code = main()
     from .interrupt import abandoned_work
 
-    if code in (130, 143) or abandoned_work():
-        import os
+    _exit_now(code, clean=not (code in (130, 143) or abandoned_work()))
 
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(code)
-    sys.exit(code)
+
+#: numpy's submodules that no femkit command uses but every process imported: scipy's array-API
+#: layer (``scipy._lib.array_api_compat.numpy``, imported by ``scipy.sparse``, ``scipy.linalg``
+#: and numba's BLAS check) reads every name of ``numpy.__all__``, and numpy imports a submodule
+#: when its name is read: ``numpy.f2py`` (the Fortran wrapper generator, ~0.15 s) and
+#: ``numpy.testing`` (``unittest`` with it). (``numpy.ma`` is in use: ``np.unique`` asks it.)
+DEFERRED_IMPORTS = ("numpy.f2py", "numpy.testing")
+
+
+class _Deferred:
+    """A :data:`sys.meta_path` finder giving the modules of :data:`DEFERRED_IMPORTS` Python's
+    :class:`importlib.util.LazyLoader`: importing one makes its module object, executed when
+    an attribute of it is first used. Only the command's own process installs it (:func:`entry`)."""
+
+    def __init__(self, names) -> None:
+        self.names = set(names)
+
+    def find_spec(self, name, path=None, target=None):
+        if name not in self.names:
+            return None
+        self.names.discard(name)  # once: the module is in sys.modules from now on
+        import importlib.machinery
+        import importlib.util
+
+        spec = importlib.machinery.PathFinder.find_spec(name, path, target)
+        if spec is None or spec.loader is None or not hasattr(spec.loader, "exec_module"):
+            return spec
+        spec.loader = importlib.util.LazyLoader(spec.loader)
+        return spec
+
+
+def _defer_unused_imports() -> None:
+    """Install :class:`_Deferred` (nothing is imported now) unless a module is imported already."""
+    if not any(name in sys.modules for name in DEFERRED_IMPORTS):
+        sys.meta_path.insert(0, _Deferred(DEFERRED_IMPORTS))
+
+
+def _exit_now(code: int, *, clean: bool = True) -> None:
+    """End the process with ``code`` by ``os._exit``; ``clean``: first join the non-daemon
+    threads and run the ``atexit`` handlers (what a normal exit does before its teardown)."""
+    import os
+
+    if clean:
+        import threading
+
+        shutdown = getattr(threading, "_shutdown", None)  # joins non-daemon threads
+        if shutdown is not None:
+            shutdown()
+        import atexit
+
+        atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe (``femkit solve ... | head``)
+            pass
+    os._exit(code)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -17,6 +17,7 @@ A plugin that cannot be imported, or fails while importing (e.g. registers a nam
 
 from __future__ import annotations
 
+import functools
 import importlib
 import os
 
@@ -32,6 +33,17 @@ _loaded: set[str] = set()
 
 def plugin_names() -> list[tuple[str, str]]:
     """``(where, module)`` of every plugin: entry points first, then ``FEMKIT_PLUGINS``."""
+    out = list(_entry_point_plugins())
+    for name in os.environ.get(ENV_VAR, "").split(","):
+        if name.strip():
+            out.append((ENV_VAR, name.strip()))
+    return out
+
+
+@functools.lru_cache(maxsize=None)
+def _entry_point_plugins() -> tuple[tuple[str, str], ...]:
+    """The entry-point plugins, read once per process: every file-kind look-up asks, and each
+    reading scans the metadata of every installed distribution (~10-20 ms)."""
     out = []
     try:
         from importlib.metadata import entry_points
@@ -40,10 +52,7 @@ def plugin_names() -> list[tuple[str, str]]:
             out.append((f"entry point {ep.name!r} ({ENTRY_POINT_GROUP})", ep.value.split(":")[0]))
     except Exception:  # a broken distribution's metadata must not stop femkit
         pass
-    for name in os.environ.get(ENV_VAR, "").split(","):
-        if name.strip():
-            out.append((ENV_VAR, name.strip()))
-    return out
+    return tuple(out)
 
 
 def load_plugins() -> list[str]:

@@ -15,8 +15,6 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .timing import pin_blas_threads
-
 HELP = "run a study file (convergence, work-precision or stability sweep) and write its report"
 
 
@@ -75,6 +73,8 @@ def cli_main(args) -> int:
         p = argparse.ArgumentParser(prog="femkit study", description=HELP)
         _arguments(p)
         args = p.parse_args(list(args))
+    from .timing import pin_blas_threads  # here: `femkit solve` builds this parser too
+
     pin_blas_threads(1)
     from ..errors import InputError
     from .load import load_study
