@@ -434,7 +434,9 @@ def entry() -> None:
     after the results of a solve are written, doing nothing the user can see. What that teardown
     does that matters is done first, in CPython's order: the non-daemon threads are joined, the
     ``atexit`` handlers run, and stdout and stderr are flushed. What the run keeps is already
-    written and closed (atomic writes) when :func:`main` returns.
+    written and closed (atomic writes) when :func:`main` returns. Under a profiler or a tracer
+    (``python -m cProfile -o p.out -m femkit.cli ...``, coverage, a debugger), which write their
+    results after the command returns, the exit is the interpreter's own.
 
     After a stop request (exit 130 / 143) the process ends at once, its output flushed but no
     thread joined: the request may have abandoned compiled work in a thread (gmsh's mesher:
@@ -446,7 +448,10 @@ def entry() -> None:
     code = main()
     from .interrupt import abandoned_work
 
-    _exit_now(code, clean=not (code in (130, 143) or abandoned_work()))
+    stopped = code in (130, 143) or abandoned_work()
+    if not stopped and (sys.getprofile() is not None or sys.gettrace() is not None):
+        sys.exit(code)  # under a profiler or a debugger, which write their results after us
+    _exit_now(code, clean=not stopped)
 
 
 #: numpy's submodules that no femkit command uses but every process imported: scipy's array-API

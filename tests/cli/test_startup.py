@@ -128,3 +128,15 @@ def test_deferred_modules_are_not_deferred_when_already_imported():
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "False"
+
+
+def test_a_profiled_command_still_writes_its_profile(tmp_path):
+    """``python -m cProfile -o p.out -m femkit.cli solve ...``: cProfile writes after the command
+    returns, so under a profiler the exit is the interpreter's own."""
+    proc = subprocess.run([sys.executable, "-m", "cProfile", "-o", str(tmp_path / "p.out"), "-m",
+                           "femkit.cli", "solve", str(_case(tmp_path)), "--quiet"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    import pstats
+
+    assert pstats.Stats(str(tmp_path / "p.out")).total_calls > 0
