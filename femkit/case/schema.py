@@ -123,11 +123,15 @@ def validate_against(instance: Any, schema: dict, prefix: str = "") -> None:
     The reported error is the first one in document order (shallowest path first among
     equals), so the message is stable from run to run.
     """
+    known = _validity_record(instance, schema)
+    if known is not None and known.exists():
+        return
     from jsonschema import Draft202012Validator
 
     validator = Draft202012Validator(schema)
     errors = list(validator.iter_errors(instance))
     if not errors:
+        _remember(known)
         return
     errors.sort(key=lambda e: (list(map(str, e.absolute_path)), -len(e.absolute_path)))
     # Prefer a concrete problem (unknown key, type, range) over a composite one.
@@ -135,6 +139,42 @@ def validate_against(instance: Any, schema: dict, prefix: str = "") -> None:
     concrete = [e for e in errors if e.validator not in composite]
     err = concrete[0] if concrete else errors[0]
     raise CaseFileError(format_error(err, prefix))
+
+
+def _validity_record(instance: Any, schema: dict):
+    """The file recording that ``instance`` is valid under ``schema`` (whether or not it exists):
+    named by a hash of both as JSON and of jsonschema's version, in femkit's cache directory
+    (``FEMKIT_CACHE_DIR``, :func:`femkit.codegen.cache_dir`); ``None`` for what JSON cannot
+    write exactly (e.g. mixed key types), which is always validated.
+
+    Validation is a pure function of the two documents: the same case file under the same
+    schema is valid again, and importing jsonschema (with ``referencing``, ``attrs``, ``idna``,
+    ...) and validating cost ~0.1-0.2 s of every run. Only a success is recorded; a failing
+    document is validated (and its first problem reported) every time.
+    """
+    import hashlib
+    import json
+
+    try:
+        text = json.dumps([instance, schema], sort_keys=True, allow_nan=True)
+        from importlib.metadata import version
+
+        text += "\n" + version("jsonschema")
+    except Exception:  # not JSON, or no jsonschema metadata: validate as always
+        return None
+    from ..codegen import cache_dir
+
+    return cache_dir("validated") / hashlib.sha256(text.encode()).hexdigest()
+
+
+def _remember(record) -> None:
+    if record is None:
+        return
+    try:
+        record.parent.mkdir(parents=True, exist_ok=True)
+        record.touch()
+    except OSError:  # a read-only cache: validate every time
+        pass
 
 
 def fill_defaults(instance: Any, schema: dict) -> Any:
