@@ -140,3 +140,21 @@ def test_a_profiled_command_still_writes_its_profile(tmp_path):
     import pstats
 
     assert pstats.Stats(str(tmp_path / "p.out")).total_calls > 0
+
+
+def test_numba_start_up_is_its_own_stage_before_the_mesh(tmp_path):
+    """A run that calls compiled kernels (fmg) books numba's import and registries in a ``numba``
+    stage, once, before the mesh stage (not inside it, nor in "other"); the parts still sum."""
+    import json
+
+    path = _case(tmp_path, solver={"method": "fmg"}, mesh={"geometry": "unit_square", "h": 0.25,
+                                                            "refine": 1})
+    proc = subprocess.run([sys.executable, "-m", "femkit.cli", "solve", str(path)], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    res = json.loads((tmp_path / "out" / "result.json").read_text())
+    stages = list(res["timings"])
+    assert stages[0] == "numba" and stages.count("numba") == 1 and "mesh" in stages
+    w = res["wall"]
+    assert w["total"] == pytest.approx(w["startup"] + w["stages"] + w["other"], rel=1e-9)
+    assert "time      numba " in proc.stdout

@@ -277,9 +277,11 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
 def _compile_stage(case: Case, mesh, stage, echo) -> None:
     """The first run after an install compiles the kernels it needs ahead, in its own
     ``compile`` stage (not inside assembly and solve), saying so on the terminal (``echo``)."""
-    from .warmup import must_compile, warm_up
+    from .warmup import must_compile, needs_kernels, start_numba, warm_up
 
     multigrid = case.solver.needs_hierarchy
+    if needs_kernels(mesh, multigrid):
+        start_numba(stage)  # numba's own start-up, once, in its own stage
     if must_compile(mesh, multigrid):
         with stage("compile"):
             seconds = warm_up(echo, multigrid)

@@ -28,7 +28,7 @@ import time
 from typing import Callable
 
 __all__ = ["warm_up", "kernels_cached", "needs_kernels", "must_compile", "families", "FAMILIES",
-           "COMPILE_MESSAGE"]
+           "COMPILE_MESSAGE", "start_numba", "NUMBA_STAGE"]
 
 COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)"
 
@@ -145,6 +145,35 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True)
 
 #: True while :func:`warm_up` runs its tiny case (which must not warm up again).
 _ACTIVE = False
+
+
+#: The stage booking numba's start-up (:func:`start_numba`).
+NUMBA_STAGE = "numba"
+
+_NUMBA_STARTED = False
+
+
+def start_numba(stage) -> None:
+    """numba's start-up, once per process, in the stage :data:`NUMBA_STAGE` of ``stage`` (a
+    :class:`~femkit.timing.StageTimer`): its import (~0.2-0.3 s) and the typing and lowering
+    registries it loads before its first compiled or cached function (~0.4-0.6 s: numba's
+    ``BaseContext.refresh``, which imports ``numba.np.arraymath``, its BLAS check and the rest).
+    Without this the first kernel called paid it inside the stage that called it (the mesh
+    stage's refinement), and the import was "other" time. Not inside a warm-up; a numba whose
+    internals differ is only imported (the first kernel then loads the registries, as before)."""
+    global _NUMBA_STARTED
+    if _NUMBA_STARTED or _ACTIVE:
+        return
+    _NUMBA_STARTED = True
+    with stage(NUMBA_STAGE):
+        import numba  # noqa: F401
+
+        try:
+            from numba.core.registry import cpu_target
+
+            cpu_target.target_context.refresh()
+        except Exception:  # pragma: no cover - another numba's layout
+            pass
 
 
 def must_compile(mesh, multigrid: bool) -> bool:
