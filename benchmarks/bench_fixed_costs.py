@@ -49,7 +49,8 @@ def one_run(tree: Path, case: Path, out: Path) -> dict:
     env = dict(os.environ, PYTHONPATH=str(tree), PYTHONDONTWRITEBYTECODE="1")
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "femkit", "solve", str(case), "--force", "--quiet",
-                           "--output", str(out)], env=env, capture_output=True, text=True)
+                           "--output", str(out)], env=env, capture_output=True, text=True,
+                          cwd=case.parent)  # not the caller's folder: `-m` puts it first on sys.path
     process = time.perf_counter() - t0
     if proc.returncode != 0:
         raise SystemExit(f"{tree}: exit {proc.returncode}: {proc.stderr.strip()}")
