@@ -73,7 +73,7 @@ def families(multigrid: bool) -> tuple[str, ...]:
 
 #: The errors and estimate stages' compiled passes: the residual estimator's (a family of the
 #: warm-up), and the size thresholds of those and of a case's compiled expressions.
-FAMILIES["error estimate"] = (("femkit.fem.estimators._kernels", "residual_edges"),)
+FAMILIES["error estimate"] = (("femkit.fem.estimators._kernels", "residual_pass"),)
 _THRESHOLDS += (("femkit.fem.fused.kernels", "NUMBA_THRESHOLD"),
                 ("femkit.fem.estimators.geometry", "NUMBA_THRESHOLD"),
                 ("femkit.fem.estimators.residual", "NUMBA_THRESHOLD"))
