@@ -1,0 +1,87 @@
+"""Freed memory handed back to the operating system (glibc's allocator, Linux), and the process's
+resident memory now and at its peak.
+
+NumPy allocates its arrays with ``malloc``. glibc serves a large request (at least
+``M_MMAP_THRESHOLD``, 128 KiB at start) by its own ``mmap`` and unmaps it on ``free``; but each
+such free raises the threshold to the freed size (up to 32 MiB on 64-bit), so after the first
+large temporaries every array below that size comes from the heap, and the heap keeps what is
+freed inside it: a run's resident memory then stays near the sum of everything it ever held
+(the glibc manual, "Memory Allocation Tunables"; ``mallopt(3)``, ``malloc_trim(3)``).
+
+:func:`tune_allocator` fixes the threshold (no dynamic raise), so large arrays are returned to
+the system as soon as NumPy frees them; :func:`release_freed_memory` returns the heap's free
+pages (``malloc_trim(0)``), for a long-lived process after it dropped a stage's arrays. Both do
+nothing (and say so by returning False) where glibc is not the allocator: another OS, musl, or
+a threshold the user set through ``MALLOC_MMAP_THRESHOLD_``, which is left alone.
+
+>>> isinstance(tune_allocator(), bool), isinstance(release_freed_memory(), bool)
+(True, True)
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+__all__ = ["tune_allocator", "release_freed_memory", "resident_memory", "MMAP_THRESHOLD"]
+
+#: ``M_MMAP_THRESHOLD`` set by :func:`tune_allocator`: requests from 1 MiB up get their own
+#: mapping (a few hundred per run at a million unknowns: cheap), smaller ones the heap.
+MMAP_THRESHOLD = 1 << 20
+
+_M_TRIM_THRESHOLD = -1  # mallopt parameter numbers, <malloc.h>
+_M_MMAP_THRESHOLD = -3
+
+_LIBC = None
+
+
+def _glibc():
+    """glibc's ``libc.so.6`` through ctypes, or None (not Linux, not glibc)."""
+    global _LIBC
+    if _LIBC is None:
+        _LIBC = False
+        if sys.platform.startswith("linux"):
+            try:
+                import ctypes
+
+                libc = ctypes.CDLL("libc.so.6", use_errno=True)
+                libc.gnu_get_libc_version  # glibc only (musl has no such symbol)
+                libc.mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
+                libc.malloc_trim.argtypes = [ctypes.c_size_t]
+                _LIBC = libc
+            except (OSError, AttributeError):
+                pass
+    return _LIBC or None
+
+
+def tune_allocator(mmap_threshold: int = MMAP_THRESHOLD) -> bool:
+    """Fix glibc's mmap threshold at ``mmap_threshold`` bytes (and the heap's trim threshold at
+    twice it), so arrays from that size up go back to the system when freed; True when set.
+
+    Left alone when ``MALLOC_MMAP_THRESHOLD_`` is in the environment (the user's choice)."""
+    libc = _glibc()
+    if libc is None or "MALLOC_MMAP_THRESHOLD_" in os.environ:
+        return False
+    ok = libc.mallopt(_M_MMAP_THRESHOLD, int(mmap_threshold)) == 1
+    return ok and libc.mallopt(_M_TRIM_THRESHOLD, 2 * int(mmap_threshold)) == 1
+
+
+def release_freed_memory() -> bool:
+    """Give the heap's free pages back to the system (``malloc_trim(0)``); True when some were."""
+    libc = _glibc()
+    return bool(libc.malloc_trim(0)) if libc is not None else False
+
+
+def resident_memory() -> dict[str, int]:
+    """``{"now": bytes, "peak": bytes}`` of this process's resident memory (``VmRSS`` and
+    ``VmHWM`` of ``/proc/self/status``); empty where there is no such file."""
+    out = {}
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                key = {"VmRSS:": "now", "VmHWM:": "peak"}.get(line.split(maxsplit=1)[0])
+                if key:
+                    out[key] = int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return out
