@@ -1,5 +1,5 @@
-"""glibc's retention of freed arrays and :mod:`femkit.memory`, which hands them back: measured on
-the process's resident memory (``/proc``), in fresh interpreters."""
+"""glibc's retention of freed arrays and :mod:`femkit.allocator`, which hands them back: measured
+on the process's resident memory (``/proc``), in fresh interpreters."""
 
 from __future__ import annotations
 
@@ -9,23 +9,24 @@ import sys
 
 import pytest
 
-from femkit.memory import ENVIRONMENT, resident_memory
+from femkit.allocator import ENVIRONMENT
 
 #: After one 24 MB array is freed glibc serves every smaller request from its heap and keeps
-#: it when freed; 40 arrays of 8 MB, each followed by a small block, are freed: how many MB
+#: it when freed; 40 arrays of 8 MB, each followed by a 256 kB one, are freed: how many MB
 #: go back to the system?
 PATTERN = """
 import numpy as np
-from femkit.memory import from_environment, resident_memory
+from femkit.allocator import from_environment
+from femkit.cost.memory import current_rss
 assert from_environment() == {tuned}
 a = np.ones(3 << 20); del a
 held, pins = [], []
 for _ in range(40):
     held.append(np.ones(1 << 20))
-    pins.append(bytearray(3 * 4096))
-base = resident_memory()["now"]
+    pins.append(np.ones(1 << 15))
+base = current_rss()
 del held
-print((base - resident_memory()["now"]) >> 20)
+print((base - current_rss()) >> 20)
 """
 
 linux_glibc = pytest.mark.skipif(not sys.platform.startswith("linux") or
@@ -47,9 +48,3 @@ def _returned_mb(tuned: bool) -> int:
 def test_freed_arrays_stay_resident_unless_the_allocator_is_tuned():
     kept, returned = _returned_mb(False), _returned_mb(True)
     assert kept < 40 and returned > 280, (kept, returned)
-
-
-@linux_glibc
-def test_resident_memory_reads_the_process_status():
-    got = resident_memory()
-    assert set(got) == {"now", "peak"} and 0 < got["now"] <= got["peak"]

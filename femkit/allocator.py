@@ -1,5 +1,4 @@
-"""Freed memory handed back to the operating system (glibc's allocator, Linux), and the process's
-resident memory now and at its peak.
+"""Freed memory handed back to the operating system: glibc's allocator (Linux), through ctypes.
 
 NumPy allocates its arrays with ``malloc``. glibc serves a large request (at least
 ``M_MMAP_THRESHOLD``, 128 KiB at start) by its own ``mmap`` and unmaps it on ``free``; but each
@@ -15,8 +14,8 @@ the system as soon as NumPy frees them (``femkit`` does it at start when ``FEMKI
 nothing (and say so by returning False) where glibc is not the allocator: another OS, musl, or
 a threshold the user set through ``MALLOC_MMAP_THRESHOLD_``, which is left alone.
 
->>> isinstance(tune_allocator(), bool), isinstance(release_freed_memory(), bool)
-(True, True)
+>>> isinstance(release_freed_memory(), bool)
+True
 """
 
 from __future__ import annotations
@@ -24,7 +23,7 @@ from __future__ import annotations
 import os
 import sys
 
-__all__ = ["tune_allocator", "release_freed_memory", "resident_memory", "from_environment",
+__all__ = ["tune_allocator", "release_freed_memory", "from_environment",
            "MMAP_THRESHOLD", "ENVIRONMENT"]
 
 #: Set to 1 to have ``femkit`` return freed arrays to the system (:func:`tune_allocator`):
@@ -34,7 +33,8 @@ __all__ = ["tune_allocator", "release_freed_memory", "resident_memory", "from_en
 ENVIRONMENT = "FEMKIT_RETURN_MEMORY"
 
 #: ``M_MMAP_THRESHOLD`` set by :func:`tune_allocator`: requests from 1 MiB up get their own
-#: mapping (a few hundred per run at a million unknowns: cheap), smaller ones the heap.
+#: mapping, given back when freed (each new one is faulted in afresh: the cost above); smaller
+#: ones come from the heap.
 MMAP_THRESHOLD = 1 << 20
 
 _M_TRIM_THRESHOLD = -1  # mallopt parameter numbers, <malloc.h>
@@ -85,18 +85,3 @@ def release_freed_memory() -> bool:
     """Give the heap's free pages back to the system (``malloc_trim(0)``); True when some were."""
     libc = _glibc()
     return bool(libc.malloc_trim(0)) if libc is not None else False
-
-
-def resident_memory() -> dict[str, int]:
-    """``{"now": bytes, "peak": bytes}`` of this process's resident memory (``VmRSS`` and
-    ``VmHWM`` of ``/proc/self/status``); empty where there is no such file."""
-    out = {}
-    try:
-        with open("/proc/self/status", encoding="ascii") as fh:
-            for line in fh:
-                key = {"VmRSS:": "now", "VmHWM:": "peak"}.get(line.split(maxsplit=1)[0])
-                if key:
-                    out[key] = int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return out
