@@ -392,6 +392,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     from .interrupt import Interrupted
 
     handler = getattr(args, "handler", None) or getattr(args, "func")  # func: femkit.study.cli style
+    from .allocator import from_environment
+
+    from_environment()  # FEMKIT_RETURN_MEMORY=1: freed arrays go back to the system at once
     speaks = _mpi_rank() == 0  # under mpirun every rank raises the same error: rank 0 says it
     try:
         args.overrides = parse_sets(getattr(args, "sets", ()))

@@ -11,9 +11,11 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def cell_edges(cells, local, n):  # pragma: no cover - compiled
+def cell_edges(cells, local, n, node_type, edge_type):  # pragma: no cover - compiled
     """Unique edges of ``cells`` in lexicographic order and the edge of each local edge.
 
+    ``node_type`` and ``edge_type`` (empty arrays) give the integer types of the two outputs
+    (int32 where the ids fit: :func:`femkit.mesh.edges.index_dtype`).
     ``local`` (k, 2) lists the local edges of a cell (:data:`femkit.mesh.mesh.LOCAL_EDGES`).
     Reads ``cells`` directly (no (m, k, 2) copy, no separate min / max arrays): a counting sort
     of the m k local edges by their lower node (O(m k), no comparison sort of the keys), then an
@@ -57,8 +59,8 @@ def cell_edges(cells, local, n):  # pragma: no cover - compiled
         for a in range(s, t):
             if a == s or bucket_hi[a] != bucket_hi[a - 1]:
                 count += 1
-    edge_nodes = np.empty((count, 2), np.int64)  # exactly sized: no (m k, 2) buffer
-    inverse = np.empty((m, k), np.int64)
+    edge_nodes = np.empty((count, 2), node_type.dtype)  # exactly sized: no (m k, 2) buffer
+    inverse = np.empty((m, k), edge_type.dtype)
     count = 0
     for v in range(n):
         for a in range(start[v], start[v + 1]):
@@ -75,4 +77,6 @@ def warm_up() -> None:
     """Compile (or load from the on-disk cache) the kernel for triangles and tetrahedra."""
     from .mesh import LOCAL_EDGES
 
-    cell_edges(np.array([[0, 1, 2], [0, 2, 3]], np.int64), LOCAL_EDGES[3], 4)
+    for cells in (np.array([[0, 1, 2], [0, 2, 3]], np.int64), np.array([[0, 1, 2, 3]], np.int64)):
+        cell_edges(cells, LOCAL_EDGES[cells.shape[1]], 4, np.zeros(0, np.int32),
+                   np.zeros(0, np.int32))

@@ -50,7 +50,7 @@ class Bisection:
         coarse edge, in the order of ``new_node_edges``.
     parent : (m_fine,) int64
         Coarse element each fine element comes from (cell tags are inherited through it).
-    new_node_edges : (k, 2) int64
+    new_node_edges : (k, 2) int (int32, as :func:`~femkit.mesh.edges.edges` gives them)
         The coarse edge (two coarse node ids) whose midpoint is each new node.
     """
 

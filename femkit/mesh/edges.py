@@ -39,13 +39,15 @@ def edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
 
     Returns
     -------
-    edge_nodes : (E, 2) int64
+    edge_nodes : (E, 2) int32 (int64 when the node ids do not fit)
         Node pairs, each sorted ascending, rows sorted lexicographically.
-    cell_edges : (m, 3) or (m, 6) int64
+    cell_edges : (m, 3) or (m, 6) int32 (int64 when the edge ids do not fit)
         ``cell_edges[t, k]`` is the edge of triangle ``t`` opposite its local vertex ``k``, or
         the local edge ``k`` of a tetrahedron (:data:`LOCAL_EDGES`).
 
-    Computed once per mesh (cached while the mesh lives; the arrays are read-only).
+    Computed once per mesh (cached while the mesh lives; the arrays are read-only). 32-bit
+    indices halve what the finest mesh's edges hold through a run (the estimator's, the
+    quality numbers'); arithmetic on them (keys ``lo * n + hi``) is done in int64.
     """
     try:
         hit = _CACHE.get(mesh)
@@ -68,18 +70,26 @@ def forget_edges(mesh: Mesh) -> None:
         pass
 
 
+def index_dtype(count: int) -> type:
+    """int32 when ids ``0 .. count - 1`` fit in it, else int64."""
+    return np.int32 if count <= np.iinfo(np.int32).max else np.int64
+
+
 def _edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     n = max(mesh.n_points, 1)
     k = 3 if mesh.dim == 2 else 6
+    node_type = index_dtype(n)
+    edge_type = index_dtype(mesh.n_cells * k)  # at most one edge per local edge
     if mesh.n_cells >= NUMBA_THRESHOLD:
         from ._edges_kernel import cell_edges
 
-        return cell_edges(mesh.cells, LOCAL_EDGES[mesh.cells.shape[1]], n)
-    loc = _local_edges(mesh.cells).reshape(-1, 2)
+        return cell_edges(mesh.cells, LOCAL_EDGES[mesh.cells.shape[1]], n,
+                          np.zeros(0, node_type), np.zeros(0, edge_type))
+    loc = _local_edges(mesh.cells).reshape(-1, 2).astype(np.int64, copy=False)
     lo, hi = loc.min(axis=1), loc.max(axis=1)
     keys, inverse = np.unique(lo * n + hi, return_inverse=True)
-    edge_nodes = np.stack([keys // n, keys % n], axis=1)
-    return edge_nodes, inverse.reshape(-1, k).astype(np.int64)
+    edge_nodes = np.stack([keys // n, keys % n], axis=1).astype(node_type)
+    return edge_nodes, inverse.reshape(-1, k).astype(edge_type)
 
 
 def boundary_edges_topological(mesh: Mesh) -> np.ndarray:
@@ -121,7 +131,7 @@ def edge_ids(mesh: Mesh, edge_nodes: np.ndarray, pairs: np.ndarray) -> np.ndarra
     """
     pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     n = max(mesh.n_points, 1)
-    keys = edge_nodes[:, 0] * n + edge_nodes[:, 1]
+    keys = edge_nodes[:, 0].astype(np.int64) * n + edge_nodes[:, 1]
     q = pairs.min(axis=1) * n + pairs.max(axis=1)
     pos = np.minimum(np.searchsorted(keys, q), max(len(keys) - 1, 0))
     bad = np.flatnonzero(keys[pos] != q) if len(keys) else np.arange(len(pairs))

@@ -73,7 +73,8 @@ def families(multigrid: bool) -> tuple[str, ...]:
 
 #: The errors and estimate stages' compiled passes: the residual estimator's (a family of the
 #: warm-up), and the size thresholds of those and of a case's compiled expressions.
-FAMILIES["error estimate"] = (("femkit.fem.estimators._kernels", "residual_edges"),)
+FAMILIES["error estimate"] = tuple(("femkit.fem.estimators._kernels", name) for name in
+                                   ("residual_pass", "slot_fluxes", "triangle_areas", "squares_by_tag"))
 _THRESHOLDS += (("femkit.fem.fused.kernels", "NUMBA_THRESHOLD"),
                 ("femkit.fem.estimators.geometry", "NUMBA_THRESHOLD"),
                 ("femkit.fem.estimators.residual", "NUMBA_THRESHOLD"))
@@ -136,6 +137,9 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True)
         from ...fem._kernels import warm_up as assembly_kernels
 
         assembly_kernels()  # the cached-pattern assembly, which a one-off run does not call
+        from ...fem.estimators._kernels import warm_up as estimator_kernels
+
+        estimator_kernels()  # the estimator's Neumann and area passes, which the tiny case skips
     finally:
         _ACTIVE = False
         for (mod, name), value in zip(saved, values):

@@ -3,6 +3,7 @@ roles."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,16 +36,38 @@ class ElementFields:
     edge_count: np.ndarray
 
 
-def element_fields(mesh, u: np.ndarray, kappa) -> ElementFields:
-    """Gradients, kappa and the edge structure of ``mesh`` for the P1 function ``u``."""
+def checked_solution(mesh, u) -> np.ndarray:
+    """``u`` as a contiguous float64 array of one finite value per node (else InputError)."""
     from ...errors import InputError
-    from ...mesh.edges import edges
 
-    u = np.asarray(u, dtype=np.float64)
+    u = np.ascontiguousarray(u, dtype=np.float64)
     if u.shape != (mesh.n_points,):
         raise InputError(f"u must have one value per node, shape ({mesh.n_points},), got {u.shape}")
     if not np.isfinite(u).all():
         raise InputError("u has non-finite values: no error estimate for it")
+    return u
+
+
+def element_kappa(mesh, kappa) -> np.ndarray:
+    """The element values of ``kappa`` (checked as :func:`element_coefficient` does), or one
+    value, shape (1,), when it is the same on every element: a constant costs no (m,) array."""
+    from ...errors import InputError
+
+    if np.ndim(kappa) == 0 and not callable(kappa) and not isinstance(kappa, (str, Mapping)) \
+            and mesh.n_cells:
+        try:
+            return element_coefficient(mesh, kappa, np.zeros(1, dtype=np.int64))
+        except InputError:  # a bad constant: the message of the whole mesh's check
+            return element_coefficient(mesh, kappa)
+    kap = element_coefficient(mesh, kappa)
+    return kap[:1] if len(kap) and kap.min() == kap.max() else kap
+
+
+def element_fields(mesh, u: np.ndarray, kappa) -> ElementFields:
+    """Gradients, kappa and the edge structure of ``mesh`` for the P1 function ``u``."""
+    from ...mesh.edges import edges
+
+    u = checked_solution(mesh, u)
     kap = element_coefficient(mesh, kappa)
     if mesh.dim == 3:
         from ...mesh.faces import faces

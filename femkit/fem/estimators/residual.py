@@ -42,25 +42,29 @@ from ..fused import source_norm_sq
 from ..quadrature import blocks, rule_for_degree
 from ..sparsity import NUMBA_THRESHOLD
 from .base import ESTIMATORS, ErrorEstimate
-from .geometry import element_fields
+from .._elements import triangle_geometry
+from .geometry import checked_solution, element_fields, element_kappa
 
 #: Gauss-Legendre points on [0, 1] (3 points, exact to degree 5) for edge integrals of the Neumann data
 _GL_S = 0.5 + 0.5 * np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])
 _GL_W = np.array([5.0, 8.0, 5.0]) / 18.0
 
 
-def _source_norm_sq(mesh, f, area: np.ndarray) -> np.ndarray:
-    """``||f||_T^2`` per element (7-point rule of degree 5 for a callable ``f``)."""
+def _source_norm_sq(mesh, f, area) -> np.ndarray:
+    """``||f||_T^2`` per element (7-point rule of degree 5 for a callable ``f``); ``area`` the
+    element areas, or a function giving them (called only when they are needed)."""
     if callable(f):
         rule = rule_for_degree(5)
         fused = source_norm_sq(mesh, f, area, rule)  # compiled (or kept from the error pass)
         if fused is not None:
             return fused
+        area = area() if callable(area) else area
         out = np.empty(len(area))
         for s in blocks(len(area)):  # (block, 7) values at a time: in cache, bounded memory
             fv = evaluate_callable(f, *rule.physical_points(mesh, mesh.triangles[s]), name="f")
             out[s] = area[s] * ((fv * fv) @ rule.weights)
         return out
+    area = area() if callable(area) else area
     return area * float(f) ** 2
 
 
@@ -79,6 +83,87 @@ def _edge_terms(fl, n_edges: int, c_jump: float):
     # h_E ||J||_E^2 / kappa_E with ||J||_E^2 = J^2 h_E and J = jump_len / h_E: jump_len^2 / kappa_E
     eta_edge = np.where(fl.edge_count == 2, jump_len ** 2 / kmax, 0.0)
     return lens, qlen, 0.5 * c_jump ** 2 * eta_edge[te].sum(axis=1)
+
+
+def _numpy_terms(mesh, u, kappa, f, c_volume: float, c_jump: float):
+    """``(volume, jump, kappa, te, count, edge_nodes, fluxes)`` by NumPy over (m, 3) arrays
+    (small meshes; the reference of :func:`_compiled_terms`). ``fluxes(elem, k)`` gives the
+    length and the flux times the length of local edge ``k`` of triangle ``elem``."""
+    fl = element_fields(mesh, u, kappa)
+    lens, qlen, jump = _edge_terms(fl, len(fl.edge_nodes), c_jump)
+    volume = c_volume ** 2 * lens.max(axis=1) ** 2 * _source_norm_sq(mesh, f, fl.area) / fl.kappa
+    return (volume, jump, fl.kappa, fl.tri_edges, fl.edge_count, fl.edge_nodes,
+            lambda elem, k: (lens[elem, k], qlen[elem, k]))
+
+
+def _compiled_terms(mesh, u, kappa, f, c_volume: float, c_jump: float):
+    """:func:`_numpy_terms` in compiled passes that allocate only their outputs (large meshes)."""
+    from ...mesh.edges import edges
+    from . import _kernels
+
+    u = checked_solution(mesh, u)
+    kap = element_kappa(mesh, kappa)
+    points = np.ascontiguousarray(mesh.points, dtype=np.float64)
+    tri = np.ascontiguousarray(mesh.triangles)
+    edge_nodes, te = edges(mesh)
+    m = mesh.n_triangles
+    if callable(f):  # the error pass's source norm when it kept one, written over in place
+        fsq, f_sq = _source_norm_sq(mesh, f, lambda: _kernels.triangle_areas(points, tri)), 0.0
+        volume = fsq
+    else:
+        fsq, f_sq = np.empty(0), float(f) ** 2
+        volume = np.empty(m)
+    jump = np.empty(m)
+    count = np.zeros(len(edge_nodes), dtype=np.uint8)
+    bad = _kernels.residual_pass(points, tri, u, kap, te, len(edge_nodes), fsq, f_sq,
+                                 c_volume ** 2, 0.5 * c_jump ** 2, volume, jump, count)
+    if bad:
+        triangle_geometry(mesh, None)  # names the degenerate triangles
+    return (volume, jump, kap, te, count, edge_nodes,
+            lambda elem, k: _kernels.slot_fluxes(points, tri, u, kap, elem, k))
+
+
+def _neumann_part(mesh, te, count, edge_nodes, fluxes, kap, neumann, dirichlet_nodes,
+                  c_jump: float) -> np.ndarray | None:
+    """Per element ``c_J^2 h_E / kappa_T ||h - kappa du_h/dn||_E^2`` summed over its boundary
+    edges that are not Dirichlet edges; None when there is no such edge."""
+    from ...mesh.edges import edge_ids
+    from ..neumann import tagged_edges
+
+    slots = np.flatnonzero(count[te.ravel()] == 1)   # (element, local edge) of the boundary
+    bnd = te.ravel()[slots].astype(np.int64)
+    order = np.argsort(bnd, kind="stable")           # by edge id
+    bnd, slots = bnd[order], slots[order]
+    if dirichlet_nodes is not None:                  # both ends prescribed: a Dirichlet edge
+        is_dir = np.zeros(mesh.n_points, dtype=bool)
+        is_dir[np.asarray(dirichlet_nodes, dtype=np.int64)] = True
+        keep = ~(is_dir[edge_nodes[bnd, 0]] & is_dir[edge_nodes[bnd, 1]])
+        bnd, slots = bnd[keep], slots[keep]
+    if not len(bnd):
+        return None
+    elem, k = slots // 3, slots % 3
+    tri = mesh.triangles
+    a = mesh.points[tri[elem, (k + 1) % 3]]
+    b = mesh.points[tri[elem, (k + 2) % 3]]
+    # data h at 3 Gauss points of each Neumann edge (0 where no Neumann entry covers the edge)
+    hq = np.zeros((len(bnd), len(_GL_S)))
+    for tags, h in neumann:                            # a few entries, not a loop over edges
+        ids = edge_ids(mesh, edge_nodes, tagged_edges(mesh, tags))
+        pos = np.minimum(np.searchsorted(bnd, ids), len(bnd) - 1)
+        ids = pos[bnd[pos] == ids]                     # those among the non-Dirichlet edges
+        if not len(ids):
+            continue
+        if callable(h):
+            x = a[ids, 0, None] + _GL_S * (b[ids, 0] - a[ids, 0])[:, None]
+            y = a[ids, 1, None] + _GL_S * (b[ids, 1] - a[ids, 1])[:, None]
+            hq[ids] = evaluate_callable(h, x, y, name="h")
+        else:
+            hq[ids] = float(h)
+    L, qlen = fluxes(elem, k)
+    r = hq - (qlen / L)[:, None]                        # h - kappa du_h/dn at the points
+    norm_sq = L * ((r * r) @ _GL_W)
+    ke = kap[elem] if len(kap) == mesh.n_triangles else np.full(len(elem), kap[0])
+    return np.bincount(elem, weights=c_jump ** 2 * L * norm_sq / ke, minlength=mesh.n_triangles)
 
 
 @ESTIMATORS.register("residual")
@@ -105,63 +190,22 @@ def residual_estimator(mesh, u: np.ndarray, *, kappa=1.0, f=0.0, neumann: Sequen
     ErrorEstimate
         ``parts``: ``volume``, ``jump``, ``neumann`` (each ``(m,)``, squared).
     """
-    from ...mesh.edges import edge_ids
-    from ..neumann import tagged_edges
-
-    fl = element_fields(mesh, u, kappa)
     if mesh.dim == 3:
         from .residual_faces import residual_terms_3d
 
+        fl = element_fields(mesh, u, kappa)
         parts = residual_terms_3d(mesh, fl, f, neumann, dirichlet_nodes, c_volume, c_jump)
         return ErrorEstimate("residual", np.sqrt(sum(parts.values())), parts)
-    e, te, count = fl.e, fl.tri_edges, fl.edge_count
-    n_edges = len(fl.edge_nodes)
-    if mesh.n_cells >= NUMBA_THRESHOLD:  # the same numbers in one compiled pass
-        from ._kernels import residual_edges
-
-        lens, qlen, jump = residual_edges(e, fl.grad, fl.kappa, te, count, n_edges,
-                                          0.5 * c_jump ** 2)
+    terms = _compiled_terms if mesh.n_cells >= NUMBA_THRESHOLD else _numpy_terms
+    volume, jump, kap, te, count, edge_nodes, fluxes = terms(mesh, u, kappa, f, c_volume, c_jump)
+    neumann_part = _neumann_part(mesh, te, count, edge_nodes, fluxes, kap, neumann,
+                                 dirichlet_nodes, c_jump)
+    del te, count, edge_nodes, fluxes
+    indicators = volume + jump                          # eta_T^2, then eta_T in place
+    if neumann_part is None:
+        neumann_part = np.zeros(mesh.n_triangles)       # untouched pages: no memory until read
     else:
-        lens, qlen, jump = _edge_terms(fl, n_edges, c_jump)
-    h_T = lens.max(axis=1)
-    volume = c_volume ** 2 * h_T ** 2 * _source_norm_sq(mesh, f, fl.area) / fl.kappa
-
-    # boundary edges: Neumann mismatch unless both ends are Dirichlet nodes
-    bnd = np.flatnonzero(count == 1)
-    is_dir = np.zeros(mesh.n_points, dtype=bool)
-    if dirichlet_nodes is not None:
-        is_dir[np.asarray(dirichlet_nodes, dtype=np.int64)] = True
-    bnd = bnd[~(is_dir[fl.edge_nodes[bnd, 0]] & is_dir[fl.edge_nodes[bnd, 1]])]
-    neumann_part = np.zeros(mesh.n_triangles)
-    if len(bnd):
-        # data h at 3 Gauss points of each Neumann edge (0 where no Neumann entry covers the edge)
-        owner_slot = np.flatnonzero(count[te.ravel()] == 1)
-        slot_of_edge = np.full(n_edges, -1, dtype=np.int64)
-        slot_of_edge[te.ravel()[owner_slot]] = owner_slot
-        slot = slot_of_edge[bnd]
-        elem, k = slot // 3, slot % 3
-        tri = mesh.triangles
-        a = mesh.points[tri[elem, (k + 1) % 3]]
-        b = mesh.points[tri[elem, (k + 2) % 3]]
-        hq = np.zeros((len(bnd), len(_GL_S)))
-        pos_of_edge = np.full(n_edges, -1, dtype=np.int64)
-        pos_of_edge[bnd] = np.arange(len(bnd))
-        for tags, h in neumann:                            # a few entries, not a loop over edges
-            ids = pos_of_edge[edge_ids(mesh, fl.edge_nodes, tagged_edges(mesh, tags))]
-            ids = ids[ids >= 0]
-            if not len(ids):
-                continue
-            if callable(h):
-                x = a[ids, 0, None] + _GL_S * (b[ids, 0] - a[ids, 0])[:, None]
-                y = a[ids, 1, None] + _GL_S * (b[ids, 1] - a[ids, 1])[:, None]
-                hq[ids] = evaluate_callable(h, x, y, name="h")
-            else:
-                hq[ids] = float(h)
-        L = lens[elem, k]
-        r = hq - (qlen[elem, k] / L)[:, None]               # h - kappa du_h/dn at the points
-        norm_sq = L * ((r * r) @ _GL_W)
-        neumann_part = np.bincount(elem, weights=c_jump ** 2 * L * norm_sq / fl.kappa[elem],
-                                   minlength=mesh.n_triangles)
-    total = volume + jump + neumann_part
-    return ErrorEstimate("residual", np.sqrt(total),
+        indicators += neumann_part
+    np.sqrt(indicators, out=indicators)
+    return ErrorEstimate("residual", indicators,
                          {"volume": volume, "jump": jump, "neumann": neumann_part})

@@ -56,10 +56,11 @@ def error_sums(mesh, u: np.ndarray, rule, kernels: FusedKernels):
     return l2, (h1 if kernels.n_grad else None)
 
 
-def source_norm_sq(mesh, f: Callable, measure: np.ndarray, rule) -> np.ndarray | None:
+def source_norm_sq(mesh, f: Callable, measure, rule) -> np.ndarray | None:
     """``measure * sum_q w_q f^2`` per cell (``||f||_T^2`` by ``rule``): the one an error pass
     just computed for the same ``f`` and rule, else a compiled pass; None when the NumPy path
-    must run."""
+    must run. ``measure``: the cells' measures, or a function giving them (called only for
+    the compiled pass)."""
     try:
         hit = _SOURCE_NORM.pop(mesh, None)
     except TypeError:
@@ -69,6 +70,8 @@ def source_norm_sq(mesh, f: Callable, measure: np.ndarray, rule) -> np.ndarray |
     kernels = kernels_for(mesh, source=f)
     if kernels is None:
         return None
+    if callable(measure):
+        measure = measure()
     points, cells, bary, weights = _arrays(mesh, rule)
     fsq = np.empty(len(cells))
     kernels.module.source_pass(points, cells, bary, weights,
