@@ -161,6 +161,8 @@ def _passes(kernels, dim: int) -> list[str]:
         names += ["triangle_pass" if dim == 2 else "simplex_pass", "nodal_pass"]
     if kernels.source is not None and (kernels.exact is None or not kernels.module.HAS_SOURCE):
         names.append("source_pass")
+    if kernels.source is not None:
+        names.append("source_values")  # the load vector's source
     return names
 
 
@@ -196,6 +198,8 @@ def _compile_passes(kernels, mesh) -> None:
             mod.simplex_pass(points, cells, bary, weights, u, np.zeros((2, d)), np.ones(2), *out)
         elif name == "nodal_pass":
             mod.nodal_pass(points, u)
+        elif name == "source_values":
+            mod.source_values(points, cells, bary, np.empty((2, len(bary))))
         else:
             mod.source_pass(points, cells, bary, weights, np.ones(2), out[0])
 

@@ -169,6 +169,19 @@ def source_pass(points, cells, bary, weights, measure, fsq):  # pragma: no cover
 
 
 @numba.njit(cache=True, error_model="numpy")
+def source_values(points, cells, bary, out):  # pragma: no cover - compiled
+    """``out[k, q] = f`` at the rule's point ``q`` of cell ``k``: the load's source values, at
+    the points :meth:`~femkit.fem.quadrature.TriangleRule.physical_points` gives (same rounding),
+    without its coordinate arrays."""
+    vals = np.empty(1)
+    for k in range(cells.shape[0]):
+        for q in range(bary.shape[0]):
+            x, y, z = physical_point(points, cells, k, bary, q)
+            source_point(x, y, z, vals)
+            out[k, q] = vals[0]
+
+
+@numba.njit(cache=True, error_model="numpy")
 def nodal_pass(points, u):  # pragma: no cover - compiled
     """``max_i |u_i - u(x_i)|`` (NaN as soon as one difference is NaN, as ``np.max``)."""
     vals = np.empty(1)
