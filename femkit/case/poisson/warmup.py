@@ -37,7 +37,8 @@ COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)"
 FAMILIES = {
     "mesh passes": (("femkit.mesh._edges_kernel", "cell_edges"),
                     ("femkit.mesh._quality_kernel", "triangle_quality"),
-                    ("femkit.mesh._refine_kernel", "red_children")),
+                    ("femkit.mesh._refine_kernel", "red_children"),
+                    ("femkit.mesh._refine_kernel", "child_edges")),
     "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
                     ("femkit.fem._kernels", "_stiffness_rows"), ("femkit.fem._kernels", "_eliminate")),
     "solver checks": (("femkit.solvers._check_kernels", "asymmetry_sums"),),
