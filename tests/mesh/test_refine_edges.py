@@ -10,19 +10,11 @@ import numpy as np
 import pytest
 
 from femkit.mesh import Mesh, MeshHierarchy, generate, structured_mesh
-from femkit.mesh.mesh import LOCAL_EDGES
+
+from .test_edges_cached import _by_unique, _scrambled_square
 
 refine_module = importlib.import_module("femkit.mesh.refine")
 edges_module = importlib.import_module("femkit.mesh.edges")
-
-
-def _scrambled(mesh, draw=4):
-    """Nodes and triangles in random order: no structure the derivation could lean on."""
-    rng = np.random.default_rng(draw)
-    perm = rng.permutation(mesh.n_points)
-    inv = np.empty_like(perm)
-    inv[perm] = np.arange(len(perm))
-    return Mesh(mesh.points[perm], inv[mesh.triangles][rng.permutation(mesh.n_cells)])
 
 
 def _with_duplicate():
@@ -33,17 +25,10 @@ def _with_duplicate():
 
 MESHES = {
     "structured": lambda: structured_mesh(7, 5),
-    "scrambled": lambda: _scrambled(structured_mesh(9, 6)),
+    "scrambled": _scrambled_square,
     "gmsh-l-shape": lambda: generate("l_shape", 0.2),
     "duplicate-triangle": _with_duplicate,
 }
-
-
-def _by_unique(mesh):
-    """The definition: np.unique of the sorted node pairs of every local edge."""
-    loc = mesh.cells[:, LOCAL_EDGES[3]].reshape(-1, 2)
-    pairs, inverse = np.unique(np.sort(loc, axis=1), axis=0, return_inverse=True)
-    return pairs, inverse.reshape(mesh.n_cells, -1)
 
 
 @pytest.mark.parametrize("name", sorted(MESHES))
