@@ -133,8 +133,9 @@ def child_edges(n, edge_nodes, tri, tri_edges):  # pragma: no cover - compiled
         for k in range(3):                       # the halves at vertex k: of edges k+1, k+2
             v = tri[t, k]
             e1, e2 = tri_edges[t, (k + 1) % 3], tri_edges[t, (k + 2) % 3]
-            h1 = half[e1, 0] if edge_nodes[e1, 0] == v else half[e1, 1]
-            h2 = half[e2, 0] if edge_nodes[e2, 0] == v else half[e2, 1]
+            # edge k+1 joins v to vertex k+2, edge k+2 to vertex k+1: v is its lower node or not
+            h1 = half[e1, 0] if v < tri[t, (k + 2) % 3] else half[e1, 1]
+            h2 = half[e2, 0] if v < tri[t, (k + 1) % 3] else half[e2, 1]
             # child k holds v at local k and the pair of the two midpoints opposite it; the
             # half opposite midpoint m_j lies on the other edge at v
             if k == 0:      # (v0, m2, m1): opposite m2 the half of e1, opposite m1 of e2
