@@ -39,14 +39,15 @@ _INNER = np.array([
 _DIAGONALS = np.array([[4, 9], [5, 8], [6, 7]])
 
 
-def refine_once(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
+def refine_once(mesh: Mesh, *, derive_edges: bool = True) -> tuple[Mesh, np.ndarray]:
     """One level of red refinement, and the coarse edges whose midpoints are the new nodes.
 
     Returns ``(fine, edge_nodes)``: fine node ``n + e`` is the midpoint of coarse edge
     ``edge_nodes[e]`` (:func:`edges` order), so a nested prolongation needs no second edge search
     (:class:`femkit.mesh.hierarchy.MeshHierarchy`). On large triangle meshes the fine mesh's own
     edges are derived from the coarse ones on the way (:func:`~._refine_kernel.child_edges`) and
-    given to :func:`edges`, so no level of a hierarchy searches its edges but the coarsest.
+    given to :func:`edges`, so no level of a hierarchy searches its edges but the coarsest
+    (``derive_edges=False``: not, for a caller that renumbers the fine mesh's nodes).
     """
     if mesh.dim == 3:
         return _refine_tetrahedra(mesh)
@@ -59,7 +60,8 @@ def refine_once(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
 
         points = with_midpoints(mesh.points, edge_nodes)
         children = red_children(t, tri_edges, n)
-        known = child_edges(n, edge_nodes, t, tri_edges)  # the fine mesh's, without a search
+        if derive_edges:  # the fine mesh's, without a search
+            known = child_edges(n, edge_nodes, t, tri_edges)
     else:
         points = np.vstack([mesh.points, mesh.points[edge_nodes].mean(axis=1)])
         m0, m1, m2 = (n + tri_edges[:, k] for k in range(3))

@@ -60,3 +60,17 @@ def test_a_hierarchy_searches_only_its_coarsest_edges(monkeypatch):
     H = MeshHierarchy.from_refinement(coarse, 2)
     edges_module.edges(H.finest)
     assert searched == [m.n_cells for m in H.meshes]
+
+
+def test_a_renumbered_hierarchy_derives_no_edges_it_would_drop(monkeypatch):
+    """Renumbering reorders the fine mesh's edges: the derived ones would be thrown away."""
+    kernel = importlib.import_module("femkit.mesh._refine_kernel")
+    monkeypatch.setattr(refine_module, "NUMBA_THRESHOLD", 0)
+    calls = []
+    real = kernel.child_edges
+    monkeypatch.setattr(kernel, "child_edges", lambda *a: calls.append(1) or real(*a))
+    coarse = generate("unit_square", 0.25)
+    H = MeshHierarchy.from_refinement(coarse, 2, renumber="rcm")
+    assert calls == [] and all(m not in edges_module._CACHE for m in H.meshes[1:])
+    MeshHierarchy.from_refinement(coarse, 2)
+    assert calls == [1, 1]
