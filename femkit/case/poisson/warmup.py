@@ -137,11 +137,25 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True)
         from ...fem._kernels import warm_up as assembly_kernels
 
         assembly_kernels()  # the cached-pattern assembly, which a one-off run does not call
+        _symmetry_check()   # fmg skips it on the pipeline's matrix; pcg, cg ... do not
     finally:
         _ACTIVE = False
         for (mod, name), value in zip(saved, values):
             setattr(mod, name, value)
     return time.perf_counter() - t0
+
+
+def _symmetry_check() -> None:
+    """The solvers' symmetry check on a system the pipeline's way assembled and reduced (the
+    argument types of a large run)."""
+    from ...fem import PoissonProblem
+    from ...mesh import generate, refine
+    from ...solvers.checks import check_symmetric
+
+    problem = PoissonProblem(refine(generate("unit_square", 0.5), 1), kappa=1.0, f=1.0,
+                             dirichlet=[(["boundary"], 0.0)])
+    K, F = problem.assemble_matrices(keep_pattern=False)
+    check_symmetric(problem.reduce(K, F, "pcg", overwrite=True).A, method="pcg")
 
 
 #: True while :func:`warm_up` runs its tiny case (which must not warm up again).
