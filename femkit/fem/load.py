@@ -78,9 +78,19 @@ def assemble_load(mesh, f: Source, *, rule: str = "barycentric", elements=None,
 
 
 def _source_values(mesh, f, quad, tri, idx) -> np.ndarray:
-    """``f`` at the rule's physical points, (k, q); raises naming elements where it is not finite."""
-    coords = quad.physical_points(mesh, tri)  # d arrays (m, q)
-    fq = evaluate_callable(f, *coords, name="f")
+    """``f`` at the rule's physical points, (k, q); raises naming elements where it is not finite.
+
+    A case's compiled source (:mod:`femkit.fem.fused`) is evaluated point by point in one pass
+    over the cells, without the (m, q) coordinate arrays; otherwise NumPy evaluates ``f`` on them.
+    """
+    fq = None
+    if idx is None:
+        from .fused import source_values
+
+        fq = source_values(mesh, f, quad)
+    if fq is None:
+        coords = quad.physical_points(mesh, tri)  # d arrays (m, q)
+        fq = evaluate_callable(f, *coords, name="f")
     if not np.isfinite(fq).all():
         bad = np.flatnonzero(~np.isfinite(fq).all(axis=1))
         ids = bad if idx is None else idx[bad]

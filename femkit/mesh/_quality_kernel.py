@@ -15,9 +15,10 @@ import numpy as np
 def triangle_quality(points, tri):  # pragma: no cover - compiled
     """``(h_max, h_min, min_angle, max_angle, max_aspect, sum_aspect, area_sum)`` over the
     triangles: side lengths, angles by the law of cosines (degrees, NaN for a degenerate
-    triangle, ignored like ``np.nanmin``), aspect ratio ``R / (2 r)`` (inf when the area is 0)."""
+    triangle, ignored like ``np.nanmin``; the extreme angles are the arccos of the extreme
+    cosines, the same numbers as the extremes of every angle), aspect ratio ``R / (2 r)`` (inf when the area is 0)."""
     h_max, h_min = -np.inf, np.inf
-    a_min, a_max = np.nan, np.nan
+    c_max, c_min = np.nan, np.nan  # the extreme cosines: the angle is decreasing in its cosine
     asp_max, asp_sum, area_sum = -np.inf, 0.0, 0.0
     blk_asp, blk_area = 0.0, 0.0  # sums per block of 4096 triangles: round-off ~ pairwise
     rad = 180.0 / np.pi
@@ -36,11 +37,10 @@ def triangle_quality(points, tri):  # pragma: no cover - compiled
             h_min = min(h_min, a)
             cosang = (b * b + c * c - a * a) / (2.0 * b * c)
             if cosang == cosang:  # NaN for a degenerate triangle: skipped like nanmin
-                ang = np.arccos(min(max(cosang, -1.0), 1.0)) * rad
-                if not (a_min <= ang):
-                    a_min = ang
-                if not (a_max >= ang):
-                    a_max = ang
+                if not (c_max >= cosang):
+                    c_max = cosang
+                if not (c_min <= cosang):
+                    c_min = cosang
         area = abs(0.5 * ((x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)))
         blk_area += area
         if area > 0:
@@ -57,6 +57,9 @@ def triangle_quality(points, tri):  # pragma: no cover - compiled
             blk_asp, blk_area = 0.0, 0.0
     asp_sum += blk_asp
     area_sum += blk_area
+    # two arccos instead of three per triangle: the smallest angle is that of the largest cosine
+    a_min = np.arccos(min(max(c_max, -1.0), 1.0)) * rad  # NaN stays NaN (no angle at all)
+    a_max = np.arccos(min(max(c_min, -1.0), 1.0)) * rad
     return h_max, h_min, a_min, a_max, asp_max, asp_sum, area_sum
 
 

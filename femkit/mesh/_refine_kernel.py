@@ -42,8 +42,116 @@ def with_midpoints(points, edge_nodes):  # pragma: no cover - compiled
     return out
 
 
+@numba.njit(cache=True)
+def child_edges(n, edge_nodes, tri, tri_edges):  # pragma: no cover - compiled
+    """The edges of the red refinement :func:`red_children` makes, from the coarse mesh's:
+    ``(edge_nodes, cell_edges)`` of the fine mesh, the arrays
+    :func:`femkit.mesh.edges.edges` would find on it by a search (sorted node pairs in
+    lexicographic order; ``cell_edges[c, k]`` the edge opposite local vertex ``k`` of child
+    ``c``).
+
+    A fine edge is either half of a coarse edge ``e``, ``(a, n + e)`` with ``a`` one of its
+    nodes, or joins two midpoints of a coarse triangle, ``(n + p, n + q)`` with ``p < q``. The
+    halves come first (their lower node is a coarse node), grouped by that node and ordered by
+    ``e`` within the group: a counting sort of the coarse edges' ends in edge order. The
+    midpoint edges follow, ordered by ``(p, q)``: a counting sort by ``p`` (a bucket holds the
+    at most two pairs of each triangle on edge ``p``), then an insertion sort by ``q``. O(E + m)
+    with no comparison sort of all keys; two triangles giving the same pair (duplicate
+    triangles) share one edge, as in the search.
+    """
+    n_edges = edge_nodes.shape[0]
+    m = tri.shape[0]
+    # halves: bucket of coarse node a = the coarse edges at a, in edge order
+    start = np.zeros(n + 1, np.int64)
+    for e in range(n_edges):
+        start[edge_nodes[e, 0] + 1] += 1
+        start[edge_nodes[e, 1] + 1] += 1
+    for v in range(n):
+        start[v + 1] += start[v]
+    fill = start[:-1].copy()
+    half = np.empty((n_edges, 2), np.int64)      # fine edge of (edge_nodes[e, j], n + e)
+    n_half = 2 * n_edges
+    out_pairs = np.empty((n_half, 2), np.int64)
+    for e in range(n_edges):
+        for j in range(2):
+            a = edge_nodes[e, j]
+            q = fill[a]
+            fill[a] = q + 1
+            half[e, j] = q
+            out_pairs[q, 0] = a
+            out_pairs[q, 1] = n + e
+    # midpoint edges: three per triangle, bucketed by their lower coarse edge
+    bstart = np.zeros(n_edges + 1, np.int64)
+    for t in range(m):
+        for j in range(3):
+            p, q = tri_edges[t, (j + 1) % 3], tri_edges[t, (j + 2) % 3]
+            bstart[min(p, q) + 1] += 1
+    for e in range(n_edges):
+        bstart[e + 1] += bstart[e]
+    bfill = bstart[:-1].copy()
+    b_hi = np.empty(3 * m, np.int64)
+    b_id = np.empty(3 * m, np.int64)             # 3 t + j: the pair opposite midpoint j of t
+    for t in range(m):
+        for j in range(3):
+            p, q = tri_edges[t, (j + 1) % 3], tri_edges[t, (j + 2) % 3]
+            lo = min(p, q)
+            r = bfill[lo]
+            bfill[lo] = r + 1
+            b_hi[r] = max(p, q)
+            b_id[r] = 3 * t + j
+    mid = np.empty(3 * m, np.int64)              # fine edge of pair 3 t + j
+    count = 0
+    for e in range(n_edges):
+        s, u = bstart[e], bstart[e + 1]
+        for a in range(s + 1, u):                # insertion sort of the bucket by q
+            h, i = b_hi[a], b_id[a]
+            b = a
+            while b > s and b_hi[b - 1] > h:
+                b_hi[b] = b_hi[b - 1]
+                b_id[b] = b_id[b - 1]
+                b -= 1
+            b_hi[b] = h
+            b_id[b] = i
+        for a in range(s, u):
+            if a == s or b_hi[a] != b_hi[a - 1]:
+                count += 1
+    edge_out = np.empty((n_half + count, 2), np.int64)
+    edge_out[:n_half] = out_pairs
+    count = n_half
+    for e in range(n_edges):
+        s, u = bstart[e], bstart[e + 1]
+        for a in range(s, u):
+            if a == s or b_hi[a] != b_hi[a - 1]:
+                edge_out[count, 0] = n + e
+                edge_out[count, 1] = n + b_hi[a]
+                count += 1
+            mid[b_id[a]] = count - 1
+    # the children of red_children: (v0, m2, m1), (m2, v1, m0), (m1, m0, v2), (m0, m1, m2)
+    cells = np.empty((4 * m, 3), np.int64)
+    for t in range(m):
+        c = 4 * t
+        for k in range(3):                       # the halves at vertex k: of edges k+1, k+2
+            v = tri[t, k]
+            e1, e2 = tri_edges[t, (k + 1) % 3], tri_edges[t, (k + 2) % 3]
+            # edge k+1 joins v to vertex k+2, edge k+2 to vertex k+1: v is its lower node or not
+            h1 = half[e1, 0] if v < tri[t, (k + 2) % 3] else half[e1, 1]
+            h2 = half[e2, 0] if v < tri[t, (k + 1) % 3] else half[e2, 1]
+            # child k holds v at local k and the pair of the two midpoints opposite it; the
+            # half opposite midpoint m_j lies on the other edge at v
+            if k == 0:      # (v0, m2, m1): opposite m2 the half of e1, opposite m1 of e2
+                cells[c, 0], cells[c, 1], cells[c, 2] = mid[3 * t], h1, h2
+            elif k == 1:    # (m2, v1, m0): opposite m2 the half of e0, opposite m0 of e2
+                cells[c + 1, 0], cells[c + 1, 1], cells[c + 1, 2] = h2, mid[3 * t + 1], h1
+            else:           # (m1, m0, v2): opposite m1 the half of e0, opposite m0 of e1
+                cells[c + 2, 0], cells[c + 2, 1], cells[c + 2, 2] = h1, h2, mid[3 * t + 2]
+        cells[c + 3, 0], cells[c + 3, 1], cells[c + 3, 2] = mid[3 * t], mid[3 * t + 1], mid[3 * t + 2]
+    return edge_out, cells
+
+
 def warm_up() -> None:
-    """Compile (or load from the on-disk cache) both kernels."""
+    """Compile (or load from the on-disk cache) the kernels."""
     tri = np.array([[0, 1, 2]], np.int64)
     red_children(tri, np.array([[0, 1, 2]], np.int64), 3)
     with_midpoints(np.zeros((3, 2)), np.array([[0, 1]], np.int64))
+    child_edges(3, np.array([[0, 1], [0, 2], [1, 2]], np.int64), tri,
+                np.array([[2, 1, 0]], np.int64))

@@ -61,6 +61,21 @@ def edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     return hit
 
 
+def remember_edges(mesh: Mesh, edge_nodes: np.ndarray, cell_edges: np.ndarray) -> None:
+    """Give ``mesh`` the edges a caller derived without a search (red refinement derives the
+    fine mesh's from the coarse mesh's): the arrays :func:`edges` would compute, which it then
+    returns, with the same index types (:func:`index_dtype`)."""
+    k = 3 if mesh.dim == 2 else 6
+    edge_nodes = edge_nodes.astype(index_dtype(max(mesh.n_points, 1)), copy=False)
+    cell_edges = cell_edges.astype(index_dtype(mesh.n_cells * k), copy=False)
+    for a in (edge_nodes, cell_edges):
+        a.flags.writeable = False
+    try:
+        _CACHE[mesh] = (edge_nodes, cell_edges)
+    except TypeError:  # a mesh-like object that cannot be weakly referenced
+        pass
+
+
 def forget_edges(mesh: Mesh) -> None:
     """Drop ``mesh``'s cached edges (a coarser level of a hierarchy needs them only while it
     is refined; :func:`edges` computes them again if asked)."""

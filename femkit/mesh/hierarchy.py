@@ -165,7 +165,8 @@ class MeshHierarchy:
         meshes, prols, injs = [mesh], [], []
         for _ in range(int(levels)):
             n_c = mesh.n_points
-            fine, edge_nodes = refine_once(mesh)
+            # renumbered nodes reorder the edges: the fine mesh's are not derived then
+            fine, edge_nodes = refine_once(mesh, derive_edges=renumber == "none")
             forget_edges(mesh)  # kept only through edge_nodes, which P needs
             P = prolongation(n_c, edge_nodes)
             inj = np.arange(n_c, dtype=np.int64)

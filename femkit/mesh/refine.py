@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .edges import boundary_edge_ids, edge_ids, edges
+from .edges import boundary_edge_ids, edge_ids, edges, remember_edges
 from .mesh import Mesh
 
 #: Triangle meshes with at least this many cells are refined by compiled passes
@@ -39,23 +39,29 @@ _INNER = np.array([
 _DIAGONALS = np.array([[4, 9], [5, 8], [6, 7]])
 
 
-def refine_once(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
+def refine_once(mesh: Mesh, *, derive_edges: bool = True) -> tuple[Mesh, np.ndarray]:
     """One level of red refinement, and the coarse edges whose midpoints are the new nodes.
 
     Returns ``(fine, edge_nodes)``: fine node ``n + e`` is the midpoint of coarse edge
     ``edge_nodes[e]`` (:func:`edges` order), so a nested prolongation needs no second edge search
-    (:class:`femkit.mesh.hierarchy.MeshHierarchy`).
+    (:class:`femkit.mesh.hierarchy.MeshHierarchy`). On large triangle meshes the fine mesh's own
+    edges are derived from the coarse ones on the way (:func:`~._refine_kernel.child_edges`) and
+    given to :func:`edges`, so no level of a hierarchy searches its edges but the coarsest
+    (``derive_edges=False``: not, for a caller that renumbers the fine mesh's nodes).
     """
     if mesh.dim == 3:
         return _refine_tetrahedra(mesh)
     n = mesh.n_points
     edge_nodes, tri_edges = edges(mesh)
     t = mesh.triangles
+    known = None
     if len(t) >= NUMBA_THRESHOLD:  # the same arrays from two compiled passes
-        from ._refine_kernel import red_children, with_midpoints
+        from ._refine_kernel import child_edges, red_children, with_midpoints
 
         points = with_midpoints(mesh.points, edge_nodes)
         children = red_children(t, tri_edges, n)
+        if derive_edges:  # the fine mesh's, without a search
+            known = child_edges(n, edge_nodes, t, tri_edges)
     else:
         points = np.vstack([mesh.points, mesh.points[edge_nodes].mean(axis=1)])
         m0, m1, m2 = (n + tri_edges[:, k] for k in range(3))
@@ -79,6 +85,8 @@ def refine_once(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
         new_be, new_bt = be, mesh.boundary_tags
     fine = Mesh(points=points, triangles=children, cell_tags=cell_tags,
                 boundary_edges=new_be, boundary_tags=new_bt, tag_names=mesh.tag_names)
+    if known is not None:  # what edges(fine) would find: the next refinement, quality, estimator
+        remember_edges(fine, *known)
     return fine, edge_nodes
 
 

@@ -157,3 +157,44 @@ def test_compiled_residual_estimator_gives_the_same_bits(kappa, monkeypatch):
         results.append(residual_estimator(mesh, u, kappa=k, f=1.0, dirichlet_nodes=bottom))
     for part in ("volume", "jump", "neumann"):
         np.testing.assert_array_equal(results[1].parts[part], results[0].parts[part])
+
+
+@pytest.mark.parametrize("name, rule", [
+    (name, rule) for name in SETS
+    for rule in (("barycentric", "stroud8") if name.endswith("3d") else ("barycentric", "gauss3", "gauss7"))])
+def test_load_vector_of_a_compiled_source_matches_the_numpy_path(name, rule, monkeypatch):
+    """The load's source values by the compiled pass: the points of ``physical_points`` and the
+    same expression, so the same load vector (bit for bit on this machine; asserted to 1e-12)."""
+    from femkit.fem import assemble_load
+    from femkit.fem.fused import source_values
+    from femkit.fem.quadrature import get_rule
+
+    mesh = _mesh(name)
+    _, _, f, kernels = _functions(name)
+    calls = []
+    real = kernels.module.source_values
+    monkeypatch.setattr(kernels.module, "source_values", lambda *a: calls.append(1) or real(*a))
+    F0, F1 = _numpy_and_fused(monkeypatch, lambda: assemble_load(mesh, f, rule=rule))
+    assert calls == [1]                                               # the compiled pass ran
+    np.testing.assert_allclose(F1, F0, rtol=1e-12, atol=1e-14 * np.abs(F0).max())
+    quad = get_rule(rule, dim=mesh.dim)
+    fq = source_values(mesh, f, quad)
+    np.testing.assert_allclose(fq, f(*quad.physical_points(mesh, mesh.cells)), rtol=1e-12, atol=0)
+    assert source_values(mesh, compile_expression(SETS[name][2], V, {"k": 2.0, "c": 3.0}),
+                         quad) is None                                # not the case's source
+
+
+def test_load_of_a_non_finite_compiled_source_is_refused_as_by_numpy(monkeypatch):
+    from femkit.errors import InputError
+    from femkit.fem import assemble_load
+
+    mesh = _mesh("sin-2d")
+    f = compile_expression("sqrt(x - 0.5)", V, check_finite=False)   # NaN for x < 1/2
+    expression_kernels(None, (), f)
+    messages = []
+    for threshold in (10 ** 12, 0):
+        monkeypatch.setattr(fused_kernels, "NUMBA_THRESHOLD", threshold)
+        with pytest.raises(InputError) as info:
+            assemble_load(mesh, f, rule="gauss3")
+        messages.append(str(info.value))
+    assert messages[0] == messages[1] and "source f is not finite" in messages[0]

@@ -140,14 +140,21 @@ def multigrid_inputs(case: Case, hierarchy, system) -> dict:
     levels' own right-hand sides (:func:`level_system`: the load alone when the Dirichlet data are
     zero). Empty for every other solver. (fmg's ``dirichlet=`` option builds the coarser problems
     from the finest level's Dirichlet values alone; the pipeline keeps the assembled loads, whose
-    results it has always given.)"""
+    results it has always given.) fmg is told not to check the symmetry of ``system.A``, the
+    pipeline's own assembly, symmetric by construction."""
     spec = case.solver
     if not spec.needs_hierarchy:
         return {}
     levels = None
     if spec.method == "fmg" and not is_pure_neumann(case):
         levels = [level_system(case, m, spec.method) for m in hierarchy.meshes[:-1]]
-    return multigrid_overrides(spec, hierarchy, system.free, levels)
+    out = multigrid_overrides(spec, hierarchy, system.free, levels)
+    if spec.method == "fmg":
+        # the P1 stiffness is symmetric bit for bit by construction (entry (i, j) and (j, i) sum
+        # the same products in the same element order; elimination drops rows and columns
+        # alike): fmg's symmetry check of the finest matrix would only confirm it
+        out["options"]["check_symmetry"] = False
+    return out
 
 
 def level_system(case: Case, mesh, method: str):

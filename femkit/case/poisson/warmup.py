@@ -37,7 +37,8 @@ COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)"
 FAMILIES = {
     "mesh passes": (("femkit.mesh._edges_kernel", "cell_edges"),
                     ("femkit.mesh._quality_kernel", "triangle_quality"),
-                    ("femkit.mesh._refine_kernel", "red_children")),
+                    ("femkit.mesh._refine_kernel", "red_children"),
+                    ("femkit.mesh._refine_kernel", "child_edges")),
     "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
                     ("femkit.fem._kernels", "_stiffness_rows"), ("femkit.fem._kernels", "_eliminate")),
     "solver checks": (("femkit.solvers._check_kernels", "asymmetry_sums"),),
@@ -140,11 +141,25 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True)
         from ...fem.estimators._kernels import warm_up as estimator_kernels
 
         estimator_kernels()  # the estimator's Neumann and area passes, which the tiny case skips
+        _symmetry_check()   # fmg skips it on the pipeline's matrix; pcg, cg ... do not
     finally:
         _ACTIVE = False
         for (mod, name), value in zip(saved, values):
             setattr(mod, name, value)
     return time.perf_counter() - t0
+
+
+def _symmetry_check() -> None:
+    """The solvers' symmetry check on a system the pipeline's way assembled and reduced (the
+    argument types of a large run)."""
+    from ...fem import PoissonProblem
+    from ...mesh import generate, refine
+    from ...solvers.checks import check_symmetric
+
+    problem = PoissonProblem(refine(generate("unit_square", 0.5), 1), kappa=1.0, f=1.0,
+                             dirichlet=[(["boundary"], 0.0)])
+    K, F = problem.assemble_matrices(keep_pattern=False)
+    check_symmetric(problem.reduce(K, F, "pcg", overwrite=True).A, method="pcg")
 
 
 #: True while :func:`warm_up` runs its tiny case (which must not warm up again).
@@ -194,6 +209,8 @@ def _passes(kernels, dim: int) -> list[str]:
         names += ["triangle_pass" if dim == 2 else "simplex_pass", "nodal_pass"]
     if kernels.source is not None and (kernels.exact is None or not kernels.module.HAS_SOURCE):
         names.append("source_pass")
+    if kernels.source is not None:
+        names.append("source_values")  # the load vector's source
     return names
 
 
@@ -229,6 +246,8 @@ def _compile_passes(kernels, mesh) -> None:
             mod.simplex_pass(points, cells, bary, weights, u, np.zeros((2, d)), np.ones(2), *out)
         elif name == "nodal_pass":
             mod.nodal_pass(points, u)
+        elif name == "source_values":
+            mod.source_values(points, cells, bary, np.empty((2, len(bary))))
         else:
             mod.source_pass(points, cells, bary, weights, np.ones(2), out[0])
 

@@ -7,7 +7,8 @@ layer compiles a case file's expressions, :mod:`femkit.case.compiled_expressions
 here as :class:`FusedKernels`: numba passes generated from :mod:`.templates` whose point function
 evaluates every function at once (common subexpressions shared) and adds each value to every
 integral on the spot. The passes are used by :func:`femkit.fem.error_norms`,
-:func:`~femkit.fem.energy_error` and the residual estimator when
+:func:`~femkit.fem.energy_error`, the residual estimator and the load vector
+(:func:`~femkit.fem.assemble_load`, the source at its rule's points) when
 
 - the callables opt in: each has the kernels as its ``fused`` attribute, and the kernels stand
   for exactly these callables (``kernels.exact is exact``, ``kernels.source is f``; the gradient
@@ -23,7 +24,7 @@ order of the sums over points and vertices; tests/fem/test_fused.py).
 from __future__ import annotations
 
 from .kernels import FusedKernels, kernels_for
-from .passes import error_sums, nodal_error, source_norm_sq
+from .passes import error_sums, nodal_error, source_norm_sq, source_values
 
 __all__ = ["FusedKernels", "kernels_for", "error_sums", "nodal_error",
-           "source_norm_sq"]
+           "source_norm_sq", "source_values"]

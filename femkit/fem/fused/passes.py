@@ -1,4 +1,5 @@
-"""The fused passes run on a mesh: error norms, the source norm, the largest nodal error.
+"""The fused passes run on a mesh: error norms, the source norm, the largest nodal error, the
+load's source values.
 
 Each returns None when the NumPy path must run instead: no kernels for these callables, or a
 non-finite value or a degenerate cell met on the way (the NumPy path then reports it as it
@@ -77,6 +78,18 @@ def source_norm_sq(mesh, f: Callable, measure, rule) -> np.ndarray | None:
     kernels.module.source_pass(points, cells, bary, weights,
                                np.ascontiguousarray(measure, dtype=np.float64), fsq)
     return fsq if np.isfinite(fsq).all() else None
+
+
+def source_values(mesh, f: Callable, rule) -> np.ndarray | None:
+    """``f`` at the physical points of ``rule`` on every cell, (m, q), by a compiled pass (the
+    load vector's source values); None when the NumPy path must run."""
+    kernels = kernels_for(mesh, source=f)
+    if kernels is None:
+        return None
+    points, cells, bary, _ = _arrays(mesh, rule)
+    out = np.empty((len(cells), len(bary)))
+    kernels.module.source_values(points, cells, bary, out)
+    return out
 
 
 def nodal_error(mesh, u: np.ndarray, exact: Callable) -> float | None:
