@@ -14,22 +14,12 @@ from femkit.errors import DegenerateMeshError
 from femkit.fem import SparsityPattern, assemble_stiffness
 from femkit.mesh import Mesh
 
-from ._tets import perturbed_box
-
-
-def _scrambled(state=3):
-    base = perturbed_box(4, state=state)
-    rng = np.random.default_rng(state)
-    perm = rng.permutation(base.n_points)
-    inv = np.empty_like(perm)
-    inv[perm] = np.arange(len(perm))
-    order = rng.permutation(base.n_cells)
-    return Mesh(base.points[perm], inv[base.cells][order]), base.cell_tags[order]
+from ._tets import scrambled_box
 
 
 @pytest.mark.parametrize("kappa", ["scalar", "per-element"])
 def test_rows_equal_the_fused_pass_bit_for_bit(kappa):
-    mesh, _ = _scrambled()
+    mesh = scrambled_box()
     kap = 2.5 if kappa == "scalar" else np.linspace(1.0, 3.0, mesh.n_cells)
     K = assemble_stiffness(mesh, kap, backend="numba", keep_pattern=False)
     assert SparsityPattern.cached(mesh) is None
@@ -43,7 +33,7 @@ def test_rows_equal_scikit_fem():
     skfem = pytest.importorskip("skfem")
     from skfem.helpers import dot, grad
 
-    mesh, _ = _scrambled(state=7)
+    mesh = scrambled_box(state=7)
     c = mesh.centroids()
     values = 1.0 + c[:, 0] * c[:, 1] + c[:, 2] ** 2
     basis = skfem.Basis(skfem.MeshTet(mesh.points.T.copy(), mesh.cells.T.copy()), skfem.ElementTetP1())
@@ -55,7 +45,7 @@ def test_rows_equal_scikit_fem():
 
 
 def test_rows_name_a_flat_tetrahedron():
-    mesh, _ = _scrambled(state=5)
+    mesh = scrambled_box(state=5)
     pts = mesh.points.copy()
     a, b, c, d = mesh.cells[11]
     pts[d] = pts[a]                          # two vertices at one point: volume exactly 0

@@ -35,16 +35,23 @@ class ElementFields:
     edge_count: np.ndarray
 
 
-def element_fields(mesh, u: np.ndarray, kappa) -> ElementFields:
-    """Gradients, kappa and the edge structure of ``mesh`` for the P1 function ``u``."""
+def nodal_values(mesh, u: np.ndarray) -> np.ndarray:
+    """``u`` as float64, checked: one finite value per node (else :class:`InputError`)."""
     from ...errors import InputError
-    from ...mesh.edges import edges
 
     u = np.asarray(u, dtype=np.float64)
     if u.shape != (mesh.n_points,):
         raise InputError(f"u must have one value per node, shape ({mesh.n_points},), got {u.shape}")
     if not np.isfinite(u).all():
         raise InputError("u has non-finite values: no error estimate for it")
+    return u
+
+
+def element_fields(mesh, u: np.ndarray, kappa) -> ElementFields:
+    """Gradients, kappa and the edge structure of ``mesh`` for the P1 function ``u``."""
+    from ...mesh.edges import edges
+
+    u = nodal_values(mesh, u)
     kap = element_coefficient(mesh, kappa)
     if mesh.dim == 3:
         from ...mesh.faces import faces

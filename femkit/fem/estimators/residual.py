@@ -108,12 +108,12 @@ def residual_estimator(mesh, u: np.ndarray, *, kappa=1.0, f=0.0, neumann: Sequen
     from ...mesh.edges import edge_ids
     from ..neumann import tagged_edges
 
-    fl = element_fields(mesh, u, kappa)
     if mesh.dim == 3:
         from .residual_faces import residual_terms_3d
 
-        parts = residual_terms_3d(mesh, fl, f, neumann, dirichlet_nodes, c_volume, c_jump)
+        parts = residual_terms_3d(mesh, u, kappa, f, neumann, dirichlet_nodes, c_volume, c_jump)
         return ErrorEstimate("residual", np.sqrt(sum(parts.values())), parts)
+    fl = element_fields(mesh, u, kappa)
     e, te, count = fl.e, fl.tri_edges, fl.edge_count
     n_edges = len(fl.edge_nodes)
     if mesh.n_cells >= NUMBA_THRESHOLD:  # the same numbers in one compiled pass

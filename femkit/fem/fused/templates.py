@@ -26,6 +26,8 @@ from llvmlite import ir
 from numba.core import types
 from numba.extending import intrinsic
 
+from .._kernels import _tetrahedron
+
 #: Components of the exact gradient ``exact_point`` gives after ``u`` (0: none).
 N_GRAD = 0
 #: True when ``exact_point`` gives the source ``f`` after the gradient.
@@ -144,18 +146,6 @@ def triangle_pass(points, tri, bary, weights, u, l2, h1, fsq):  # pragma: no cov
 
 
 @numba.njit(cache=True, error_model="numpy")
-def simplex_pass(points, cells, bary, weights, u, grad_h, measure, l2, h1, fsq):  # pragma: no cover - compiled
-    """:func:`triangle_pass` on cells of any dimension whose gradients of ``u_h`` (``grad_h``,
-    (m, d)) and measures are given."""
-    vals = np.empty(5)
-    for k in range(cells.shape[0]):
-        a, b, c = element_sums(points, cells, k, bary, weights, u, grad_h[k], vals)
-        l2[k] = measure[k] * a
-        h1[k] = measure[k] * b
-        fsq[k] = measure[k] * c
-
-
-@numba.njit(cache=True, error_model="numpy")
 def source_pass(points, cells, bary, weights, measure, fsq):  # pragma: no cover - compiled
     """``fsq[k] = measure[k] * sum_q w_q f^2``: the source norm alone."""
     vals = np.empty(1)
@@ -183,3 +173,33 @@ def nodal_pass(points, u):  # pragma: no cover - compiled
         if v > big:
             big = v
     return big
+
+
+@numba.njit(cache=True, error_model="numpy")
+def tetrahedron_pass(points, tets, bary, weights, u, l2, h1, fsq):  # pragma: no cover - compiled
+    """Per tetrahedron ``volume * element_sums`` into ``l2``, ``h1``, ``fsq``, the volume and
+    the gradient of ``u_h`` computed on the way (``D grad N_a`` by the assembly's
+    :func:`femkit.fem._kernels._tetrahedron`, ``D = 6 V_signed``), so no (m, 4, 3) array of
+    gradients is formed (the gradients agree with the NumPy path's to round-off); returns the
+    number of tetrahedra of zero or non-finite volume (then the caller reports them by the NumPy
+    path)."""
+    vals = np.empty(5)
+    gh = np.empty(3)
+    g = np.empty((4, 3))
+    bad = 0
+    for k in range(tets.shape[0]):
+        det = _tetrahedron(tets, points, k, g)
+        volume = abs(det) / 6.0
+        if not (volume > 0.0 and volume < np.inf):
+            bad += 1
+            continue
+        for d in range(3):
+            acc = 0.0
+            for a in range(4):
+                acc += u[tets[k, a]] * (g[a, d] / det)
+            gh[d] = acc
+        a, b, c = element_sums(points, tets, k, bary, weights, u, gh, vals)
+        l2[k] = volume * a
+        h1[k] = volume * b
+        fsq[k] = volume * c
+    return bad
