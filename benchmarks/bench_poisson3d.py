@@ -5,6 +5,7 @@ Run by hand::
     python benchmarks/bench_poisson3d.py [--coarse 3] [--levels 5] [--repeat 3] [--no-solve]
                                          [--no-assembly] [--numbering rcm|none]
     python benchmarks/bench_poisson3d.py --memory [--coarse 3] [--levels 5] [--limit-gb 16]
+    python benchmarks/bench_poisson3d.py --memory --sizes 1M 4M [--skip-peer] [--limit-gb 16]
 
 The mesh is ``structured_box(c, c, c)`` refined ``levels`` times by Bey's red refinement (the
 Kuhn box of ``c 2^levels`` cells per side; c = 3, levels = 5: 97^3 = 912,673 nodes, 5.3M
@@ -28,7 +29,9 @@ edges; ``--numbering none``: the refinement's own). BLAS and numba threads are p
   the identical mesh read from ``.npz`` (scikit-fem ``MeshTet`` + ``ElementTetP1`` assembly,
   ``condense``, pyamg smoothed aggregation CG to 1e-6, the L2 error), each a fresh process;
   ``--limit-gb`` caps each one's address space (``ulimit -v``) so a peer that cannot fit fails
-  instead of taking the machine.
+  instead of taking the machine; ``--sizes 117k 1M 4M`` runs named sizes in turn,
+  ``--skip-peer`` the femkit row alone. Printed: wall, peak RSS, exit code, the L2 error and
+  ``femkit solve``'s stage times, and the femkit / peer peak ratio.
 """
 
 from __future__ import annotations
@@ -212,8 +215,13 @@ def peak_rss(cmd: list[str], limit_gb: float | None) -> tuple[float, float, int,
     return wall, gb, out.returncode, text
 
 
-def memory(coarse: int, levels: int, limit_gb: float | None) -> None:
+#: ``--sizes`` names: (coarse cells per side, red refinements) of the Kuhn cube.
+SIZES = {"117k": (3, 4), "1M": (3, 5), "4M": (5, 5)}
+
+
+def memory(coarse: int, levels: int, limit_gb: float | None, skip_peer: bool = False) -> None:
     """Peak memory of ``femkit solve`` on the cube case against scikit-fem + pyamg on its mesh."""
+    import json
     import sys
     import tempfile
     from pathlib import Path
@@ -223,23 +231,31 @@ def memory(coarse: int, levels: int, limit_gb: float | None) -> None:
     tmp = Path(tempfile.mkdtemp(prefix="bench3d-"))
     case = tmp / "cube.yaml"
     case.write_text(CASE.format(h=repr(1.0 / coarse), k=levels))
-    fine = MeshHierarchy.from_refinement(generate("kuhn_cube", 1.0 / coarse), levels,
-                                         renumber="rcm").finest
-    np.savez(tmp / "mesh.npz", points=fine.points, cells=fine.cells)
-    print(f"memory: kuhn_cube h = 1/{coarse} refined {levels} times: {fine.n_points} nodes, "
-          f"{fine.n_cells} tetrahedra (the peer reads the same mesh from .npz, untimed)")
-    del fine
+    n = coarse * 2 ** levels + 1
+    print(f"memory: kuhn_cube h = 1/{coarse} refined {levels} times: {n ** 3} nodes, "
+          f"{6 * (n - 1) ** 3} tetrahedra")
     env_py = sys.executable
-    rows = [("femkit solve", [env_py, "-m", "femkit.cli", "solve", str(case), "-o", str(tmp / "out")]),
-            ("skfem + pyamg SA", [env_py, "-c", PEER.format(mesh=str(tmp / "mesh.npz"))])]
+    rows = [("femkit solve", [env_py, "-m", "femkit.cli", "solve", str(case), "-o", str(tmp / "out")])]
+    if not skip_peer:  # the same mesh, written for the peer (untimed)
+        fine = MeshHierarchy.from_refinement(generate("kuhn_cube", 1.0 / coarse), levels,
+                                             renumber="rcm").finest
+        np.savez(tmp / "mesh.npz", points=fine.points, cells=fine.cells)
+        del fine
+        rows.append(("skfem + pyamg SA", [env_py, "-c", PEER.format(mesh=str(tmp / "mesh.npz"))]))
+    peaks = {}
     for name, cmd in rows:
         wall, gb, rc, text = peak_rss(cmd, limit_gb)
         result = tmp / "out" / "result.json"
         if name.startswith("femkit") and result.exists():
-            import json
-
-            text = f"L2 {json.loads(result.read_text())['errors']['L2']!r}; {text}"
+            res = json.loads(result.read_text())
+            stages = ", ".join(f"{k} {v:.1f}" for k, v in res["timings"].items())
+            text = f"L2 {res['errors']['L2']!r}; stages (s): {stages}"
         print(f"{name:18s} {wall:7.1f} s  peak RSS {gb:6.2f} GB  exit {rc}  {text}")
+        if rc == 0:
+            peaks[name] = gb
+    if len(peaks) == 2:
+        print(f"femkit / peer peak RSS: {peaks['femkit solve'] / peaks['skfem + pyamg SA']:.2f} "
+              "(goal: below 1)")
 
 
 def main() -> None:
@@ -253,12 +269,19 @@ def main() -> None:
                     help="only the peak memory of femkit solve against scikit-fem + pyamg")
     ap.add_argument("--limit-gb", type=float, default=None,
                     help="address-space limit of each --memory process (ulimit -v)")
+    ap.add_argument("--sizes", nargs="+", choices=tuple(SIZES), default=None,
+                    help="--memory at these named sizes (overrides --coarse/--levels): "
+                         + ", ".join(f"{k} = h 1/{c} refined {k_}" for k, (c, k_) in SIZES.items()))
+    ap.add_argument("--skip-peer", action="store_true",
+                    help="--memory: femkit solve only (a peer that cannot fit is not started)")
     ap.add_argument("--numbering", choices=("rcm", "none"), default="rcm",
                     help="rcm (default): as femkit solve numbers tetrahedral hierarchies; "
                          "none: the refinement's own (coarse nodes first)")
     args = ap.parse_args()
     if args.memory:
-        memory(args.coarse, args.levels, args.limit_gb)
+        for coarse, levels in ([SIZES[k] for k in args.sizes] if args.sizes
+                               else [(args.coarse, args.levels)]):
+            memory(coarse, levels, args.limit_gb, args.skip_peer)
         return
     from femkit.mesh import MeshHierarchy, structured_box
 
