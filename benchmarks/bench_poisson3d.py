@@ -217,8 +217,11 @@ def peak_rss(cmd: list[str], limit_gb: float | None) -> tuple[float, float, int,
     rss = [ln for ln in out.stderr.splitlines() if "Maximum resident set size" in ln]
     gb = int(rss[0].split()[-1]) / 2**20 if rss else float("nan")
     text = (out.stdout.strip().splitlines() or [""])[-1]
-    if out.returncode:
-        text = (out.stderr.strip().splitlines() or [""])[-2 if rss else -1][:160]
+    if out.returncode:  # the process's last stderr line before /usr/bin/time's report
+        err = out.stderr.strip().splitlines()
+        cut = next((i for i, ln in enumerate(err) if "Command being timed" in ln), len(err))
+        err = [ln for ln in err[:cut] if not ln.startswith("Command exited")]
+        text = (err or [""])[-1][:160]
     return wall, gb, out.returncode, text
 
 
