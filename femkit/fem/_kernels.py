@@ -424,9 +424,6 @@ def warm_up() -> None:
     _, nnz3, _, _ = _pattern_cells(tet, 4, ind3, slots3, p3, np.ones(1), True, True)
     _stiffness_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, slots3, nnz3)
     _load_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, 4)
-    from ._kernels3d import warm_up as warm_up_3d
-
-    warm_up_3d()
 
 
 @numba.njit(cache=True)
@@ -473,12 +470,8 @@ def _stiffness_rows(tri, n, points, kappa, scalar_kappa, inc):  # pragma: no cov
 
 def stiffness_rows_kernel(mesh, kappa):
     """``(indptr, indices, data)`` of the stiffness of a whole triangle mesh, built row by row
-    without a slot map (:func:`_stiffness_rows`), or None if some triangle is degenerate;
-    tetrahedra: :func:`femkit.fem._kernels3d.stiffness_rows_tet_kernel`."""
-    if mesh.dim == 3:
-        from ._kernels3d import stiffness_rows_tet_kernel
-
-        return stiffness_rows_tet_kernel(mesh, kappa)
+    without a slot map (:func:`_stiffness_rows`), or None if some triangle is degenerate
+    (tetrahedra: :func:`femkit.fem._kernels3d.stiffness_rows_tet_kernel`)."""
     m, n = mesh.n_cells, mesh.n_points
     inc = np.empty(3 * m, np.int32 if max(3 * m, 8 * n) < np.iinfo(np.int32).max else np.int64)
     indptr, indices, data, bad = _stiffness_rows(mesh.cells, n, mesh.points, *_values(kappa), inc)
