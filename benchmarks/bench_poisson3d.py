@@ -5,6 +5,7 @@ Run by hand::
     python benchmarks/bench_poisson3d.py [--coarse 3] [--levels 5] [--repeat 3] [--no-solve]
                                          [--no-assembly] [--numbering rcm|none]
     python benchmarks/bench_poisson3d.py --memory [--coarse 3] [--levels 5] [--limit-gb 16]
+    python benchmarks/bench_poisson3d.py --memory --sizes 1M 4M [--skip-peer] [--limit-gb 16]
 
 The mesh is ``structured_box(c, c, c)`` refined ``levels`` times by Bey's red refinement (the
 Kuhn box of ``c 2^levels`` cells per side; c = 3, levels = 5: 97^3 = 912,673 nodes, 5.3M
@@ -13,21 +14,26 @@ tetrahedra, the ~1M-unknown target; c = 5: 161^3 = 4.17M nodes, 24.6M tetrahedra
 edges; ``--numbering none``: the refinement's own). BLAS and numba threads are pinned to 1. Printed:
 
 - assembly: ``skfem`` = ``Basis(MeshTet, ElementTetP1(), intorder=1)`` + ``asm(laplace)`` +
-  ``asm(unit load)``; ``fk first`` = ``assemble_stiffness`` + ``assemble_load`` on a new mesh
-  object (CSR pattern built in the call; numba compile excluded: cached on disk); medians of
-  interleaved runs, and the ratio;
+  ``asm(unit load)``; femkit's first call = ``assemble_stiffness`` + ``assemble_load`` on a new
+  mesh object (CSR pattern built in the call; numba compile excluded: cached on disk), both row
+  by row (``keep_pattern=False``, what ``femkit solve`` does: no slot map) and by the fused
+  element-order pass that keeps the pattern; medians of interleaved runs, and the ratios;
 - solve to the discretisation error of ``u = exp(x + y/2 - 3z/10)`` (Dirichlet data = u):
   ``fmg`` on the nested boxes given the Dirichlet values (as ``femkit solve`` calls it; its own
   stopping rule; the time includes its set-up: symmetry check, transfers, Galerkin products),
   then pyamg Ruge-Stueben and smoothed aggregation (set-up + ``solve(accel="cg")``) with the
-  tolerance lowered by 10x until their L2 error is within 1 % of fmg's; wall times in seconds and
-  in units of one SpMV ``A @ x`` (SciPy CSR, medians taken around the fmg runs);
+  tolerance lowered by 10x until their L2 error is within 1 % of fmg's (counted: the set-up and
+  the solve at that tolerance); wall times in seconds and in units of one SpMV ``A @ x`` (SciPy
+  CSR), each row in the unit measured around it (fmg: medians around its runs; each pyamg
+  solver: right before and after it), so a load that changes between rows moves the unit too;
 - ``--memory``: peak RSS (``/usr/bin/time -v``) of ``python -m femkit.cli solve`` on the same cube
   case (kuhn_cube h = 1/c, ``refine: levels``, fmg, errors, no VTU/PNG) and of the peer job on
   the identical mesh read from ``.npz`` (scikit-fem ``MeshTet`` + ``ElementTetP1`` assembly,
   ``condense``, pyamg smoothed aggregation CG to 1e-6, the L2 error), each a fresh process;
   ``--limit-gb`` caps each one's address space (``ulimit -v``) so a peer that cannot fit fails
-  instead of taking the machine.
+  instead of taking the machine; ``--sizes 117k 1M 4M`` runs named sizes in turn,
+  ``--skip-peer`` the femkit row alone. Printed: wall, peak RSS, exit code, the L2 error and
+  ``femkit solve``'s stage times, and the femkit / peer peak ratio.
 """
 
 from __future__ import annotations
@@ -62,10 +68,11 @@ def assembly(mesh, repeat: int) -> None:
     import skfem
     from skfem.helpers import dot, grad
 
-    from femkit.fem import _kernels, assemble_load, assemble_stiffness
+    from femkit.fem import _kernels, _kernels3d, assemble_load, assemble_stiffness
     from femkit.mesh import Mesh
 
     _kernels.warm_up()
+    _kernels3d.warm_up()
     laplace = skfem.BilinearForm(lambda u, v, w: dot(grad(u), grad(v)))
     unit = skfem.LinearForm(lambda v, w: 1.0 * v)
 
@@ -74,20 +81,23 @@ def assembly(mesh, repeat: int) -> None:
                             skfem.ElementTetP1(), intorder=1)
         return laplace.assemble(basis), unit.assemble(basis)
 
-    def femkit_run():
+    def femkit_run(keep: bool):
         fresh = Mesh(mesh.points, mesh.cells)           # no cached pattern
-        return assemble_stiffness(fresh), assemble_load(fresh, 1.0)
+        return assemble_stiffness(fresh, keep_pattern=keep), assemble_load(fresh, 1.0)
 
-    sk, fk = [], []
-    for _ in range(repeat):
+    sk, rows, fused = [], [], []
+    for r in range(repeat):
         sk.append(timed(skfem_run)[0])
-        t, (K, F) = timed(femkit_run)
-        fk.append(t)
+        for keep in ((False, True) if r % 2 == 0 else (True, False)):  # alternate who follows skfem
+            t, (K, F) = timed(lambda: femkit_run(keep))
+            (fused if keep else rows).append(t)
     Ks, Fs = skfem_run()
     err = abs(K - Ks).max() / abs(Ks).max()
-    print(f"assembly: skfem {statistics.median(sk):.2f} s, femkit first call "
-          f"{statistics.median(fk):.2f} s, ratio {statistics.median(sk) / statistics.median(fk):.1f}x "
-          f"(max |K - K_skfem| / max |K| = {err:.1e}, |F - F_skfem| = {abs(F - Fs).max():.1e})")
+    t_sk, t_rows, t_fused = (statistics.median(v) for v in (sk, rows, fused))
+    print(f"assembly: skfem {t_sk:.2f} s; femkit first call, row by row (as femkit solve) "
+          f"{t_rows:.2f} s, ratio {t_sk / t_rows:.1f}x; fused pass keeping the pattern "
+          f"{t_fused:.2f} s, ratio {t_sk / t_fused:.1f}x (max |K - K_skfem| / max |K| = "
+          f"{err:.1e}, |F - F_skfem| = {abs(F - Fs).max():.1e})")
 
 
 def spmv_time(A, repeat: int = 20) -> float:
@@ -135,22 +145,27 @@ def solve(H, repeat: int) -> None:
           f"operator complexity {info['operator_complexity']:.3f}, stopped by "
           f"{info['stopped_by']}; setup {res.setup_time / spmv:.0f} SpMV, cycles "
           f"{res.solve_time / spmv:.0f} SpMV (last run)")
-    rows = [("femkit fmg", t_fmg, target, f"median of {repeat}")]
+    rows = [("femkit fmg", t_fmg, spmv, target, f"median of {repeat}")]
     for name, build in (("pyamg RS", pyamg.ruge_stuben_solver),
                         ("pyamg SA", pyamg.smoothed_aggregation_solver)):
+        before = spmv_time(A)
         t_setup, ml = timed(lambda: build(A))
         for tol in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9):
             t_solve, x = timed(lambda: ml.solve(sys_.b, tol=tol, accel="cg"))
             err = l2(x)
             if err <= 1.01 * target:
                 break
-        rows.append((name, t_setup + t_solve, err,
-                     f"tol {tol:g}: setup {t_setup / spmv:.0f} + solve {t_solve / spmv:.0f} SpMV"))
+        # its own unit, measured right before and after it (the load moves between the rows);
+        # counted: the set-up and the one solve at the tolerance that reaches fmg's error
+        unit = statistics.median([before, spmv_time(A)])
+        rows.append((name, t_setup + t_solve, unit, err,
+                     f"tol {tol:g}: setup {t_setup / unit:.0f} + solve {t_solve / unit:.0f} SpMV "
+                     f"(SpMV {unit * 1e3:.2f} ms around it)"))
     print(f"{'solver':12s} {'seconds':>8s} {'SpMV units':>10s} {'L2 error':>10s}")
-    for name, t, err, note in rows:
-        print(f"{name:12s} {t:8.2f} {t / spmv:10.0f} {err:10.3e} {note}")
-    best = min(t for name, t, _, _ in rows[1:])
-    print(f"fmg / best pyamg: {t_fmg / best:.3f} (goal <= 0.2)")
+    for name, t, unit, err, note in rows:
+        print(f"{name:12s} {t:8.2f} {t / unit:10.0f} {err:10.3e} {note}")
+    best = min(t / unit for _, t, unit, _, _ in rows[1:])
+    print(f"fmg / best pyamg in SpMV units: {t_fmg / spmv / best:.3f} (goal <= 0.2)")
 
 
 CASE = """problem: poisson
@@ -203,13 +218,22 @@ def peak_rss(cmd: list[str], limit_gb: float | None) -> tuple[float, float, int,
     rss = [ln for ln in out.stderr.splitlines() if "Maximum resident set size" in ln]
     gb = int(rss[0].split()[-1]) / 2**20 if rss else float("nan")
     text = (out.stdout.strip().splitlines() or [""])[-1]
-    if out.returncode:
-        text = (out.stderr.strip().splitlines() or [""])[-2 if rss else -1][:160]
+    if out.returncode:  # the process's last stderr line before /usr/bin/time's report
+        err = out.stderr.strip().splitlines()
+        cut = next((i for i, ln in enumerate(err) if "Command being timed" in ln), len(err))
+        err = [ln for ln in err[:cut] if not ln.startswith("Command exited")]
+        text = (err or [""])[-1][:160]
     return wall, gb, out.returncode, text
 
 
-def memory(coarse: int, levels: int, limit_gb: float | None) -> None:
+#: ``--sizes`` names: (coarse cells per side, red refinements) of the Kuhn cube.
+SIZES = {"117k": (3, 4), "1M": (3, 5), "4M": (5, 5)}
+
+
+def memory(coarse: int, levels: int, limit_gb: float | None, skip_peer: bool = False,
+           force: bool = False) -> None:
     """Peak memory of ``femkit solve`` on the cube case against scikit-fem + pyamg on its mesh."""
+    import json
     import sys
     import tempfile
     from pathlib import Path
@@ -219,23 +243,32 @@ def memory(coarse: int, levels: int, limit_gb: float | None) -> None:
     tmp = Path(tempfile.mkdtemp(prefix="bench3d-"))
     case = tmp / "cube.yaml"
     case.write_text(CASE.format(h=repr(1.0 / coarse), k=levels))
-    fine = MeshHierarchy.from_refinement(generate("kuhn_cube", 1.0 / coarse), levels,
-                                         renumber="rcm").finest
-    np.savez(tmp / "mesh.npz", points=fine.points, cells=fine.cells)
-    print(f"memory: kuhn_cube h = 1/{coarse} refined {levels} times: {fine.n_points} nodes, "
-          f"{fine.n_cells} tetrahedra (the peer reads the same mesh from .npz, untimed)")
-    del fine
+    n = coarse * 2 ** levels + 1
+    print(f"memory: kuhn_cube h = 1/{coarse} refined {levels} times: {n ** 3} nodes, "
+          f"{6 * (n - 1) ** 3} tetrahedra")
     env_py = sys.executable
-    rows = [("femkit solve", [env_py, "-m", "femkit.cli", "solve", str(case), "-o", str(tmp / "out")]),
-            ("skfem + pyamg SA", [env_py, "-c", PEER.format(mesh=str(tmp / "mesh.npz"))])]
+    rows = [("femkit solve", [env_py, "-m", "femkit.cli", "solve", str(case), "-o", str(tmp / "out")]
+             + (["--force"] if force else []))]
+    if not skip_peer:  # the same mesh, written for the peer (untimed)
+        fine = MeshHierarchy.from_refinement(generate("kuhn_cube", 1.0 / coarse), levels,
+                                             renumber="rcm").finest
+        np.savez(tmp / "mesh.npz", points=fine.points, cells=fine.cells)
+        del fine
+        rows.append(("skfem + pyamg SA", [env_py, "-c", PEER.format(mesh=str(tmp / "mesh.npz"))]))
+    peaks = {}
     for name, cmd in rows:
         wall, gb, rc, text = peak_rss(cmd, limit_gb)
         result = tmp / "out" / "result.json"
         if name.startswith("femkit") and result.exists():
-            import json
-
-            text = f"L2 {json.loads(result.read_text())['errors']['L2']!r}; {text}"
+            res = json.loads(result.read_text())
+            stages = ", ".join(f"{k} {v:.1f}" for k, v in res["timings"].items())
+            text = f"L2 {res['errors']['L2']!r}; stages (s): {stages}"
         print(f"{name:18s} {wall:7.1f} s  peak RSS {gb:6.2f} GB  exit {rc}  {text}")
+        if rc == 0:
+            peaks[name] = gb
+    if len(peaks) == 2:
+        print(f"femkit / peer peak RSS: {peaks['femkit solve'] / peaks['skfem + pyamg SA']:.2f} "
+              "(goal: below 1)")
 
 
 def main() -> None:
@@ -249,12 +282,22 @@ def main() -> None:
                     help="only the peak memory of femkit solve against scikit-fem + pyamg")
     ap.add_argument("--limit-gb", type=float, default=None,
                     help="address-space limit of each --memory process (ulimit -v)")
+    ap.add_argument("--sizes", nargs="+", choices=tuple(SIZES), default=None,
+                    help="--memory at these named sizes (overrides --coarse/--levels): "
+                         + ", ".join(f"{k} = h 1/{c} refined {k_}" for k, (c, k_) in SIZES.items()))
+    ap.add_argument("--force", action="store_true",
+                    help="--memory: pass --force to femkit solve (its memory guard's model "
+                         "prices a 4M-node cube far above what it takes)")
+    ap.add_argument("--skip-peer", action="store_true",
+                    help="--memory: femkit solve only (a peer that cannot fit is not started)")
     ap.add_argument("--numbering", choices=("rcm", "none"), default="rcm",
                     help="rcm (default): as femkit solve numbers tetrahedral hierarchies; "
                          "none: the refinement's own (coarse nodes first)")
     args = ap.parse_args()
     if args.memory:
-        memory(args.coarse, args.levels, args.limit_gb)
+        for coarse, levels in ([SIZES[k] for k in args.sizes] if args.sizes
+                               else [(args.coarse, args.levels)]):
+            memory(coarse, levels, args.limit_gb, args.skip_peer, args.force)
         return
     from femkit.mesh import MeshHierarchy, structured_box
 

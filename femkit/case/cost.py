@@ -54,6 +54,15 @@ def geometry_domain(geometry: str, params: dict | None = None) -> tuple[int, flo
 
 #: Tetrahedra gmsh makes per ``h^3`` of volume (unit cube: 1,140 at h = 0.2, 8,617 at 0.1).
 TETS_PER_H3 = 9.0
+#: Geometries whose tetrahedra are counted exactly: Kuhn cubes of side ``h``, each cut into 6
+#: tetrahedra (``kuhn_cube`` h = 1/4: 384), so ``6 V / h^3``.
+EXACT_TETS_PER_H3 = {"kuhn_cube": 6.0, "kuhn_fichera": 6.0}
+
+
+def tets_per_h3(geometry: str) -> float:
+    """Tetrahedra per ``h^3`` of volume of a generated 3D geometry: exact for the Kuhn
+    geometries (:data:`EXACT_TETS_PER_H3`), gmsh's measured density otherwise."""
+    return EXACT_TETS_PER_H3.get(geometry, TETS_PER_H3)
 #: Memory of one tetrahedron in triangles of the 2D model: the stiffness entries of a cell,
 #: 4 x 4 against 3 x 3, which dominate assembly (the peak of a mesh's stages).
 TET_AS_TRIANGLES = 16.0 / 9.0
@@ -69,7 +78,7 @@ def check_mesh_fits(*, geometry: str | None = None, h: float | None = None,
 
     Only the mesh stages are planned (:func:`femkit.cost.plan_mesh`, a triangle model). A
     tetrahedral mesh is priced as :data:`TET_AS_TRIANGLES` triangles per tetrahedron, a
-    generated one at :data:`TETS_PER_H3` tetrahedra per ``h^3`` of volume, and a refinement
+    generated one at :func:`tets_per_h3` tetrahedra per ``h^3`` of volume, and a refinement
     multiplies the cells by 8 (Bey's red refinement) instead of 4. ``force`` skips the check.
 
     Raises
@@ -86,7 +95,7 @@ def check_mesh_fits(*, geometry: str | None = None, h: float | None = None,
                              params=params)
             check_budget(plan, override=override)
             return
-        triangles = TETS_PER_H3 * size / float(h) ** 3
+        triangles = tets_per_h3(geometry) * size / float(h) ** 3
     if dim == 3:  # 8^k tetrahedra after k refinements = (2^k cells) x 4^k in the 2D model
         triangles = TET_AS_TRIANGLES * triangles * 2.0 ** refine
     check_budget(plan_mesh(triangles=triangles, refine=refine), override=override)
@@ -137,8 +146,9 @@ def plan_poisson_case(case, *, measure: bool = True) -> Plan:
         params = dict(mesh.params)
         dim, size, length = geometry_domain(mesh.geometry, params)
         if dim == 3:
-            tets = TETS_PER_H3 * size / float(mesh.h) ** 3
-            plan = _tetrahedral_plan(tets, f"{tets:,.0f} tetrahedra: {TETS_PER_H3:g} per h^3 of "
+            density = tets_per_h3(mesh.geometry)
+            tets = density * size / float(mesh.h) ** 3
+            plan = _tetrahedral_plan(tets, f"{tets:,.0f} tetrahedra: {density:g} per h^3 of "
                                      f"volume {size:g}", f"{mesh.geometry} h={mesh.h:g}", common)
         else:
             plan = plan_poisson(area=size, line_length=length, h=mesh.h, name=mesh.geometry,

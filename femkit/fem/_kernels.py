@@ -22,6 +22,54 @@ def _insert_sorted(indices, s, end, j):  # pragma: no cover - compiled
     return end + 1
 
 
+@numba.njit(cache=True, inline="always")
+def _row_columns(cells, inc, k0, k1, i, stamp, indices, s, write, pos):  # pragma: no cover - compiled
+    """The distinct vertices of the elements ``inc[k0:k1]`` around node ``i`` (``stamp[j] ==
+    i`` marks the ones seen); returns their count. With ``write`` they go sorted into
+    ``indices[s:]`` (insertion sort: rows are short) and ``pos[j]`` gets each one's position."""
+    q = s
+    for k in range(k0, k1):
+        e = inc[k]
+        for b in range(cells.shape[1]):
+            j = cells[e, b]
+            if stamp[j] != i:
+                stamp[j] = i
+                q = _insert_sorted(indices, s, q, j) if write else q + 1
+    if write:
+        for p in range(s, q):
+            pos[indices[p]] = p
+    return q - s
+
+
+@numba.njit(cache=True)
+def _row_lengths(cells, n, inc):  # pragma: no cover - compiled
+    """Node -> element incidences of ``cells`` (m, w) into ``inc`` (``w m``; counting sort:
+    elements in increasing order around each node) and the CSR row lengths of the P1 pattern:
+    ``(start, indptr, stamp)``, ``inc[start[i]:start[i + 1]]`` the elements around node ``i``,
+    ``stamp`` reset to -1 for the row pass of the caller."""
+    m, w = cells.shape
+    start = np.zeros(n + 1, np.int64)
+    for e in range(m):
+        for a in range(w):
+            start[cells[e, a] + 1] += 1
+    for i in range(n):
+        start[i + 1] += start[i]
+    fill = start[:-1].copy()
+    for e in range(m):
+        for a in range(w):
+            i = cells[e, a]
+            inc[fill[i]] = e
+            fill[i] += 1
+    stamp = np.full(n, -1, np.int64)
+    indptr = np.zeros(n + 1, np.int64)
+    nothing = np.empty(0, inc.dtype)
+    for i in range(n):
+        indptr[i + 1] = indptr[i] + _row_columns(cells, inc, start[i], start[i + 1], i, stamp,
+                                                 nothing, 0, False, stamp)
+    stamp[:] = -1
+    return start, indptr, stamp
+
+
 @numba.njit(cache=True)
 def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  # pragma: no cover - compiled
     """Node-wise P1 pattern: row i = sorted unique vertices of the elements around node i.
@@ -392,51 +440,15 @@ def _stiffness_rows(tri, n, points, kappa, scalar_kappa, inc):  # pragma: no cov
     buffer of the incidences; ``indices`` get its dtype. ``bad`` counts degenerate triangles
     (then ``data`` is incomplete).
     """
-    m = tri.shape[0]
-    start = np.zeros(n + 1, np.int64)
-    for e in range(m):
-        for a in range(3):
-            start[tri[e, a] + 1] += 1
-    for i in range(n):
-        start[i + 1] += start[i]
-    fill = start[:-1].copy()
-    for e in range(m):
-        for a in range(3):
-            i = tri[e, a]
-            inc[fill[i]] = e
-            fill[i] += 1
-    # pass 1: the row lengths (distinct neighbours, a stamp array)
-    stamp = np.full(n, -1, np.int64)
-    indptr = np.zeros(n + 1, np.int64)
-    for i in range(n):
-        c = 0
-        for k in range(start[i], start[i + 1]):
-            e = inc[k]
-            for b in range(3):
-                j = tri[e, b]
-                if stamp[j] != i:
-                    stamp[j] = i
-                    c += 1
-        indptr[i + 1] = indptr[i] + c
+    start, indptr, stamp = _row_lengths(tri, n, inc)
     nnz = indptr[n]
     indices = np.empty(nnz, inc.dtype)
     data = np.zeros(nnz)
     pos = np.empty(n, np.int64)
-    stamp[:] = -1
     bad = 0
     # pass 2: sorted columns (insertion sort: rows are short), then the local rows summed
     for i in range(n):
-        s = indptr[i]
-        q_end = s
-        for k in range(start[i], start[i + 1]):
-            e = inc[k]
-            for b in range(3):
-                j = tri[e, b]
-                if stamp[j] != i:
-                    stamp[j] = i
-                    q_end = _insert_sorted(indices, s, q_end, j)
-        for q in range(s, q_end):
-            pos[indices[q]] = q
+        _row_columns(tri, inc, start[i], start[i + 1], i, stamp, indices, indptr[i], True, pos)
         for k in range(start[i], start[i + 1]):
             e = inc[k]
             i0, i1, i2, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(tri, points, e)
@@ -458,7 +470,8 @@ def _stiffness_rows(tri, n, points, kappa, scalar_kappa, inc):  # pragma: no cov
 
 def stiffness_rows_kernel(mesh, kappa):
     """``(indptr, indices, data)`` of the stiffness of a whole triangle mesh, built row by row
-    without a slot map (:func:`_stiffness_rows`), or None if some triangle is degenerate."""
+    without a slot map (:func:`_stiffness_rows`), or None if some triangle is degenerate
+    (tetrahedra: :func:`femkit.fem._kernels3d.stiffness_rows_tet_kernel`)."""
     m, n = mesh.n_cells, mesh.n_points
     inc = np.empty(3 * m, np.int32 if max(3 * m, 8 * n) < np.iinfo(np.int32).max else np.int64)
     indptr, indices, data, bad = _stiffness_rows(mesh.cells, n, mesh.points, *_values(kappa), inc)

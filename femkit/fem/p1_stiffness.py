@@ -96,10 +96,10 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
         matrix in the same compiled pass (:meth:`SparsityPattern.with_stiffness`) and caches
         the pattern for later calls.
     keep_pattern : bool
-        ``False``: a whole-mesh numba assembly of triangles without a cached pattern builds
-        the matrix row by row (:func:`femkit.fem._kernels.stiffness_rows_kernel`: the same
-        matrix bit for bit) and caches nothing, so no (m, 9) slot map is ever allocated (the
-        one-off assembly of a large run: a third of the memory of the fused pass).
+        ``False``: a whole-mesh numba assembly without a cached pattern builds the matrix
+        row by row (:func:`femkit.fem._kernels.stiffness_rows_kernel`, tetrahedra
+        :func:`femkit.fem._kernels3d.stiffness_rows_tet_kernel`: the same matrix bit for bit) and caches nothing, so no (m, 9) or (m, 16)
+        slot map is ever allocated (the one-off assembly of a large run: a third of the memory of the fused pass).
 
     Returns
     -------
@@ -114,9 +114,11 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
         backend = "numba" if count >= NUMBA_THRESHOLD else "numpy"
     if pattern is None:
         pattern = SparsityPattern.cached(mesh)
-        if pattern is None and backend == "numba" and idx is None and mesh.dim == 2 and not keep_pattern:
-            from ._kernels import stiffness_rows_kernel
-
+        if pattern is None and backend == "numba" and idx is None and not keep_pattern:
+            if mesh.dim == 3:
+                from ._kernels3d import stiffness_rows_tet_kernel as stiffness_rows_kernel
+            else:
+                from ._kernels import stiffness_rows_kernel
             arrays = stiffness_rows_kernel(mesh, _kernel_coefficient(mesh, kappa, None))
             if arrays is not None:
                 indptr, indices, data = arrays

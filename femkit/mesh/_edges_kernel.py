@@ -44,21 +44,7 @@ def cell_edges(cells, local, n, node_type, edge_type):  # pragma: no cover - com
             fill[lo] = q + 1
             bucket_hi[q] = hi
             bucket_id[q] = e * k + j
-    count = 0
-    for v in range(n):
-        s, t = start[v], start[v + 1]
-        for a in range(s + 1, t):  # insertion sort of the bucket by hi
-            h, i = bucket_hi[a], bucket_id[a]
-            b = a
-            while b > s and bucket_hi[b - 1] > h:
-                bucket_hi[b] = bucket_hi[b - 1]
-                bucket_id[b] = bucket_id[b - 1]
-                b -= 1
-            bucket_hi[b] = h
-            bucket_id[b] = i
-        for a in range(s, t):
-            if a == s or bucket_hi[a] != bucket_hi[a - 1]:
-                count += 1
+    count = sort_buckets(start, bucket_hi, bucket_id)
     edge_nodes = np.empty((count, 2), node_type.dtype)  # exactly sized: no (m k, 2) buffer
     inverse = np.empty((m, k), edge_type.dtype)
     count = 0
@@ -71,6 +57,28 @@ def cell_edges(cells, local, n, node_type, edge_type):  # pragma: no cover - com
             i = bucket_id[a]
             inverse[i // k, i % k] = count - 1
     return edge_nodes, inverse
+
+
+@numba.njit(cache=True)
+def sort_buckets(start, key, ident):  # pragma: no cover - compiled
+    """Sort each bucket ``key[start[v]:start[v + 1]]`` (carrying ``ident`` along) by insertion
+    (buckets are short); returns the number of distinct keys over all buckets."""
+    count = 0
+    for v in range(start.shape[0] - 1):
+        s, t = start[v], start[v + 1]
+        for a in range(s + 1, t):
+            h, i = key[a], ident[a]
+            b = a
+            while b > s and key[b - 1] > h:
+                key[b] = key[b - 1]
+                ident[b] = ident[b - 1]
+                b -= 1
+            key[b] = h
+            ident[b] = i
+        for a in range(s, t):
+            if a == s or key[a] != key[a - 1]:
+                count += 1
+    return count
 
 
 def warm_up() -> None:

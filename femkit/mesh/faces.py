@@ -22,6 +22,10 @@ __all__ = ["LOCAL_FACES", "local_faces", "faces", "boundary_faces_topological", 
 #: ``(b - a) x (c - a)`` points out of a positively oriented tetrahedron.
 LOCAL_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 
+#: Meshes with at least this many tetrahedra find their faces with a compiled counting sort
+#: (:mod:`femkit.mesh._faces_kernel`, the same numbering); smaller ones with a lexicographic sort.
+NUMBA_THRESHOLD = 100_000
+
 
 def local_faces(tets: np.ndarray) -> np.ndarray:
     """(m, 4, 3) outward-oriented faces of each tetrahedron (face k opposite vertex k)."""
@@ -48,7 +52,8 @@ def unique_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def faces(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
-    """Unique faces and the element -> face map.
+    """Unique faces and the element -> face map (compiled from :data:`NUMBA_THRESHOLD`
+    tetrahedra on).
 
     Returns
     -------
@@ -57,6 +62,11 @@ def faces(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     tet_faces : (m, 4) int64
         ``tet_faces[t, k]`` is the face of tetrahedron ``t`` opposite its local vertex ``k``.
     """
+    if mesh.n_cells >= NUMBA_THRESHOLD:
+        from ._faces_kernel import tet_faces
+
+        return tet_faces(np.ascontiguousarray(mesh.tetrahedra, dtype=np.int64), LOCAL_FACES,
+                         max(mesh.n_points, 1))
     loc = np.sort(local_faces(mesh.tetrahedra).reshape(-1, 3), axis=1)
     face_nodes, inverse = unique_rows(loc)
     return face_nodes, inverse.reshape(-1, 4)

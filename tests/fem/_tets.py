@@ -32,3 +32,14 @@ def perturbed_box(n=3, amount=0.2, state=5, lengths=(1.0, 1.0, 1.0)):
     return validate(Mesh(p, m.cells, cell_tags=np.where(m.centroids()[:, 0] < 0.5 * L[0], 1, 2),
                          boundary_facets=m.boundary_facets, boundary_tags=m.boundary_tags,
                          tag_names={**m.tag_names, "left_half": 1, "right_half": 2}))
+
+
+def scrambled_box(n=4, state=3):
+    """:func:`perturbed_box` with randomly permuted node and element numbers (an element's
+    vertices far apart in memory, rows in another order than the elements)."""
+    base = perturbed_box(n, state=state)
+    rng = np.random.default_rng(state)
+    perm = rng.permutation(base.n_points)
+    inv = np.empty_like(perm)
+    inv[perm] = np.arange(len(perm))
+    return Mesh(base.points[perm], inv[base.cells][rng.permutation(base.n_cells)])

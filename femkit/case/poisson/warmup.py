@@ -206,7 +206,7 @@ def _passes(kernels, dim: int) -> list[str]:
     """The fused passes (:mod:`femkit.fem.fused.templates`) a run on a ``dim``-D mesh calls."""
     names = []
     if kernels.exact is not None:
-        names += ["triangle_pass" if dim == 2 else "simplex_pass", "nodal_pass"]
+        names += ["triangle_pass" if dim == 2 else "tetrahedron_pass", "nodal_pass"]
     if kernels.source is not None and (kernels.exact is None or not kernels.module.HAS_SOURCE):
         names.append("source_pass")
     if kernels.source is not None:
@@ -240,10 +240,8 @@ def _compile_passes(kernels, mesh) -> None:
     u, out = np.zeros(len(points)), [np.empty(2) for _ in range(3)]
     mod = kernels.module
     for name in _passes(kernels, d):
-        if name == "triangle_pass":
-            mod.triangle_pass(points, cells, bary, weights, u, *out)
-        elif name == "simplex_pass":
-            mod.simplex_pass(points, cells, bary, weights, u, np.zeros((2, d)), np.ones(2), *out)
+        if name in ("triangle_pass", "tetrahedron_pass"):
+            getattr(mod, name)(points, cells, bary, weights, u, *out)
         elif name == "nodal_pass":
             mod.nodal_pass(points, u)
         elif name == "source_values":

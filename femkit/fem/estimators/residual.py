@@ -193,8 +193,7 @@ def residual_estimator(mesh, u: np.ndarray, *, kappa=1.0, f=0.0, neumann: Sequen
     if mesh.dim == 3:
         from .residual_faces import residual_terms_3d
 
-        fl = element_fields(mesh, u, kappa)
-        parts = residual_terms_3d(mesh, fl, f, neumann, dirichlet_nodes, c_volume, c_jump)
+        parts = residual_terms_3d(mesh, u, kappa, f, neumann, dirichlet_nodes, c_volume, c_jump)
         return ErrorEstimate("residual", np.sqrt(sum(parts.values())), parts)
     terms = _compiled_terms if mesh.n_cells >= NUMBA_THRESHOLD else _numpy_terms
     volume, jump, kap, te, count, edge_nodes, fluxes = terms(mesh, u, kappa, f, c_volume, c_jump)

@@ -45,16 +45,9 @@ def _longest(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
                            for a, b in combinations(range(simplices.shape[1]), 2)], axis=0))
 
 
-def residual_terms_3d(mesh, fl, f, neumann: Sequence, dirichlet_nodes, c_volume: float,
-                      c_jump: float) -> dict:
-    """``volume``, ``jump`` and ``neumann`` parts (each (m,), squared) on a tetrahedral mesh;
-    ``fl`` the :class:`~.geometry.ElementFields` of the solution."""
-    from ...mesh.faces import LOCAL_FACES, face_ids
-    from ..neumann import tagged_facets
-
+def _jump_terms(mesh, fl, c_jump: float) -> tuple:
+    """``(volume, h_T, q_area, face_area, jump, h_F)`` by NumPy from the element fields."""
     grads, vol, tf, count = fl.e, fl.area, fl.tri_edges, fl.edge_count
-    m = mesh.n_cells
-    volume = c_volume ** 2 * _longest(mesh.points, mesh.cells) ** 2 * _source_norm_sq(mesh, f, vol) / fl.kappa
     sigma = fl.kappa[:, None] * fl.grad
     q_area = -3.0 * vol[:, None] * np.einsum("md,mkd->mk", sigma, grads)     # flux x |F_k|, (m, 4)
     face_area = 3.0 * vol[:, None] * np.linalg.norm(grads, axis=2)            # |F_k|, (m, 4)
@@ -69,15 +62,50 @@ def residual_terms_3d(mesh, fl, f, neumann: Sequence, dirichlet_nodes, c_volume:
     interior = count == 2
     eta_face = np.where(interior, h_f * jump_area ** 2 / (np.where(interior, area_f, 1.0) * kmax), 0.0)
     jump = 0.5 * c_jump ** 2 * eta_face[tf].sum(axis=1)
+    return vol, _longest(mesh.points, mesh.cells), q_area, face_area, jump, h_f
 
+
+#: Tetrahedra from which the jump terms are one compiled pass (:mod:`._kernels3d`; below: NumPy).
+NUMBA_THRESHOLD = 100_000
+
+
+def residual_terms_3d(mesh, u: np.ndarray, kappa, f, neumann: Sequence, dirichlet_nodes,
+                      c_volume: float, c_jump: float) -> dict:
+    """``volume``, ``jump`` and ``neumann`` parts (each (m,), squared) of the P1 solution ``u``
+    on a tetrahedral mesh (arguments as :func:`~.residual.residual_estimator`'s)."""
+    from ...mesh.faces import LOCAL_FACES, face_ids, faces
+    from ..neumann import tagged_facets
+    from .geometry import checked_solution, element_fields
+
+    m = mesh.n_cells
+    arrays = None
+    if m >= NUMBA_THRESHOLD:
+        from ..coefficients import element_coefficient
+        from ._kernels3d import residual_faces
+
+        u = checked_solution(mesh, u)
+        kap = element_coefficient(mesh, kappa)
+        face_nodes, tf = faces(mesh)
+        count = np.bincount(tf.ravel(), minlength=len(face_nodes))
+        *arrays, bad = residual_faces(np.ascontiguousarray(mesh.points, dtype=np.float64),
+                                      np.ascontiguousarray(mesh.cells), u, kap, tf, face_nodes,
+                                      count, 0.5 * c_jump ** 2)
+        arrays = None if bad else arrays           # degenerate: the NumPy path names them
+    if arrays is None:
+        fl = element_fields(mesh, u, kappa)
+        kap, face_nodes, tf, count = fl.kappa, fl.edge_nodes, fl.tri_edges, fl.edge_count
+        arrays = _jump_terms(mesh, fl, c_jump)
+    vol, h_t, q_area, face_area, jump, h_f = arrays
+    volume = c_volume ** 2 * h_t ** 2 * _source_norm_sq(mesh, f, vol) / kap
     bnd = np.flatnonzero(count == 1)
     is_dir = np.zeros(mesh.n_points, dtype=bool)
     if dirichlet_nodes is not None:
         is_dir[np.asarray(dirichlet_nodes, dtype=np.int64)] = True
-    bnd = bnd[~is_dir[fl.edge_nodes[bnd]].all(axis=1)]
+    bnd = bnd[~is_dir[face_nodes[bnd]].all(axis=1)]
     neumann_part = np.zeros(m)
     if len(bnd):
         rule = get_rule("gauss3")                       # degree 2 on the face
+        n_faces = len(face_nodes)
         owner = np.full(n_faces, -1, dtype=np.int64)
         owner[tf.ravel()] = np.arange(tf.size)          # boundary faces have a single owner slot
         slot = owner[bnd]
@@ -87,7 +115,7 @@ def residual_terms_3d(mesh, fl, f, neumann: Sequence, dirichlet_nodes, c_volume:
         pos = np.full(n_faces, -1, dtype=np.int64)
         pos[bnd] = np.arange(len(bnd))
         for tags, h in neumann:                         # a few entries, not a loop over faces
-            ids = pos[face_ids(fl.edge_nodes, tagged_facets(mesh, tags))]
+            ids = pos[face_ids(face_nodes, tagged_facets(mesh, tags))]
             ids = ids[ids >= 0]
             if not len(ids):
                 continue
@@ -99,6 +127,6 @@ def residual_terms_3d(mesh, fl, f, neumann: Sequence, dirichlet_nodes, c_volume:
         A = face_area[elem, k]
         r = hq - (q_area[elem, k] / A)[:, None]          # h - kappa du_h/dn at the points
         norm_sq = A * ((r * r) @ rule.weights)
-        neumann_part = np.bincount(elem, weights=c_jump ** 2 * h_f[bnd] * norm_sq / fl.kappa[elem],
+        neumann_part = np.bincount(elem, weights=c_jump ** 2 * h_f[bnd] * norm_sq / kap[elem],
                                    minlength=m)
     return {"volume": volume, "jump": jump, "neumann": neumann_part}

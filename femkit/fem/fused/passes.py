@@ -40,13 +40,8 @@ def error_sums(mesh, u: np.ndarray, rule, kernels: FusedKernels):
     if mesh.dim == 2:
         if mod.triangle_pass(points, cells, bary, weights, u, l2, h1, fsq):
             return None                    # degenerate triangles: named by the NumPy path
-    else:
-        from .._elements import simplex_gradients
-
-        grads, volume, tets = simplex_gradients(mesh, None)
-        grad_h = np.einsum("ma,mad->md", u[tets], grads)
-        del grads
-        mod.simplex_pass(points, cells, bary, weights, u, grad_h, volume, l2, h1, fsq)
+    elif mod.tetrahedron_pass(points, cells, bary, weights, u, l2, h1, fsq):
+        return None                        # degenerate tetrahedra: named by the NumPy path
     if not (np.isfinite(l2).all() and np.isfinite(h1).all()):
         return None
     if kernels.source is not None and mod.HAS_SOURCE and np.isfinite(fsq).all():

@@ -26,6 +26,8 @@ from llvmlite import ir
 from numba.core import types
 from numba.extending import intrinsic
 
+from .._kernels import _tetrahedron
+
 #: Components of the exact gradient ``exact_point`` gives after ``u`` (0: none).
 N_GRAD = 0
 #: True when ``exact_point`` gives the source ``f`` after the gradient.
@@ -144,18 +146,6 @@ def triangle_pass(points, tri, bary, weights, u, l2, h1, fsq):  # pragma: no cov
 
 
 @numba.njit(cache=True, error_model="numpy")
-def simplex_pass(points, cells, bary, weights, u, grad_h, measure, l2, h1, fsq):  # pragma: no cover - compiled
-    """:func:`triangle_pass` on cells of any dimension whose gradients of ``u_h`` (``grad_h``,
-    (m, d)) and measures are given."""
-    vals = np.empty(5)
-    for k in range(cells.shape[0]):
-        a, b, c = element_sums(points, cells, k, bary, weights, u, grad_h[k], vals)
-        l2[k] = measure[k] * a
-        h1[k] = measure[k] * b
-        fsq[k] = measure[k] * c
-
-
-@numba.njit(cache=True, error_model="numpy")
 def source_pass(points, cells, bary, weights, measure, fsq):  # pragma: no cover - compiled
     """``fsq[k] = measure[k] * sum_q w_q f^2``: the source norm alone."""
     vals = np.empty(1)
@@ -196,3 +186,56 @@ def nodal_pass(points, u):  # pragma: no cover - compiled
         if v > big:
             big = v
     return big
+
+
+@numba.njit(cache=True, error_model="numpy")
+def tetrahedron_pass(points, tets, bary, weights, u, l2, h1, fsq):  # pragma: no cover - compiled
+    """Per tetrahedron ``volume * element_sums`` into ``l2``, ``h1``, ``fsq``, the volume and
+    the gradient of ``u_h`` computed on the way (``D grad N_a`` by the assembly's
+    :func:`femkit.fem._kernels._tetrahedron`, ``D = 6 V_signed``), so no (m, 4, 3) array of
+    gradients is formed (the gradients agree with the NumPy path's to round-off); returns the
+    number of tetrahedra of zero or non-finite volume (then the caller reports them by the NumPy
+    path).
+
+    The sums are :func:`element_sums`' with the element's vertices and nodal values held in
+    locals (read once per element, not once per point: the point function's stores into
+    ``vals`` would otherwise make every point reload them), rounded the same way: coordinates
+    summed vertex by vertex, ``u_h`` by fused multiply-adds."""
+    vals = np.empty(5)
+    g = np.empty((4, 3))
+    bad = 0
+    for k in range(tets.shape[0]):
+        det = _tetrahedron(tets, points, k, g)
+        volume = abs(det) / 6.0
+        if not (volume > 0.0 and volume < np.inf):
+            bad += 1
+            continue
+        i0, i1, i2, i3 = tets[k, 0], tets[k, 1], tets[k, 2], tets[k, 3]
+        u0, u1, u2, u3 = u[i0], u[i1], u[i2], u[i3]
+        g0 = u0 * (g[0, 0] / det) + u1 * (g[1, 0] / det) + u2 * (g[2, 0] / det) + u3 * (g[3, 0] / det)
+        g1 = u0 * (g[0, 1] / det) + u1 * (g[1, 1] / det) + u2 * (g[2, 1] / det) + u3 * (g[3, 1] / det)
+        g2 = u0 * (g[0, 2] / det) + u1 * (g[1, 2] / det) + u2 * (g[2, 2] / det) + u3 * (g[3, 2] / det)
+        x0, x1, x2, x3 = points[i0, 0], points[i1, 0], points[i2, 0], points[i3, 0]
+        y0, y1, y2, y3 = points[i0, 1], points[i1, 1], points[i2, 1], points[i3, 1]
+        z0, z1, z2, z3 = points[i0, 2], points[i1, 2], points[i2, 2], points[i3, 2]
+        sl2 = 0.0
+        sh1 = 0.0
+        sfs = 0.0
+        for q in range(weights.shape[0]):
+            b0, b1, b2, b3 = bary[q, 0], bary[q, 1], bary[q, 2], bary[q, 3]
+            exact_point(x0 * b0 + x1 * b1 + x2 * b2 + x3 * b3,
+                        y0 * b0 + y1 * b1 + y2 * b2 + y3 * b3,
+                        z0 * b0 + z1 * b1 + z2 * b2 + z3 * b3, vals)
+            diff = fma(u3, b3, fma(u2, b2, fma(u1, b1, u0 * b0))) - vals[0]
+            w = weights[q]
+            sl2 += w * (diff * diff)
+            if N_GRAD > 0:
+                d0, d1, d2 = g0 - vals[1], g1 - vals[2], g2 - vals[3]
+                sh1 += w * (d0 * d0 + d1 * d1 + d2 * d2)
+            if HAS_SOURCE:
+                f = vals[1 + N_GRAD]
+                sfs += w * (f * f)
+        l2[k] = volume * sl2
+        h1[k] = volume * sh1
+        fsq[k] = volume * sfs
+    return bad
