@@ -10,6 +10,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from ._edges_kernel import sort_buckets
+
 
 @numba.njit(cache=True)
 def red_children(tri, tri_edges, n):  # pragma: no cover - compiled
@@ -100,21 +102,7 @@ def child_edges(n, edge_nodes, tri, tri_edges):  # pragma: no cover - compiled
             b_hi[r] = max(p, q)
             b_id[r] = 3 * t + j
     mid = np.empty(3 * m, np.int64)              # fine edge of pair 3 t + j
-    count = 0
-    for e in range(n_edges):
-        s, u = bstart[e], bstart[e + 1]
-        for a in range(s + 1, u):                # insertion sort of the bucket by q
-            h, i = b_hi[a], b_id[a]
-            b = a
-            while b > s and b_hi[b - 1] > h:
-                b_hi[b] = b_hi[b - 1]
-                b_id[b] = b_id[b - 1]
-                b -= 1
-            b_hi[b] = h
-            b_id[b] = i
-        for a in range(s, u):
-            if a == s or b_hi[a] != b_hi[a - 1]:
-                count += 1
+    count = sort_buckets(bstart, b_hi, b_id)     # each bucket by q; distinct pairs
     edge_out = np.empty((n_half + count, 2), np.int64)
     edge_out[:n_half] = out_pairs
     count = n_half
