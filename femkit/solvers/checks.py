@@ -189,6 +189,11 @@ def check_tolerances(rtol: float, atol: float) -> None:
 SYMMETRY_NUMBA_NNZ = 200_000
 
 
+#: Up to this many rows a sparse matrix is checked as a dense array (a time step's system of a
+#: small scene, solved thousands of times: the sparse difference's set-up dominated each solve).
+SYMMETRY_DENSE_N = 64
+
+
 def asymmetry(A) -> float:
     """``||A - A^T||_inf / ||A||_inf`` for a sparse or dense matrix (0 for a zero matrix)."""
     if sp.issparse(A) and A.format == "csr" and A.nnz >= SYMMETRY_NUMBA_NNZ and (
@@ -200,6 +205,8 @@ def asymmetry(A) -> float:
             A.sum_duplicates()      # sorted, unique indices: what the bisection needs
         num, den = asymmetry_sums(A.indptr, A.indices, A.data)
         return num / den if den > 0 else 0.0
+    if sp.issparse(A) and A.shape[0] <= SYMMETRY_DENSE_N:
+        A = A.toarray()           # a few dense rows: microseconds, where A - A^T costs ~1 ms
     if sp.issparse(A):
         D = (A - A.T).tocsr()
         num = float(np.max(np.asarray(abs(D).sum(axis=1)))) if D.nnz else 0.0

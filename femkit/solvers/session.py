@@ -100,6 +100,25 @@ def check_matrix_free(name: str, spec) -> None:
                          f"assembled matrix")
 
 
+def symmetric_permutation(A, perm: np.ndarray):
+    """``A[perm][:, perm]`` of a CSR matrix by two gathers (new row ``r`` is old row
+    ``perm[r]``, old column ``c`` becomes ``inv[c]``): the same entries at the same places as
+    SciPy's fancy indexing, without its ~8 intermediate sparse matrices (a small system's
+    refactorisation spent a quarter of its time there). Row entries keep their stored order
+    (unsorted columns), as the factorisation's CSC conversion sorts them."""
+    import scipy.sparse as sp
+
+    n = A.shape[0]
+    inv = np.empty(n, dtype=np.int64)
+    inv[perm] = np.arange(n)
+    lengths = np.diff(A.indptr)
+    indptr = np.zeros(n + 1, dtype=A.indptr.dtype)
+    np.cumsum(lengths[perm], out=indptr[1:])
+    order = np.argsort(np.repeat(inv, lengths), kind="stable")   # entries grouped by new row
+    indices = inv[A.indices[order]].astype(A.indices.dtype, copy=False)
+    return sp.csr_matrix((A.data[order], indices, indptr), shape=A.shape)
+
+
 @dataclass
 class _Kept:
     """A kept factorisation (preconditioner of later solves) and what it has cost (seconds)."""
@@ -250,7 +269,7 @@ class LinearSession:
                 and np.array_equal(kept[0], A.indptr) and np.array_equal(kept[1], A.indices)):
             perm = kept[2]
             t0 = time.perf_counter()
-            Ap = A[perm][:, perm]
+            Ap = symmetric_permutation(A, perm)
             t1 = time.perf_counter()
             factor = PermutedFactor(factorize(Ap, permc_spec="NATURAL"), perm)
             self._time("time_permute", t1 - t0)

@@ -26,6 +26,18 @@ def femkit(*args, cwd, timeout=60):
     return out, time.perf_counter() - t0
 
 
+def femkit_main(*args, cwd, capsys, monkeypatch) -> tuple[int, str, str]:
+    """The same command run in this process (``femkit.cli.main``; stderr captured, not a
+    terminal), for checks that are not about the process: exit code, stdout, stderr."""
+    from femkit.cli import main
+
+    monkeypatch.chdir(cwd)
+    capsys.readouterr()
+    code = main([*map(str, args)])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
 def signal_after_first_line(cwd, *args) -> tuple[str, int, str]:
     """Start femkit, wait for its first stderr line (progress: it is running), send SIGTERM;
     return that line, the exit code and the rest of stderr."""
@@ -89,33 +101,35 @@ def test_ruinous_input_ends_fast_with_one_line(tmp_path, name, case, flags, piec
     assert not (tmp_path / "out").exists()
 
 
-def test_force_runs_a_budget_sized_variant(tmp_path):
+def test_force_runs_a_budget_sized_variant(tmp_path, capsys, monkeypatch):
     """Refused under a tight budget; --force runs it (a warning names the exceeded budget)."""
     case = write(tmp_path, {"problem": "poisson", "mesh": {"geometry": "unit_square", "h": 0.1},
                             "boundary": DIRICHLET, "limits": {"memory": "40MB", "time": 3600},
                             "output": {"dir": "out"}})
-    refused, _ = femkit("solve", case, cwd=tmp_path)
-    assert refused.returncode == 2 and "exceeds the memory limit" in refused.stderr
-    forced, _ = femkit("solve", case, "--force", "--quiet", cwd=tmp_path)
-    assert forced.returncode == 0, forced.stderr
-    assert forced.stderr.startswith("femkit: warning: predicted peak memory")
+    run = dict(cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
+    code, _, err = femkit_main("solve", case, **run)
+    assert code == 2 and "exceeds the memory limit" in err
+    code, _, err = femkit_main("solve", case, "--force", "--quiet", **run)
+    assert code == 0, err
+    assert err.startswith("femkit: warning: predicted peak memory")
     assert json.loads((tmp_path / "out" / "result.json").read_text())["converged"] is True
 
 
-def test_force_runs_a_scene_over_its_step_budget(tmp_path):
+def test_force_runs_a_scene_over_its_step_budget(tmp_path, capsys, monkeypatch):
     scene = write(tmp_path, rope_scene(limits={"steps": 500}))
-    assert femkit("solve", scene, cwd=tmp_path)[0].returncode == 2
-    forced, _ = femkit("solve", scene, "--force", "--quiet", cwd=tmp_path)
-    assert forced.returncode == 0, forced.stderr
+    run = dict(cwd=tmp_path, capsys=capsys, monkeypatch=monkeypatch)
+    assert femkit_main("solve", scene, **run)[0] == 2
+    code, _, err = femkit_main("solve", scene, "--force", "--quiet", **run)
+    assert code == 0, err
     assert json.loads((tmp_path / "out" / "result.json").read_text())["steps"] == 2000
 
 
-def test_dry_run_prints_the_plan_and_runs_nothing(tmp_path):
+def test_dry_run_prints_the_plan_and_runs_nothing(tmp_path, capsys, monkeypatch):
     case = write(tmp_path, {"problem": "poisson", "mesh": {"geometry": "l_shape", "h": 0.05, "refine": 1},
                             "boundary": DIRICHLET, "output": {"dir": "out", "plot": True}})
-    out, _ = femkit("solve", case, "--dry-run", cwd=tmp_path)
-    assert out.returncode == 0 and not (tmp_path / "out").exists()
-    text = out.stdout
+    code, text, _ = femkit_main("solve", case, "--dry-run", cwd=tmp_path, capsys=capsys,
+                                monkeypatch=monkeypatch)
+    assert code == 0 and not (tmp_path / "out").exists()
     for piece in ("plan ", "sizes     triangles", "mesh ", "refine ", "assembly ", "solve ",
                   "output ", "total ", "assumes "):
         assert piece in text

@@ -49,3 +49,33 @@ def test_unsorted_duplicate_entries_are_summed_before_the_check(monkeypatch):
     A.has_canonical_format = False
     monkeypatch.setattr(checks, "SYMMETRY_NUMBA_NNZ", 0)
     assert checks.asymmetry(A) == 0.0
+
+
+SMALL = {
+    "nonsymmetric": lambda n: _random(n, 4, 6),
+    "symmetric": lambda n: (_random(n, 4, 7) + _random(n, 4, 7).T).tocsr(),
+    "perturbed by 1e-12": lambda n: (_random(n, 4, 8) + _random(n, 4, 8).T
+                                     + 1e-12 * _random(n, 4, 9)).tocsr(),
+    "unsorted duplicates": lambda n: sp.csr_matrix(
+        (np.array([0.5, 2.0, 0.5, 1.0, 2.0]), np.array([1, 0, 1, 0, 1]), np.array([0, 3, 5])),
+        shape=(2, 2)),
+}
+
+
+@pytest.mark.parametrize("n", [2, 12, 64], ids=lambda n: f"n{n}")
+@pytest.mark.parametrize("name", list(SMALL))
+def test_small_matrices_checked_densely_give_the_sparse_algebras_value(name, n, monkeypatch):
+    """A small system (a time step of a small scene) is checked as a dense array: the same value
+    as the sparse difference, to round-off in the row sums."""
+    A = SMALL[name](n)
+    monkeypatch.setattr(checks, "SYMMETRY_DENSE_N", 0)
+    ref = checks.asymmetry(A)
+    monkeypatch.setattr(checks, "SYMMETRY_DENSE_N", 64)
+    got = checks.asymmetry(A)
+    assert got == pytest.approx(ref, rel=1e-12, abs=1e-300)
+    if name in ("symmetric", "unsorted duplicates"):
+        assert got == 0.0
+    if name == "nonsymmetric":
+        assert got > 0.1
+    if name == "perturbed by 1e-12":
+        assert 0.0 < got < 1e-10

@@ -5,13 +5,20 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import yaml
+
 from femkit.study import add_parser, cli_main
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_cli_main_runs_quick_study(tmp_path, capsys):
-    rc = cli_main([str(ROOT / "studies" / "stress.yaml"), "--quick", "-o", str(tmp_path / "r"), "--no-progress"])
+    # the entry point's wiring (the stress study's content is tested in test_stability_study):
+    # the smallest sweep a bundled file gives, one solver and one rule
+    data = yaml.safe_load((ROOT / "studies" / "poisson_convergence.yaml").read_text())
+    data.update(solvers=[{"method": "direct"}], quadrature=["barycentric"], reference="none")
+    (tmp_path / "small.yaml").write_text(yaml.safe_dump(data))
+    rc = cli_main([str(tmp_path / "small.yaml"), "--quick", "-o", str(tmp_path / "r"), "--no-progress"])
     assert rc == 0
     assert (tmp_path / "r" / "report.html").exists()
     assert "report:" in capsys.readouterr().out

@@ -162,6 +162,29 @@ def spring_energy(x, si, sj, k, rest, floor):  # pragma: no cover - compiled
     return 0.5 * total
 
 
+@numba.njit(cache=True, nogil=True)
+def spring_stretch(x, si, sj, rest, out):  # pragma: no cover - compiled
+    """``out[s] = |x_j - x_i| / L_s - 1`` (a frame's ``stretch``), the same operations in the
+    same order as the NumPy expression ``sqrt(einsum("sd,sd->s", dx, dx)) / rest - 1`` (equal
+    bits with NumPy 2's einsum); without the GIL, so the run's thread goes on while a writer thread computes it."""
+    d = x.shape[1]
+    for s in range(si.shape[0]):
+        i = si[s]
+        j = sj[s]
+        if d == 3:  # NumPy's einsum sums a row of 3 as (w0^2 + w2^2) + w1^2
+            w0 = x[j, 0] - x[i, 0]
+            w1 = x[j, 1] - x[i, 1]
+            w2 = x[j, 2] - x[i, 2]
+            s2 = (w0 * w0 + w2 * w2) + w1 * w1
+        else:
+            s2 = 0.0
+            for c in range(d):
+                w = x[j, c] - x[i, c]
+                s2 += w * w
+        out[s] = math.sqrt(s2) / rest[s] - 1.0
+    return out
+
+
 @numba.njit(cache=True)
 def hessian_values(x, v, si, sj, k, rest, damping, floor, clamp, kcoef, ccoef, slots,
                    data, force, kv):  # pragma: no cover - compiled
