@@ -454,7 +454,15 @@ def entry() -> None:
     stopped = code in (130, 143) or abandoned_work()
     if not stopped and (sys.getprofile() is not None or sys.gettrace() is not None):
         sys.exit(code)  # under a profiler or a debugger, which write their results after us
+    if not stopped and any(m in sys.modules for m in _FINALIZE_AT_EXIT):
+        sys.exit(code)  # MPI / PETSc finalise in the interpreter's own exit (mpirun needs it)
     _exit_now(code, clean=not stopped)
+
+
+#: modules whose libraries must be finalised by the interpreter's own exit (C-level exit
+#: handlers that ``os._exit`` skips): mpi4py's ``MPI_Finalize`` (without it ``mpirun`` reports
+#: the rank as exiting improperly and fails the run) and PETSc's ``PetscFinalize``.
+_FINALIZE_AT_EXIT = ("mpi4py", "petsc4py")
 
 
 #: numpy's submodules that no femkit command uses but every process imported: scipy's array-API

@@ -36,8 +36,9 @@ def _poisson(tmp_path, refine: int, rtol: float, method: str = "cg") -> Path:
 
 @SIGNALS
 def test_signal_during_assembly_stops_at_once_and_writes_nothing(tmp_path, sig, code):
-    # 1.5M triangles: the compiled assembly takes ~1 s (at 373k it ended before the signal)
-    case = _poisson(tmp_path, refine=4, rtol=1e-8)
+    # 6M triangles: the compiled row-wise assembly takes ~2 s (at 1.5M it ended before the signal
+    # on a quiet machine: 'after the assembly stage')
+    case = _poisson(tmp_path, refine=5, rtol=1e-8)
     rc, elapsed, err = signal_inside("femkit.fem.poisson:PoissonProblem.assemble_matrices",
                                      ["solve", str(case), "--quiet"], sig, cwd=tmp_path,
                                      settle=0.1)
