@@ -42,18 +42,26 @@ def _row_columns(cells, inc, k0, k1, i, stamp, indices, s, write, pos):  # pragm
 
 
 @numba.njit(cache=True)
+def _vertex_starts(cells, n):  # pragma: no cover - compiled
+    """Counting sort's offsets of the node -> element incidences: ``start[i]`` = the number of
+    cell vertices with a node id below ``i`` (``start[n]`` = all of them)."""
+    start = np.zeros(n + 1, np.int64)
+    for e in range(cells.shape[0]):
+        for a in range(cells.shape[1]):
+            start[cells[e, a] + 1] += 1
+    for i in range(n):
+        start[i + 1] += start[i]
+    return start
+
+
+@numba.njit(cache=True)
 def _row_lengths(cells, n, inc):  # pragma: no cover - compiled
     """Node -> element incidences of ``cells`` (m, w) into ``inc`` (``w m``; counting sort:
     elements in increasing order around each node) and the CSR row lengths of the P1 pattern:
     ``(start, indptr, stamp)``, ``inc[start[i]:start[i + 1]]`` the elements around node ``i``,
     ``stamp`` reset to -1 for the row pass of the caller."""
     m, w = cells.shape
-    start = np.zeros(n + 1, np.int64)
-    for e in range(m):
-        for a in range(w):
-            start[cells[e, a] + 1] += 1
-    for i in range(n):
-        start[i + 1] += start[i]
+    start = _vertex_starts(cells, n)
     fill = start[:-1].copy()
     for e in range(m):
         for a in range(w):
@@ -87,12 +95,7 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
     """
     m = tri.shape[0]
     # 1. node -> incidences, by counting sort; each incidence carries the element's vertices.
-    start = np.zeros(n + 1, np.int64)
-    for e in range(m):
-        for a in range(3):
-            start[tri[e, a] + 1] += 1
-    for i in range(n):
-        start[i + 1] += start[i]
+    start = _vertex_starts(tri, n)
     verts = np.empty((3 * m, 3), slots.dtype)  # incidence k: the three vertices of its element
     where = np.empty(3 * m, slots.dtype)  # 3 e + a -> incidence k
     for e in range(m):
@@ -156,12 +159,7 @@ def _pattern_cells(tri, n, indices, slots, points, kappa, scalar_kappa, with_dat
     m = tri.shape[0]
     w = tri.shape[1]
     # 1. node -> incidences, by counting sort; each incidence carries the element's vertices.
-    start = np.zeros(n + 1, np.int64)
-    for e in range(m):
-        for a in range(w):
-            start[tri[e, a] + 1] += 1
-    for i in range(n):
-        start[i + 1] += start[i]
+    start = _vertex_starts(tri, n)
     verts = np.empty((w * m, w), slots.dtype)  # incidence k: the w vertices of its element
     where = np.empty(w * m, slots.dtype)  # w e + a -> incidence k
     for e in range(m):
