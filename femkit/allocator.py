@@ -9,13 +9,13 @@ freed inside it: a run's resident memory then stays near the sum of everything i
 
 :func:`tune_allocator` fixes the threshold (no dynamic raise), so large arrays are returned to
 the system as soon as NumPy frees them (``femkit`` does it at start when ``FEMKIT_RETURN_MEMORY=1``,
-:func:`from_environment`); :func:`release_freed_memory` returns the heap's free pages
-(``malloc_trim(0)``), for a long-lived process after it dropped a stage's arrays. Both do
-nothing (and say so by returning False) where glibc is not the allocator: another OS, musl, or
-a threshold the user set through ``MALLOC_MMAP_THRESHOLD_``, which is left alone.
+:func:`from_environment`). It does nothing (and says so by returning False) where glibc is not
+the allocator: another OS, musl, or a threshold the user set through ``MALLOC_MMAP_THRESHOLD_``,
+which is left alone. (``malloc_trim(0)`` at every stage end was measured too: it returned nothing
+measurable, so femkit does not call it.)
 
->>> isinstance(release_freed_memory(), bool)
-True
+>>> ENVIRONMENT
+'FEMKIT_RETURN_MEMORY'
 """
 
 from __future__ import annotations
@@ -23,8 +23,7 @@ from __future__ import annotations
 import os
 import sys
 
-__all__ = ["tune_allocator", "release_freed_memory", "from_environment",
-           "MMAP_THRESHOLD", "ENVIRONMENT"]
+__all__ = ["tune_allocator", "from_environment", "MMAP_THRESHOLD", "ENVIRONMENT"]
 
 #: Set to 1 to have ``femkit`` return freed arrays to the system (:func:`tune_allocator`):
 #: at 1.9M unknowns the fmg run's resident memory after the solve falls from ~0.93 to ~0.6 GB,
@@ -55,7 +54,6 @@ def _glibc():
                 libc = ctypes.CDLL("libc.so.6", use_errno=True)
                 libc.gnu_get_libc_version  # glibc only (musl has no such symbol)
                 libc.mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
-                libc.malloc_trim.argtypes = [ctypes.c_size_t]
                 _LIBC = libc
             except (OSError, AttributeError):
                 pass
@@ -80,8 +78,3 @@ def from_environment() -> bool:
         return tune_allocator()
     return False
 
-
-def release_freed_memory() -> bool:
-    """Give the heap's free pages back to the system (``malloc_trim(0)``); True when some were."""
-    libc = _glibc()
-    return bool(libc.malloc_trim(0)) if libc is not None else False
