@@ -82,8 +82,8 @@ def load_named(name: str, kind: str, make_text: Callable[[], str], *,
 
 def copied_kernels(module: ModuleType, roots: Iterable[str]) -> list[str]:
     """Names of the compiled functions of ``module`` that reach one of ``roots`` through their
-    calls (read from each function's code object; a root need not be defined in ``module``), in
-    source order: a generated module copies
+    calls or reads of globals (read from each function's code object; a root, a function or a
+    constant, need not be defined in ``module``), in source order: a generated module copies
     their source, so that they resolve its own definitions of ``roots``; it imports the others."""
     funcs = {n: f.py_func for n, f in vars(module).items() if hasattr(f, "py_func")}
     reach = set(roots)

@@ -41,7 +41,15 @@ from typing import Sequence
 
 from ..expressions import _BINOPS, _COMPARE, FUNCTIONS
 
-__all__ = ["point_function", "COORDINATES"]
+__all__ = ["point_function", "COORDINATES", "KERNELS", "KERNEL_IMPORT"]
+
+#: NumPy functions printed as the inlined branch-free kernels of :mod:`.elementary`:
+#: ufunc name -> (kernel, its range check), as the generated module imports them.
+KERNELS = {"sin": ("fast_sin", "in_trig_range"), "cos": ("fast_cos", "in_trig_range"),
+           "exp": ("fast_exp", "in_exp_range")}
+#: The import line a generated module needs for :data:`KERNELS`.
+KERNEL_IMPORT = ("from femkit.case.compiled_expressions.elementary import "
+                 "cos as fast_cos, exp as fast_exp, in_exp_range, in_trig_range, sin as fast_sin")
 
 #: The parameters of a generated point function, in the order of an expression's variables.
 COORDINATES = ("x", "y", "z")
@@ -64,8 +72,10 @@ def _literal(value: float) -> str:
 class _Printer:
     """Prints trees into lines ``tK = ...``, one per distinct node."""
 
-    def __init__(self):
+    def __init__(self, fast: bool = False):
         self.lines: list[str] = []
+        self.checks: list[str] = []     # the range checks of the kernels' arguments
+        self.fast = fast
         self._temps: dict[str, str] = {}
 
     def _temp(self, text: str) -> str:
@@ -105,17 +115,62 @@ class _Printer:
             args = [rec(a) for a in node.args]
             if name == "where":
                 return self._temp(f"({args[1]} if {args[0]} != 0.0 else {args[2]})")
-            return self._temp(f"np.{FUNCTIONS[name][0].__name__}({', '.join(args)})")
+            ufunc = FUNCTIONS[name][0].__name__
+            if self.fast and ufunc in KERNELS:   # the inlined polynomial, its range checked
+                kernel, check = KERNELS[ufunc]
+                self.checks.append(f"{check}({args[0]})")
+                return self._temp(f"{kernel}({args[0]})")
+            return self._temp(f"np.{ufunc}({', '.join(args)})")
         raise AssertionError(f"unchecked node {type(node).__name__}")  # the parser refused it
 
 
-def point_function(name: str, expressions: Sequence) -> str:
+def point_function(name: str, expressions: Sequence, *, fast: bool = False) -> str:
     """Source of the numba function ``name(x, y, z, out)`` writing ``out[i]`` = the value of
     ``expressions[i]`` (checked :class:`~femkit.case.expressions.Expression` objects, whose
-    variables are taken as ``x, y, z`` in order) at the point."""
-    printer = _Printer()
+    variables are taken as ``x, y, z`` in order) at the point.
+
+    With ``fast``, ``sin``, ``cos`` and ``exp`` are the inlined kernels of :mod:`.elementary`
+    (:data:`KERNELS`; the module needs :data:`KERNEL_IMPORT`) and, when the expressions call one,
+    the text holds two functions: ``name_libm``, the plain form, and ``name``, which evaluates
+    the kernels and, when one of their arguments is outside the range they handle, the point
+    again by ``name_libm`` (so inf, NaN and huge arguments give NumPy's values).
+    """
+    printer = _Printer(fast=fast)
     results = [printer.value(e) for e in expressions]
-    head = ['@numba.njit(cache=True, error_model="numpy")',
-            f"def {name}(x, y, z, out):  # pragma: no cover - compiled"]
     body = printer.lines + [f"    out[{i}] = {r}" for i, r in enumerate(results)]
-    return "\n".join(head + (body or ["    pass"]))
+    if not printer.checks:
+        return "\n".join(_head(name, "x, y, z, out") + (body or ["    pass"]))
+    body += [f"    if ({' & '.join(dict.fromkeys(printer.checks))}) == 0:  # the C library's",
+             f"        {name}_libm(x, y, z, out)"]
+    return "\n".join([point_function(f"{name}_libm", expressions), "", "",
+                      *_head(name, "x, y, z, out"), *body])
+
+
+def block_function(name: str, point: str, expressions: Sequence) -> str:
+    """Source of the numba function ``name(xs, ys, zs, n, out)`` writing ``out[i, p]`` = the
+    value of ``expressions[i]`` at the point ``(xs[p], ys[p], zs[p])``, ``p < n``.
+
+    The loop over the points is straight-line code (the :mod:`.elementary` kernels, their range
+    checks folded into a minimum), which LLVM vectorises. When an argument was outside the
+    kernels' range the block is evaluated again point by point by ``point`` (the
+    :func:`point_function` of the same expressions with ``fast``), which takes the C library's
+    value where the kernels do not apply.
+    """
+    printer = _Printer(fast=True)
+    results = [printer.value(e) for e in expressions]
+    checks = list(dict.fromkeys(printer.checks))
+    body = ["    ok = 1", "    for p in range(n):", "        x = xs[p]", "        y = ys[p]",
+            "        z = zs[p]", *("    " + line for line in printer.lines),
+            *(f"        out[{i}, p] = {r}" for i, r in enumerate(results)),
+            *(f"        ok = min(ok, {c})" for c in checks)]
+    if checks:
+        body += ["    if ok == 0:  # an argument beyond the kernels: point by point",
+                 "        v = np.empty(out.shape[0])", "        for p in range(n):",
+                 f"            {point}(xs[p], ys[p], zs[p], v)",
+                 "            for i in range(out.shape[0]):", "                out[i, p] = v[i]"]
+    return "\n".join(_head(name, "xs, ys, zs, n, out") + body)
+
+
+def _head(name: str, args: str) -> list[str]:
+    return ['@numba.njit(cache=True, error_model="numpy")',
+            f"def {name}({args}):  # pragma: no cover - compiled"]

@@ -52,6 +52,29 @@ def value_point(x, y, z, out):  # pragma: no cover - placeholder
     out[0] = np.nan
 
 
+@numba.njit(cache=True)
+def exact_block(xs, ys, zs, n, out):  # pragma: no cover - placeholder
+    """``out[:, p]`` = what :func:`exact_point` gives at ``(xs[p], ys[p], zs[p])``, ``p < n``."""
+    out[:, :n] = np.nan
+
+
+@numba.njit(cache=True)
+def source_block(xs, ys, zs, n, out):  # pragma: no cover - placeholder
+    """``out[0, p] = f(xs[p], ys[p], zs[p])``, ``p < n``."""
+    out[:, :n] = np.nan
+
+
+@numba.njit(cache=True)
+def value_block(xs, ys, zs, n, out):  # pragma: no cover - placeholder
+    """``out[0, p] = u(xs[p], ys[p], zs[p])``, ``p < n``."""
+    out[:, :n] = np.nan
+
+
+#: Cells per block: their quadrature points' coordinates are gathered, the functions evaluated
+#: over the block in one vectorised loop (the ``*_block`` functions), then integrated cell by cell.
+BLOCK = 32
+
+
 @intrinsic
 def fma(typingctx, a, b, c):  # pragma: no cover - compiled
     """``a * b + c`` rounded once (LLVM's ``llvm.fma``)."""
@@ -92,27 +115,48 @@ def physical_point(points, cells, k, bary, q):  # pragma: no cover - compiled
     return (coordinate(points, cells, k, bary, q, 0), coordinate(points, cells, k, bary, q, 1), z)
 
 
+@numba.njit(cache=True, inline="always")
+def block_points(points, cells, k0, k1, bary, xs, ys, zs):  # pragma: no cover - compiled
+    """The rule's physical points on cells ``k0 .. k1-1`` into ``xs``, ``ys``, ``zs`` (cell by
+    cell, point by point; ``z = 0`` in 2D); returns their number."""
+    p = 0
+    for k in range(k0, k1):
+        for q in range(bary.shape[0]):
+            x, y, z = physical_point(points, cells, k, bary, q)
+            xs[p] = x
+            ys[p] = y
+            zs[p] = z
+            p += 1
+    return p
+
+
+@numba.njit(cache=True)
+def block_buffers(nq, rows):  # pragma: no cover - compiled
+    """Coordinate buffers and a ``(rows, BLOCK * nq)`` value buffer of one block."""
+    n = BLOCK * nq
+    return np.empty(n), np.empty(n), np.empty(n), np.empty((rows, n))
+
+
 @numba.njit(cache=True, error_model="numpy", inline="always")  # no call per cell (~5 %)
-def element_sums(points, cells, k, bary, weights, u, gh, vals):  # pragma: no cover - compiled
+def element_sums(cells, k, bary, weights, u, gh, vals, p0):  # pragma: no cover - compiled
     """``(sum_q w_q (u_h - u)^2, sum_q w_q |grad u_h - grad u|^2, sum_q w_q f^2)`` on cell
-    ``k`` (unscaled by its measure); ``gh`` the cell's gradient of ``u_h``."""
-    d = points.shape[1]
+    ``k`` (unscaled by its measure); ``gh`` the cell's gradient of ``u_h``, ``vals[:, p0 + q]``
+    what ``exact_point`` gives at its point ``q``."""
     l2 = 0.0
     h1 = 0.0
     fs = 0.0
     for q in range(weights.shape[0]):
-        x, y, z = physical_point(points, cells, k, bary, q)
-        exact_point(x, y, z, vals)
-        diff = nodal_value(u, cells, k, bary, q) - vals[0]
+        p = p0 + q
+        diff = nodal_value(u, cells, k, bary, q) - vals[0, p]
         l2 += weights[q] * (diff * diff)
         if N_GRAD > 0:
             s = 0.0
-            for c in range(d):
-                g = gh[c] - vals[1 + c]
+            for c in range(gh.shape[0]):
+                g = gh[c] - vals[1 + c, p]
                 s += g * g
             h1 += weights[q] * s
         if HAS_SOURCE:
-            f = vals[1 + N_GRAD]
+            f = vals[1 + N_GRAD, p]
             fs += weights[q] * (f * f)
     return l2, h1, fs
 
@@ -122,40 +166,54 @@ def triangle_pass(points, tri, bary, weights, u, l2, h1, fsq):  # pragma: no cov
     """Per triangle ``area * element_sums`` into ``l2``, ``h1``, ``fsq``, the area and the
     gradient of ``u_h`` computed on the way; returns the number of triangles of zero or
     non-finite area (then the caller reports them by the NumPy path)."""
-    vals = np.empty(4)
+    nq = weights.shape[0]
+    xs, ys, zs, vals = block_buffers(nq, 1 + N_GRAD + HAS_SOURCE)
     gh = np.empty(2)
     bad = 0
-    for k in range(tri.shape[0]):
-        i0, i1, i2 = tri[k, 0], tri[k, 1], tri[k, 2]
-        e0x, e0y = points[i2, 0] - points[i1, 0], points[i2, 1] - points[i1, 1]
-        e1x, e1y = points[i0, 0] - points[i2, 0], points[i0, 1] - points[i2, 1]
-        e2x, e2y = points[i1, 0] - points[i0, 0], points[i1, 1] - points[i0, 1]
-        signed = 0.5 * (e2x * (-e1y) - e2y * (-e1x))
-        area = abs(signed)
-        if not (area > 0.0 and area < np.inf):
-            bad += 1
-            continue
-        inv = 1.0 / (2.0 * signed)
-        gh[0] = -(u[i0] * e0y + u[i1] * e1y + u[i2] * e2y) * inv
-        gh[1] = (u[i0] * e0x + u[i1] * e1x + u[i2] * e2x) * inv
-        a, b, c = element_sums(points, tri, k, bary, weights, u, gh, vals)
-        l2[k] = area * a
-        h1[k] = area * b
-        fsq[k] = area * c
+    for k0 in range(0, tri.shape[0], BLOCK):
+        k1 = min(k0 + BLOCK, tri.shape[0])
+        exact_block(xs, ys, zs, block_points(points, tri, k0, k1, bary, xs, ys, zs), vals)
+        for k in range(k0, k1):
+            i0, i1, i2 = tri[k, 0], tri[k, 1], tri[k, 2]
+            e0x, e0y = points[i2, 0] - points[i1, 0], points[i2, 1] - points[i1, 1]
+            e1x, e1y = points[i0, 0] - points[i2, 0], points[i0, 1] - points[i2, 1]
+            e2x, e2y = points[i1, 0] - points[i0, 0], points[i1, 1] - points[i0, 1]
+            signed = 0.5 * (e2x * (-e1y) - e2y * (-e1x))
+            area = abs(signed)
+            if not (area > 0.0 and area < np.inf):
+                bad += 1
+                continue
+            inv = 1.0 / (2.0 * signed)
+            gh[0] = -(u[i0] * e0y + u[i1] * e1y + u[i2] * e2y) * inv
+            gh[1] = (u[i0] * e0x + u[i1] * e1x + u[i2] * e2x) * inv
+            a, b, c = element_sums(tri, k, bary, weights, u, gh, vals, (k - k0) * nq)
+            l2[k] = area * a
+            h1[k] = area * b
+            fsq[k] = area * c
     return bad
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def block_sources(points, cells, k0, bary, xs, ys, zs, vals):  # pragma: no cover - compiled
+    """``f`` at the rule's points of the block of cells from ``k0`` into ``vals[0]``; returns
+    the end of the block."""
+    k1 = min(k0 + BLOCK, cells.shape[0])
+    source_block(xs, ys, zs, block_points(points, cells, k0, k1, bary, xs, ys, zs), vals)
+    return k1
 
 
 @numba.njit(cache=True, error_model="numpy")
 def source_pass(points, cells, bary, weights, measure, fsq):  # pragma: no cover - compiled
     """``fsq[k] = measure[k] * sum_q w_q f^2``: the source norm alone."""
-    vals = np.empty(1)
-    for k in range(cells.shape[0]):
-        fs = 0.0
-        for q in range(weights.shape[0]):
-            x, y, z = physical_point(points, cells, k, bary, q)
-            source_point(x, y, z, vals)
-            fs += weights[q] * (vals[0] * vals[0])
-        fsq[k] = measure[k] * fs
+    nq = weights.shape[0]
+    xs, ys, zs, vals = block_buffers(nq, 1)
+    for k0 in range(0, cells.shape[0], BLOCK):
+        for k in range(k0, block_sources(points, cells, k0, bary, xs, ys, zs, vals)):
+            fs = 0.0
+            for q in range(nq):
+                f = vals[0, (k - k0) * nq + q]
+                fs += weights[q] * (f * f)
+            fsq[k] = measure[k] * fs
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -163,28 +221,33 @@ def source_values(points, cells, bary, out):  # pragma: no cover - compiled
     """``out[k, q] = f`` at the rule's point ``q`` of cell ``k``: the load's source values, at
     the points :meth:`~femkit.fem.quadrature.TriangleRule.physical_points` gives (same rounding),
     without its coordinate arrays."""
-    vals = np.empty(1)
-    for k in range(cells.shape[0]):
-        for q in range(bary.shape[0]):
-            x, y, z = physical_point(points, cells, k, bary, q)
-            source_point(x, y, z, vals)
-            out[k, q] = vals[0]
+    nq = bary.shape[0]
+    xs, ys, zs, vals = block_buffers(nq, 1)
+    for k0 in range(0, cells.shape[0], BLOCK):
+        for k in range(k0, block_sources(points, cells, k0, bary, xs, ys, zs, vals)):
+            for q in range(nq):
+                out[k, q] = vals[0, (k - k0) * nq + q]
 
 
 @numba.njit(cache=True, error_model="numpy")
 def nodal_pass(points, u):  # pragma: no cover - compiled
     """``max_i |u_i - u(x_i)|`` (NaN as soon as one difference is NaN, as ``np.max``)."""
-    vals = np.empty(1)
     d = points.shape[1]
+    xs, ys, zs, vals = block_buffers(1, 1)
     big = 0.0
-    for i in range(points.shape[0]):
-        z = points[i, 2] if d > 2 else 0.0
-        value_point(points[i, 0], points[i, 1], z, vals)
-        v = abs(u[i] - vals[0])
-        if v != v:
-            return v
-        if v > big:
-            big = v
+    for i0 in range(0, points.shape[0], BLOCK):
+        n = min(BLOCK, points.shape[0] - i0)
+        for p in range(n):
+            xs[p] = points[i0 + p, 0]
+            ys[p] = points[i0 + p, 1]
+            zs[p] = points[i0 + p, 2] if d > 2 else 0.0
+        value_block(xs, ys, zs, n, vals)
+        for p in range(n):
+            v = abs(u[i0 + p] - vals[0, p])
+            if v != v:
+                return v
+            if v > big:
+                big = v
     return big
 
 
@@ -197,45 +260,42 @@ def tetrahedron_pass(points, tets, bary, weights, u, l2, h1, fsq):  # pragma: no
     number of tetrahedra of zero or non-finite volume (then the caller reports them by the NumPy
     path).
 
-    The sums are :func:`element_sums`' with the element's vertices and nodal values held in
-    locals (read once per element, not once per point: the point function's stores into
-    ``vals`` would otherwise make every point reload them), rounded the same way: coordinates
-    summed vertex by vertex, ``u_h`` by fused multiply-adds."""
-    vals = np.empty(5)
+    The sums are :func:`element_sums`' with the element's nodal values held in locals, rounded
+    the same way: ``u_h`` by fused multiply-adds."""
+    nq = weights.shape[0]
+    xs, ys, zs, vals = block_buffers(nq, 1 + N_GRAD + HAS_SOURCE)
     g = np.empty((4, 3))
     bad = 0
-    for k in range(tets.shape[0]):
-        det = _tetrahedron(tets, points, k, g)
-        volume = abs(det) / 6.0
-        if not (volume > 0.0 and volume < np.inf):
-            bad += 1
-            continue
-        i0, i1, i2, i3 = tets[k, 0], tets[k, 1], tets[k, 2], tets[k, 3]
-        u0, u1, u2, u3 = u[i0], u[i1], u[i2], u[i3]
-        g0 = u0 * (g[0, 0] / det) + u1 * (g[1, 0] / det) + u2 * (g[2, 0] / det) + u3 * (g[3, 0] / det)
-        g1 = u0 * (g[0, 1] / det) + u1 * (g[1, 1] / det) + u2 * (g[2, 1] / det) + u3 * (g[3, 1] / det)
-        g2 = u0 * (g[0, 2] / det) + u1 * (g[1, 2] / det) + u2 * (g[2, 2] / det) + u3 * (g[3, 2] / det)
-        x0, x1, x2, x3 = points[i0, 0], points[i1, 0], points[i2, 0], points[i3, 0]
-        y0, y1, y2, y3 = points[i0, 1], points[i1, 1], points[i2, 1], points[i3, 1]
-        z0, z1, z2, z3 = points[i0, 2], points[i1, 2], points[i2, 2], points[i3, 2]
-        sl2 = 0.0
-        sh1 = 0.0
-        sfs = 0.0
-        for q in range(weights.shape[0]):
-            b0, b1, b2, b3 = bary[q, 0], bary[q, 1], bary[q, 2], bary[q, 3]
-            exact_point(x0 * b0 + x1 * b1 + x2 * b2 + x3 * b3,
-                        y0 * b0 + y1 * b1 + y2 * b2 + y3 * b3,
-                        z0 * b0 + z1 * b1 + z2 * b2 + z3 * b3, vals)
-            diff = fma(u3, b3, fma(u2, b2, fma(u1, b1, u0 * b0))) - vals[0]
-            w = weights[q]
-            sl2 += w * (diff * diff)
-            if N_GRAD > 0:
-                d0, d1, d2 = g0 - vals[1], g1 - vals[2], g2 - vals[3]
-                sh1 += w * (d0 * d0 + d1 * d1 + d2 * d2)
-            if HAS_SOURCE:
-                f = vals[1 + N_GRAD]
-                sfs += w * (f * f)
-        l2[k] = volume * sl2
-        h1[k] = volume * sh1
-        fsq[k] = volume * sfs
+    for k0 in range(0, tets.shape[0], BLOCK):
+        k1 = min(k0 + BLOCK, tets.shape[0])
+        exact_block(xs, ys, zs, block_points(points, tets, k0, k1, bary, xs, ys, zs), vals)
+        for k in range(k0, k1):
+            det = _tetrahedron(tets, points, k, g)
+            volume = abs(det) / 6.0
+            if not (volume > 0.0 and volume < np.inf):
+                bad += 1
+                continue
+            u0, u1, u2, u3 = u[tets[k, 0]], u[tets[k, 1]], u[tets[k, 2]], u[tets[k, 3]]
+            g0 = u0 * (g[0, 0] / det) + u1 * (g[1, 0] / det) + u2 * (g[2, 0] / det) + u3 * (g[3, 0] / det)
+            g1 = u0 * (g[0, 1] / det) + u1 * (g[1, 1] / det) + u2 * (g[2, 1] / det) + u3 * (g[3, 1] / det)
+            g2 = u0 * (g[0, 2] / det) + u1 * (g[1, 2] / det) + u2 * (g[2, 2] / det) + u3 * (g[3, 2] / det)
+            sl2 = 0.0
+            sh1 = 0.0
+            sfs = 0.0
+            p0 = (k - k0) * nq
+            for q in range(nq):
+                p = p0 + q
+                b0, b1, b2, b3 = bary[q, 0], bary[q, 1], bary[q, 2], bary[q, 3]
+                diff = fma(u3, b3, fma(u2, b2, fma(u1, b1, u0 * b0))) - vals[0, p]
+                w = weights[q]
+                sl2 += w * (diff * diff)
+                if N_GRAD > 0:
+                    d0, d1, d2 = g0 - vals[1, p], g1 - vals[2, p], g2 - vals[3, p]
+                    sh1 += w * (d0 * d0 + d1 * d1 + d2 * d2)
+                if HAS_SOURCE:
+                    f = vals[1 + N_GRAD, p]
+                    sfs += w * (f * f)
+            l2[k] = volume * sl2
+            h1[k] = volume * sh1
+            fsq[k] = volume * sfs
     return bad
