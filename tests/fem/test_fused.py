@@ -32,6 +32,14 @@ SETS = {
     "sin-3d": ("sin(pi*x) * sin(pi*y) * sin(pi*z)",
                ["pi*cos(pi*x)*sin(pi*y)*sin(pi*z)", "pi*sin(pi*x)*cos(pi*y)*sin(pi*z)",
                 "pi*sin(pi*x)*sin(pi*y)*cos(pi*z)"], "3*pi**2*sin(pi*x)*sin(pi*y)*sin(pi*z)"),
+    # arguments beyond the inlined kernels' range (|x| > 1e5 for sin, < -708 for exp) in some
+    # blocks of points: those take the C library's functions
+    "beyond-kernel-range-2d": ("1e-3 * sin(2e5 * x) + exp(720 * x - 719)",
+                               ["200 * cos(2e5 * x) + 720 * exp(720 * x - 719)", "0 * y"],
+                               "4e7 * sin(2e5 * x) - 518400 * exp(720 * x - 719)"),
+    "exp-cos-3d": ("exp(x + 2*y - z) * cos(3*z)",
+                   ["exp(x + 2*y - z) * cos(3*z)", "2 * exp(x + 2*y - z) * cos(3*z)",
+                    "-exp(x + 2*y - z) * (cos(3*z) + 3 * sin(3*z))"], "exp(x + 2*y) * 0 + 1"),
 }
 
 

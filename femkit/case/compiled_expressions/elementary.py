@@ -101,7 +101,8 @@ def sin(x):  # pragma: no cover - compiled
     r, q = _reduce(x)
     s, c = _sin_cos(r)
     v = c if q & 1 else s
-    return -v if q & 2 else v
+    v = -v if q & 2 else v
+    return v if x != 0.0 else x                    # sin(-0) = -0
 
 
 @numba.njit(cache=True, inline="always", error_model="numpy")
