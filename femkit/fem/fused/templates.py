@@ -118,14 +118,31 @@ def physical_point(points, cells, k, bary, q):  # pragma: no cover - compiled
 @numba.njit(cache=True, inline="always")
 def block_points(points, cells, k0, k1, bary, xs, ys, zs):  # pragma: no cover - compiled
     """The rule's physical points on cells ``k0 .. k1-1`` into ``xs``, ``ys``, ``zs`` (cell by
-    cell, point by point; ``z = 0`` in 2D); returns their number."""
+    cell, point by point; ``z = 0`` in 2D), each coordinate ``sum_a lambda_a X_a`` summed vertex
+    by vertex as :func:`coordinate` sums it, the cell's vertices read once; returns their
+    number."""
+    nv = cells.shape[1]
+    nq = bary.shape[0]
+    d = points.shape[1]
+    corner = np.empty((3, 4))
     p = 0
     for k in range(k0, k1):
-        for q in range(bary.shape[0]):
-            x, y, z = physical_point(points, cells, k, bary, q)
+        for a in range(nv):
+            i = cells[k, a]
+            corner[0, a] = points[i, 0]
+            corner[1, a] = points[i, 1]
+            corner[2, a] = points[i, 2] if d > 2 else 0.0
+        for q in range(nq):
+            x = corner[0, 0] * bary[q, 0]
+            y = corner[1, 0] * bary[q, 0]
+            z = corner[2, 0] * bary[q, 0]
+            for a in range(1, nv):
+                x += corner[0, a] * bary[q, a]
+                y += corner[1, a] * bary[q, a]
+                z += corner[2, a] * bary[q, a]
             xs[p] = x
             ys[p] = y
-            zs[p] = z
+            zs[p] = z if d > 2 else 0.0
             p += 1
     return p
 
