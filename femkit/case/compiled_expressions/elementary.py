@@ -75,31 +75,39 @@ def _from_bits(typingctx, bits):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, inline="always", error_model="numpy")
 def _reduce(x):  # pragma: no cover - compiled
-    """``(r, q)``: ``x = k pi/2 + r`` with ``|r| <= pi/4`` (about), ``q = k mod 4``."""
+    """``(r, t, q)``: ``x = k pi/2 + r + t`` with ``r + t`` a double-double (``|t| <= ulp(r)/2``),
+    ``|r| <= pi/4`` (about) and ``q = k mod 4``."""
     k = (x * _TWO_OVER_PI + _ROUND) - _ROUND
-    r = _fma(-k, _PIO2_HI, x)                      # exact: k * HI is formed without rounding
-    r = _fma(-k, _PIO2_MID, r)
-    r = _fma(-k, _PIO2_LO, r)
-    return r, numba.int64(k) & 3
+    a = _fma(-k, _PIO2_HI, x)                       # exact: k * HI is formed without rounding
+    b = k * _PIO2_MID
+    b_err = _fma(k, _PIO2_MID, -b)                  # k * MID = b + b_err exactly
+    r = a - b
+    bv = r - a                                      # a - b = r + ((a - (r - bv)) - (b + bv)) exactly
+    t = ((a - (r - bv)) - (b + bv)) - b_err - k * _PIO2_LO
+    hi = r + t
+    return hi, (r - hi) + t, numba.int64(k) & 3
 
 
 @numba.njit(cache=True, inline="always", error_model="numpy")
-def _sin_cos(r):  # pragma: no cover - compiled
-    """``(sin r, cos r)`` for ``|r| <= pi/4`` (fdlibm's ``__kernel_sin`` / ``__kernel_cos``)."""
+def _sin_cos(r, t):  # pragma: no cover - compiled
+    """``(sin(r + t), cos(r + t))`` for ``|r| <= pi/4`` and the tail ``t`` (fdlibm's
+    ``__kernel_sin`` / ``__kernel_cos`` with their ``y``)."""
     z = r * r
-    s = r + (z * r) * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
+    v = z * r
+    w = _S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))
+    s = r - ((z * (0.5 * t - v * w) - t) - v * _S1)
     p = z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
     hz = 0.5 * z
-    w = 1.0 - hz
-    c = w + (((1.0 - w) - hz) + z * p)
+    c = 1.0 - hz
+    c = c + (((1.0 - c) - hz) + (z * p - r * t))
     return s, c
 
 
 @numba.njit(cache=True, inline="always", error_model="numpy")
 def sin(x):  # pragma: no cover - compiled
     """``sin(x)`` for ``|x| <= SIN_COS_LIMIT`` (finite), branch-free."""
-    r, q = _reduce(x)
-    s, c = _sin_cos(r)
+    r, t, q = _reduce(x)
+    s, c = _sin_cos(r, t)
     v = c if q & 1 else s
     v = -v if q & 2 else v
     return v if x != 0.0 else x                    # sin(-0) = -0
@@ -108,8 +116,8 @@ def sin(x):  # pragma: no cover - compiled
 @numba.njit(cache=True, inline="always", error_model="numpy")
 def cos(x):  # pragma: no cover - compiled
     """``cos(x)`` for ``|x| <= SIN_COS_LIMIT`` (finite), branch-free."""
-    r, q = _reduce(x)
-    s, c = _sin_cos(r)
+    r, t, q = _reduce(x)
+    s, c = _sin_cos(r, t)
     v = s if q & 1 else c
     return -v if (q + 1) & 2 else v
 

@@ -29,7 +29,7 @@ __all__ = ["case_kernels", "module_text", "expression_kernels"]
 _CONSTANTS = ("N_GRAD", "HAS_SOURCE")
 #: The point and block functions the templates call (:mod:`femkit.fem.fused.templates`).
 _ROOTS = ("exact_point", "source_point", "value_point", "exact_block", "source_block",
-          "value_block")
+          "value_block", "source_block_libm")
 
 
 def module_text(exact=None, gradient: Sequence = (), source=None, *, fuse_source: bool) -> str:
@@ -55,6 +55,9 @@ def module_text(exact=None, gradient: Sequence = (), source=None, *, fuse_source
                           ("value", [exact] if exact is not None else [])):
         parts += [point_function(f"{kind}_point", members, fast=True), "", "",
                   block_function(f"{kind}_block", f"{kind}_point", members), "", ""]
+    # the load's source values by the C library: the solution's bits do not depend on the kernels
+    parts += [block_function("source_block_libm", "", [source] if source is not None else [],
+                             fast=False), "", ""]
     for text in function_sources(templates, copied):
         parts += [text, "", ""]
     return "\n".join(parts).rstrip() + "\n"

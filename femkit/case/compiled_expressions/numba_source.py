@@ -146,7 +146,7 @@ def point_function(name: str, expressions: Sequence, *, fast: bool = False) -> s
                       *_head(name, "x, y, z, out"), *body])
 
 
-def block_function(name: str, point: str, expressions: Sequence) -> str:
+def block_function(name: str, point: str, expressions: Sequence, *, fast: bool = True) -> str:
     """Source of the numba function ``name(xs, ys, zs, n, out)`` writing ``out[i, p]`` = the
     value of ``expressions[i]`` at the point ``(xs[p], ys[p], zs[p])``, ``p < n``.
 
@@ -154,9 +154,10 @@ def block_function(name: str, point: str, expressions: Sequence) -> str:
     checks folded into a minimum), which LLVM vectorises. When an argument was outside the
     kernels' range the block is evaluated again point by point by ``point`` (the
     :func:`point_function` of the same expressions with ``fast``), which takes the C library's
-    value where the kernels do not apply.
+    value where the kernels do not apply. Without ``fast``: the C library's functions throughout
+    (``point`` unused).
     """
-    printer = _Printer(fast=True)
+    printer = _Printer(fast=fast)
     results = [printer.value(e) for e in expressions]
     checks = list(dict.fromkeys(printer.checks))
     body = ["    ok = 1", "    for p in range(n):", "        x = xs[p]", "        y = ys[p]",

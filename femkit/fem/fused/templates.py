@@ -65,6 +65,12 @@ def source_block(xs, ys, zs, n, out):  # pragma: no cover - placeholder
 
 
 @numba.njit(cache=True)
+def source_block_libm(xs, ys, zs, n, out):  # pragma: no cover - placeholder
+    """:func:`source_block` by the C library's functions (the load: the solution's bits)."""
+    out[:, :n] = np.nan
+
+
+@numba.njit(cache=True)
 def value_block(xs, ys, zs, n, out):  # pragma: no cover - placeholder
     """``out[0, p] = u(xs[p], ys[p], zs[p])``, ``p < n``."""
     out[:, :n] = np.nan
@@ -237,11 +243,14 @@ def source_pass(points, cells, bary, weights, measure, fsq):  # pragma: no cover
 def source_values(points, cells, bary, out):  # pragma: no cover - compiled
     """``out[k, q] = f`` at the rule's point ``q`` of cell ``k``: the load's source values, at
     the points :meth:`~femkit.fem.quadrature.TriangleRule.physical_points` gives (same rounding),
-    without its coordinate arrays."""
+    without its coordinate arrays; by the C library's functions, so the solution does not
+    change with the inlined kernels."""
     nq = bary.shape[0]
     xs, ys, zs, vals = block_buffers(nq, 1)
     for k0 in range(0, cells.shape[0], BLOCK):
-        for k in range(k0, block_sources(points, cells, k0, bary, xs, ys, zs, vals)):
+        k1 = min(k0 + BLOCK, cells.shape[0])
+        source_block_libm(xs, ys, zs, block_points(points, cells, k0, k1, bary, xs, ys, zs), vals)
+        for k in range(k0, k1):
             for q in range(nq):
                 out[k, q] = vals[0, (k - k0) * nq + q]
 
