@@ -12,7 +12,10 @@ in NumPy (the function is compiled with numba's ``error_model="numpy"``).
 Common subexpressions are shared exactly: every node is printed once as a temporary named by
 its text, and a structurally identical node (``sin(pi * x)`` in ``u``, in ``du/dy`` and in ``f``)
 reuses it. Nothing is reordered or simplified, so each value is rounded as the NumPy closures
-round it.
+round it, except, with ``fast``, ``sin``, ``cos`` and ``exp``: those are the inlined kernels of
+:mod:`.elementary` (within 2 ulp of NumPy's), and :func:`block_function` prints the loop over a
+block of points that LLVM vectorises; arguments beyond the kernels' range take the C library's
+function, as without ``fast``.
 
 >>> from femkit.case.expressions import compile_expression
 >>> u = compile_expression("sin(pi * x) * sin(pi * y)", ("x", "y", "z"))

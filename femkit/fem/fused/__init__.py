@@ -4,9 +4,9 @@ Evaluated by NumPy, a function given as a callable (an exact solution, its gradi
 costs one array of values per function at every quadrature point of the mesh, and each
 integral that needs it evaluates it again. A caller that can compile its functions (the case
 layer compiles a case file's expressions, :mod:`femkit.case.compiled_expressions`) hands them
-here as :class:`FusedKernels`: numba passes generated from :mod:`.templates` whose point function
-evaluates every function at once (common subexpressions shared) and adds each value to every
-integral on the spot. The passes are used by :func:`femkit.fem.error_norms`,
+here as :class:`FusedKernels`: numba passes generated from :mod:`.templates` that evaluate every
+function at once (common subexpressions shared) over a block of cells' quadrature points, in one
+loop LLVM vectorises, and add each value to every integral from that small buffer. The passes are used by :func:`femkit.fem.error_norms`,
 :func:`~femkit.fem.energy_error`, the residual estimator and the load vector
 (:func:`~femkit.fem.assemble_load`, the source at its rule's points) when
 
@@ -18,7 +18,8 @@ integral on the spot. The passes are used by :func:`femkit.fem.error_norms`,
 
 Otherwise, and whenever a pass meets a non-finite value or a degenerate cell, the NumPy path
 runs and reports it exactly as before. Results agree with the NumPy path to round-off (the
-order of the sums over points and vertices; tests/fem/test_fused.py).
+order of the sums over points and vertices, and ``sin``/``cos``/``exp`` within 2 ulp of NumPy's
+where the generated functions inline them; tests/fem/test_fused.py).
 """
 
 from __future__ import annotations

@@ -1,12 +1,14 @@
 """Template kernels of the fused quadrature passes, copied into every generated module.
 
-The passes below call ``exact_point``, ``source_point`` and ``value_point`` and read the
-constants ``N_GRAD`` and ``HAS_SOURCE``; here those are placeholders. A generated module (the case
-layer writes one per set of expressions, see :mod:`femkit.fem.fused`) defines them for its
-functions and copies in the source of every function below that reaches them
-(:func:`femkit.codegen.copied_kernels`), so numba compiles each pass with the point functions
-inlined: one visit of each quadrature point evaluates every function and adds it to every
-integral, and no array of point values is ever formed.
+The passes below call ``exact_block``, ``source_block``, ``value_block`` and
+``source_block_libm`` and read the constants ``N_GRAD`` and ``HAS_SOURCE``; here those are
+placeholders. A generated module (the case layer writes one per set of expressions, see
+:mod:`femkit.fem.fused`) defines them for its functions and copies in the source of every
+function below that reaches them (:func:`femkit.codegen.copied_kernels`). Each pass walks the
+cells in blocks of :data:`BLOCK`: the block's quadrature points are gathered (each cell's
+vertices read once), every function is evaluated over them in one loop (vectorised by LLVM when
+the functions are straight-line code, as the generated ones are), and each cell's integrals are
+summed from that small buffer; no array of point values over the mesh is ever formed.
 
 Rounding: the physical point is ``sum_a lambda_a X_a`` summed vertex by vertex, as
 :meth:`femkit.fem.quadrature.TriangleRule.physical_points` does; ``u_h`` at the point is summed
