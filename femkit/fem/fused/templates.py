@@ -98,37 +98,10 @@ def fma(typingctx, a, b, c):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
-def nodal_value(u, cells, k, bary, q):  # pragma: no cover - compiled
-    """``u_h`` at the rule's point ``q`` of cell ``k``: ``sum_a lambda_a u_a`` with fused
-    multiply-adds, the rounding of the BLAS product ``u[cells] @ bary.T`` (OpenBLAS)."""
-    acc = u[cells[k, 0]] * bary[q, 0]
-    for a in range(1, cells.shape[1]):
-        acc = fma(u[cells[k, a]], bary[q, a], acc)
-    return acc
-
-
-@numba.njit(cache=True, inline="always")
-def coordinate(points, cells, k, bary, q, d):  # pragma: no cover - compiled
-    """Coordinate ``d`` of the rule's point ``q`` on cell ``k``: ``sum_a lambda_a X_a``."""
-    acc = points[cells[k, 0], d] * bary[q, 0]
-    for a in range(1, cells.shape[1]):
-        acc += points[cells[k, a], d] * bary[q, a]
-    return acc
-
-
-@numba.njit(cache=True, inline="always")
-def physical_point(points, cells, k, bary, q):  # pragma: no cover - compiled
-    """``(x, y, z)`` of the rule's point ``q`` on cell ``k`` (``z = 0`` in 2D)."""
-    z = coordinate(points, cells, k, bary, q, 2) if points.shape[1] > 2 else 0.0
-    return (coordinate(points, cells, k, bary, q, 0), coordinate(points, cells, k, bary, q, 1), z)
-
-
-@numba.njit(cache=True, inline="always")
 def block_points(points, cells, k0, k1, bary, xs, ys, zs):  # pragma: no cover - compiled
     """The rule's physical points on cells ``k0 .. k1-1`` into ``xs``, ``ys``, ``zs`` (cell by
     cell, point by point; ``z = 0`` in 2D), each coordinate ``sum_a lambda_a X_a`` summed vertex
-    by vertex as :func:`coordinate` sums it, the cell's vertices read once; returns their
-    number."""
+    by vertex, the cell's vertices read once; returns their number."""
     nv = cells.shape[1]
     nq = bary.shape[0]
     d = points.shape[1]
@@ -163,26 +136,25 @@ def block_buffers(nq, rows):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")  # no call per cell (~5 %)
-def element_sums(cells, k, bary, weights, u, gh, vals, p0):  # pragma: no cover - compiled
-    """``(sum_q w_q (u_h - u)^2, sum_q w_q |grad u_h - grad u|^2, sum_q w_q f^2)`` on cell
-    ``k`` (unscaled by its measure); ``gh`` the cell's gradient of ``u_h``, ``vals[:, p0 + q]``
-    what ``exact_point`` gives at its point ``q``."""
+def element_sums(u0, u1, u2, bary, weights, g0, g1, vals, p0):  # pragma: no cover - compiled
+    """``(sum_q w_q (u_h - u)^2, sum_q w_q |grad u_h - grad u|^2, sum_q w_q f^2)`` on a
+    triangle (unscaled by its area) of nodal values ``u0, u1, u2`` and gradient ``(g0, g1)`` of
+    ``u_h``; ``vals[:, p0 + q]`` what ``exact_point`` gives at its point ``q``; ``u_h`` at the
+    point summed with fused multiply-adds."""
     l2 = 0.0
     h1 = 0.0
     fs = 0.0
     for q in range(weights.shape[0]):
         p = p0 + q
-        diff = nodal_value(u, cells, k, bary, q) - vals[0, p]
-        l2 += weights[q] * (diff * diff)
+        diff = fma(u2, bary[q, 2], fma(u1, bary[q, 1], u0 * bary[q, 0])) - vals[0, p]
+        w = weights[q]
+        l2 += w * (diff * diff)
         if N_GRAD > 0:
-            s = 0.0
-            for c in range(gh.shape[0]):
-                g = gh[c] - vals[1 + c, p]
-                s += g * g
-            h1 += weights[q] * s
+            d0, d1 = g0 - vals[1, p], g1 - vals[2, p]
+            h1 += w * (d0 * d0 + d1 * d1)
         if HAS_SOURCE:
             f = vals[1 + N_GRAD, p]
-            fs += weights[q] * (f * f)
+            fs += w * (f * f)
     return l2, h1, fs
 
 
@@ -193,7 +165,6 @@ def triangle_pass(points, tri, bary, weights, u, l2, h1, fsq):  # pragma: no cov
     non-finite area (then the caller reports them by the NumPy path)."""
     nq = weights.shape[0]
     xs, ys, zs, vals = block_buffers(nq, 1 + N_GRAD + HAS_SOURCE)
-    gh = np.empty(2)
     bad = 0
     for k0 in range(0, tri.shape[0], BLOCK):
         k1 = min(k0 + BLOCK, tri.shape[0])
@@ -209,9 +180,10 @@ def triangle_pass(points, tri, bary, weights, u, l2, h1, fsq):  # pragma: no cov
                 bad += 1
                 continue
             inv = 1.0 / (2.0 * signed)
-            gh[0] = -(u[i0] * e0y + u[i1] * e1y + u[i2] * e2y) * inv
-            gh[1] = (u[i0] * e0x + u[i1] * e1x + u[i2] * e2x) * inv
-            a, b, c = element_sums(tri, k, bary, weights, u, gh, vals, (k - k0) * nq)
+            u0, u1, u2 = u[i0], u[i1], u[i2]
+            g0 = -(u0 * e0y + u1 * e1y + u2 * e2y) * inv
+            g1 = (u0 * e0x + u1 * e1x + u2 * e2x) * inv
+            a, b, c = element_sums(u0, u1, u2, bary, weights, g0, g1, vals, (k - k0) * nq)
             l2[k] = area * a
             h1[k] = area * b
             fsq[k] = area * c
