@@ -1,4 +1,4 @@
-"""Compiled (numba) passes of red refinement of triangles (:func:`femkit.mesh.refine`).
+"""Compiled (numba) passes of red refinement of triangles and tetrahedra (:func:`femkit.mesh.refine`).
 
 Used from :data:`femkit.mesh.refine.NUMBA_THRESHOLD` triangles on; they write the arrays
 the NumPy path builds with ``np.stack`` (children, midpoints), element by element, without
@@ -136,6 +136,57 @@ def child_edges(n, edge_nodes, tri, tri_edges):  # pragma: no cover - compiled
     return edge_out, cells
 
 
+@numba.njit(cache=True)
+def red_tetrahedra(points, cells, cell_edges, n, corners, inner, diagonals):  # pragma: no cover - compiled
+    """Bey's eight children of every tetrahedron, ``(8 m, 4)``, as
+    :func:`femkit.mesh.refine._refine_tetrahedra` builds them with NumPy (the same array).
+
+    ``points`` already holds the midpoints (:func:`with_midpoints`); local vertex ``4 + k`` of
+    a tetrahedron is the midpoint ``n + cell_edges[t, k]``. ``corners`` (4, 4), ``inner``
+    (3, 4, 4) and ``diagonals`` (3, 2) are the tables of that module. The inner octahedron is
+    cut along its shortest diagonal, a tie (within a relative 1e-10) going to the diagonal most
+    aligned with (1, 1, 1), the first on equal terms; a negatively oriented child has its last
+    two vertices swapped. The floats compared are formed as the NumPy path forms them.
+    """
+    m = cells.shape[0]
+    out = np.empty((8 * m, 4), np.int64)
+    loc = np.empty(10, np.int64)
+    len2 = np.empty(3)
+    align = np.empty(3)
+    for t in range(m):
+        for k in range(4):
+            loc[k] = cells[t, k]
+        for k in range(6):
+            loc[4 + k] = n + cell_edges[t, k]
+        for k in range(3):
+            a, b = loc[diagonals[k, 0]], loc[diagonals[k, 1]]
+            d0, d1, d2 = points[a, 0] - points[b, 0], points[a, 1] - points[b, 1], points[a, 2] - points[b, 2]
+            len2[k] = (d0 * d0 + d2 * d2) + d1 * d1  # einsum's order over three terms
+            align[k] = abs(d0 + d1 + d2) / np.sqrt(len2[k])
+        bound = min(len2[0], min(len2[1], len2[2])) * (1.0 + 1e-10)
+        choice, best = 0, -np.inf  # np.argmax: the first maximum, or the first NaN
+        for k in range(3):
+            score = align[k] if len2[k] <= bound else -1.0
+            if best != best:
+                break
+            if score != score or score > best or k == 0:
+                choice, best = k, score
+        c = 8 * t
+        for j in range(4):
+            for k in range(4):
+                out[c + j, k] = loc[corners[j, k]]
+                out[c + 4 + j, k] = loc[inner[choice, j, k]]
+        for j in range(8):
+            i0, i1, i2, i3 = out[c + j, 0], out[c + j, 1], out[c + j, 2], out[c + j, 3]
+            a0, a1, a2 = points[i1, 0] - points[i0, 0], points[i1, 1] - points[i0, 1], points[i1, 2] - points[i0, 2]
+            b0, b1, b2 = points[i2, 0] - points[i0, 0], points[i2, 1] - points[i0, 1], points[i2, 2] - points[i0, 2]
+            e0, e1, e2 = points[i3, 0] - points[i0, 0], points[i3, 1] - points[i0, 1], points[i3, 2] - points[i0, 2]
+            det = (a0 * (b1 * e2 - b2 * e1) + a2 * (b0 * e1 - b1 * e0)) + a1 * (b2 * e0 - b0 * e2)
+            if det / 6.0 < 0:
+                out[c + j, 2], out[c + j, 3] = i3, i2
+    return out
+
+
 def warm_up() -> None:
     """Compile (or load from the on-disk cache) the kernels."""
     tri = np.array([[0, 1, 2]], np.int64)
@@ -143,3 +194,7 @@ def warm_up() -> None:
     with_midpoints(np.zeros((3, 2)), np.array([[0, 1]], np.int64))
     child_edges(3, np.array([[0, 1], [0, 2], [1, 2]], np.int64), tri,
                 np.array([[2, 1, 0]], np.int64))
+    from .refine import _CORNERS, _DIAGONALS, _INNER
+
+    red_tetrahedra(np.zeros((10, 3)), np.array([[0, 1, 2, 3]], np.int64),
+                   np.arange(6, dtype=np.int32)[None, :], 4, _CORNERS, _INNER, _DIAGONALS)

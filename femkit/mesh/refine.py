@@ -26,6 +26,10 @@ from .mesh import Mesh
 #: (:mod:`femkit.mesh._refine_kernel`; the same arrays as the NumPy path).
 NUMBA_THRESHOLD = 50_000
 
+#: Tetrahedral meshes with at least this many cells are refined by compiled passes
+#: (:func:`~._refine_kernel.red_tetrahedra`: the same children as the NumPy path).
+NUMBA_THRESHOLD_3D = 20_000
+
 # Local vertices of a tetrahedron during refinement: v0..v3, then the midpoints of its edges in
 # :data:`~femkit.mesh.edges.LOCAL_EDGES` order, m01 m02 m03 m12 m13 m23 (ids 4..9).
 _CORNERS = np.array([[0, 4, 5, 6], [4, 1, 7, 8], [5, 7, 2, 9], [6, 8, 9, 3]])
@@ -94,8 +98,22 @@ def _refine_tetrahedra(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
     """Bey's red refinement of every tetrahedron (shortest inner diagonal), as :func:`refine_once`."""
     n = mesh.n_points
     edge_nodes, cell_edges = edges(mesh)
-    points = np.vstack([mesh.points, mesh.points[edge_nodes].mean(axis=1)])
-    local = np.concatenate([mesh.cells, n + cell_edges], axis=1)          # (m, 10)
+    if mesh.n_cells >= NUMBA_THRESHOLD_3D:  # the same arrays from two compiled passes
+        from ._refine_kernel import red_tetrahedra, with_midpoints
+
+        points = with_midpoints(mesh.points, edge_nodes)
+        children = red_tetrahedra(points, mesh.cells, cell_edges, n, _CORNERS, _INNER, _DIAGONALS)
+    else:
+        points = np.vstack([mesh.points, mesh.points[edge_nodes].mean(axis=1)])
+        children = _tetrahedron_children(points, mesh.cells, cell_edges, n)
+    return _fine_tetrahedra(mesh, points, children, edge_nodes), edge_nodes
+
+
+def _tetrahedron_children(points: np.ndarray, cells: np.ndarray, cell_edges: np.ndarray,
+                          n: int) -> np.ndarray:
+    """The (8 m, 4) children of Bey's refinement by NumPy (small meshes; the compiled
+    :func:`~._refine_kernel.red_tetrahedra` makes the same array on large ones)."""
+    local = np.concatenate([cells, n + cell_edges], axis=1)              # (m, 10)
     d = points[local[:, _DIAGONALS[:, 0]]] - points[local[:, _DIAGONALS[:, 1]]]
     len2 = np.einsum("mkd,mkd->mk", d, d)
     # the shortest diagonal; ties (a Kuhn tetrahedron has two) go to the one closest to the
@@ -112,6 +130,14 @@ def _refine_tetrahedra(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
 
     neg = signed_volumes(points, children) < 0
     children[neg, 2], children[neg, 3] = children[neg, 3], children[neg, 2].copy()
+    return children
+
+
+def _fine_tetrahedra(mesh: Mesh, points: np.ndarray, children: np.ndarray,
+                     edge_nodes: np.ndarray) -> Mesh:
+    """The refined tetrahedral mesh: ``children`` inherit their parent's tag, and each tagged
+    boundary face becomes its four red children."""
+    n = mesh.n_points
     cell_tags = np.repeat(mesh.cell_tags, 8)
 
     bf = mesh.boundary_facets
@@ -125,9 +151,8 @@ def _refine_tetrahedra(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
         new_bt = np.repeat(mesh.boundary_tags, 4)
     else:
         new_bf, new_bt = bf, mesh.boundary_tags
-    fine = Mesh(points, children, cell_tags=cell_tags, boundary_facets=new_bf,
+    return Mesh(points, children, cell_tags=cell_tags, boundary_facets=new_bf,
                 boundary_tags=new_bt, tag_names=mesh.tag_names)
-    return fine, edge_nodes
 
 
 def refine(mesh: Mesh, levels: int = 1) -> Mesh:
