@@ -155,7 +155,7 @@ def warm_up() -> None:
     """Compile (or load from the on-disk cache) the kernels."""
     pts = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     triangle_quality(pts, np.array([[0, 1, 2]], np.int64))
-    mean_edge_length(pts, np.array([[0, 1]], np.int64))
+    mean_edge_length(pts, np.array([[0, 1]], np.int32))
     tet = np.array([[0, 1, 2, 3]], np.int64)
     pts3 = np.eye(4, 3)[[3, 0, 1, 2]]
     tetrahedron_quality(pts3, tet, np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]]),

@@ -51,7 +51,8 @@ def refine_once(mesh: Mesh, *, derive_edges: bool = True) -> tuple[Mesh, np.ndar
     (:class:`femkit.mesh.hierarchy.MeshHierarchy`). On large triangle meshes the fine mesh's own
     edges are derived from the coarse ones on the way (:func:`~._refine_kernel.child_edges`) and
     given to :func:`edges`, so no level of a hierarchy searches its edges but the coarsest
-    (``derive_edges=False``: not, for a caller that renumbers the fine mesh's nodes).
+    (``derive_edges=False``: not). A renumbered hierarchy refines large triangle meshes with
+    :func:`refine_interleaved` instead, which derives them in its numbering.
     """
     if mesh.dim == 3:
         return _refine_tetrahedra(mesh)
@@ -92,6 +93,42 @@ def refine_once(mesh: Mesh, *, derive_edges: bool = True) -> tuple[Mesh, np.ndar
     if known is not None:  # what edges(fine) would find: the next refinement, quality, estimator
         remember_edges(fine, *known)
     return fine, edge_nodes
+
+
+def interleaves(mesh: Mesh) -> bool:
+    """True when :func:`refine_interleaved` refines ``mesh`` (a triangle mesh of at least
+    :data:`NUMBA_THRESHOLD` cells); a hierarchy renumbers smaller ones after refining."""
+    return mesh.dim == 2 and mesh.n_cells >= NUMBA_THRESHOLD
+
+
+def refine_interleaved(mesh: Mesh) -> tuple[Mesh, np.ndarray, np.ndarray]:
+    """:func:`refine_once` of a triangle mesh numbered as
+    :func:`femkit.mesh.hierarchy.interleave_permutation` orders it (each coarse node followed by
+    the midpoints of its edges to higher nodes), in one compiled pass
+    (:func:`~._refine_kernel.interleaved_red`), the fine mesh's edges known in that numbering.
+
+    Returns ``(fine, edge_nodes, inv)``: ``fine`` equals ``permute_nodes(refine_once(mesh)[0],
+    perm, sort_elements=False)`` array for array, ``edge_nodes`` are the coarse edges as
+    :func:`refine_once` returns them, and ``inv[j]`` is the new id of fine node ``j`` of
+    :func:`refine_once`'s numbering (``perm``'s inverse).
+    """
+    from ._refine_kernel import interleaved_red
+    from .edges import index_dtype
+
+    n = mesh.n_points
+    edge_nodes, tri_edges = edges(mesh)
+    points, children, inv, fine_edges, cell_edges = interleaved_red(
+        mesh.points, mesh.triangles, edge_nodes, tri_edges,
+        np.zeros(0, index_dtype(n + len(edge_nodes))), np.zeros(0, index_dtype(12 * mesh.n_cells)))
+    be = mesh.boundary_edges
+    bm = n + boundary_edge_ids(mesh, edge_nodes)
+    new_be = inv[np.stack([np.stack([be[:, 0], bm], axis=1),
+                           np.stack([bm, be[:, 1]], axis=1)], axis=1).reshape(-1, 2)]
+    fine = Mesh(points=points, triangles=children, cell_tags=np.repeat(mesh.cell_tags, 4),
+                boundary_edges=new_be, boundary_tags=np.repeat(mesh.boundary_tags, 2),
+                tag_names=mesh.tag_names)
+    remember_edges(fine, fine_edges, cell_edges)
+    return fine, edge_nodes, inv
 
 
 def _refine_tetrahedra(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
