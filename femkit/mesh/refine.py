@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from .edges import boundary_edge_ids, edge_ids, edges, remember_edges
-from .mesh import Mesh
+from .mesh import LOCAL_EDGES, Mesh
 
 #: Triangle meshes with at least this many cells are refined by compiled passes
 #: (:mod:`femkit.mesh._refine_kernel`; the same arrays as the NumPy path).
@@ -78,57 +78,68 @@ def refine_once(mesh: Mesh, *, derive_edges: bool = True) -> tuple[Mesh, np.ndar
             np.stack([m1, m0, v2], axis=1),
             np.stack([m0, m1, m2], axis=1),
         ], axis=1).reshape(-1, 3)
-    cell_tags = np.repeat(mesh.cell_tags, 4)
-
-    be = mesh.boundary_edges
-    if len(be):
-        bm = n + boundary_edge_ids(mesh, edge_nodes)
-        new_be = np.stack([np.stack([be[:, 0], bm], axis=1),
-                           np.stack([bm, be[:, 1]], axis=1)], axis=1).reshape(-1, 2)
-        new_bt = np.repeat(mesh.boundary_tags, 2)
-    else:
-        new_be, new_bt = be, mesh.boundary_tags
-    fine = Mesh(points=points, triangles=children, cell_tags=cell_tags,
-                boundary_edges=new_be, boundary_tags=new_bt, tag_names=mesh.tag_names)
+    fine = _fine_triangles(mesh, points, children, edge_nodes)
     if known is not None:  # what edges(fine) would find: the next refinement, quality, estimator
         remember_edges(fine, *known)
     return fine, edge_nodes
 
 
 def interleaves(mesh: Mesh) -> bool:
-    """True when :func:`refine_interleaved` refines ``mesh`` (a triangle mesh of at least
-    :data:`NUMBA_THRESHOLD` cells); a hierarchy renumbers smaller ones after refining."""
-    return mesh.dim == 2 and mesh.n_cells >= NUMBA_THRESHOLD
+    """True when :func:`refine_interleaved` refines ``mesh`` (at least :data:`NUMBA_THRESHOLD`
+    triangles or :data:`NUMBA_THRESHOLD_3D` tetrahedra); a hierarchy renumbers smaller ones
+    after refining."""
+    return mesh.n_cells >= (NUMBA_THRESHOLD if mesh.dim == 2 else NUMBA_THRESHOLD_3D)
 
 
 def refine_interleaved(mesh: Mesh) -> tuple[Mesh, np.ndarray, np.ndarray]:
-    """:func:`refine_once` of a triangle mesh numbered as
-    :func:`femkit.mesh.hierarchy.interleave_permutation` orders it (each coarse node followed by
-    the midpoints of its edges to higher nodes), in one compiled pass
-    (:func:`~._refine_kernel.interleaved_red`), the fine mesh's edges known in that numbering.
+    """:func:`refine_once` numbered as :func:`femkit.mesh.hierarchy.interleave_permutation`
+    orders the fine nodes (each coarse node followed by the midpoints of its edges to higher
+    nodes), in one compiled pass (:func:`~._refine_kernel.interleaved_red`,
+    :func:`~._refine_kernel.interleaved_bey`), the fine mesh's edges known in that numbering.
 
     Returns ``(fine, edge_nodes, inv)``: ``fine`` equals ``permute_nodes(refine_once(mesh)[0],
     perm, sort_elements=False)`` array for array, ``edge_nodes`` are the coarse edges as
     :func:`refine_once` returns them, and ``inv[j]`` is the new id of fine node ``j`` of
     :func:`refine_once`'s numbering (``perm``'s inverse).
     """
-    from ._refine_kernel import interleaved_red
+    from . import _refine_kernel as kernel
     from .edges import index_dtype
 
-    n = mesh.n_points
-    edge_nodes, tri_edges = edges(mesh)
-    points, children, inv, fine_edges, cell_edges = interleaved_red(
-        mesh.points, mesh.triangles, edge_nodes, tri_edges,
-        np.zeros(0, index_dtype(n + len(edge_nodes))), np.zeros(0, index_dtype(12 * mesh.n_cells)))
-    be = mesh.boundary_edges
-    bm = n + boundary_edge_ids(mesh, edge_nodes)
-    new_be = inv[np.stack([np.stack([be[:, 0], bm], axis=1),
-                           np.stack([bm, be[:, 1]], axis=1)], axis=1).reshape(-1, 2)]
-    fine = Mesh(points=points, triangles=children, cell_tags=np.repeat(mesh.cell_tags, 4),
-                boundary_edges=new_be, boundary_tags=np.repeat(mesh.boundary_tags, 2),
-                tag_names=mesh.tag_names)
-    remember_edges(fine, fine_edges, cell_edges)
+    edge_nodes, cell_edges = edges(mesh)
+    k = 3 if mesh.dim == 2 else 6
+    types = (np.zeros(0, index_dtype(mesh.n_points + len(edge_nodes))),
+             np.zeros(0, index_dtype(2 ** mesh.dim * k * mesh.n_cells)))
+    if mesh.dim == 2:
+        points, children, inv, fine_edges, fine_cells = kernel.interleaved_red(
+            mesh.points, mesh.cells, edge_nodes, cell_edges, LOCAL_EDGES[3], *types)
+        fine = _fine_triangles(mesh, points, children, edge_nodes, inv)
+    else:
+        points, children, inv, fine_edges, fine_cells = kernel.interleaved_bey(
+            mesh.points, mesh.cells, edge_nodes, cell_edges, LOCAL_EDGES[4], *types, _CORNERS, _INNER,
+            _DIAGONALS, kernel.FACE_PAIRS, kernel.DIAGONAL_PAIRS)
+        fine = _fine_tetrahedra(mesh, points, children, edge_nodes, inv)
+    remember_edges(fine, fine_edges, fine_cells)
     return fine, edge_nodes, inv
+
+
+def _fine_triangles(mesh: Mesh, points: np.ndarray, children: np.ndarray,
+                    edge_nodes: np.ndarray, inv: np.ndarray | None = None) -> Mesh:
+    """The refined triangle mesh: children inherit their parent's tag, each tagged boundary
+    edge becomes its two halves (same direction); ``inv`` renumbers their nodes (the
+    children are given renumbered)."""
+    n = mesh.n_points
+    be = mesh.boundary_edges
+    if len(be):
+        bm = n + boundary_edge_ids(mesh, edge_nodes)
+        new_be = np.stack([np.stack([be[:, 0], bm], axis=1),
+                           np.stack([bm, be[:, 1]], axis=1)], axis=1).reshape(-1, 2)
+        new_bt = np.repeat(mesh.boundary_tags, 2)
+        if inv is not None:
+            new_be = inv[new_be]
+    else:
+        new_be, new_bt = be, mesh.boundary_tags
+    return Mesh(points=points, triangles=children, cell_tags=np.repeat(mesh.cell_tags, 4),
+                boundary_edges=new_be, boundary_tags=new_bt, tag_names=mesh.tag_names)
 
 
 def _refine_tetrahedra(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
@@ -171,9 +182,10 @@ def _tetrahedron_children(points: np.ndarray, cells: np.ndarray, cell_edges: np.
 
 
 def _fine_tetrahedra(mesh: Mesh, points: np.ndarray, children: np.ndarray,
-                     edge_nodes: np.ndarray) -> Mesh:
+                     edge_nodes: np.ndarray, inv: np.ndarray | None = None) -> Mesh:
     """The refined tetrahedral mesh: ``children`` inherit their parent's tag, and each tagged
-    boundary face becomes its four red children."""
+    boundary face becomes its four red children; ``inv`` renumbers their nodes (the children
+    are given renumbered)."""
     n = mesh.n_points
     cell_tags = np.repeat(mesh.cell_tags, 8)
 
@@ -186,6 +198,8 @@ def _fine_tetrahedra(mesh: Mesh, points: np.ndarray, children: np.ndarray,
                            np.stack([mca, mbc, c], 1), np.stack([mab, mbc, mca], 1)],
                           axis=1).reshape(-1, 3)
         new_bt = np.repeat(mesh.boundary_tags, 4)
+        if inv is not None:
+            new_bf = inv[new_bf]
     else:
         new_bf, new_bt = bf, mesh.boundary_tags
     return Mesh(points, children, cell_tags=cell_tags, boundary_facets=new_bf,

@@ -126,8 +126,11 @@ def test_compiled_refinement_is_the_numpy_refinement(monkeypatch, levels):
 
 
 @pytest.mark.parametrize("renumber", ["none", "rcm"])
-def test_compiled_hierarchy_is_the_numpy_hierarchy(monkeypatch, renumber):
-    mesh = _tagged_skewed(7)
+@pytest.mark.parametrize("dim", [2, 3], ids=["triangles", "tetrahedra"])
+def test_compiled_hierarchy_is_the_numpy_hierarchy(monkeypatch, renumber, dim):
+    """Renumbered, the compiled path refines straight into the interleaved numbering (and
+    builds the prolongation's rows in it): the NumPy path refines, then permutes."""
+    mesh = _tagged_skewed(7) if dim == 2 else _wobbled_box(3)
     _numpy_paths(monkeypatch)
     ref = MeshHierarchy.from_refinement(mesh, 2, renumber=renumber)
     _compiled_paths(monkeypatch)
@@ -139,6 +142,7 @@ def test_compiled_hierarchy_is_the_numpy_hierarchy(monkeypatch, renumber):
             assert np.array_equal(getattr(a, name), getattr(b, name)), name
     for P, Q in zip(got.prolongations, ref.prolongations):
         assert (P != Q).nnz == 0 and P.shape == Q.shape
+        assert np.array_equal(P.indptr, Q.indptr) and np.array_equal(P.indices, Q.indices)
     for a, b in zip(got.injections, ref.injections):
         assert np.array_equal(a, b)
 

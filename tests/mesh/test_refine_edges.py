@@ -62,20 +62,30 @@ def test_a_hierarchy_searches_only_its_coarsest_edges(monkeypatch):
     assert searched == [m.n_cells for m in H.meshes]
 
 
-@pytest.mark.parametrize("renumber", ["none", "rcm"])
-@pytest.mark.parametrize("name", ["gmsh-l-shape", "scrambled"])
+def _wobbled_box():
+    from .test_compiled_mesh_passes import _wobbled_box as box
+
+    return box(3)
+
+
+@pytest.mark.parametrize(("name", "renumber"), [
+    ("gmsh-l-shape", "none"), ("gmsh-l-shape", "rcm"), ("scrambled", "none"),
+    ("scrambled", "rcm"), ("kuhn-cube", "rcm"), ("wobbled-box", "rcm"), ("fichera", "rcm")])
 def test_every_level_of_a_hierarchy_knows_the_searched_edges(monkeypatch, name, renumber):
-    """Renumbered or not, each fine level's edges come from the refinement (renumbered by a
-    counting sort when the nodes are): the search finds the same arrays, and only the coarsest
-    level is searched. (A hierarchy drops a level's edges once it is refined: the finest of
-    hierarchies of 1, 2 and 3 refinements are checked.)"""
+    """Each fine level's edges come from the refinement (in the interleaved numbering when the
+    hierarchy is renumbered: triangles and tetrahedra): the search finds the same arrays, and
+    only the coarsest level is searched. (A hierarchy drops a level's edges once it is refined:
+    the finest of hierarchies of 1, 2 and 3 refinements are checked.)"""
     monkeypatch.setattr(refine_module, "NUMBA_THRESHOLD", 0)
+    monkeypatch.setattr(refine_module, "NUMBA_THRESHOLD_3D", 0)
     searched = []
     real = edges_module._edges
     monkeypatch.setattr(edges_module, "_edges", lambda m: searched.append(m.n_cells) or real(m))
+    make = {**MESHES, "kuhn-cube": lambda: generate("kuhn_cube", 0.5), "wobbled-box": _wobbled_box,
+            "fichera": lambda: generate("kuhn_fichera", 1.0)}[name]
     for levels in (1, 2, 3):
         searched.clear()
-        H = MeshHierarchy.from_refinement(MESHES[name](), levels, renumber=renumber)
+        H = MeshHierarchy.from_refinement(make(), levels, renumber=renumber)
         assert searched == [H.coarsest.n_cells]
         derived = edges_module._CACHE[H.finest]
         for a, b, c in zip(derived, real(H.finest), _by_unique(H.finest)):

@@ -41,6 +41,7 @@ FAMILIES = {
                     ("femkit.mesh._refine_kernel", "child_edges"),
                     ("femkit.mesh._refine_kernel", "interleaved_red"),
                     ("femkit.mesh._refine_kernel", "red_tetrahedra"),
+                    ("femkit.mesh._refine_kernel", "interleaved_bey"),
                     ("femkit.mesh._quality_kernel", "tetrahedron_quality")),
     "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
                     ("femkit.fem._kernels", "_stiffness_rows"), ("femkit.fem._kernels", "_eliminate")),
