@@ -343,12 +343,6 @@ def bey_children(points, loc, out, c, corners, inner, diagonals, work):  # pragm
     return choice
 
 
-#: The pairs of a tetrahedron's local edges (:data:`femkit.mesh.mesh.LOCAL_EDGES` order 01 02
-#: 03 12 13 23) whose midpoints Bey's children join: three per face (faces 123, 023, 013, 012),
-#: then the inner diagonal of each choice (m01-m23, m02-m13, m03-m12).
-FACE_PAIRS = np.array([[3, 4], [3, 5], [4, 5], [1, 2], [1, 5], [2, 5],
-                       [0, 2], [0, 4], [2, 4], [0, 1], [0, 3], [1, 3]], np.int64)
-DIAGONAL_PAIRS = np.array([[0, 5], [1, 4], [2, 3]], np.int64)
 
 
 @numba.njit(cache=True, inline="always")
@@ -452,12 +446,12 @@ def warm_up() -> None:
     interleaved_red(np.zeros((3, 2)), tri, edge_nodes, tri_edges, LOCAL_EDGES[3],
                     np.zeros(0, np.int32), np.zeros(0, np.int32))
     interleaved_rows(3, edge_nodes, np.arange(6), np.zeros(0, np.int32))
-    from .refine import _CORNERS, _DIAGONALS, _INNER
+    from .bey_tables import CORNERS, DIAGONAL_PAIRS, DIAGONALS, FACE_PAIRS, INNER
 
     tet = np.array([[0, 1, 2, 3]], np.int64)
-    red_tetrahedra(np.zeros((10, 3)), tet, np.arange(6, dtype=np.int32)[None, :], 4, _CORNERS,
-                   _INNER, _DIAGONALS)
+    red_tetrahedra(np.zeros((10, 3)), tet, np.arange(6, dtype=np.int32)[None, :], 4, CORNERS,
+                   INNER, DIAGONALS)
     tet_edges = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]], np.int32)
     interleaved_bey(np.eye(4, 3)[[3, 0, 1, 2]], tet, tet_edges,
                     np.arange(6, dtype=np.int32)[None, :], LOCAL_EDGES[4], np.zeros(0, np.int32),
-                    np.zeros(0, np.int32), _CORNERS, _INNER, _DIAGONALS, FACE_PAIRS, DIAGONAL_PAIRS)
+                    np.zeros(0, np.int32), CORNERS, INNER, DIAGONALS, FACE_PAIRS, DIAGONAL_PAIRS)

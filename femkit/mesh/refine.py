@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .bey_tables import CORNERS, DIAGONAL_PAIRS, DIAGONALS, FACE_PAIRS, INNER
 from .edges import boundary_edge_ids, edge_ids, edges, remember_edges
 from .mesh import LOCAL_EDGES, Mesh
 
@@ -29,18 +30,6 @@ NUMBA_THRESHOLD = 50_000
 #: Tetrahedral meshes with at least this many cells are refined by compiled passes
 #: (:func:`~._refine_kernel.red_tetrahedra`: the same children as the NumPy path).
 NUMBA_THRESHOLD_3D = 20_000
-
-# Local vertices of a tetrahedron during refinement: v0..v3, then the midpoints of its edges in
-# :data:`~femkit.mesh.edges.LOCAL_EDGES` order, m01 m02 m03 m12 m13 m23 (ids 4..9).
-_CORNERS = np.array([[0, 4, 5, 6], [4, 1, 7, 8], [5, 7, 2, 9], [6, 8, 9, 3]])
-#: The inner octahedron cut along diagonal m01-m23, m02-m13 or m03-m12: the four tetrahedra
-#: around the diagonal (its ends, then consecutive vertices of the equator).
-_INNER = np.array([
-    [[4, 9, 5, 6], [4, 9, 6, 8], [4, 9, 8, 7], [4, 9, 7, 5]],     # m01-m23; equator m02 m03 m13 m12
-    [[5, 8, 4, 6], [5, 8, 6, 9], [5, 8, 9, 7], [5, 8, 7, 4]],     # m02-m13; equator m01 m03 m23 m12
-    [[6, 7, 4, 5], [6, 7, 5, 9], [6, 7, 9, 8], [6, 7, 8, 4]],     # m03-m12; equator m01 m02 m23 m13
-])
-_DIAGONALS = np.array([[4, 9], [5, 8], [6, 7]])
 
 
 def refine_once(mesh: Mesh, *, derive_edges: bool = True) -> tuple[Mesh, np.ndarray]:
@@ -115,8 +104,8 @@ def refine_interleaved(mesh: Mesh) -> tuple[Mesh, np.ndarray, np.ndarray]:
         fine = _fine_triangles(mesh, points, children, edge_nodes, inv)
     else:
         points, children, inv, fine_edges, fine_cells = kernel.interleaved_bey(
-            mesh.points, mesh.cells, edge_nodes, cell_edges, LOCAL_EDGES[4], *types, _CORNERS, _INNER,
-            _DIAGONALS, kernel.FACE_PAIRS, kernel.DIAGONAL_PAIRS)
+            mesh.points, mesh.cells, edge_nodes, cell_edges, LOCAL_EDGES[4], *types, CORNERS,
+            INNER, DIAGONALS, FACE_PAIRS, DIAGONAL_PAIRS)
         fine = _fine_tetrahedra(mesh, points, children, edge_nodes, inv)
     remember_edges(fine, fine_edges, fine_cells)
     return fine, edge_nodes, inv
@@ -150,7 +139,7 @@ def _refine_tetrahedra(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
         from ._refine_kernel import red_tetrahedra, with_midpoints
 
         points = with_midpoints(mesh.points, edge_nodes)
-        children = red_tetrahedra(points, mesh.cells, cell_edges, n, _CORNERS, _INNER, _DIAGONALS)
+        children = red_tetrahedra(points, mesh.cells, cell_edges, n, CORNERS, INNER, DIAGONALS)
     else:
         points = np.vstack([mesh.points, mesh.points[edge_nodes].mean(axis=1)])
         children = _tetrahedron_children(points, mesh.cells, cell_edges, n)
@@ -162,7 +151,7 @@ def _tetrahedron_children(points: np.ndarray, cells: np.ndarray, cell_edges: np.
     """The (8 m, 4) children of Bey's refinement by NumPy (small meshes; the compiled
     :func:`~._refine_kernel.red_tetrahedra` makes the same array on large ones)."""
     local = np.concatenate([cells, n + cell_edges], axis=1)              # (m, 10)
-    d = points[local[:, _DIAGONALS[:, 0]]] - points[local[:, _DIAGONALS[:, 1]]]
+    d = points[local[:, DIAGONALS[:, 0]]] - points[local[:, DIAGONALS[:, 1]]]
     len2 = np.einsum("mkd,mkd->mk", d, d)
     # the shortest diagonal; ties (a Kuhn tetrahedron has two) go to the one closest to the
     # direction (1, 1, 1), so a structured Kuhn box refines into the structured box of half
@@ -170,9 +159,9 @@ def _tetrahedron_children(points: np.ndarray, cells: np.ndarray, cell_edges: np.
     tied = len2 <= len2.min(axis=1, keepdims=True) * (1.0 + 1e-10)
     align = np.abs(d.sum(axis=2)) / np.sqrt(len2)
     choice = np.argmax(np.where(tied, align, -1.0), axis=1)
-    inner = _INNER[choice]                                                 # (m, 4, 4)
+    inner = INNER[choice]                                                 # (m, 4, 4)
     rows = np.arange(len(local))[:, None, None]
-    children = np.concatenate([local[:, _CORNERS], local[rows, inner]], axis=1)
+    children = np.concatenate([local[:, CORNERS], local[rows, inner]], axis=1)
     children = children.reshape(-1, 4)
     from .mesh import signed_volumes
 
