@@ -180,25 +180,20 @@ class MeshHierarchy:
         for _ in range(int(levels)):
             n_c = mesh.n_points
             if renumber != "none" and interleaves(mesh):
-                # refined straight into the interleaved numbering (one compiled pass)
+                # refined straight into the interleaved numbering (one compiled pass, the fine
+                # edges derived in it), P's rows built in it
                 fine, edge_nodes, inv = refine_interleaved(mesh)
-                forget_edges(mesh)
                 P, inj = interleaved_prolongation(n_c, edge_nodes, inv), inv[:n_c]
-                meshes.append(fine)
-                prols.append(P)
-                injs.append(inj)
-                mesh = fine
-                continue
-            fine, edge_nodes = refine_once(mesh)
+            else:
+                fine, edge_nodes = refine_once(mesh)
+                P, inj = prolongation(n_c, edge_nodes), np.arange(n_c, dtype=np.int64)
+                if renumber != "none":
+                    perm = interleave_permutation(n_c, edge_nodes)
+                    fine = permute_nodes(fine, perm, sort_elements=False)
+                    inv = np.empty_like(perm)
+                    inv[perm] = np.arange(len(perm))
+                    P, inj = P[perm], inv[:n_c]
             forget_edges(mesh)  # kept only through edge_nodes, which P needs
-            P = prolongation(n_c, edge_nodes)
-            inj = np.arange(n_c, dtype=np.int64)
-            if renumber != "none":
-                perm = interleave_permutation(n_c, edge_nodes)
-                fine = permute_nodes(fine, perm, sort_elements=False)
-                inv = np.empty_like(perm)
-                inv[perm] = np.arange(len(perm))
-                P, inj = P[perm], inv[:n_c]
             meshes.append(fine)
             prols.append(P.tocsr())
             injs.append(inj)
