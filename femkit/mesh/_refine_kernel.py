@@ -431,27 +431,32 @@ def interleaved_bey(points, cells, edge_nodes, cell_edges, local, node_type, edg
     return out_pts, children, inv, fine_edges, fine_cell_edges
 
 
-def warm_up() -> None:
-    """Compile (or load from the on-disk cache) the kernels, with the argument types of a run
-    (int64 cells, the 32-bit edge arrays of :func:`femkit.mesh.edges.edges`)."""
-    tri = np.array([[0, 1, 2]], np.int64)
-    edge_nodes = np.array([[0, 1], [0, 2], [1, 2]], np.int32)
-    tri_edges = np.array([[2, 1, 0]], np.int32)
-    red_children(tri, tri_edges, 3)
-    for d in (2, 3):
-        with_midpoints(np.zeros((3, d)), edge_nodes)
-    child_edges(3, edge_nodes, tri, tri_edges)
+def warm_up(dims: tuple[int, ...] = (2, 3)) -> None:
+    """Compile (or load from the on-disk cache) the kernels of the dimensions ``dims``, with
+    the argument types of a run (int64 cells, the 32-bit edge arrays of
+    :func:`femkit.mesh.edges.edges`)."""
     from .mesh import LOCAL_EDGES
 
-    interleaved_red(np.zeros((3, 2)), tri, edge_nodes, tri_edges, LOCAL_EDGES[3],
-                    np.zeros(0, np.int32), np.zeros(0, np.int32))
-    interleaved_rows(3, edge_nodes, np.arange(6), np.zeros(0, np.int32))
-    from .bey_tables import CORNERS, DIAGONAL_PAIRS, DIAGONALS, FACE_PAIRS, INNER
+    if 2 in dims:
+        tri = np.array([[0, 1, 2]], np.int64)
+        edge_nodes = np.array([[0, 1], [0, 2], [1, 2]], np.int32)
+        tri_edges = np.array([[2, 1, 0]], np.int32)
+        red_children(tri, tri_edges, 3)
+        with_midpoints(np.zeros((3, 2)), edge_nodes)
+        child_edges(3, edge_nodes, tri, tri_edges)
+        interleaved_red(np.zeros((3, 2)), tri, edge_nodes, tri_edges, LOCAL_EDGES[3],
+                        np.zeros(0, np.int32), np.zeros(0, np.int32))
+        interleaved_rows(3, edge_nodes, np.arange(6), np.zeros(0, np.int32))
+    if 3 in dims:
+        from .bey_tables import CORNERS, DIAGONAL_PAIRS, DIAGONALS, FACE_PAIRS, INNER
 
-    tet = np.array([[0, 1, 2, 3]], np.int64)
-    red_tetrahedra(np.zeros((10, 3)), tet, np.arange(6, dtype=np.int32)[None, :], 4, CORNERS,
-                   INNER, DIAGONALS)
-    tet_edges = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]], np.int32)
-    interleaved_bey(np.eye(4, 3)[[3, 0, 1, 2]], tet, tet_edges,
-                    np.arange(6, dtype=np.int32)[None, :], LOCAL_EDGES[4], np.zeros(0, np.int32),
-                    np.zeros(0, np.int32), CORNERS, INNER, DIAGONALS, FACE_PAIRS, DIAGONAL_PAIRS)
+        tet = np.array([[0, 1, 2, 3]], np.int64)
+        cell_edges = np.arange(6, dtype=np.int32)[None, :]
+        tet_edges = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]], np.int32)
+        points = np.eye(4, 3)[[3, 0, 1, 2]]
+        with_midpoints(points, tet_edges)
+        red_tetrahedra(np.vstack([points, points[tet_edges].mean(axis=1)]), tet, cell_edges, 4,
+                       CORNERS, INNER, DIAGONALS)
+        interleaved_bey(points, tet, tet_edges, cell_edges, LOCAL_EDGES[4], np.zeros(0, np.int32),
+                        np.zeros(0, np.int32), CORNERS, INNER, DIAGONALS, FACE_PAIRS,
+                        DIAGONAL_PAIRS)
