@@ -33,7 +33,7 @@ import scipy.sparse as sp
 from ..errors import InputError
 from .edges import forget_edges
 from .mesh import Mesh
-from .refine import refine_once
+from .refine import interleaves, refine_interleaved, refine_once
 
 
 def prolongation(n_coarse: int, edge_nodes: np.ndarray) -> sp.csr_matrix:
@@ -49,6 +49,20 @@ def prolongation(n_coarse: int, edge_nodes: np.ndarray) -> sp.csr_matrix:
                               np.asarray(edge_nodes, dtype=np.int64).ravel()])
     data = np.concatenate([np.ones(n_coarse), np.full(2 * n_edges, 0.5)])
     return sp.csr_matrix((data, indices, indptr), shape=(n_coarse + n_edges, n_coarse))
+
+
+def interleaved_prolongation(n_coarse: int, edge_nodes: np.ndarray, inv: np.ndarray) -> sp.csr_matrix:
+    """:func:`prolongation` with its rows renumbered: row ``inv[j]`` is row ``j`` (the same
+    matrix as ``prolongation(n_coarse, edge_nodes)[perm]``, ``perm`` the inverse of ``inv``),
+    built directly by one compiled pass (:func:`~._refine_kernel.interleaved_rows`): a coarse
+    node's row holds one entry, a midpoint's two, in 32-bit indices when they fit (as SciPy
+    would store them)."""
+    from ._refine_kernel import interleaved_rows
+
+    n_fine = n_coarse + len(edge_nodes)
+    idx = np.int32 if n_fine + len(edge_nodes) < np.iinfo(np.int32).max else np.int64
+    indptr, indices, data = interleaved_rows(n_coarse, edge_nodes, inv, np.zeros(0, idx))
+    return sp.csr_matrix((data, indices, indptr), shape=(n_fine, n_coarse))
 
 
 def _restrict_free(P: sp.csr_matrix, rows: np.ndarray, cols: np.ndarray) -> sp.csr_matrix:
@@ -165,17 +179,21 @@ class MeshHierarchy:
         meshes, prols, injs = [mesh], [], []
         for _ in range(int(levels)):
             n_c = mesh.n_points
-            # renumbered nodes reorder the edges: the fine mesh's are not derived then
-            fine, edge_nodes = refine_once(mesh, derive_edges=renumber == "none")
+            if renumber != "none" and interleaves(mesh):
+                # refined straight into the interleaved numbering (one compiled pass, the fine
+                # edges derived in it), P's rows built in it
+                fine, edge_nodes, inv = refine_interleaved(mesh)
+                P, inj = interleaved_prolongation(n_c, edge_nodes, inv), inv[:n_c]
+            else:
+                fine, edge_nodes = refine_once(mesh)
+                P, inj = prolongation(n_c, edge_nodes), np.arange(n_c, dtype=np.int64)
+                if renumber != "none":
+                    perm = interleave_permutation(n_c, edge_nodes)
+                    fine = permute_nodes(fine, perm, sort_elements=False)
+                    inv = np.empty_like(perm)
+                    inv[perm] = np.arange(len(perm))
+                    P, inj = P[perm], inv[:n_c]
             forget_edges(mesh)  # kept only through edge_nodes, which P needs
-            P = prolongation(n_c, edge_nodes)
-            inj = np.arange(n_c, dtype=np.int64)
-            if renumber != "none":
-                perm = interleave_permutation(n_c, edge_nodes)
-                fine = permute_nodes(fine, perm, sort_elements=False)
-                inv = np.empty_like(perm)
-                inv[perm] = np.arange(len(perm))
-                P, inj = P[perm], inv[:n_c]
             meshes.append(fine)
             prols.append(P.tocsr())
             injs.append(inj)

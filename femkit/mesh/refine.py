@@ -19,24 +19,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from .bey_tables import CORNERS, DIAGONAL_PAIRS, DIAGONALS, FACE_PAIRS, INNER
 from .edges import boundary_edge_ids, edge_ids, edges, remember_edges
-from .mesh import Mesh
+from .mesh import LOCAL_EDGES, Mesh
 
 #: Triangle meshes with at least this many cells are refined by compiled passes
 #: (:mod:`femkit.mesh._refine_kernel`; the same arrays as the NumPy path).
 NUMBA_THRESHOLD = 50_000
 
-# Local vertices of a tetrahedron during refinement: v0..v3, then the midpoints of its edges in
-# :data:`~femkit.mesh.edges.LOCAL_EDGES` order, m01 m02 m03 m12 m13 m23 (ids 4..9).
-_CORNERS = np.array([[0, 4, 5, 6], [4, 1, 7, 8], [5, 7, 2, 9], [6, 8, 9, 3]])
-#: The inner octahedron cut along diagonal m01-m23, m02-m13 or m03-m12: the four tetrahedra
-#: around the diagonal (its ends, then consecutive vertices of the equator).
-_INNER = np.array([
-    [[4, 9, 5, 6], [4, 9, 6, 8], [4, 9, 8, 7], [4, 9, 7, 5]],     # m01-m23; equator m02 m03 m13 m12
-    [[5, 8, 4, 6], [5, 8, 6, 9], [5, 8, 9, 7], [5, 8, 7, 4]],     # m02-m13; equator m01 m03 m23 m12
-    [[6, 7, 4, 5], [6, 7, 5, 9], [6, 7, 9, 8], [6, 7, 8, 4]],     # m03-m12; equator m01 m02 m23 m13
-])
-_DIAGONALS = np.array([[4, 9], [5, 8], [6, 7]])
+#: Tetrahedral meshes with at least this many cells are refined by compiled passes
+#: (:func:`~._refine_kernel.red_tetrahedra`: the same children as the NumPy path).
+NUMBA_THRESHOLD_3D = 20_000
 
 
 def refine_once(mesh: Mesh, *, derive_edges: bool = True) -> tuple[Mesh, np.ndarray]:
@@ -47,7 +40,8 @@ def refine_once(mesh: Mesh, *, derive_edges: bool = True) -> tuple[Mesh, np.ndar
     (:class:`femkit.mesh.hierarchy.MeshHierarchy`). On large triangle meshes the fine mesh's own
     edges are derived from the coarse ones on the way (:func:`~._refine_kernel.child_edges`) and
     given to :func:`edges`, so no level of a hierarchy searches its edges but the coarsest
-    (``derive_edges=False``: not, for a caller that renumbers the fine mesh's nodes).
+    (``derive_edges=False``: not). A renumbered hierarchy refines large triangle meshes with
+    :func:`refine_interleaved` instead, which derives them in its numbering.
     """
     if mesh.dim == 3:
         return _refine_tetrahedra(mesh)
@@ -73,30 +67,91 @@ def refine_once(mesh: Mesh, *, derive_edges: bool = True) -> tuple[Mesh, np.ndar
             np.stack([m1, m0, v2], axis=1),
             np.stack([m0, m1, m2], axis=1),
         ], axis=1).reshape(-1, 3)
-    cell_tags = np.repeat(mesh.cell_tags, 4)
+    fine = _fine_triangles(mesh, points, children, edge_nodes)
+    if known is not None:  # what edges(fine) would find: the next refinement, quality, estimator
+        remember_edges(fine, *known)
+    return fine, edge_nodes
 
+
+def interleaves(mesh: Mesh) -> bool:
+    """True when :func:`refine_interleaved` refines ``mesh`` (at least :data:`NUMBA_THRESHOLD`
+    triangles or :data:`NUMBA_THRESHOLD_3D` tetrahedra); a hierarchy renumbers smaller ones
+    after refining."""
+    return mesh.n_cells >= (NUMBA_THRESHOLD if mesh.dim == 2 else NUMBA_THRESHOLD_3D)
+
+
+def refine_interleaved(mesh: Mesh) -> tuple[Mesh, np.ndarray, np.ndarray]:
+    """:func:`refine_once` numbered as :func:`femkit.mesh.hierarchy.interleave_permutation`
+    orders the fine nodes (each coarse node followed by the midpoints of its edges to higher
+    nodes), in one compiled pass (:func:`~._refine_kernel.interleaved_red`,
+    :func:`~._refine_kernel.interleaved_bey`), the fine mesh's edges known in that numbering.
+
+    Returns ``(fine, edge_nodes, inv)``: ``fine`` equals ``permute_nodes(refine_once(mesh)[0],
+    perm, sort_elements=False)`` array for array, ``edge_nodes`` are the coarse edges as
+    :func:`refine_once` returns them, and ``inv[j]`` is the new id of fine node ``j`` of
+    :func:`refine_once`'s numbering (``perm``'s inverse).
+    """
+    from . import _refine_kernel as kernel
+    from .edges import index_dtype
+
+    edge_nodes, cell_edges = edges(mesh)
+    k = 3 if mesh.dim == 2 else 6
+    types = (np.zeros(0, index_dtype(mesh.n_points + len(edge_nodes))),
+             np.zeros(0, index_dtype(2 ** mesh.dim * k * mesh.n_cells)))
+    if mesh.dim == 2:
+        points, children, inv, fine_edges, fine_cells = kernel.interleaved_red(
+            mesh.points, mesh.cells, edge_nodes, cell_edges, LOCAL_EDGES[3], *types)
+        fine = _fine_triangles(mesh, points, children, edge_nodes, inv)
+    else:
+        points, children, inv, fine_edges, fine_cells = kernel.interleaved_bey(
+            mesh.points, mesh.cells, edge_nodes, cell_edges, LOCAL_EDGES[4], *types, CORNERS,
+            INNER, DIAGONALS, FACE_PAIRS, DIAGONAL_PAIRS)
+        fine = _fine_tetrahedra(mesh, points, children, edge_nodes, inv)
+    remember_edges(fine, fine_edges, fine_cells)
+    return fine, edge_nodes, inv
+
+
+def _fine_triangles(mesh: Mesh, points: np.ndarray, children: np.ndarray,
+                    edge_nodes: np.ndarray, inv: np.ndarray | None = None) -> Mesh:
+    """The refined triangle mesh: children inherit their parent's tag, each tagged boundary
+    edge becomes its two halves (same direction); ``inv`` renumbers their nodes (the
+    children are given renumbered)."""
+    n = mesh.n_points
     be = mesh.boundary_edges
     if len(be):
         bm = n + boundary_edge_ids(mesh, edge_nodes)
         new_be = np.stack([np.stack([be[:, 0], bm], axis=1),
                            np.stack([bm, be[:, 1]], axis=1)], axis=1).reshape(-1, 2)
         new_bt = np.repeat(mesh.boundary_tags, 2)
+        if inv is not None:
+            new_be = inv[new_be]
     else:
         new_be, new_bt = be, mesh.boundary_tags
-    fine = Mesh(points=points, triangles=children, cell_tags=cell_tags,
+    return Mesh(points=points, triangles=children, cell_tags=np.repeat(mesh.cell_tags, 4),
                 boundary_edges=new_be, boundary_tags=new_bt, tag_names=mesh.tag_names)
-    if known is not None:  # what edges(fine) would find: the next refinement, quality, estimator
-        remember_edges(fine, *known)
-    return fine, edge_nodes
 
 
 def _refine_tetrahedra(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
     """Bey's red refinement of every tetrahedron (shortest inner diagonal), as :func:`refine_once`."""
     n = mesh.n_points
     edge_nodes, cell_edges = edges(mesh)
-    points = np.vstack([mesh.points, mesh.points[edge_nodes].mean(axis=1)])
-    local = np.concatenate([mesh.cells, n + cell_edges], axis=1)          # (m, 10)
-    d = points[local[:, _DIAGONALS[:, 0]]] - points[local[:, _DIAGONALS[:, 1]]]
+    if mesh.n_cells >= NUMBA_THRESHOLD_3D:  # the same arrays from two compiled passes
+        from ._refine_kernel import red_tetrahedra, with_midpoints
+
+        points = with_midpoints(mesh.points, edge_nodes)
+        children = red_tetrahedra(points, mesh.cells, cell_edges, n, CORNERS, INNER, DIAGONALS)
+    else:
+        points = np.vstack([mesh.points, mesh.points[edge_nodes].mean(axis=1)])
+        children = _tetrahedron_children(points, mesh.cells, cell_edges, n)
+    return _fine_tetrahedra(mesh, points, children, edge_nodes), edge_nodes
+
+
+def _tetrahedron_children(points: np.ndarray, cells: np.ndarray, cell_edges: np.ndarray,
+                          n: int) -> np.ndarray:
+    """The (8 m, 4) children of Bey's refinement by NumPy (small meshes; the compiled
+    :func:`~._refine_kernel.red_tetrahedra` makes the same array on large ones)."""
+    local = np.concatenate([cells, n + cell_edges], axis=1)              # (m, 10)
+    d = points[local[:, DIAGONALS[:, 0]]] - points[local[:, DIAGONALS[:, 1]]]
     len2 = np.einsum("mkd,mkd->mk", d, d)
     # the shortest diagonal; ties (a Kuhn tetrahedron has two) go to the one closest to the
     # direction (1, 1, 1), so a structured Kuhn box refines into the structured box of half
@@ -104,14 +159,23 @@ def _refine_tetrahedra(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
     tied = len2 <= len2.min(axis=1, keepdims=True) * (1.0 + 1e-10)
     align = np.abs(d.sum(axis=2)) / np.sqrt(len2)
     choice = np.argmax(np.where(tied, align, -1.0), axis=1)
-    inner = _INNER[choice]                                                 # (m, 4, 4)
+    inner = INNER[choice]                                                 # (m, 4, 4)
     rows = np.arange(len(local))[:, None, None]
-    children = np.concatenate([local[:, _CORNERS], local[rows, inner]], axis=1)
+    children = np.concatenate([local[:, CORNERS], local[rows, inner]], axis=1)
     children = children.reshape(-1, 4)
     from .mesh import signed_volumes
 
     neg = signed_volumes(points, children) < 0
     children[neg, 2], children[neg, 3] = children[neg, 3], children[neg, 2].copy()
+    return children
+
+
+def _fine_tetrahedra(mesh: Mesh, points: np.ndarray, children: np.ndarray,
+                     edge_nodes: np.ndarray, inv: np.ndarray | None = None) -> Mesh:
+    """The refined tetrahedral mesh: ``children`` inherit their parent's tag, and each tagged
+    boundary face becomes its four red children; ``inv`` renumbers their nodes (the children
+    are given renumbered)."""
+    n = mesh.n_points
     cell_tags = np.repeat(mesh.cell_tags, 8)
 
     bf = mesh.boundary_facets
@@ -123,11 +187,12 @@ def _refine_tetrahedra(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
                            np.stack([mca, mbc, c], 1), np.stack([mab, mbc, mca], 1)],
                           axis=1).reshape(-1, 3)
         new_bt = np.repeat(mesh.boundary_tags, 4)
+        if inv is not None:
+            new_bf = inv[new_bf]
     else:
         new_bf, new_bt = bf, mesh.boundary_tags
-    fine = Mesh(points, children, cell_tags=cell_tags, boundary_facets=new_bf,
+    return Mesh(points, children, cell_tags=cell_tags, boundary_facets=new_bf,
                 boundary_tags=new_bt, tag_names=mesh.tag_names)
-    return fine, edge_nodes
 
 
 def refine(mesh: Mesh, levels: int = 1) -> Mesh:

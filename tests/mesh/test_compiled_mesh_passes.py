@@ -9,7 +9,7 @@ import importlib
 import numpy as np
 import pytest
 
-from femkit.mesh import Mesh, MeshHierarchy, refine, structured_mesh
+from femkit.mesh import Mesh, MeshHierarchy, generate, refine, structured_mesh
 from femkit.mesh.edges import edges
 
 refine_module = importlib.import_module("femkit.mesh.refine")
@@ -38,11 +38,78 @@ def _tagged_skewed(n=9, draw=5):
 def _numpy_paths(monkeypatch):
     for mod in (refine_module, quality_module, edges_module):
         monkeypatch.setattr(mod, "NUMBA_THRESHOLD", 10 ** 12)
+    for mod in (refine_module, quality_module):
+        monkeypatch.setattr(mod, "NUMBA_THRESHOLD_3D", 10 ** 12)
 
 
 def _compiled_paths(monkeypatch):
     for mod in (refine_module, quality_module, edges_module):
         monkeypatch.setattr(mod, "NUMBA_THRESHOLD", 0)
+    for mod in (refine_module, quality_module):
+        monkeypatch.setattr(mod, "NUMBA_THRESHOLD_3D", 0)
+
+
+def _wobbled_box(n=4, draw=7):
+    """A Kuhn box with moved interior nodes, its nodes and tetrahedra in random order and two
+    cell tags: shortest diagonals without ties, and ties (the untouched boundary layer)."""
+    box = generate("kuhn_cube", 1.0 / n)
+    rng = np.random.default_rng(draw)
+    pts = box.points.copy()
+    inside = np.all((pts > 1e-9) & (pts < 1 - 1e-9), axis=1)
+    pts[inside] += 0.3 / n * (rng.random((inside.sum(), 3)) - 0.5)
+    perm = rng.permutation(box.n_points)
+    inv = np.empty_like(perm)
+    inv[perm] = np.arange(len(perm))
+    order = rng.permutation(box.n_cells)
+    tags = np.where(box.centroids()[order, 2] < 0.5, 1, 2)
+    return Mesh(pts[perm], inv[box.cells][order], cell_tags=tags,
+                boundary_facets=inv[box.boundary_facets], boundary_tags=box.boundary_tags,
+                tag_names=dict(box.tag_names))
+
+
+def _flat_one():
+    """:func:`_wobbled_box` with one flat tetrahedron (a repeated vertex): NaN dihedral angles,
+    radius ratio 0, diagonals of length 0."""
+    m = _wobbled_box(3)
+    cells = m.cells.copy()
+    cells[0, 3] = cells[0, 2]
+    return Mesh(m.points, cells)
+
+
+TET_MESHES = {"kuhn-cube": lambda: generate("kuhn_cube", 1 / 3), "wobbled": _wobbled_box,
+              "fichera": lambda: generate("kuhn_fichera", 0.5), "one-flat": _flat_one}
+
+
+@pytest.mark.parametrize("name", sorted(TET_MESHES))
+def test_compiled_tetrahedral_refinement_is_the_numpy_refinement(monkeypatch, name):
+    mesh = TET_MESHES[name]()
+    _numpy_paths(monkeypatch)
+    ref = refine(mesh, 2)
+    _compiled_paths(monkeypatch)
+    got = refine(Mesh(mesh.points, mesh.cells, mesh.cell_tags, mesh.boundary_facets,
+                      mesh.boundary_tags, mesh.tag_names), 2)
+    for name in MESH_ARRAYS:
+        a, b = getattr(got, name), getattr(ref, name)
+        assert a.dtype == b.dtype and a.tobytes() == b.tobytes(), name
+
+
+def _both_qualities(monkeypatch, mesh):
+    """``quality(mesh)`` by the NumPy formulas and by the compiled pass (a fresh mesh record,
+    so nothing cached is shared)."""
+    _numpy_paths(monkeypatch)
+    ref = quality_module.quality(mesh)
+    _compiled_paths(monkeypatch)
+    got = quality_module.quality(Mesh(mesh.points, mesh.cells))
+    assert got.keys() == ref.keys()
+    return ref, got
+
+
+@pytest.mark.parametrize("name", sorted(TET_MESHES))
+def test_compiled_tetrahedral_quality_is_the_numpy_quality_bit_for_bit(monkeypatch, name):
+    """The same floats (result.json's mesh numbers do not move), NaN angles skipped alike."""
+    ref, got = _both_qualities(monkeypatch, refine(TET_MESHES[name](), 1))
+    for k in ref:
+        assert np.array_equal(got[k], ref[k], equal_nan=True), (k, got[k], ref[k])
 
 
 @pytest.mark.parametrize("levels", [1, 3], ids=["one-level", "three-levels"])
@@ -59,8 +126,11 @@ def test_compiled_refinement_is_the_numpy_refinement(monkeypatch, levels):
 
 
 @pytest.mark.parametrize("renumber", ["none", "rcm"])
-def test_compiled_hierarchy_is_the_numpy_hierarchy(monkeypatch, renumber):
-    mesh = _tagged_skewed(7)
+@pytest.mark.parametrize("dim", [2, 3], ids=["triangles", "tetrahedra"])
+def test_compiled_hierarchy_is_the_numpy_hierarchy(monkeypatch, renumber, dim):
+    """Renumbered, the compiled path refines straight into the interleaved numbering (and
+    builds the prolongation's rows in it): the NumPy path refines, then permutes."""
+    mesh = _tagged_skewed(7) if dim == 2 else _wobbled_box(3)
     _numpy_paths(monkeypatch)
     ref = MeshHierarchy.from_refinement(mesh, 2, renumber=renumber)
     _compiled_paths(monkeypatch)
@@ -72,6 +142,7 @@ def test_compiled_hierarchy_is_the_numpy_hierarchy(monkeypatch, renumber):
             assert np.array_equal(getattr(a, name), getattr(b, name)), name
     for P, Q in zip(got.prolongations, ref.prolongations):
         assert (P != Q).nnz == 0 and P.shape == Q.shape
+        assert np.array_equal(P.indptr, Q.indptr) and np.array_equal(P.indices, Q.indices)
     for a, b in zip(got.injections, ref.injections):
         assert np.array_equal(a, b)
 
@@ -96,12 +167,7 @@ def _degenerate_one():
 
 @pytest.mark.parametrize("make", [_tagged_skewed, _degenerate_one], ids=["skewed", "degenerate"])
 def test_compiled_quality_is_the_numpy_quality(monkeypatch, make):
-    mesh = make()
-    _numpy_paths(monkeypatch)
-    ref = quality_module.quality(mesh)
-    _compiled_paths(monkeypatch)
-    got = quality_module.quality(Mesh(mesh.points, mesh.cells))
-    assert got.keys() == ref.keys()
+    ref, got = _both_qualities(monkeypatch, make())
     for k in ref:
         if np.isinf(ref[k]):
             assert got[k] == ref[k], k

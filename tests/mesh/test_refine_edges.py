@@ -62,15 +62,33 @@ def test_a_hierarchy_searches_only_its_coarsest_edges(monkeypatch):
     assert searched == [m.n_cells for m in H.meshes]
 
 
-def test_a_renumbered_hierarchy_derives_no_edges_it_would_drop(monkeypatch):
-    """Renumbering reorders the fine mesh's edges: the derived ones would be thrown away."""
-    kernel = importlib.import_module("femkit.mesh._refine_kernel")
+def _wobbled_box():
+    from .test_compiled_mesh_passes import _wobbled_box as box
+
+    return box(3)
+
+
+@pytest.mark.parametrize(("name", "renumber"), [
+    ("gmsh-l-shape", "none"), ("gmsh-l-shape", "rcm"), ("scrambled", "none"),
+    ("scrambled", "rcm"), ("kuhn-cube", "rcm"), ("wobbled-box", "rcm"), ("fichera", "rcm")])
+def test_every_level_of_a_hierarchy_knows_the_searched_edges(monkeypatch, name, renumber):
+    """Each fine level's edges come from the refinement (in the interleaved numbering when the
+    hierarchy is renumbered: triangles and tetrahedra): the search finds the same arrays, and
+    only the coarsest level is searched. (A hierarchy drops a level's edges once it is refined:
+    the finest of hierarchies of 1, 2 and 3 refinements are checked.)"""
     monkeypatch.setattr(refine_module, "NUMBA_THRESHOLD", 0)
-    calls = []
-    real = kernel.child_edges
-    monkeypatch.setattr(kernel, "child_edges", lambda *a: calls.append(1) or real(*a))
-    coarse = generate("unit_square", 0.25)
-    H = MeshHierarchy.from_refinement(coarse, 2, renumber="rcm")
-    assert calls == [] and all(m not in edges_module._CACHE for m in H.meshes[1:])
-    MeshHierarchy.from_refinement(coarse, 2)
-    assert calls == [1, 1]
+    monkeypatch.setattr(refine_module, "NUMBA_THRESHOLD_3D", 0)
+    searched = []
+    real = edges_module._edges
+    monkeypatch.setattr(edges_module, "_edges", lambda m: searched.append(m.n_cells) or real(m))
+    make = {**MESHES, "kuhn-cube": lambda: generate("kuhn_cube", 0.5), "wobbled-box": _wobbled_box,
+            "fichera": lambda: generate("kuhn_fichera", 1.0)}[name]
+    for levels in (1, 2, 3):
+        searched.clear()
+        H = MeshHierarchy.from_refinement(make(), levels, renumber=renumber)
+        assert searched == [H.coarsest.n_cells]
+        derived = edges_module._CACHE[H.finest]
+        for a, b, c in zip(derived, real(H.finest), _by_unique(H.finest)):
+            assert a.dtype == b.dtype and a.shape == b.shape
+            assert np.array_equal(a, b) and np.array_equal(a, c)
+            assert not a.flags.writeable

@@ -38,7 +38,8 @@ FAMILIES = {
     "mesh passes": (("femkit.mesh._edges_kernel", "cell_edges"),
                     ("femkit.mesh._quality_kernel", "triangle_quality"),
                     ("femkit.mesh._refine_kernel", "red_children"),
-                    ("femkit.mesh._refine_kernel", "child_edges")),
+                    ("femkit.mesh._refine_kernel", "child_edges"),
+                    ("femkit.mesh._refine_kernel", "interleaved_red")),
     "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
                     ("femkit.fem._kernels", "_stiffness_rows"), ("femkit.fem._kernels", "_eliminate")),
     "solver checks": (("femkit.solvers._check_kernels", "asymmetry_sums"),),
@@ -138,6 +139,9 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True)
         from ...fem._kernels import warm_up as assembly_kernels
 
         assembly_kernels()  # the cached-pattern assembly, which a one-off run does not call
+        from ...mesh._refine_kernel import warm_up as refinement_kernels
+
+        refinement_kernels(dims=(2,))  # a renumbered (large) hierarchy's, which the tiny case skips
         from ...fem.estimators._kernels import warm_up as estimator_kernels
 
         estimator_kernels()  # the estimator's Neumann and area passes, which the tiny case skips
