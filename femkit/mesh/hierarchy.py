@@ -88,6 +88,30 @@ def _restrict_free(P: sp.csr_matrix, rows: np.ndarray, cols: np.ndarray) -> sp.c
     return sp.csr_matrix((P.data[keep], new_cols[keep], indptr), shape=(len(rows), len(cols)))
 
 
+def _fixed_columns(P: sp.csr_matrix, row_kept: np.ndarray, col_fixed: np.ndarray) -> sp.csr_matrix:
+    """``P[rows][:, cols]`` for the rows where ``row_kept`` and the columns where ``col_fixed``
+    (boolean masks), entries in their order: the few entries of ``P`` that carry the Dirichlet
+    values of the coarse level to the free fine nodes (midpoints of edges with a fixed end).
+
+    >>> P = sp.csr_matrix(np.array([[1.0, 0, 0], [0.5, 0.5, 0], [0, 0.5, 0.5], [0, 0, 1]]))
+    >>> _fixed_columns(P, np.array([False, True, True, False]),
+    ...                np.array([True, False, True])).toarray()
+    array([[0.5, 0. ],
+           [0. , 0.5]])
+    """
+    n_rows = P.shape[0]
+    idx = P.indices.dtype
+    rows = np.repeat(np.arange(n_rows, dtype=idx), np.diff(P.indptr))
+    keep = col_fixed[P.indices] & row_kept[rows]
+    row_map = np.cumsum(row_kept, dtype=np.int64) - 1
+    col_map = np.cumsum(col_fixed, dtype=np.int64) - 1
+    n_out = int(row_kept.sum())
+    indptr = np.zeros(n_out + 1, dtype=np.int64)
+    np.cumsum(np.bincount(row_map[rows[keep]], minlength=n_out), out=indptr[1:])
+    return sp.csr_matrix((P.data[keep], col_map[P.indices[keep]].astype(idx), indptr.astype(idx)),
+                         shape=(n_out, int(col_fixed.sum())))
+
+
 def interleave_permutation(n_coarse: int, edge_nodes: np.ndarray) -> np.ndarray:
     """Fine-level order keeping a locality-ordered coarse level local: every coarse node is
     followed by the midpoints of its edges to higher-numbered nodes (``perm[j]`` = old id of new
@@ -226,6 +250,36 @@ class MeshHierarchy:
         frees = self.level_free(free)
         return [_restrict_free(P.tocsr(), frees[lvl + 1], frees[lvl])
                 for lvl, P in enumerate(self.prolongations)]
+
+    def fixed_prolongations(self, free) -> list[tuple[sp.csr_matrix, np.ndarray]]:
+        """``(P_l[free_{l+1}][:, fixed_l], fixed_l)`` for every level: the part of each
+        prolongation that carries level ``l``'s Dirichlet values (at its fixed nodes ``fixed_l``,
+        sorted) to the free nodes of level ``l + 1``.
+
+        With :meth:`free_prolongations` it splits the prolongation of a full nodal vector
+        ``u = (x on free_l, g on fixed_l)``: ``(P_l u)[free_{l+1}] = Pf_l x + Pd_l g``, the
+        same sums (a P1 row has at most two entries) without the full matrices or vectors.
+        ``free``: as for :meth:`level_free`.
+
+        >>> from femkit.mesh import Mesh, boundary_nodes
+        >>> sq = Mesh(points=[[0, 0], [1, 0], [1, 1], [0, 1]], triangles=[[0, 1, 2], [0, 2, 3]])
+        >>> H = MeshHierarchy.from_refinement(sq, 2)
+        >>> free = np.setdiff1d(np.arange(H.finest.n_points), boundary_nodes(H.finest))
+        >>> (Pd, fixed), f0, f1 = H.fixed_prolongations(free)[1], *H.level_free(free)[1:]
+        >>> u = np.arange(H.meshes[1].n_points, dtype=float)   # free and fixed values
+        >>> Pf = H.free_prolongations(free)[1]
+        >>> bool(np.array_equal(Pf @ u[f0] + Pd @ u[fixed], H.prolongate(u, 1)[f1]))
+        True
+        """
+        frees = self.level_free(free)
+        out = []
+        for lvl, P in enumerate(self.prolongations):
+            fixed = np.ones(P.shape[1], dtype=bool)
+            fixed[frees[lvl]] = False
+            rows = np.zeros(P.shape[0], dtype=bool)
+            rows[frees[lvl + 1]] = True
+            out.append((_fixed_columns(P.tocsr(), rows, fixed), np.flatnonzero(fixed)))
+        return out
 
     def _free_mask(self, free) -> np.ndarray:
         n = self.finest.n_points

@@ -250,6 +250,14 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
             raise InputError("fmg: give either levels (the coarse systems) or dirichlet (the "
                              "finest level's Dirichlet values), not both")
         dirichlet = _coarse_dirichlet(mg, dirichlet)
+    # the coarse Dirichlet values reach the finer free nodes through the few entries of the
+    # prolongations with a fixed column (not the full matrices and nodal vectors)
+    fixed_parts = (mg.hierarchy.fixed_prolongations(mg.frees[-1])
+                   if levels is not None or dirichlet is not None else None)
+    if levels is not None:
+        # each level's Dirichlet values at its fixed nodes (None where all are zero: nothing to add)
+        lifted = [sy.expand(np.zeros(len(sy.free)))[fx] for sy, (_, fx) in zip(levels, fixed_parts)]
+        lifted = [g if np.any(g) else None for g in lifted]
     rho0 = max(_contraction(mg), RHO_FLOOR)
     setup_time = time.perf_counter() - t_setup
     if prob.b_is_zero:
@@ -267,7 +275,8 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
         if levels is not None:
             rhs[lvl] = scaled(levels[lvl].b, -e)
         elif dirichlet is not None:
-            w = scaled(mg.hierarchy.prolongate(dirichlet[lvl], lvl)[mg.frees[lvl + 1]], -e)
+            Pd, fixed = fixed_parts[lvl]
+            w = Pd @ scaled(dirichlet[lvl][fixed], -e)
             rhs[lvl] = mg.restrictions[lvl] @ (rhs[lvl + 1] - mg.levels[lvl + 1].A @ w)
         else:
             rhs[lvl] = mg.restrictions[lvl] @ rhs[lvl + 1]
@@ -286,15 +295,14 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
     for lvl in range(1, top + 1):
         A_l = mg.levels[lvl].A
         P = mg.prolongations[lvl - 1]
-        if levels is not None:
-            full = levels[lvl - 1].expand(scaled(x, e))   # Dirichlet values in b's units
-            x = scaled(mg.hierarchy.prolongate(full, lvl - 1)[mg.frees[lvl]], -e)
+        # (P u)[free] = P x + Pd g for u = (x on the free nodes, g on the fixed ones): the same
+        # sums as the full product (a row has at most two entries), g in b's units times 2^-e
+        x = P @ x
+        if levels is not None and lifted[lvl - 1] is not None:
+            x += fixed_parts[lvl - 1][0] @ scaled(lifted[lvl - 1], -e)
         elif dirichlet is not None:
-            full = scaled(dirichlet[lvl - 1], -e)      # zero on the free nodes
-            full[mg.frees[lvl - 1]] = x
-            x = mg.hierarchy.prolongate(full, lvl - 1)[mg.frees[lvl]]
-        else:
-            x = P @ x
+            Pd, fixed = fixed_parts[lvl - 1]
+            x += Pd @ scaled(dirichlet[lvl - 1][fixed], -e)
         r = rhs[lvl] - A_l @ x
         # ||x - x0||_A^2 = (x - x0).(r0 - r) = x.r0 - x.r - x0.r0 + x0.r: dot products, no copies
         r0 = r.copy()
@@ -320,6 +328,7 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
             prev_d = dA
             alg = rho / (1.0 - rho) * dA
             eta = math.sqrt(max(float(x @ r0) - float(x @ r) - s00 + float(x_start @ r), 0.0) / 3.0)
+            d = Ad = None  # released before the next cycle or the true residual allocates
             if finest:
                 res_norm = norm2(r)
                 residuals.append(res_norm)
@@ -365,6 +374,7 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
                 message = (f"maxiter = {prob.maxiter} V-cycles on the finest level reached; "
                            f"algebraic error bound {unscale(alg, e):.3e}, estimated "
                            f"discretisation error {unscale(eta, e):.3e}")
+    rhs = r = r0 = x_start = None  # the finest level's vectors, before finish() forms b - A x
     alg, eta = unscale(alg, e), unscale(eta, e)   # energy norms in the units of b
     etas = [unscale(v, e) for v in etas]
     if top:

@@ -221,7 +221,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         system = problem.system
         dofs, nnz = int(system.A.shape[0]), int(system.A.nnz)
     else:
-        problem = poisson_problem(case, mesh)
+        problem = poisson_problem(case, mesh, scalar_kappa=True)  # a constant: one number
         with raising("assembly"), stage("assembly"):
             K, F = problem.assemble_matrices(keep_pattern=False)  # a one-off: no slot map kept
         check_stop("assembly")
