@@ -222,6 +222,7 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
         raise InputError(f"fmg: fraction must be a number in (0, 1], got {fraction!r}")
     prob = prepare(A, b, None, rtol=rtol, atol=atol, maxiter=50 if maxiter is None else maxiter,
                    method="fmg", symmetric=True, check_symmetry=check_symmetry)
+    prob.x = None  # FMG starts from the coarsest level: no zero start vector of n floats
     mg = getattr(M, "info", {}).get("hierarchy") if M is not None else None
     if M is not None and not isinstance(mg, Multigrid):
         raise InputError("fmg: M must be a 'gmg' preconditioner of this system (or None)")
@@ -252,7 +253,7 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
         dirichlet = _coarse_dirichlet(mg, dirichlet)
     # the coarse Dirichlet values reach the finer free nodes through the few entries of the
     # prolongations with a fixed column (not the full matrices and nodal vectors)
-    fixed_parts = (mg.hierarchy.fixed_prolongations(mg.frees[-1])
+    fixed_parts = (mg.hierarchy.fixed_prolongations(frees=mg.frees)
                    if levels is not None or dirichlet is not None else None)
     if levels is not None:
         # each level's Dirichlet values at its fixed nodes (None where all are zero: nothing to add)

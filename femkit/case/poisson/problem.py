@@ -148,7 +148,9 @@ def multigrid_inputs(case: Case, hierarchy, system) -> dict:
     levels = None
     if spec.method == "fmg" and not is_pure_neumann(case):
         levels = [level_system(case, m, spec.method) for m in hierarchy.meshes[:-1]]
-    out = multigrid_overrides(spec, hierarchy, system.free, levels)
+    # the solve reads the coarser levels' sizes and transfers only: their meshes are released
+    # with the caller's hierarchy (run_poisson drops it before the solve)
+    out = multigrid_overrides(spec, hierarchy.without_coarse_meshes(), system.free, levels)
     if spec.method == "fmg":
         # the P1 stiffness is symmetric bit for bit by construction (entry (i, j) and (j, i) sum
         # the same products in the same element order; elimination drops rows and columns

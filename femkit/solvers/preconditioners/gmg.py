@@ -258,7 +258,7 @@ class Multigrid:
             raise _hierarchy_error("geometric multigrid")
         # duck-typed: the solver layer does not import femkit.mesh (docs/architecture.md)
         if not all(hasattr(hierarchy, a) for a in ("level_free", "free_prolongations",
-                                                   "prolongate", "finest")):
+                                                   "fixed_prolongations", "finest")):
             raise HierarchyError(f"hierarchy must be a femkit.mesh.MeshHierarchy, got "
                                  f"{type(hierarchy).__name__}; {ALTERNATIVE}")
         if isinstance(sweeps, bool) or not isinstance(sweeps, (int, np.integer)) or sweeps < 1:
