@@ -126,9 +126,9 @@ def test_fmg_holds_less_than_a_few_matrices(data):
     """NumPy's allocations during an fmg solve (tracemalloc; the compiled Galerkin pass's own
     buffers are not traced) against the bytes of the finest matrix: the work vectors, the
     transfers and the coarse data. Before the restriction became a view, the Dirichlet values a
-    split product and the loop's vectors were released in time, this was 3.8x (zero data) and
-    5.3x (inhomogeneous) the matrix on a 30,657-unknown square (refined 4 times), 1.75x and 3.2x
-    after."""
+    split product, the start and the finest right-hand side formed when needed and the loop's
+    vectors released in time, this was 3.8x (zero data) and 5.3x (inhomogeneous) the matrix on
+    a 30,657-unknown square (refined 4 times), 1.6x and 3.1x after."""
     g = (lambda x, y: 0 * x) if data == "zero" else (lambda x, y: 1 + x * y)
     H, sys_, m = _square_system(g)
     kw = {} if data == "zero" else {"dirichlet": sys_.expand(np.zeros(len(sys_.free)))}

@@ -352,6 +352,17 @@ class Multigrid:
             rho = float(np.sqrt(e @ (A @ e)))
         return rho
 
+    def matvec(self, v: np.ndarray, level: int) -> np.ndarray:
+        """``A_level v`` written into the level's residual work vector (no allocation), valid
+        until the next :meth:`vcycle` or :meth:`matvec` on that level: the same sums in the same
+        order as SciPy's CSR product, so the same numbers."""
+        from ._gmg_kernels import add_matvec
+
+        L = self.levels[level]
+        L.r.fill(0.0)
+        add_matvec(L.indptr, L.indices, L.data, np.ascontiguousarray(v, dtype=np.float64), L.r)
+        return L.r
+
     def vcycle(self, b: np.ndarray, level: int | None = None) -> np.ndarray:
         """``M_level b``: one V(sweeps, sweeps)-cycle on ``level`` (default the finest) from zero.
 
