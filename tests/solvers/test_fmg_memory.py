@@ -89,6 +89,10 @@ def test_restriction_is_the_prolongation_read_as_csc_with_the_transposes_sums(ki
         assert np.array_equal(R @ r, transpose_csr(P) @ r)
     assert mg.levels[-1].x is None                           # the cycle's output is new anyway
     assert all(L.x is not None for L in mg.levels[1:-1])
+    for lvl, L in enumerate(mg.levels):                      # A v in the work vector: SciPy's sums
+        v = rng.standard_normal(L.A.shape[0])
+        out = mg.matvec(v, lvl)
+        assert out is L.r and np.array_equal(out, L.A @ v)
 
 
 def test_level_free_reuses_increasing_finest_ids_and_sorts_any_other():
