@@ -40,13 +40,17 @@ def prolongation(n_coarse: int, edge_nodes: np.ndarray) -> sp.csr_matrix:
     """P1 prolongation of one red refinement: ``(n_coarse + E, n_coarse)`` CSR.
 
     Row ``i < n_coarse`` is the unit vector ``e_i``; row ``n_coarse + e`` has ``1/2`` at both
-    nodes of ``edge_nodes[e]`` (the nesting of :func:`femkit.mesh.refine`).
+    nodes of ``edge_nodes[e]`` (the nesting of :func:`femkit.mesh.refine`). Indices are int32
+    while the entries fit (SciPy's own choice; half the memory of int64: 4 bytes per entry and
+    per row less, 21 MB at 1.9M fine nodes), int64 beyond.
     """
     n_edges = len(edge_nodes)
-    indptr = np.concatenate([np.arange(n_coarse + 1, dtype=np.int64),
-                             n_coarse + 2 * np.arange(1, n_edges + 1, dtype=np.int64)])
-    indices = np.concatenate([np.arange(n_coarse, dtype=np.int64),
-                              np.asarray(edge_nodes, dtype=np.int64).ravel()])
+    nnz = n_coarse + 2 * n_edges
+    idx = np.int32 if max(nnz, n_coarse + n_edges) <= np.iinfo(np.int32).max else np.int64
+    indptr = np.concatenate([np.arange(n_coarse + 1, dtype=idx),
+                             n_coarse + 2 * np.arange(1, n_edges + 1, dtype=idx)])
+    indices = np.concatenate([np.arange(n_coarse, dtype=idx),
+                              np.asarray(edge_nodes).astype(idx, copy=False).ravel()])
     data = np.concatenate([np.ones(n_coarse), np.full(2 * n_edges, 0.5)])
     return sp.csr_matrix((data, indices, indptr), shape=(n_coarse + n_edges, n_coarse))
 
@@ -100,6 +104,32 @@ def _restrict_free(P: sp.csr_matrix, rows: np.ndarray, cols: np.ndarray) -> sp.c
     keep = np.ones(P.nnz, dtype=bool)
     keep[dropped] = False
     return sp.csr_matrix((P.data[keep], new_cols[keep], indptr), shape=(len(rows), len(cols)))
+
+
+def _fixed_columns(P: sp.csr_matrix, rows: np.ndarray, col_fixed: np.ndarray) -> sp.csr_matrix:
+    """``P[rows][:, cols]`` for increasing ``rows`` and the columns where ``col_fixed`` (a
+    boolean mask), entries in their order: the few entries of ``P`` that carry the Dirichlet
+    values of the coarse level to the free fine nodes (midpoints of edges with a fixed end).
+    Only those entries are located (one boolean pass over the column indices), so the
+    temporaries are a byte per entry of ``P``.
+
+    >>> P = sp.csr_matrix(np.array([[1.0, 0, 0], [0.5, 0.5, 0], [0, 0.5, 0.5], [0, 0, 1]]))
+    >>> _fixed_columns(P, np.array([1, 2]), np.array([True, False, True])).toarray()
+    array([[0.5, 0. ],
+           [0. , 0.5]])
+    """
+    idx = P.indices.dtype
+    ent = np.flatnonzero(col_fixed[P.indices])
+    row = np.searchsorted(P.indptr, ent, side="right") - 1
+    pos = np.searchsorted(rows, row)
+    hit = pos < len(rows)
+    hit[hit] = rows[pos[hit]] == row[hit]    # the entry's row is one of ``rows``
+    ent, pos = ent[hit], pos[hit]
+    col_map = np.cumsum(col_fixed, dtype=np.int64) - 1
+    indptr = np.zeros(len(rows) + 1, dtype=np.int64)
+    np.cumsum(np.bincount(pos, minlength=len(rows)), out=indptr[1:])
+    return sp.csr_matrix((P.data[ent], col_map[P.indices[ent]].astype(idx), indptr.astype(idx)),
+                         shape=(len(rows), int(col_fixed.sum())))
 
 
 def interleave_permutation(n_coarse: int, edge_nodes: np.ndarray) -> np.ndarray:
@@ -229,7 +259,12 @@ class MeshHierarchy:
             ``free`` is not a mask of the finest mesh's nodes nor valid node ids.
         """
         mask = self._free_mask(free)
-        out = [np.flatnonzero(mask)]
+        ids = np.asarray(free)
+        # increasing int64 ids (DirichletSystem.free) are the finest level's list as they are:
+        # no second copy of n node ids
+        same = (ids.dtype == np.int64 and ids.ndim == 1 and len(ids) == np.count_nonzero(mask)
+                and bool(np.all(ids[1:] > ids[:-1])))
+        out = [ids if same else np.flatnonzero(mask)]
         for inj in reversed(self.injections):
             mask = mask[inj]
             out.append(np.flatnonzero(mask))
@@ -244,6 +279,45 @@ class MeshHierarchy:
         frees = self.level_free(free)
         return [_restrict_free(P.tocsr(), frees[lvl + 1], frees[lvl])
                 for lvl, P in enumerate(self.prolongations)]
+
+    def fixed_prolongations(self, free=None, *, frees=None) -> list[tuple[sp.csr_matrix, np.ndarray]]:
+        """``(P_l[free_{l+1}][:, fixed_l], fixed_l)`` for every level: the part of each
+        prolongation that carries level ``l``'s Dirichlet values (at its fixed nodes ``fixed_l``,
+        sorted) to the free nodes of level ``l + 1``.
+
+        With :meth:`free_prolongations` it splits the prolongation of a full nodal vector
+        ``u = (x on free_l, g on fixed_l)``: ``(P_l u)[free_{l+1}] = Pf_l x + Pd_l g``, the
+        same sums (a P1 row has at most two entries) without the full matrices or vectors.
+        ``free``: as for :meth:`level_free`; or ``frees``, its output (the free ids of every
+        level) when already known.
+
+        >>> from femkit.mesh import Mesh, boundary_nodes
+        >>> sq = Mesh(points=[[0, 0], [1, 0], [1, 1], [0, 1]], triangles=[[0, 1, 2], [0, 2, 3]])
+        >>> H = MeshHierarchy.from_refinement(sq, 2)
+        >>> free = np.setdiff1d(np.arange(H.finest.n_points), boundary_nodes(H.finest))
+        >>> (Pd, fixed), f0, f1 = H.fixed_prolongations(free)[1], *H.level_free(free)[1:]
+        >>> u = np.arange(H.meshes[1].n_points, dtype=float)   # free and fixed values
+        >>> Pf = H.free_prolongations(free)[1]
+        >>> bool(np.array_equal(Pf @ u[f0] + Pd @ u[fixed], H.prolongate(u, 1)[f1]))
+        True
+        """
+        if frees is None:
+            frees = self.level_free(free)
+        out = []
+        for lvl, P in enumerate(self.prolongations):
+            fixed = np.ones(P.shape[1], dtype=bool)
+            fixed[frees[lvl]] = False
+            out.append((_fixed_columns(P.tocsr(), frees[lvl + 1], fixed), np.flatnonzero(fixed)))
+        return out
+
+    def without_coarse_meshes(self) -> "MeshHierarchy":
+        """The same levels and transfers with the coarser meshes dropped (``None``; the finest
+        kept): all a multigrid solve reads once the coarser levels' loads are assembled (sizes,
+        injections, prolongations), so their cells and points can be released during the solve
+        (a third of the finest mesh's arrays in 2D, a seventh in 3D)."""
+        from dataclasses import replace
+
+        return replace(self, meshes=(None,) * (self.n_levels - 1) + (self.finest,))
 
     def _free_mask(self, free) -> np.ndarray:
         n = self.finest.n_points
@@ -263,5 +337,6 @@ class MeshHierarchy:
         return mask
 
     def __repr__(self) -> str:
-        sizes = ", ".join(str(m.n_points) for m in self.meshes)
+        sizes = ", ".join(str(P.shape[1]) for P in self.prolongations)
+        sizes = ", ".join(filter(None, (sizes, str(self.finest.n_points))))
         return f"MeshHierarchy(levels={self.n_levels}, nodes=[{sizes}], renumbering={self.renumbering!r})"

@@ -222,6 +222,7 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
         raise InputError(f"fmg: fraction must be a number in (0, 1], got {fraction!r}")
     prob = prepare(A, b, None, rtol=rtol, atol=atol, maxiter=50 if maxiter is None else maxiter,
                    method="fmg", symmetric=True, check_symmetry=check_symmetry)
+    prob.x = None  # FMG starts from the coarsest level: no zero start vector of n floats
     mg = getattr(M, "info", {}).get("hierarchy") if M is not None else None
     if M is not None and not isinstance(mg, Multigrid):
         raise InputError("fmg: M must be a 'gmg' preconditioner of this system (or None)")
@@ -250,6 +251,14 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
             raise InputError("fmg: give either levels (the coarse systems) or dirichlet (the "
                              "finest level's Dirichlet values), not both")
         dirichlet = _coarse_dirichlet(mg, dirichlet)
+    # the coarse Dirichlet values reach the finer free nodes through the few entries of the
+    # prolongations with a fixed column (not the full matrices and nodal vectors)
+    fixed_parts = (mg.hierarchy.fixed_prolongations(frees=mg.frees)
+                   if levels is not None or dirichlet is not None else None)
+    if levels is not None:
+        # each level's Dirichlet values at its fixed nodes (None where all are zero: nothing to add)
+        lifted = [sy.expand(np.zeros(len(sy.free)))[fx] for sy, (_, fx) in zip(levels, fixed_parts)]
+        lifted = [g if np.any(g) else None for g in lifted]
     rho0 = max(_contraction(mg), RHO_FLOOR)
     setup_time = time.perf_counter() - t_setup
     if prob.b_is_zero:
@@ -267,10 +276,30 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
         if levels is not None:
             rhs[lvl] = scaled(levels[lvl].b, -e)
         elif dirichlet is not None:
-            w = scaled(mg.hierarchy.prolongate(dirichlet[lvl], lvl)[mg.frees[lvl + 1]], -e)
+            Pd, fixed = fixed_parts[lvl]
+            w = Pd @ scaled(dirichlet[lvl][fixed], -e)
             rhs[lvl] = mg.restrictions[lvl] @ (rhs[lvl + 1] - mg.levels[lvl + 1].A @ w)
         else:
             rhs[lvl] = mg.restrictions[lvl] @ rhs[lvl + 1]
+    # the finest right-hand side is b times 2^-e (exact): formed when needed, not kept beside b
+    rhs[top] = None
+
+    def start(lvl: int, xc: np.ndarray) -> np.ndarray:
+        """Level ``lvl``'s start interpolated from the coarser level's ``xc``: ``(P u)[free] =
+        P xc + Pd g`` for ``u = (xc on the free nodes, g on the fixed ones)``, the same sums as
+        the full product (a row has at most two entries), ``g`` in b's units times 2^-e. Formed
+        again where it is needed (the same numbers), not kept."""
+        x0 = mg.prolongations[lvl - 1] @ xc
+        if levels is not None and lifted[lvl - 1] is not None:
+            x0 += fixed_parts[lvl - 1][0] @ scaled(lifted[lvl - 1], -e)
+        elif dirichlet is not None:
+            Pd, fixed = fixed_parts[lvl - 1]
+            x0 += Pd @ scaled(dirichlet[lvl - 1][fixed], -e)
+        return x0
+
+    def level_rhs(lvl: int) -> np.ndarray:
+        """A new array holding level ``lvl``'s right-hand side (the caller may overwrite it)."""
+        return np.ldexp(prob.b, -e) if lvl == top else rhs[lvl].copy()
 
     cycles, rho = [0] * (top + 1), rho0
     etas = [float("nan")] * (top + 1)
@@ -284,23 +313,14 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
         residuals = [norm2(prob.b - prob.A @ prob.x)]
         stopped_by, reason = "direct coarse solve", "converged"
     for lvl in range(1, top + 1):
-        A_l = mg.levels[lvl].A
-        P = mg.prolongations[lvl - 1]
-        if levels is not None:
-            full = levels[lvl - 1].expand(scaled(x, e))   # Dirichlet values in b's units
-            x = scaled(mg.hierarchy.prolongate(full, lvl - 1)[mg.frees[lvl]], -e)
-        elif dirichlet is not None:
-            full = scaled(dirichlet[lvl - 1], -e)      # zero on the free nodes
-            full[mg.frees[lvl - 1]] = x
-            x = mg.hierarchy.prolongate(full, lvl - 1)[mg.frees[lvl]]
-        else:
-            x = P @ x
-        r = rhs[lvl] - A_l @ x
-        # ||x - x0||_A^2 = (x - x0).(r0 - r) = x.r0 - x.r - x0.r0 + x0.r: dot products, no copies
+        x_coarse = x    # the start x0 of this level is start(lvl, x_coarse)
+        x = start(lvl, x_coarse)
+        r = level_rhs(lvl)
+        r -= mg.matvec(x, lvl)
+        # ||x - x0||_A^2 = (x - x0).(r0 - r) = x.r0 - x.r - x0.r0 + x0.r: dot products
         r0 = r.copy()
-        x_start = x.copy()
-        s00 = float(x_start @ r0)
-        started = bool(np.any(x_start))  # else eta measures the solution, not an error
+        s00 = float(x @ r0)
+        started = bool(np.any(x))  # else eta measures the solution, not an error
         finest = lvl == top
         if finest:
             residuals.append(norm2(r))
@@ -310,16 +330,18 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
         met = False
         while cycles[lvl] < limit:
             d = mg.vcycle(r, lvl)
-            Ad = A_l @ d
+            Ad = mg.matvec(d, lvl)   # in the level's work vector: free until the next cycle
             x += d
             r -= Ad
             cycles[lvl] += 1
             dA = math.sqrt(max(float(d @ Ad), 0.0))
+            d = Ad = None  # released before the next cycle, the start or the true residual
             if prev_d is not None and prev_d > 0:
                 rho = max(rho, min(dA / prev_d, 0.99))
             prev_d = dA
             alg = rho / (1.0 - rho) * dA
-            eta = math.sqrt(max(float(x @ r0) - float(x @ r) - s00 + float(x_start @ r), 0.0) / 3.0)
+            x0_r = float(start(lvl, x_coarse) @ r)
+            eta = math.sqrt(max(float(x @ r0) - float(x @ r) - s00 + x0_r, 0.0) / 3.0)
             if finest:
                 res_norm = norm2(r)
                 residuals.append(res_norm)
@@ -332,7 +354,8 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
                                 and alg <= fraction * eta)
                 if res_norm <= tol or estimate_met:
                     # residual replacement (van der Vorst and Ye 2000) before any verdict
-                    true_r = rhs[lvl] - A_l @ x
+                    true_r = level_rhs(lvl)
+                    true_r -= mg.matvec(x, lvl)
                     true_norm = norm2(true_r)
                     if true_norm <= tol or (estimate_met and true_norm <= 2.0 * res_norm + tol):
                         stopped_by = ("residual rule" if res_norm <= tol and true_norm <= tol
@@ -365,6 +388,7 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
                 message = (f"maxiter = {prob.maxiter} V-cycles on the finest level reached; "
                            f"algebraic error bound {unscale(alg, e):.3e}, estimated "
                            f"discretisation error {unscale(eta, e):.3e}")
+    rhs = r = r0 = x_coarse = None  # the finest level's vectors, before finish() forms b - A x
     alg, eta = unscale(alg, e), unscale(eta, e)   # energy norms in the units of b
     etas = [unscale(v, e) for v in etas]
     if top:

@@ -24,8 +24,8 @@ RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs",
                "timings", "wall", "expressions", "files", "backend", "parallel")
 
 
-def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarray | None = None,
-                   extra_point_data: dict | None = None, compression: str | None = None) -> Path:
+def write_solution(path: str | os.PathLike, mesh, u: np.ndarray,
+                   kappa: np.ndarray | float | None = None, extra_point_data: dict | None = None, compression: str | None = None) -> Path:
     """Write the mesh with point data ``u`` and cell data ``kappa`` and ``tag`` (vtu/xdmf by extension).
 
     Not atomic by itself (meshio may write sibling files); use it inside
@@ -36,8 +36,9 @@ def write_solution(path: str | os.PathLike, mesh, u: np.ndarray, kappa: np.ndarr
     point_data = {"u": np.asarray(u, dtype=np.float64)}
     point_data.update(extra_point_data or {})
     cell_data = {"tag": np.asarray(mesh.cell_tags, dtype=np.int32)}
-    if kappa is not None:
-        cell_data["kappa"] = np.asarray(kappa, dtype=np.float64)
+    if kappa is not None:  # a constant coefficient is one number until here
+        kappa = np.asarray(kappa, dtype=np.float64)
+        cell_data["kappa"] = np.full(mesh.n_cells, float(kappa)) if kappa.ndim == 0 else kappa
     # Written in place: sibling files (XDMF's .h5, a tag-name sidecar) are named after the
     # file, so a temporary name would orphan them. Callers write into an atomic directory.
     target = Path(path)

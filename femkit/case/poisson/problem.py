@@ -19,7 +19,7 @@ from ..names import with_prefix
 
 __all__ = ["VARIABLES", "check_dimension", "build_mesh", "build_mesh_levels", "multigrid_inputs",
            "multigrid_overrides", "level_system",
-           "element_kappa", "poisson_problem", "is_pure_neumann", "exact_gradient",
+           "element_kappa", "constant_kappa", "poisson_problem", "is_pure_neumann", "exact_gradient",
            "compute_errors", "CaseResult", "nullspace_facts"]
 
 # ----------------------------------------------------------------------------- stages
@@ -148,7 +148,9 @@ def multigrid_inputs(case: Case, hierarchy, system) -> dict:
     levels = None
     if spec.method == "fmg" and not is_pure_neumann(case):
         levels = [level_system(case, m, spec.method) for m in hierarchy.meshes[:-1]]
-    out = multigrid_overrides(spec, hierarchy, system.free, levels)
+    # the solve reads the coarser levels' sizes and transfers only: their meshes are released
+    # with the caller's hierarchy (run_poisson drops it before the solve)
+    out = multigrid_overrides(spec, hierarchy.without_coarse_meshes(), system.free, levels)
     if spec.method == "fmg":
         # the P1 stiffness is symmetric bit for bit by construction (entry (i, j) and (j, i) sum
         # the same products in the same element order; elimination drops rows and columns
@@ -168,7 +170,7 @@ def level_system(case: Case, mesh, method: str):
     from ...fem import assemble_load
     from ...fem.dirichlet import DirichletSystem
 
-    problem = poisson_problem(case, mesh)
+    problem = poisson_problem(case, mesh, scalar_kappa=True)  # only its load is needed here
     fixed, values = problem.dirichlet_data()
     if np.any(values != 0):
         return problem.assemble(method)
@@ -236,13 +238,26 @@ def _tags(mesh, tags: list):
     return named if len(named) == len(tags) else None
 
 
-def poisson_problem(case: Case, mesh, *, load_rule: str | None = None):
+def constant_kappa(case: Case) -> float | None:
+    """The coefficient as one number when the case gives a plain positive finite number, else
+    None. Assembly, the energy error and the residual estimator take it as is: the same numbers
+    as an array of that value per cell, without the array."""
+    coef = case.spec.coefficient
+    if isinstance(coef, bool) or not isinstance(coef, (int, float)):
+        return None
+    val = float(coef)
+    return val if np.isfinite(val) and val > 0 else None
+
+
+def poisson_problem(case: Case, mesh, *, load_rule: str | None = None,
+                    scalar_kappa: bool = False):
     """The case on ``mesh`` as a :class:`femkit.fem.PoissonProblem` (the one translation).
 
     Dirichlet entries naming the whole boundary together with other tags cover both (a later
     entry wins on shared nodes); a Neumann entry naming the whole boundary takes each boundary
     edge once. Pure Neumann with ``nullspace: pin`` pins node 0 to the exact solution's value
-    there when ``exact`` is given, else to 0.
+    there when ``exact`` is given, else to 0. ``scalar_kappa``: a constant coefficient stays one
+    number (:func:`constant_kappa`) instead of one value per cell (:func:`element_kappa`).
     """
     from ...fem import PoissonProblem
 
@@ -263,7 +278,9 @@ def poisson_problem(case: Case, mesh, *, load_rule: str | None = None):
         if bnd.nullspace == "pin" and "exact.u" in case.functions:
             u0 = case.functions["exact.u"](*mesh.points[:1].T)
             extra["pin_value"] = float(np.asarray(u0).ravel()[0])
-    return PoissonProblem(mesh, element_kappa(case, mesh), case.functions["source"],
+    kappa = constant_kappa(case) if scalar_kappa else None
+    return PoissonProblem(mesh, element_kappa(case, mesh) if kappa is None else kappa,
+                          case.functions["source"],
                           dirichlet=dirichlet, neumann=neumann,
                           load_rule=load_rule or case.spec.load_rule, **extra)
 
@@ -307,7 +324,7 @@ class CaseResult:
     case: Case
     mesh: Any
     u: np.ndarray
-    kappa: np.ndarray
+    kappa: np.ndarray | float  # one number for a constant coefficient
     solve: Any
     errors: dict | None
     timings: dict

@@ -221,7 +221,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         system = problem.system
         dofs, nnz = int(system.A.shape[0]), int(system.A.nnz)
     else:
-        problem = poisson_problem(case, mesh)
+        problem = poisson_problem(case, mesh, scalar_kappa=True)  # a constant: one number
         with raising("assembly"), stage("assembly"):
             K, F = problem.assemble_matrices(keep_pattern=False)  # a one-off: no slot map kept
         check_stop("assembly")
@@ -231,10 +231,11 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         check_stop("boundary")
         with raising("assembly"), stage("assembly"):  # the coarser levels' systems (fmg only)
             mg = multigrid_inputs(case, hierarchy, system)
+        del hierarchy  # the coarser meshes: mg holds the levels' transfers only
         with stage("solve"):
             res = _solve(case, system, stop, **mg)
             u = system.expand(res.x)
-        del mg, hierarchy  # the coarser levels and their operators: not needed after the solve
+        del mg  # the coarser levels and their operators: not needed after the solve
         dofs, nnz = int(system.A.shape[0]), int(system.A.nnz)
         system.A = None  # nor is the matrix (the errors and the estimate work on the mesh)
         report.done("solve")

@@ -9,8 +9,9 @@ the same matrix (the P1 spaces are nested and the element integrals exact).
 
 The Galerkin product is one compiled pass per level (:func:`galerkin_product`): Gustavson's
 row-wise sparse product (Gustavson, "Two fast algorithms for sparse matrices: multiplication and
-permuted transposition", ACM TOMS 4(3), 1978) over the rows of ``P^T``, which is built once by a
-counting-sort transposition (:func:`transpose_csr`) and then also serves as the restriction. The
+permuted transposition", ACM TOMS 4(3), 1978) over the rows of ``P^T``, which is built by a
+counting-sort transposition (:func:`transpose_csr`) for that pass only: the V-cycle restricts with
+``P``'s own arrays read as CSC (``P.T``, no copy, the same sums in the same order). The
 pass returns canonical CSR and the diagonal the smoother needs; it equals SciPy's
 ``P.T @ A @ P`` to round-off.
 
@@ -189,7 +190,8 @@ class _Level:
 
     __slots__ = ("A", "indptr", "indices", "data", "inv_diag", "x", "r")
 
-    def __init__(self, A: sp.csr_matrix, omega: float, diag: np.ndarray | None = None):
+    def __init__(self, A: sp.csr_matrix, omega: float, diag: np.ndarray | None = None,
+                 finest: bool = False):
         A = A.tocsr()
         A.sum_duplicates()      # no-ops on canonical CSR (flags set by galerkin_product)
         A.sort_indices()
@@ -201,7 +203,9 @@ class _Level:
         check_positive_diagonal(d, what="the gmg preconditioner (a level operator)")
         self.inv_diag = omega / d
         n = A.shape[0]
-        self.x = np.empty(n)    # both overwritten before they are read (gs_forward_zero, residual)
+        # both overwritten before they are read (gs_forward_zero, residual); the finest level's
+        # iterate is the cycle's output, a new array (``x`` would be n floats never used)
+        self.x = None if finest else np.empty(n)
         self.r = np.empty(n)
 
 
@@ -234,8 +238,8 @@ class Multigrid:
         Per level (coarsest first) the operator and smoother data.
     prolongations : list of csr_matrix
         Free-dof prolongations ``P_l`` (level ``l`` -> ``l + 1``).
-    restrictions : list of csr_matrix
-        Their transposes ``P_l^T`` (:func:`transpose_csr`), which the Galerkin products also use.
+    restrictions : list of csc_matrix
+        Their transposes ``P_l^T``: views of ``P_l``'s arrays (CSC), no copy.
     frees : list of ndarray
         Free node ids of every level.
     hierarchy : MeshHierarchy
@@ -254,7 +258,7 @@ class Multigrid:
             raise _hierarchy_error("geometric multigrid")
         # duck-typed: the solver layer does not import femkit.mesh (docs/architecture.md)
         if not all(hasattr(hierarchy, a) for a in ("level_free", "free_prolongations",
-                                                   "prolongate", "finest")):
+                                                   "fixed_prolongations", "finest")):
             raise HierarchyError(f"hierarchy must be a femkit.mesh.MeshHierarchy, got "
                                  f"{type(hierarchy).__name__}; {ALTERNATIVE}")
         if isinstance(sweeps, bool) or not isinstance(sweeps, (int, np.integer)) or sweeps < 1:
@@ -283,13 +287,17 @@ class Multigrid:
         self.sweeps = int(sweeps)
         P = [_float_csr(p) for p in hierarchy.free_prolongations(frees[-1])]
         self.prolongations = P
-        self.restrictions = [transpose_csr(p) for p in P]
+        # the restriction P^T is P's arrays read as CSC (no copy): SciPy's CSC product scatters
+        # row i of P in increasing i, the order in which a CSR copy of P^T sums its rows, so the
+        # results are the same bit for bit; the CSR transpose the Galerkin pass needs is built
+        # per level and dropped after it
+        self.restrictions = [p.T for p in P]
         self._p_arrays = [(_unsigned(p.indptr), _unsigned(p.indices), p.data) for p in P]
         ops = [A]
         diags = [None] * (len(P) + 1)   # known diagonals (the Galerkin pass returns them)
         if coarse_operators is None:
             for lvl in range(len(P) - 1, -1, -1):
-                op, diags[lvl] = galerkin_product(ops[-1], P[lvl], self.restrictions[lvl])
+                op, diags[lvl] = galerkin_product(ops[-1], P[lvl], transpose_csr(P[lvl]))
                 ops.append(op)
             ops = ops[::-1]
             kind = "galerkin"
@@ -305,7 +313,9 @@ class Multigrid:
                                      f"{lvl} has {len(frees[lvl])} free nodes")
             kind = "given"
         self.omega = float(omega)
-        self.levels = [_Level(op, self.omega, d) for op, d in zip(ops, diags)]
+        top = len(ops) - 1
+        self.levels = [_Level(op, self.omega, d, finest=lvl == top)
+                       for lvl, (op, d) in enumerate(zip(ops, diags))]
         coarsest = ops[0]
         # the one kept-factor path of the solvers (LinearSession.factorize uses it too): SuperLU
         # in symmetric mode
@@ -341,6 +351,17 @@ class Multigrid:
             e = e - self.vcycle(A @ e)
             rho = float(np.sqrt(e @ (A @ e)))
         return rho
+
+    def matvec(self, v: np.ndarray, level: int) -> np.ndarray:
+        """``A_level v`` written into the level's residual work vector (no allocation), valid
+        until the next :meth:`vcycle` or :meth:`matvec` on that level: the same sums in the same
+        order as SciPy's CSR product, so the same numbers."""
+        from ._gmg_kernels import add_matvec
+
+        L = self.levels[level]
+        L.r.fill(0.0)
+        add_matvec(L.indptr, L.indices, L.data, np.ascontiguousarray(v, dtype=np.float64), L.r)
+        return L.r
 
     def vcycle(self, b: np.ndarray, level: int | None = None) -> np.ndarray:
         """``M_level b``: one V(sweeps, sweeps)-cycle on ``level`` (default the finest) from zero.
