@@ -2,10 +2,13 @@
 SIGINT for 657 s, the stress study waited 37 s for its current run): during a Poisson case's
 assembly, during its long iterative solve, and inside a study's run. Each test signals a
 ``femkit`` subprocess once it has entered the work under test and measures signal-to-exit time
-(the target is 1 s; the assertion allows 3 s for a loaded machine), the exit code, the one line
+(the target is 1 s; the assertion allows 3 s on an idle machine, scaled by the load per core
+when other processes share it: a stop that waited for the work to end would take the rest of the
+run, tens of seconds), the exit code, the one line
 saying what was kept, and the kept output."""
 
 import json
+import os
 import signal
 import sys
 from pathlib import Path
@@ -19,7 +22,8 @@ from _signals import signal_inside  # noqa: E402
 REPO = Path(__file__).resolve().parents[2]
 SIGNALS = pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
                                   ids=["SIGINT", "SIGTERM"])
-SLACK = 3.0  # seconds from the signal to the exit (target 1 s)
+# seconds from the signal to the exit (target 1 s), more when the machine is shared
+SLACK = 3.0 * max(1.0, os.getloadavg()[0] / (os.cpu_count() or 1))
 
 
 def _poisson(tmp_path, refine: int, rtol: float, method: str = "cg") -> Path:
