@@ -56,8 +56,8 @@ _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiff
                ("femkit.solvers.checks", "SYMMETRY_NUMBA_NNZ"))
 
 #: The tetrahedral tiny case (run after :data:`_TINY`): the 3D kernels of the same families
-#: (the tetrahedron assembly, the face numbering, the estimator's face jumps) with a constant
-#: source, so no expression module is compiled for it.
+#: (the tetrahedron assembly, the face numbering, the estimator's face jumps); a constant source
+#: and no exact solution, so its own expression module is small (the load's source passes).
 _TINY_3D = {
     "problem": "poisson", "name": "warmup3d",
     "mesh": {"geometry": "kuhn_cube", "h": 0.5, "refine": 1},
