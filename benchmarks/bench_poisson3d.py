@@ -15,9 +15,10 @@ edges; ``--numbering none``: the refinement's own). BLAS and numba threads are p
 
 - assembly: ``skfem`` = ``Basis(MeshTet, ElementTetP1(), intorder=1)`` + ``asm(laplace)`` +
   ``asm(unit load)``; femkit's first call = ``assemble_stiffness`` + ``assemble_load`` on a new
-  mesh object (CSR pattern built in the call; numba compile excluded: cached on disk), both row
-  by row (``keep_pattern=False``, what ``femkit solve`` does: no slot map) and by the fused
-  element-order pass that keeps the pattern; medians of interleaved runs, and the ratios;
+  mesh object (CSR pattern built in the call; numba compile excluded: cached on disk), both by
+  the one-off path (``keep_pattern=False``, what ``femkit solve`` does: rows from the node ->
+  element incidences, then each element once, no slot map) and by the fused element-order pass
+  that keeps the pattern; medians of interleaved runs, and the ratios;
 - solve to the discretisation error of ``u = exp(x + y/2 - 3z/10)`` (Dirichlet data = u):
   ``fmg`` on the nested boxes given the Dirichlet values (as ``femkit solve`` calls it; its own
   stopping rule; the time includes its set-up: symmetry check, transfers, Galerkin products),
@@ -94,7 +95,7 @@ def assembly(mesh, repeat: int) -> None:
     Ks, Fs = skfem_run()
     err = abs(K - Ks).max() / abs(Ks).max()
     t_sk, t_rows, t_fused = (statistics.median(v) for v in (sk, rows, fused))
-    print(f"assembly: skfem {t_sk:.2f} s; femkit first call, row by row (as femkit solve) "
+    print(f"assembly: skfem {t_sk:.2f} s; femkit first call, one-off path (as femkit solve) "
           f"{t_rows:.2f} s, ratio {t_sk / t_rows:.1f}x; fused pass keeping the pattern "
           f"{t_fused:.2f} s, ratio {t_sk / t_fused:.1f}x (max |K - K_skfem| / max |K| = "
           f"{err:.1e}, |F - F_skfem| = {abs(F - Fs).max():.1e})")

@@ -11,6 +11,14 @@ squares over every bundled geometry.
     OPENBLAS_NUM_THREADS=1 python benchmarks/calibrate_cost.py              # print the constants
     OPENBLAS_NUM_THREADS=1 python benchmarks/calibrate_cost.py --write ~/.config/femkit/cost.json
     OPENBLAS_NUM_THREADS=1 python benchmarks/calibrate_cost.py --quick      # smaller runs (~1 min)
+    OPENBLAS_NUM_THREADS=1 python benchmarks/calibrate_cost.py --tetrahedra [--levels 3 4 5]
+
+``--tetrahedra`` fits the 3D memory laws (the ``tetrahedra`` section, femkit/cost/tetrahedra.py)
+alone: ``cost_probe.measure_case`` runs ``femkit solve``'s pipeline on the Kuhn cube (h = 1/3,
+refined 3, 4, 5 times: 83k to 5.3M tetrahedra; fmg, errors, estimate) in fresh processes; per
+law the slope of the stage peak between the two largest runs, ``fixed_bytes`` the largest
+intercept (total peak minus slope times tetrahedra) above the model's baseline. The margin is
+not fitted: it is checked against whole-run peaks (docs/benchmarks.md).
 """
 
 from __future__ import annotations
@@ -27,7 +35,8 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from cost_probe import child_env, domain, measure_poisson_subprocess  # noqa: E402
+from cost_probe import (CUBE_CASE, child_env, domain, measure_case_subprocess,  # noqa: E402
+                        measure_poisson_subprocess)
 
 from femkit.cost.constants import load_constants  # noqa: E402
 from femkit.cost.poisson import fixed_bytes, solver_key  # noqa: E402
@@ -89,9 +98,16 @@ def main(argv=None) -> int:
     ap.add_argument("--write", help="write the fitted constants (complete JSON) to this file")
     ap.add_argument("--runs", help="also dump the raw measurements (JSON) to this file")
     ap.add_argument("--from-runs", help="fit from measurements dumped earlier with --runs (no runs)")
+    ap.add_argument("--tetrahedra", action="store_true",
+                    help="fit the 3D memory laws alone (the tetrahedra section)")
+    ap.add_argument("--levels", type=int, nargs="+", default=[3, 4, 5],
+                    help="--tetrahedra: refinements of the h = 1/3 Kuhn cube to measure")
     args = ap.parse_args(argv)
 
     c = load_constants()
+    if args.tetrahedra:
+        print(json.dumps({"tetrahedra": fit_tetrahedra(c, args.levels)}, indent=2))
+        return 0
     if args.from_runs:
         with open(args.from_runs) as fh:
             saved = json.load(fh)
@@ -162,6 +178,32 @@ def measure(args) -> list[dict]:
     for kind in ("xdmf", "png"):
         run(geometry="unit_square", h=0.02, refine=2, outputs=(kind,), errors=False)
     return runs
+
+
+#: The stage of ``femkit solve`` each 3D law is fitted on (femkit/cost/tetrahedra.py).
+TET_LAWS = {"mesh": "mesh", "assembly": "assembly", "boundary": "boundary", "solve_fmg": "solve",
+            "errors": "errors", "estimate": "estimate"}
+
+
+def fit_tetrahedra(c: dict, levels) -> dict:
+    """The ``tetrahedra`` section from ``femkit solve``'s stage peaks on refined Kuhn cubes."""
+    runs = []
+    for k in levels:
+        r = measure_case_subprocess(dict(CUBE_CASE, mesh={**CUBE_CASE["mesh"], "refine": k}))
+        runs.append(r)
+        peaks = ", ".join(f"{s} {v['peak_bytes'] / 2**20:.0f}" for s, v in r["stages"].items())
+        print(f"refine {k}: {r['n_cells']:,} tetrahedra; stage peaks (MiB above the start): {peaks}",
+              flush=True)
+    small, big = sorted(runs, key=lambda r: r["n_cells"])[-2:]
+    per_tet, fixed = {}, 0.0
+    for law, stage in TET_LAWS.items():
+        slope = ((big["stages"][stage]["peak_bytes"] - small["stages"][stage]["peak_bytes"])
+                 / (big["n_cells"] - small["n_cells"]))
+        per_tet[law] = round(slope, 1)
+        total = big["baseline_bytes"] + big["stages"][stage]["peak_bytes"]
+        fixed = max(fixed, total - slope * big["n_cells"] - c["bytes"]["baseline"])
+    return {"fixed_bytes": float(f"{fixed:.3g}"), "margin": c["tetrahedra"]["margin"],
+            "bytes_per_tetrahedron": per_tet}
 
 
 def fit(c: dict, runs: list[dict], min_fit: float) -> None:

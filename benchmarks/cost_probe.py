@@ -27,7 +27,8 @@ import numpy as np
 
 from femkit.cost.memory import current_rss, peak_rss, reset_peak_rss
 
-__all__ = ["measure_poisson", "measure_poisson_subprocess", "preload", "child_env", "domain"]
+__all__ = ["measure_poisson", "measure_poisson_subprocess", "preload", "child_env", "domain",
+           "measure_case", "measure_case_subprocess", "CUBE_CASE"]
 
 
 def domain(geometry: str, params: dict | None = None) -> dict:
@@ -165,6 +166,88 @@ def measure_poisson_subprocess(timeout: float = 600.0, **kwargs) -> dict:
             "print(json.dumps(measure_poisson(**json.loads(sys.argv[1]))))")
     out = subprocess.run([sys.executable, "-c", code, json.dumps(kwargs)], capture_output=True,
                          text=True, env=env, timeout=timeout, check=False)
+    if out.returncode != 0:
+        raise RuntimeError(f"probe failed ({out.returncode}): {out.stderr.strip()[-2000:]}")
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+#: The tetrahedral case the 3D memory model is calibrated on (as ``bench_poisson3d.py --memory``):
+#: the Kuhn cube of side ``h`` refined ``refine`` times, fmg, errors and the estimate, no files.
+CUBE_CASE = {
+    "problem": "poisson", "name": "probe3d",
+    "mesh": {"geometry": "kuhn_cube", "h": 1 / 3, "refine": 3},
+    "source": "-(1 + 0.25 + 0.09) * exp(x + 0.5*y - 0.3*z)",
+    "boundary": {"dirichlet": [{"tags": ["boundary"], "value": "exp(x + 0.5*y - 0.3*z)"}]},
+    "exact": {"u": "exp(x + 0.5*y - 0.3*z)",
+              "grad": ["exp(x + 0.5*y - 0.3*z)", "0.5*exp(x + 0.5*y - 0.3*z)",
+                       "-0.3*exp(x + 0.5*y - 0.3*z)"]},
+    "solver": {"method": "fmg"},
+    "output": {"vtu": False, "plot": False},
+}
+
+
+def measure_case(case: dict) -> dict:
+    """Run a case file's dict through ``femkit solve``'s pipeline in this process (kernels
+    compiled first, outside the stages); per stage of its :class:`~femkit.timing.StageTimer`
+    the wall time and the peak resident memory above the resident memory at the start (VmHWM
+    reset when a stage starts, read when it ends and when a stage inside it starts; a stage
+    entered twice keeps its largest).
+
+    Returns ``{"stages": {name: {"seconds", "peak_bytes"}}, "baseline_bytes", "peak_bytes",
+    "n_cells", "n_points"}``.
+    """
+    preload()
+    import femkit.timing as timing
+    from femkit.case.load import case_from_dict
+    from femkit.case.poisson.warmup import warm_up
+
+    warm_up()
+    import contextlib
+
+    base = current_rss() or 0
+    stages: dict[str, dict] = {}
+    sizes = {}
+
+    open_peaks: list[int] = []  # running peak of each stage entered and not left (nested stages)
+
+    def fold() -> int:
+        now = max((peak_rss() or 0) - base, 0)
+        for k in range(len(open_peaks)):
+            open_peaks[k] = max(open_peaks[k], now)
+        return now
+
+    @contextlib.contextmanager
+    def probe(self, name):
+        fold()                      # an enclosing stage keeps its peak so far: reset below
+        reset_peak_rss()
+        open_peaks.append(0)
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            dt = time.perf_counter() - t0
+            fold()
+            peak = open_peaks.pop()
+            self.times[name] = self.times.get(name, 0.0) + dt
+            got = stages.setdefault(name, {"seconds": 0.0, "peak_bytes": 0})
+            got["seconds"] += dt
+            got["peak_bytes"] = max(got["peak_bytes"], peak)
+
+    timing.StageTimer.__call__ = probe
+    result = case_from_dict(case).run(write=False, quiet=True)
+    mesh = getattr(result, "mesh", None)
+    if mesh is not None:
+        sizes = {"n_cells": int(mesh.n_cells), "n_points": int(mesh.n_points)}
+    return {"stages": stages, "baseline_bytes": base,
+            "peak_bytes": max(s["peak_bytes"] for s in stages.values()), **sizes}
+
+
+def measure_case_subprocess(case: dict, timeout: float = 3600.0) -> dict:
+    """:func:`measure_case` in a fresh Python process (BLAS pinned to one thread)."""
+    code = ("import json, sys; from cost_probe import measure_case; "
+            "print(json.dumps(measure_case(json.loads(sys.argv[1]))))")
+    out = subprocess.run([sys.executable, "-c", code, json.dumps(case)], capture_output=True,
+                         text=True, env=child_env(), timeout=timeout, check=False)
     if out.returncode != 0:
         raise RuntimeError(f"probe failed ({out.returncode}): {out.stderr.strip()[-2000:]}")
     return json.loads(out.stdout.strip().splitlines()[-1])

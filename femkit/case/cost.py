@@ -63,23 +63,43 @@ def tets_per_h3(geometry: str) -> float:
     """Tetrahedra per ``h^3`` of volume of a generated 3D geometry: exact for the Kuhn
     geometries (:data:`EXACT_TETS_PER_H3`), gmsh's measured density otherwise."""
     return EXACT_TETS_PER_H3.get(geometry, TETS_PER_H3)
-#: Memory of one tetrahedron in triangles of the 2D model: the stiffness entries of a cell,
-#: 4 x 4 against 3 x 3, which dominate assembly (the peak of a mesh's stages).
+#: One tetrahedron in triangles of the 2D model (the stiffness entries of a cell, 4 x 4 against
+#: 3 x 3): the time of a tetrahedral run's stages, and the memory of the stages the 3D memory
+#: model has no law for (:mod:`femkit.cost.tetrahedra`).
 TET_AS_TRIANGLES = 16.0 / 9.0
+
+
+def _in_3d(plan: Plan, tets: float, refine: int, method: str) -> Plan:
+    """``plan`` (priced in triangle equivalents) with the memory of its stages from the 3D laws
+    (:func:`femkit.cost.tetrahedra.stage_bytes`) for ``tets`` cells before ``refine``
+    refinements: the mesh stage (generation or reading) holds the coarse mesh, every later
+    stage the refined one; a stage without a 3D law keeps its price."""
+    from ..cost import load_constants
+    from ..cost.tetrahedra import stage_bytes
+
+    c = load_constants()
+    for st in plan.stages:
+        coarse = st.name == "mesh"
+        price = stage_bytes(st.name, tets if coarse else tets * 8.0 ** refine, method, c)
+        if price is not None:
+            st.peak_bytes = max(st.peak_bytes, price) if coarse else price
+    return plan
 
 
 def check_mesh_fits(*, geometry: str | None = None, h: float | None = None,
                     params: dict | None = None, triangles: float | None = None, refine: int = 0,
-                    dim: int = 2, force: bool = False, override: str = OVERRIDE) -> None:
+                    dim: int = 2, force: bool = False, override: str = OVERRIDE,
+                    available: float | None = None) -> None:
     """Refuse a mesh generation (``geometry``, ``h``, ``params``) or a refinement of a mesh of
     ``triangles`` cells of dimension ``dim`` ``refine`` times whose predicted memory exceeds
     the available memory; call it before :func:`femkit.mesh.generate` /
     :func:`femkit.mesh.refine`.
 
     Only the mesh stages are planned (:func:`femkit.cost.plan_mesh`, a triangle model). A
-    tetrahedral mesh is priced as :data:`TET_AS_TRIANGLES` triangles per tetrahedron, a
-    generated one at :func:`tets_per_h3` tetrahedra per ``h^3`` of volume, and a refinement
-    multiplies the cells by 8 (Bey's red refinement) instead of 4. ``force`` skips the check.
+    tetrahedral mesh (a generated one at :func:`tets_per_h3` tetrahedra per ``h^3`` of volume;
+    8 children per refinement, Bey's red refinement) is priced by the 3D laws of
+    :mod:`femkit.cost.tetrahedra` (the refined hierarchy, its numbering and quality). ``force``
+    skips the check; ``available`` replaces the machine's available memory (bytes).
 
     Raises
     ------
@@ -93,12 +113,15 @@ def check_mesh_fits(*, geometry: str | None = None, h: float | None = None,
         if dim == 2:
             plan = plan_mesh(area=size, line_length=length, h=h, refine=refine, name=geometry,
                              params=params)
-            check_budget(plan, override=override)
+            check_budget(plan, override=override, available=available)
             return
         triangles = tets_per_h3(geometry) * size / float(h) ** 3
     if dim == 3:  # 8^k tetrahedra after k refinements = (2^k cells) x 4^k in the 2D model
-        triangles = TET_AS_TRIANGLES * triangles * 2.0 ** refine
-    check_budget(plan_mesh(triangles=triangles, refine=refine), override=override)
+        plan = _in_3d(plan_mesh(triangles=TET_AS_TRIANGLES * triangles * 2.0 ** refine,
+                                refine=refine), triangles, refine, "")
+    else:
+        plan = plan_mesh(triangles=triangles, refine=refine)
+    check_budget(plan, override=override, available=available)
 
 
 def measure_step_seconds(system, integrator, dt: float, *, ctx=None, batch: int = 20,
@@ -161,17 +184,20 @@ def plan_poisson_case(case, *, measure: bool = True) -> Plan:
 
 
 def _tetrahedral_plan(tets: float, source: str, title: str, common: dict) -> Plan:
-    """The plan of a tetrahedral Poisson run of ``tets`` cells before refinement, priced as
-    :func:`check_mesh_fits` does with ``dim=3``: :data:`TET_AS_TRIANGLES` triangles of the 2D
-    model per tetrahedron, 8 children per refinement (Bey 1995); sizes in tetrahedra."""
+    """The plan of a tetrahedral Poisson run of ``tets`` cells before refinement: memory by
+    the 3D laws (:mod:`femkit.cost.tetrahedra`, as :func:`check_mesh_fits` with ``dim=3``),
+    time and the stages without a 3D law as :data:`TET_AS_TRIANGLES` triangles of the 2D model
+    per tetrahedron; 8 children per refinement (Bey 1995); sizes in tetrahedra."""
     k = common["refine"]
-    plan = plan_poisson(triangles=TET_AS_TRIANGLES * tets * 2.0 ** k, **common)
+    plan = _in_3d(plan_poisson(triangles=TET_AS_TRIANGLES * tets * 2.0 ** k, **common), tets, k,
+                  common["method"])
     rest = {key: v for key, v in plan.sizes.items() if key != "triangles"}
     plan.sizes = {"tetrahedra": tets * 8.0 ** k, **rest}
     plan.title = title
-    plan.assumptions[0] = (f"{source}; a tetrahedron priced as {TET_AS_TRIANGLES:.3g} triangles "
-                           "of the 2D model (its 4 x 4 stiffness block against 3 x 3), x8 per "
-                           "refinement")
+    plan.assumptions[0] = (f"{source}, x8 per refinement; memory per tetrahedron calibrated on "
+                           "tetrahedral runs (femkit/cost/tetrahedra.py), time and the stages "
+                           f"without a 3D calibration as {TET_AS_TRIANGLES:.3g} triangles of the "
+                           "2D model (the 4 x 4 stiffness block against 3 x 3)")
     return plan
 
 

@@ -1,9 +1,29 @@
-"""Compiled (numba) row-wise assembly of P1 tetrahedra; imported only for large meshes.
+"""Compiled (numba) one-off assembly of the P1 stiffness of tetrahedra; imported only for large meshes.
 
-The tetrahedron counterpart of :func:`femkit.fem._kernels._stiffness_rows`: the stiffness as
-CSR built row by row from a node -> element incidence list, without the (m, 16) slot map and
-the (4 m, 4) vertex copies of the element-order pattern pass (5.3M tetrahedra: 0.68 GB of int32
-buffers fewer, and the memory traffic that made the pattern ~80 % of a first assembly).
+The tetrahedron counterpart of :func:`femkit.fem._kernels._stiffness_rows` (what ``femkit solve``
+calls: ``keep_pattern=False``): the stiffness as CSR without the (m, 16) slot map and the (4 m, 4)
+vertex copies of the element-order pattern pass. Two passes (:func:`_tet_rows`,
+:func:`_tet_values`) and a sort of each row:
+
+1. rows, node by node from a node -> element incidence list (counting sort): each row's columns
+   in the order they are met, appended to one buffer (no pass that counts the rows first), and
+   for each element and vertex ``a`` the positions of its other three vertices in row
+   ``cells[e, a]`` as bytes (``rel``, (m, 12) uint8: 12 bytes per element, a third of an int32
+   slot map), with each row's own diagonal position (``diag``, one byte per node);
+2. values, element by element: each element's geometry once (the row-wise kernel this replaced
+   computed it once per vertex, four times) and its 16 local entries added at
+   ``indptr[row] + position``;
+3. each row's (column, value) pairs sorted by column (insertion sort, rows are short:
+   :func:`femkit.mesh._edges_kernel.sort_buckets`).
+
+Every entry is the same products ``kappa (g_a . g_b) / (6 |D|)`` summed over its elements in
+increasing element order, as the element-order pass sums them: the matrix is
+:func:`~femkit.fem._kernels._pattern_cells` / ``_stiffness_tet``'s bit for bit
+(tests/fem/test_rows3d.py). Memory besides the matrix: the incidences (4 m int32) and ``rel``
+(12 m bytes) while the rows are built, ``rel`` alone while the values are summed. The column
+buffer is reserved at its bound (n + 12 m entries) and shrunk to the entry count: only the pages
+written are ever resident. A row with more than 255 columns (a node in more than ~85 elements)
+does not fit a byte: the caller then takes the element-order pass.
 """
 
 from __future__ import annotations
@@ -11,61 +31,122 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ._kernels import _row_columns, _row_lengths, _tetrahedron, _values
+from ..mesh._edges_kernel import sort_buckets
+from ._kernels import _tetrahedron, _values, _vertex_starts
+
+#: Row positions are stored in one byte: rows longer than this take the element-order pass.
+MAX_ROW = 255
 
 
 @numba.njit(cache=True)
-def _stiffness_rows_tet(tets, n, points, kappa, scalar_kappa, inc):  # pragma: no cover - compiled
-    """The P1 stiffness of tetrahedra as CSR, row by row: ``(indptr, indices, data, bad)``.
+def _incidences(cells, n, inc):  # pragma: no cover - compiled
+    """The node -> element incidences of ``cells`` into ``inc`` (counting sort: elements in
+    increasing order around each node); returns ``start``, ``inc[start[i]:start[i + 1]]``
+    the elements around node ``i``."""
+    start = _vertex_starts(cells, n)
+    fill = start[:-1].copy()
+    for e in range(cells.shape[0]):
+        for a in range(cells.shape[1]):
+            i = cells[e, a]
+            inc[fill[i]] = e
+            fill[i] += 1
+    return start
 
-    ``inc`` is the ``4 m`` buffer of the node -> element incidences (counting sort: elements in
-    increasing order around each node); ``indices`` get its dtype. Row ``i`` is the sorted set
-    of the vertices of its elements; each element adds its local row ``a`` (``i`` = its vertex
-    ``a``): ``kappa (g_a . g_b) / (6 |D|)`` with ``g = D grad N`` from the same
-    :func:`~femkit.fem._kernels._tetrahedron` as the element-order kernels, so every entry is
-    the same products summed over its elements in increasing element order: bit for bit the
-    matrix of :func:`~femkit.fem._kernels._pattern_cells` / ``_stiffness_tet``. Each element's
-    geometry is computed once per vertex (4 times) instead of read back from a slot map.
-    ``bad`` counts degenerate tetrahedra (then ``data`` is incomplete).
-    """
-    start, indptr, stamp = _row_lengths(tets, n, inc)
-    nnz = indptr[n]
-    indices = np.empty(nnz, inc.dtype)
-    data = np.zeros(nnz)
-    pos = np.empty(n, np.int64)
-    g = np.empty((4, 3))
-    bad = 0
-    # pass 2: sorted columns (insertion sort: rows are short, ~15), then the local rows summed
+
+@numba.njit(cache=True)
+def _tet_rows(tets, n, inc, start, indices, rel, diag):  # pragma: no cover - compiled
+    """Pass 1: the columns of every row in the order met (``indices``, appended), ``rel[e, 3 a
+    + c]`` the position in row ``tets[e, a]`` of the ``c``-th other vertex of ``e``, ``diag[i]``
+    the position of ``i`` in its row. Returns ``(indptr, nnz, fits)``; ``fits`` is False (and
+    the rest incomplete) when a row has more than :data:`MAX_ROW` columns."""
+    indptr = np.zeros(n + 1, np.int64)
+    mark = np.full(n, -1, np.int64)  # (row << 8) | position of the column in that row
+    q = 0
     for i in range(n):
-        _row_columns(tets, inc, start[i], start[i + 1], i, stamp, indices, indptr[i], True, pos)
+        s = q
+        tag = np.int64(i) << 8
         for k in range(start[i], start[i + 1]):
             e = inc[k]
-            vol6 = abs(_tetrahedron(tets, points, e, g))
-            if not (vol6 > 0.0 and vol6 < np.inf):
-                bad += 1
-                continue
-            sc = (kappa[0] if scalar_kappa else kappa[e]) / (6.0 * vol6)
-            a = 0
-            while tets[e, a] != i:
-                a += 1
+            a = 0 if tets[e, 0] == i else (1 if tets[e, 1] == i else (2 if tets[e, 2] == i else 3))
+            c = 3 * a
             for b in range(4):
-                data[pos[tets[e, b]]] += sc * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
-    return indptr, indices, data, bad
+                j = tets[e, b]
+                mj = mark[j]
+                if (mj >> 8) != i:
+                    if q - s == MAX_ROW:
+                        return indptr, q, False
+                    mj = tag | (q - s)
+                    mark[j] = mj
+                    indices[q] = j
+                    q += 1
+                if b != a:
+                    rel[e, c] = mj & 255
+                    c += 1
+        diag[i] = mark[i] & 255
+        indptr[i + 1] = q
+    return indptr, q, True
+
+
+@numba.njit(cache=True)
+def _tet_values(tets, points, kappa, scalar_kappa, indptr, rel, diag, nnz):  # pragma: no cover - compiled
+    """Pass 2: each element's ``kappa (g_a . g_b) / (6 |D|)`` (``g = D grad N``, the geometry of
+    :func:`~femkit.fem._kernels._tetrahedron`, once per element) added at the positions of pass
+    1, in element order. Returns ``(data, bad)``, ``bad`` the number of degenerate
+    tetrahedra (then ``data`` is incomplete)."""
+    data = np.zeros(nnz)
+    g = np.empty((4, 3))
+    bad = 0
+    for e in range(tets.shape[0]):
+        vol6 = abs(_tetrahedron(tets, points, e, g))
+        if not (vol6 > 0.0 and vol6 < np.inf):
+            bad += 1
+            continue
+        sc = (kappa[0] if scalar_kappa else kappa[e]) / (6.0 * vol6)
+        for a in range(4):
+            i = tets[e, a]
+            base = indptr[i]
+            c = 3 * a
+            for b in range(4):
+                v = sc * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
+                if b == a:
+                    data[base + diag[i]] += v
+                else:
+                    data[base + rel[e, c]] += v
+                    c += 1
+    return data, bad
 
 
 def stiffness_rows_tet_kernel(mesh, kappa):
-    """``(indptr, indices, data)`` of the stiffness of a whole tetrahedral mesh built row by row
-    (:func:`_stiffness_rows_tet`), or None if some tetrahedron is degenerate; ``kappa`` a float
-    or one value per element."""
+    """``(indptr, indices, data)`` of the stiffness of a whole tetrahedral mesh (passes 1-3 of
+    the module's docstring), or None if some tetrahedron is degenerate or some row has more than
+    :data:`MAX_ROW` columns (the caller then takes the element-order pass, which says which
+    tetrahedra are degenerate); ``kappa`` a float or one value per element."""
     m, n = mesh.n_cells, mesh.n_points
-    inc = np.empty(4 * m, np.int32 if max(4 * m, 27 * n) < np.iinfo(np.int32).max else np.int64)
+    index = np.int32 if max(4 * m, n + 12 * m) < np.iinfo(np.int32).max else np.int64
     tets = np.ascontiguousarray(mesh.cells, dtype=np.int64)
-    indptr, indices, data, bad = _stiffness_rows_tet(tets, n, mesh.points, *_values(kappa), inc)
-    return None if bad else (indptr, indices, data)
+    inc = np.empty(4 * m, index)
+    start = _incidences(tets, n, inc)
+    indices = np.empty(n + 12 * m, index)   # the bound; pages past the entries are never touched
+    rel = np.empty((m, 12), np.uint8)
+    diag = np.empty(n, np.uint8)
+    indptr, nnz, fits = _tet_rows(tets, n, inc, start, indices, rel, diag)
+    del inc, start
+    if not fits:
+        return None
+    indices.resize(nnz, refcheck=False)     # shrinks in place (no copy)
+    data, bad = _tet_values(tets, mesh.points, *_values(kappa), indptr, rel, diag, nnz)
+    del rel
+    if bad:
+        return None
+    sort_buckets(indptr, indices, data)     # each row's (column, value) pairs by column
+    return indptr, indices, data
 
 
 def warm_up() -> None:
-    """Compile (or load from the on-disk cache) the kernels of this module on one tetrahedron."""
-    tet = np.array([[0, 1, 2, 3]], dtype=np.int64)
+    """Compile (or load from the on-disk cache) the kernels of this module on one tetrahedron,
+    with the argument types of a large mesh (int64 cells, int32 incidences and columns)."""
+    from ..mesh import Mesh
+
     p3 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
-    _stiffness_rows_tet(tet, 4, p3, np.ones(1), True, np.empty(4, np.int32))
+    stiffness_rows_tet_kernel(Mesh(p3, np.array([[0, 1, 2, 3]], dtype=np.int64)), 1.0)
+    stiffness_rows_tet_kernel(Mesh(p3, np.array([[0, 1, 2, 3]], dtype=np.int64)), np.ones(1))

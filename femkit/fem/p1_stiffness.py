@@ -97,9 +97,11 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
         the pattern for later calls.
     keep_pattern : bool
         ``False``: a whole-mesh numba assembly without a cached pattern builds the matrix
-        row by row (:func:`femkit.fem._kernels.stiffness_rows_kernel`, tetrahedra
-        :func:`femkit.fem._kernels3d.stiffness_rows_tet_kernel`: the same matrix bit for bit) and caches nothing, so no (m, 9) or (m, 16)
-        slot map is ever allocated (the one-off assembly of a large run: a third of the memory of the fused pass).
+        row by row (:func:`femkit.fem._kernels.stiffness_rows_kernel`; tetrahedra: rows from
+        a node -> element incidence list, then each element's geometry once,
+        :func:`femkit.fem._kernels3d.stiffness_rows_tet_kernel`: the same matrix bit for bit)
+        and caches nothing, so no (m, 9) or (m, 16) int slot map is ever allocated (the one-off
+        assembly of a large run: a third of the memory of the fused pass).
 
     Returns
     -------

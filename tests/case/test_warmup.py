@@ -139,3 +139,36 @@ def test_first_use_of_new_expressions_compiles_in_the_compile_stage(tmp_path):
     assert EXPRESSIONS_MESSAGE in outs[0] and "'compile'" in outs[0]
     assert "compiling" not in outs[1] and "'compile'" not in outs[1]
     assert list((tmp_path / "femkit" / "expressions").glob("femkit_expr_*.py"))
+
+
+FIRST_3D_RUN = """
+import importlib, sys
+import numba
+from femkit.case import case_from_dict
+from femkit.case.poisson import warmup
+for module, name in warmup._THRESHOLDS:   # the compiled paths a large tetrahedral mesh takes
+    setattr(importlib.import_module(module), name, 0)
+case = case_from_dict({case!r})
+print("compile now:", warmup.must_compile(None, True))
+case.run(write=False, quiet=True)
+missed = sorted(f"{{mod}}.{{name}}" for mod, m in list(sys.modules.items()) if mod.startswith("femkit")
+                for name, fn in vars(m).items()
+                if isinstance(fn, numba.core.registry.CPUDispatcher) and fn.stats.cache_misses)
+print("compiled:", missed)
+"""
+
+
+def test_warmup_compiles_the_tetrahedral_kernels(tmp_path):
+    """After ``femkit warmup`` a first run on tetrahedra (fmg, every compiled path taken) loads
+    every kernel from the cache: none is compiled in the run, and none is missing from the
+    families the run checks before it starts."""
+    from femkit.case.poisson.warmup import _TINY_3D
+
+    _run(["warmup"], tmp_path)
+    case = dict(_TINY_3D, mesh={"geometry": "kuhn_cube", "h": 0.5, "refine": 2},
+                solver={"method": "fmg"}, output={"vtu": False})
+    proc = subprocess.run([sys.executable, "-c", FIRST_3D_RUN.format(case=case)], cwd=tmp_path,
+                          env=dict(os.environ), capture_output=True, text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr
+    assert "compile now: False" in proc.stdout
+    assert "compiled: []" in proc.stdout, proc.stdout

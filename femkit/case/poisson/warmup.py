@@ -39,9 +39,11 @@ FAMILIES = {
                     ("femkit.mesh._quality_kernel", "triangle_quality"),
                     ("femkit.mesh._refine_kernel", "red_children"),
                     ("femkit.mesh._refine_kernel", "child_edges"),
-                    ("femkit.mesh._refine_kernel", "interleaved_red")),
+                    ("femkit.mesh._refine_kernel", "interleaved_red"),
+                    ("femkit.mesh._faces_kernel", "tet_faces")),
     "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
-                    ("femkit.fem._kernels", "_stiffness_rows"), ("femkit.fem._kernels", "_eliminate")),
+                    ("femkit.fem._kernels", "_stiffness_rows"), ("femkit.fem._kernels", "_eliminate"),
+                    ("femkit.fem._kernels3d", "_tet_rows"), ("femkit.fem._kernels3d", "_tet_values")),
     "solver checks": (("femkit.solvers._check_kernels", "asymmetry_sums"),),
     "geometric multigrid": (("femkit.solvers.preconditioners._gmg_kernels", "_galerkin_rows"),
                             ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps")),
@@ -51,8 +53,19 @@ FAMILIES = {
 _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiffness", "NUMBA_THRESHOLD"),
                ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"),
                ("femkit.mesh.quality", "NUMBA_THRESHOLD"), ("femkit.mesh.refine", "NUMBA_THRESHOLD"),
+               ("femkit.mesh.quality", "NUMBA_THRESHOLD_3D"), ("femkit.mesh.refine", "NUMBA_THRESHOLD_3D"),
                ("femkit.fem.dirichlet", "NUMBA_THRESHOLD"),
                ("femkit.solvers.checks", "SYMMETRY_NUMBA_NNZ"))
+
+#: The tetrahedral tiny case (run after :data:`_TINY`): the 3D kernels of the same families
+#: (the tetrahedron assembly, the face numbering, the estimator's face jumps); a constant source
+#: and no exact solution, so its own expression module is small (the load's source passes).
+_TINY_3D = {
+    "problem": "poisson", "name": "warmup3d",
+    "mesh": {"geometry": "kuhn_cube", "h": 0.5, "refine": 1},
+    "source": "1",
+    "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
+}
 
 _TINY = {
     "problem": "poisson", "name": "warmup",
@@ -76,10 +89,13 @@ def families(multigrid: bool) -> tuple[str, ...]:
 #: The errors and estimate stages' compiled passes: the residual estimator's (a family of the
 #: warm-up), and the size thresholds of those and of a case's compiled expressions.
 FAMILIES["error estimate"] = tuple(("femkit.fem.estimators._kernels", name) for name in
-                                   ("residual_pass", "slot_fluxes", "triangle_areas", "squares_by_tag"))
+                                   ("residual_pass", "slot_fluxes", "triangle_areas", "squares_by_tag")
+                                   ) + (("femkit.fem.estimators._kernels3d", "residual_faces"),)
 _THRESHOLDS += (("femkit.fem.fused.kernels", "NUMBA_THRESHOLD"),
                 ("femkit.fem.estimators.geometry", "NUMBA_THRESHOLD"),
-                ("femkit.fem.estimators.residual", "NUMBA_THRESHOLD"))
+                ("femkit.fem.estimators.residual", "NUMBA_THRESHOLD"),
+                ("femkit.fem.estimators.residual_faces", "NUMBA_THRESHOLD"),
+                ("femkit.mesh.faces", "NUMBA_THRESHOLD"))
 
 __all__ += ["compile_expressions", "expressions_cached", "EXPRESSIONS_MESSAGE"]
 
@@ -115,9 +131,10 @@ def kernels_cached(names: tuple[str, ...] | None = None) -> bool:
 
 
 def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True) -> float:
-    """Compile (or load) the kernels of the Poisson pipeline on a tiny problem; seconds taken.
+    """Compile (or load) the kernels of the Poisson pipeline on two tiny problems (triangles,
+    tetrahedra); seconds taken.
 
-    ``multigrid``: the tiny problem runs fmg (every family), else pcg + jacobi (edges and
+    ``multigrid``: the tiny problems run fmg (every family), else pcg + jacobi (edges and
     assembly only). The compiled paths are forced for its duration (the size thresholds set to
     0, restored after), so the argument types of a large run are the ones compiled. ``echo``
     receives one line naming the families compiled.
@@ -135,13 +152,14 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True)
         for mod, name in saved:
             setattr(mod, name, 0)
         solver = {"method": "fmg"} if multigrid else {"method": "pcg", "preconditioner": "jacobi"}
-        case_from_dict(dict(_TINY, solver=solver)).run(write=False, quiet=True)
+        for tiny in (_TINY, _TINY_3D):  # triangles, then tetrahedra
+            case_from_dict(dict(tiny, solver=solver)).run(write=False, quiet=True)
         from ...fem._kernels import warm_up as assembly_kernels
 
         assembly_kernels()  # the cached-pattern assembly, which a one-off run does not call
         from ...mesh._refine_kernel import warm_up as refinement_kernels
 
-        refinement_kernels(dims=(2,))  # a renumbered (large) hierarchy's, which the tiny case skips
+        refinement_kernels(dims=(2, 3))  # a renumbered (large) hierarchy's, which the tiny cases skip
         from ...fem.estimators._kernels import warm_up as estimator_kernels
 
         estimator_kernels()  # the estimator's Neumann and area passes, which the tiny case skips
