@@ -45,6 +45,12 @@ def test_first_run_compiles_in_its_own_stage_then_never_again(tmp_path):
     second = _run(["solve", "case.yaml"], tmp_path, cache)
     assert "compiling" not in second
     assert "compile" not in json.loads((tmp_path / "out" / "result.json").read_text())["timings"]
+    # a case on triangles compiled the triangle run's kernels, not the tetrahedra's
+    probe = ("from femkit.case.poisson.warmup import kernels_cached as k, families as f; "
+             "print(k(f(True), (2,)), k(f(True), (2, 3)))")
+    res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         env=dict(os.environ, NUMBA_CACHE_DIR=str(cache)))
+    assert res.stdout.strip() == "True False", res.stderr
 
 
 def test_warmup_fills_the_cache(tmp_path):
@@ -79,9 +85,9 @@ def test_a_run_without_multigrid_compiles_no_multigrid_kernel(tmp_path):
                               "error estimate")
     assert families(False) == ("mesh passes", "P1 assembly", "solver checks", "error estimate")
     probe = ("from femkit.case.poisson.warmup import warm_up, kernels_cached, families; "
-             "warm_up(print, multigrid=False); "
-             "print(kernels_cached(families(False)), "
-             "kernels_cached(('geometric multigrid',)))")
+             "warm_up(print, multigrid=False, dims=(2,)); "
+             "print(kernels_cached(families(False), (2,)), "
+             "kernels_cached(('geometric multigrid',), (2,)))")
     res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                          env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache")),
                          timeout=900)

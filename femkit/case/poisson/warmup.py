@@ -27,7 +27,7 @@ import importlib
 import time
 from typing import Callable
 
-__all__ = ["warm_up", "kernels_cached", "needs_kernels", "must_compile", "families", "FAMILIES",
+__all__ = ["warm_up", "kernels_cached", "dimensions", "TETRAHEDRA_ONLY", "needs_kernels", "must_compile", "families", "FAMILIES",
            "COMPILE_MESSAGE", "start_numba", "NUMBA_STAGE"]
 
 COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)"
@@ -116,13 +116,29 @@ def needs_kernels(mesh, multigrid: bool) -> bool:
     return mesh.n_cells >= min(NUMBA_THRESHOLD, EDGES)
 
 
-def kernels_cached(names: tuple[str, ...] | None = None) -> bool:
-    """True when every kernel of the families ``names`` (default: all of :data:`FAMILIES`) is in
-    numba's on-disk cache (``NUMBA_CACHE_DIR`` or the package's ``__pycache__``)."""
+#: The kernels only tetrahedra call: a run on triangles neither needs nor compiles them (a run on
+#: tetrahedra compiles every dimension's: its boundary and coarse passes share the 2D kernels).
+TETRAHEDRA_ONLY = frozenset({("femkit.mesh._faces_kernel", "tet_faces"),
+                             ("femkit.fem._kernels3d", "_tet_rows"),
+                             ("femkit.fem._kernels3d", "_tet_values"),
+                             ("femkit.fem.estimators._kernels3d", "residual_faces")})
+
+
+def dimensions(dim: int | None) -> tuple[int, ...]:
+    """The dimensions whose kernels a run on a ``dim``-D mesh compiles (None: unknown, all)."""
+    return (2,) if dim == 2 else (2, 3)
+
+
+def kernels_cached(names: tuple[str, ...] | None = None, dims: tuple[int, ...] = (2, 3)) -> bool:
+    """True when every kernel of the families ``names`` (default: all of :data:`FAMILIES`) that a
+    run in the dimensions ``dims`` calls is in numba's on-disk cache (``NUMBA_CACHE_DIR`` or the
+    package's ``__pycache__``)."""
     import os
 
     for family in (tuple(FAMILIES) if names is None else names):
         for module, name in FAMILIES[family]:
+            if 3 not in dims and (module, name) in TETRAHEDRA_ONLY:
+                continue
             cache = getattr(importlib.import_module(module), name)._cache
             path = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
             if path is None or not os.path.exists(path):
@@ -130,12 +146,14 @@ def kernels_cached(names: tuple[str, ...] | None = None) -> bool:
     return True
 
 
-def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True) -> float:
+def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True,
+            dims: tuple[int, ...] = (2, 3)) -> float:
     """Compile (or load) the kernels of the Poisson pipeline on two tiny problems (triangles,
     tetrahedra); seconds taken.
 
     ``multigrid``: the tiny problems run fmg (every family), else pcg + jacobi (edges and
-    assembly only). The compiled paths are forced for its duration (the size thresholds set to
+    assembly only). ``dims``: (2,) compiles the triangle run's kernels only (the first run of a
+    2D case), (2, 3) the tetrahedra's too (``femkit warmup``, a 3D case). The compiled paths are forced for its duration (the size thresholds set to
     0, restored after), so the argument types of a large run are the ones compiled. ``echo``
     receives one line naming the families compiled.
     """
@@ -152,14 +170,14 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True)
         for mod, name in saved:
             setattr(mod, name, 0)
         solver = {"method": "fmg"} if multigrid else {"method": "pcg", "preconditioner": "jacobi"}
-        for tiny in (_TINY, _TINY_3D):  # triangles, then tetrahedra
+        for tiny in (_TINY, _TINY_3D)[:len(dims)]:  # triangles, then tetrahedra
             case_from_dict(dict(tiny, solver=solver)).run(write=False, quiet=True)
         from ...fem._kernels import warm_up as assembly_kernels
 
         assembly_kernels()  # the cached-pattern assembly, which a one-off run does not call
         from ...mesh._refine_kernel import warm_up as refinement_kernels
 
-        refinement_kernels(dims=(2, 3))  # a renumbered (large) hierarchy's, which the tiny cases skip
+        refinement_kernels(dims=dims)  # a renumbered (large) hierarchy's, which the tiny cases skip
         from ...fem.estimators._kernels import warm_up as estimator_kernels
 
         estimator_kernels()  # the estimator's Neumann and area passes, which the tiny case skips
@@ -217,11 +235,12 @@ def start_numba(stage) -> None:
             pass
 
 
-def must_compile(mesh, multigrid: bool) -> bool:
+def must_compile(mesh, multigrid: bool, dims: tuple[int, ...] = (2, 3)) -> bool:
     """True before the first run after an install whose ``mesh`` (with geometric multigrid when
-    ``multigrid``) will call kernels that are not compiled yet (not inside a warm-up)."""
+    ``multigrid``; in the dimensions ``dims``) will call kernels that are not compiled yet (not
+    inside a warm-up)."""
     return (not _ACTIVE and needs_kernels(mesh, multigrid)
-            and not kernels_cached(families(multigrid)))
+            and not kernels_cached(families(multigrid), dims))
 
 
 def _passes(kernels, dim: int) -> list[str]:
