@@ -26,7 +26,8 @@ import time
 
 from ..cost import Plan, check_budget, plan_mesh, plan_poisson, plan_scene
 
-__all__ = ["plan_poisson_case", "plan_scene_case", "geometry_domain", "check_mesh_fits",
+__all__ = ["plan_poisson_case", "plan_scene_case", "geometry_domain", "case_dimension",
+           "check_mesh_fits",
            "check_scene_fits", "measure_step_seconds", "OVERRIDE"]
 
 #: How a user overrides a refused budget (quoted in the one-line refusal).
@@ -50,6 +51,22 @@ def geometry_domain(geometry: str, params: dict | None = None) -> tuple[int, flo
     entry = GEOMETRIES.get(geometry)
     size, lines = entry.measures(params)
     return entry.dim, size, lines
+
+
+def case_dimension(case) -> int | None:
+    """The dimension of a Poisson ``case``'s mesh before it is built, as the plan reads it (a
+    geometry's entry, a ``.msh`` file's header); None when the input cannot be read (the mesh
+    stage reports why)."""
+    from ..cost import msh_has_volume
+    from ..errors import FemkitError
+
+    mesh = case.spec.mesh
+    try:
+        if mesh.file is not None:
+            return 3 if msh_has_volume(mesh.file) else 2
+        return geometry_domain(mesh.geometry, dict(mesh.params))[0]
+    except (FemkitError, OSError):
+        return None
 
 
 #: Tetrahedra gmsh makes per ``h^3`` of volume (unit cube: 1,140 at h = 0.2, 8,617 at 0.1).

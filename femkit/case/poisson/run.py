@@ -278,32 +278,18 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
 def _compile_stage(case: Case, mesh, stage, echo) -> None:
     """The first run after an install compiles the kernels it needs ahead, in its own
     ``compile`` stage (not inside assembly and solve), saying so on the terminal (``echo``)."""
+    from ..cost import case_dimension
     from .warmup import dimensions, must_compile, needs_kernels, start_numba, warm_up
 
     multigrid = case.solver.needs_hierarchy
     if needs_kernels(mesh, multigrid):
         start_numba(stage)  # numba's own start-up, once, in its own stage
-    dims = dimensions(mesh.dim if mesh is not None else _case_dimension(case))
+    dims = dimensions(mesh.dim if mesh is not None else case_dimension(case))
     if must_compile(mesh, multigrid, dims):
         with stage("compile"):
             seconds = warm_up(echo, multigrid, dims)
         if echo is not None:
             echo(f"compiled in {seconds:.1f} s (stage 'compile'; the next runs load them)")
-
-
-def _case_dimension(case: Case) -> int | None:
-    """The dimension of ``case``'s mesh before it is built (None when it cannot be told cheaply)."""
-    mesh = case.spec.mesh
-    try:
-        if mesh.file is not None:
-            from ...cost import msh_has_volume
-
-            return 3 if msh_has_volume(mesh.file) else 2
-        from ..cost import geometry_domain
-
-        return geometry_domain(mesh.geometry, dict(mesh.params))[0]
-    except Exception:  # noqa: BLE001 - unknown: compile every dimension's kernels
-        return None
 
 
 def _solve(case: Case, system, stop, **mg):
