@@ -55,19 +55,27 @@ def _vertex_starts(cells, n):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
+def _incidences(cells, n, inc):  # pragma: no cover - compiled
+    """The node -> element incidences of ``cells`` (m, w) into ``inc`` (counting sort: elements in
+    increasing order around each node); returns ``start``, ``inc[start[i]:start[i + 1]]``
+    the elements around node ``i``."""
+    start = _vertex_starts(cells, n)
+    fill = start[:-1].copy()
+    for e in range(cells.shape[0]):
+        for a in range(cells.shape[1]):
+            i = cells[e, a]
+            inc[fill[i]] = e
+            fill[i] += 1
+    return start
+
+
+@numba.njit(cache=True)
 def _row_lengths(cells, n, inc):  # pragma: no cover - compiled
     """Node -> element incidences of ``cells`` (m, w) into ``inc`` (``w m``; counting sort:
     elements in increasing order around each node) and the CSR row lengths of the P1 pattern:
     ``(start, indptr, stamp)``, ``inc[start[i]:start[i + 1]]`` the elements around node ``i``,
     ``stamp`` reset to -1 for the row pass of the caller."""
-    m, w = cells.shape
-    start = _vertex_starts(cells, n)
-    fill = start[:-1].copy()
-    for e in range(m):
-        for a in range(w):
-            i = cells[e, a]
-            inc[fill[i]] = e
-            fill[i] += 1
+    start = _incidences(cells, n, inc)
     stamp = np.full(n, -1, np.int64)
     indptr = np.zeros(n + 1, np.int64)
     nothing = np.empty(0, inc.dtype)

@@ -32,25 +32,10 @@ import numba
 import numpy as np
 
 from ..mesh._edges_kernel import sort_buckets
-from ._kernels import _tetrahedron, _values, _vertex_starts
+from ._kernels import _incidences, _tetrahedron, _values
 
 #: Row positions are stored in one byte: rows longer than this take the element-order pass.
 MAX_ROW = 255
-
-
-@numba.njit(cache=True)
-def _incidences(cells, n, inc):  # pragma: no cover - compiled
-    """The node -> element incidences of ``cells`` into ``inc`` (counting sort: elements in
-    increasing order around each node); returns ``start``, ``inc[start[i]:start[i + 1]]``
-    the elements around node ``i``."""
-    start = _vertex_starts(cells, n)
-    fill = start[:-1].copy()
-    for e in range(cells.shape[0]):
-        for a in range(cells.shape[1]):
-            i = cells[e, a]
-            inc[fill[i]] = e
-            fill[i] += 1
-    return start
 
 
 @numba.njit(cache=True)
