@@ -11,7 +11,7 @@ import numba
 import numpy as np
 
 
-@numba.njit(cache=True, error_model="numpy")  # 0 / 0 is NaN (a degenerate triangle), no raise
+@numba.njit(cache=True, nogil=True, error_model="numpy")  # 0 / 0 is NaN (a degenerate triangle), no raise
 def triangle_quality(points, tri):  # pragma: no cover - compiled
     """``(h_max, h_min, min_angle, max_angle, max_aspect, sum_aspect, area_sum)`` over the
     triangles: side lengths, angles by the law of cosines (degrees, NaN for a degenerate
@@ -63,7 +63,7 @@ def triangle_quality(points, tri):  # pragma: no cover - compiled
     return h_max, h_min, a_min, a_max, asp_max, asp_sum, area_sum
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def mean_edge_length(points, edge_nodes):  # pragma: no cover - compiled
     """Mean length of the edges ``edge_nodes`` (E, 2) of a 2D mesh."""
     s, blk = 0.0, 0.0
@@ -78,7 +78,7 @@ def mean_edge_length(points, edge_nodes):  # pragma: no cover - compiled
 
 
 
-@numba.njit(cache=True, error_model="numpy")  # 0 / 0 is NaN (a flat tetrahedron), no raise
+@numba.njit(cache=True, nogil=True, error_model="numpy")  # 0 / 0 is NaN (a flat tetrahedron), no raise
 def tetrahedron_quality(points, tets, faces, pairs, ratio, volume):  # pragma: no cover - compiled
     """One pass over the tetrahedra: ``(c_min, c_max)``, the extreme cosines between outward
     face normals (NaN ones skipped, like ``np.nanmin``; the dihedral angle ``180 - acos(c)`` is
@@ -140,7 +140,7 @@ def tetrahedron_quality(points, tets, faces, pairs, ratio, volume):  # pragma: n
     return c_min, c_max
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def edge_lengths(points, edge_nodes):  # pragma: no cover - compiled
     """Length of every edge ``edge_nodes`` (E, 2) of a 3D mesh (as ``np.linalg.norm`` forms it)."""
     out = np.empty(edge_nodes.shape[0])

@@ -144,13 +144,27 @@ def _write_vtu_raw(path: str, points: np.ndarray, blocks: list, point_data: dict
                        sum(a.nbytes for a in pieces)))
 
     conn = [_native(c) for _, c in blocks]
-    idx = np.result_type(*[c.dtype for c in conn]) if conn else np.dtype(np.int64)
-    add("Cells", "connectivity", [c.astype(idx, copy=False).ravel() for c in conn])
-    ends, offsets = 0, []
-    for c in conn:
-        offsets.append(ends + c.shape[1] * np.arange(1, len(c) + 1, dtype=idx))
-        ends += c.size
-    add("Cells", "offsets", offsets)
+    total = sum(c.size for c in conn)
+    # Int32 connectivity and offsets whenever the ids fit (VTK's and ParaView's usual type):
+    # half the bytes of Int64, converted a block of rows at a time (bounded temporary)
+    idx = np.dtype(np.int32) if max(len(points), total) <= np.iinfo(np.int32).max else np.dtype(np.int64)
+
+    def connectivity():
+        for c in conn:
+            for lo in range(0, len(c), _ROWS):
+                yield c[lo:lo + _ROWS].astype(idx, copy=False).ravel()
+
+    def offsets():
+        ends = 0
+        for c in conn:
+            w = c.shape[1]
+            for lo in range(0, len(c), _ROWS):
+                yield ends + w * np.arange(lo + 1, min(lo + _ROWS, len(c)) + 1, dtype=idx)
+            ends += c.size
+
+    cell_arrays = [("Cells", "connectivity", _VTK_TYPES[idx], None, connectivity(), total * idx.itemsize),
+                   ("Cells", "offsets", _VTK_TYPES[idx], None, offsets(),
+                    sum(len(c) for c in conn) * idx.itemsize)]
     add("Cells", "types", [np.full(len(c), _vtk_cell_type(kind), np.uint8)
                            for (kind, _), c in zip(blocks, conn)])
     for name, a in point_data.items():
@@ -168,6 +182,7 @@ def _write_vtu_raw(path: str, points: np.ndarray, blocks: list, point_data: dict
 
     declared = {"Points": [("Points", "Float64", 3, 3 * len(pts) * 8)],
                 "Cells": [], "PointData": [], "CellData": []}
+    arrays = cell_arrays + arrays  # connectivity, offsets, types, the data
     for section, name, vtype, comps, _, nbytes in arrays:
         declared[section].append((name, vtype, comps, nbytes))
     header = _appended_header(len(pts), sum(len(c) for c in conn), declared)

@@ -24,6 +24,23 @@ def test_cells_and_data_read_back(tmp_path):
     assert [a.tolist() for a in m.cell_data["tag"]] == [[1, 2], [7]]
 
 
+@pytest.mark.parametrize("rows", [1 << 20, 2], ids=["one-block", "blocks-of-2-rows"])
+def test_cell_ids_are_int32_and_read_back_across_blocks(tmp_path, monkeypatch, rows):
+    """Connectivity and offsets are Int32 when the ids fit (half the bytes of Int64), converted
+    a block of rows at a time: the blocks join into the same cells and offsets."""
+    import femkit.mesh.vtk as vtk
+
+    monkeypatch.setattr(vtk, "_ROWS", rows)
+    tris = np.array([[0, 1, 2], [0, 2, 3], [1, 2, 3], [0, 1, 3], [2, 3, 0]], np.int64)
+    cells = [("triangle", tris), ("line", np.array([[0, 1], [1, 2], [2, 3]], np.int64))]
+    path = write_cells(tmp_path / "m.vtu", POINTS, cells, point_data={"u": np.arange(4.0)})
+    arrays = {a.get("Name"): a.get("type") for a in vtk.vtu_header(path).iter("DataArray")}
+    assert arrays["connectivity"] == arrays["offsets"] == "Int32"
+    m = meshio.read(path)
+    assert [(c.type, c.data.tolist()) for c in m.cells] == [(k, c.tolist()) for k, c in cells]
+    assert np.array_equal(m.point_data["u"], np.arange(4.0))
+
+
 @pytest.mark.parametrize("kw, match", [
     (dict(point_data={"u": np.zeros(3)}), "point_data 'u' has 3 rows"),
     (dict(cell_data={"c": [np.zeros(2), np.zeros(2)]}), r"cell_data 'c' has \[2, 2\] rows"),

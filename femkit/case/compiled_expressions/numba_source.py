@@ -21,7 +21,7 @@ function, as without ``fast``.
 >>> u = compile_expression("sin(pi * x) * sin(pi * y)", ("x", "y", "z"))
 >>> f = compile_expression("2*pi**2*sin(pi*x)*sin(pi*y)", ("x", "y", "z"))
 >>> print(point_function("both", [u, f]))  # doctest: +NORMALIZE_WHITESPACE
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def both(x, y, z, out):  # pragma: no cover - compiled
     t0 = (3.141592653589793 * x)
     t1 = np.sin(t0)
@@ -176,5 +176,5 @@ def block_function(name: str, point: str, expressions: Sequence, *, fast: bool =
 
 
 def _head(name: str, args: str) -> list[str]:
-    return ['@numba.njit(cache=True, error_model="numpy")',
+    return ['@numba.njit(cache=True, nogil=True, error_model="numpy")',
             f"def {name}({args}):  # pragma: no cover - compiled"]

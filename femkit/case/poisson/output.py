@@ -6,6 +6,7 @@ are documented in docs/case-files.md ("Outputs").
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from pathlib import Path
@@ -16,7 +17,7 @@ from ...errors import InputError, with_prefix
 from ...io.figures import new_figure, save_figure
 
 __all__ = ["write_solution", "write_plot", "write_outputs", "output_location",
-           "RESULT_KEYS"]
+           "SolutionFile", "solution_file", "RESULT_KEYS"]
 
 #: Top-level keys of result.json.
 RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs", "nnz",
@@ -122,14 +123,78 @@ def output_location(directory: str | os.PathLike) -> Path:
         raise with_prefix(exc, "output.dir") from None
 
 
-def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None) -> Path:
+class SolutionFile:
+    """``solution.vtu`` written by a writer thread while the run goes on (the errors and the
+    estimate need neither the file nor anything it is made of, and the mesh is immutable).
+
+    The file (and its sidecar of tag names) is written into a temporary directory beside the
+    output directory (the prefix of :func:`~femkit.io.atomic.atomic_directory`'s) and moved
+    into the run's temporary directory by :func:`write_outputs`, which waits for it there: the
+    output directory still appears whole or not at all. :meth:`discard` (the run failed or was
+    stopped before its outputs; leaving the ``with`` block) waits for the thread and removes
+    what was not moved. An error of the writer is raised by :meth:`move_into` (a
+    :class:`~femkit.errors.FemkitError`).
+
+    ``u`` and ``kappa`` must not be modified until then (the run hands over its final arrays).
+    On one core the write costs what it cost in the output stage; with two, the output stage
+    only waits for what is left of it.
+    """
+
+    NAME = "solution.vtu"
+
+    def __init__(self, directory: Path, mesh, u: np.ndarray, kappa, compression: str | None):
+        import tempfile
+
+        from ...io.background import BackgroundWriter
+
+        directory.parent.mkdir(parents=True, exist_ok=True)
+        self.staging: Path | None = Path(tempfile.mkdtemp(prefix=f"{directory.name}.tmp-",
+                                                          dir=directory.parent))
+        self._writer = BackgroundWriter(depth=1, name="femkit solution writer")
+        self._writer.submit(write_solution, self.staging / self.NAME, mesh, u, kappa, None,
+                            compression)
+
+    def move_into(self, directory: Path) -> None:
+        """Wait for the file, then move it and its sidecars into ``directory`` (renames)."""
+        self._writer.close()
+        for path in sorted(self.staging.iterdir()):
+            os.replace(path, directory / path.name)
+        self.discard()
+
+    def __enter__(self) -> "SolutionFile":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.discard()
+
+    def discard(self) -> None:
+        """Wait for the writer (bounded) and remove what was not moved."""
+        self._writer.cancel()
+        if self.staging is not None:
+            import shutil
+
+            shutil.rmtree(self.staging, ignore_errors=True)
+            self.staging = None
+
+
+def solution_file(case, target: Path | None, mesh, u: np.ndarray, kappa):
+    """A :class:`SolutionFile` being written when the case asks for ``solution.vtu`` and the
+    run writes its outputs (``target``), else a context that holds ``None``."""
+    if target is None or not case.spec.output.vtu:
+        return contextlib.nullcontext(None)
+    return SolutionFile(target, mesh, u, kappa, case.spec.output.compression)
+
+
+def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None,
+                  solution: SolutionFile | None = None) -> Path:
     """Write result.json and the requested solution files into ``directory`` (atomically).
 
     ``directory`` is replaced as a whole, so it must be new, empty or an earlier run
     (:func:`output_location`). ``write_pieces(tmp)`` (a distributed run whose solution is
     too large to gather) writes ``solution.pvtu`` and its pieces instead of ``solution.vtu``;
     the xdmf and png outputs need the gathered solution (``result.u``) and are left out
-    without it (listed in ``result.parallel["not_written"]``).
+    without it (listed in ``result.parallel["not_written"]``). ``solution``: ``solution.vtu``
+    already being written (:class:`SolutionFile`), moved in here.
     """
     from ...io.atomic import EARLIER_RUN, atomic_directory
     from ...io.writers import write_json
@@ -141,6 +206,8 @@ def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None) ->
     with atomic_directory(final, EARLIER_RUN) as tmp:
         if opts.vtu and write_pieces is not None:
             write_pieces(tmp)
+        elif opts.vtu and solution is not None:
+            solution.move_into(tmp)
         elif opts.vtu:
             write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa,
                            compression=opts.compression)

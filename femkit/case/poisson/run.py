@@ -239,32 +239,36 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         dofs, nnz = int(system.A.shape[0]), int(system.A.nnz)
         system.A = None  # nor is the matrix (the errors and the estimate work on the mesh)
         report.done("solve")
-    # after a complete solve a signal during the errors or the estimate stops at once (nothing
-    # written); after an interrupted solve they run to write its last iterate
-    after = contextlib.nullcontext() if res.reason == "interrupted" else raising("the error estimate")
-    with after:
-        with stage("mesh"):  # the mesh's numbers (its edges are shared with the estimator)
-            q = quality(mesh)
-        errors = None
-        if "exact.u" in case.functions:
-            with stage("errors"):  # with the gradient the estimate stage's energy error gets
-                errors = problem.errors(u, case.functions["exact.u"], grad)
-        from .estimate import adaptive_facts, estimate_facts
+    # solution.vtu needs only the mesh and u: a writer thread writes it beside the errors and
+    # the estimate, write_outputs moves it into the output directory (removed on a failure)
+    from .output import solution_file
 
-        with stage("estimate"):
-            estimate, effectivity, est = estimate_facts(case, problem, u, grad, est)
-    result = CaseResult(case=case, mesh=mesh, u=u, kappa=problem.kappa, solve=res, errors=errors,
-                        timings=stage.times, quality=q, dofs=dofs,
-                        n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
-                        nnz=nnz, nullspace=nullspace_facts(system),
-                        error_estimate=estimate, effectivity=effectivity, indicators=est.indicators,
-                        adaptive=adaptive_facts(run) if run is not None else None,
-                        interrupted=stop.name if res.reason == "interrupted" else None,
-                        clock=clock)
-    if write:
-        from .output import write_outputs
+    with solution_file(case, target, mesh, u, problem.kappa) as solution:
+        # after a complete solve a signal during the errors or the estimate stops at once (nothing
+        # written); after an interrupted solve they run to write its last iterate
+        interrupted = res.reason == "interrupted"
+        with contextlib.nullcontext() if interrupted else raising("the error estimate"):
+            with stage("mesh"):  # the mesh's numbers (its edges are shared with the estimator)
+                q = quality(mesh)
+            errors = None
+            if "exact.u" in case.functions:
+                with stage("errors"):  # with the gradient the estimate stage's energy error gets
+                    errors = problem.errors(u, case.functions["exact.u"], grad)
+            from .estimate import adaptive_facts, estimate_facts
 
-        write_outputs(result, target)
+            with stage("estimate"):
+                estimate, effectivity, est = estimate_facts(case, problem, u, grad, est)
+        result = CaseResult(case=case, mesh=mesh, u=u, kappa=problem.kappa, solve=res,
+                            errors=errors, timings=stage.times, quality=q, dofs=dofs,
+                            n_dirichlet=len(system.fixed) if not is_pure_neumann(case) else 0,
+                            nnz=nnz, nullspace=nullspace_facts(system), error_estimate=estimate,
+                            effectivity=effectivity, indicators=est.indicators,
+                            adaptive=adaptive_facts(run) if run is not None else None,
+                            interrupted=stop.name if interrupted else None, clock=clock)
+        if write:
+            from .output import write_outputs
+
+            write_outputs(result, target, solution=solution)
     if not quiet:
         out = echo or print
         for line in result.summary_lines():

@@ -34,7 +34,7 @@ def _triangle(points, tri, u, k, e, grad):  # pragma: no cover - compiled
     return signed
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def triangle_fields(points, tri, u, e, area, grad):  # pragma: no cover - compiled
     """Fill ``e`` (m, 3, 2), ``area`` and ``grad`` (m, 2) as
     :func:`~femkit.fem._elements.triangle_geometry` and :func:`~femkit.fem._elements.p1_gradients`
@@ -47,7 +47,7 @@ def triangle_fields(points, tri, u, e, area, grad):  # pragma: no cover - compil
     return bad
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def residual_pass(points, tri, u, kappa, te, n_edges, fsq, f_sq, c_volume_sq, jump_factor,
                   volume, jump, count):  # pragma: no cover - compiled
     """The volume and jump terms of every triangle; returns the number of degenerate triangles.
@@ -98,7 +98,7 @@ def residual_pass(points, tri, u, kappa, te, n_edges, fsq, f_sq, c_volume_sq, ju
     return bad
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def slot_fluxes(points, tri, u, kappa, elem, local):  # pragma: no cover - compiled
     """``(length, flux * length)`` of the local edge ``local[i]`` of triangle ``elem[i]``: the
     numbers :func:`residual_pass` forms for that edge (the boundary edges' Neumann term)."""
@@ -117,7 +117,7 @@ def slot_fluxes(points, tri, u, kappa, elem, local):  # pragma: no cover - compi
     return lens, qlen
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def squares_by_tag(tags, uniq, ind):  # pragma: no cover - compiled
     """``sum ind^2`` per value of ``uniq`` (sorted, every tag among them), element by element:
     ``np.bincount(inverse, weights=ind ** 2)`` without the inverse map and the squares."""
@@ -127,7 +127,7 @@ def squares_by_tag(tags, uniq, ind):  # pragma: no cover - compiled
     return out
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def triangle_areas(points, tri):  # pragma: no cover - compiled
     """``|T|`` of every triangle, as :func:`triangle_fields` computes it."""
     area = np.empty(tri.shape[0])

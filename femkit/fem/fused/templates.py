@@ -36,43 +36,43 @@ N_GRAD = 0
 HAS_SOURCE = False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def exact_point(x, y, z, out):  # pragma: no cover - placeholder, defined by the generated module
     """``out[:] = u, du/dx, du/dy[, du/dz][, f]`` at ``(x, y, z)``."""
     out[0] = np.nan
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def source_point(x, y, z, out):  # pragma: no cover - placeholder
     """``out[0] = f(x, y, z)``."""
     out[0] = np.nan
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def value_point(x, y, z, out):  # pragma: no cover - placeholder
     """``out[0] = u(x, y, z)``."""
     out[0] = np.nan
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def exact_block(xs, ys, zs, n, out):  # pragma: no cover - placeholder
     """``out[:, p]`` = what :func:`exact_point` gives at ``(xs[p], ys[p], zs[p])``, ``p < n``."""
     out[:, :n] = np.nan
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def source_block(xs, ys, zs, n, out):  # pragma: no cover - placeholder
     """``out[0, p] = f(xs[p], ys[p], zs[p])``, ``p < n``."""
     out[:, :n] = np.nan
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def source_block_libm(xs, ys, zs, n, out):  # pragma: no cover - placeholder
     """:func:`source_block` by the C library's functions (the load: the solution's bits)."""
     out[:, :n] = np.nan
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def value_block(xs, ys, zs, n, out):  # pragma: no cover - placeholder
     """``out[0, p] = u(xs[p], ys[p], zs[p])``, ``p < n``."""
     out[:, :n] = np.nan
@@ -128,7 +128,7 @@ def block_points(points, cells, k0, k1, bary, xs, ys, zs):  # pragma: no cover -
     return p
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def block_buffers(nq, rows):  # pragma: no cover - compiled
     """Coordinate buffers and a ``(rows, BLOCK * nq)`` value buffer of one block."""
     n = BLOCK * nq
@@ -158,7 +158,7 @@ def element_sums(u0, u1, u2, bary, weights, g0, g1, vals, p0):  # pragma: no cov
     return l2, h1, fs
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def triangle_pass(points, tri, bary, weights, u, l2, h1, fsq):  # pragma: no cover - compiled
     """Per triangle ``area * element_sums`` into ``l2``, ``h1``, ``fsq``, the area and the
     gradient of ``u_h`` computed on the way; returns the number of triangles of zero or
@@ -199,7 +199,7 @@ def block_sources(points, cells, k0, bary, xs, ys, zs, vals):  # pragma: no cove
     return k1
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def source_pass(points, cells, bary, weights, measure, fsq):  # pragma: no cover - compiled
     """``fsq[k] = measure[k] * sum_q w_q f^2``: the source norm alone."""
     nq = weights.shape[0]
@@ -213,7 +213,7 @@ def source_pass(points, cells, bary, weights, measure, fsq):  # pragma: no cover
             fsq[k] = measure[k] * fs
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def source_values(points, cells, bary, out):  # pragma: no cover - compiled
     """``out[k, q] = f`` at the rule's point ``q`` of cell ``k``: the load's source values, at
     the points :meth:`~femkit.fem.quadrature.TriangleRule.physical_points` gives (same rounding),
@@ -229,7 +229,7 @@ def source_values(points, cells, bary, out):  # pragma: no cover - compiled
                 out[k, q] = vals[0, (k - k0) * nq + q]
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def nodal_pass(points, u):  # pragma: no cover - compiled
     """``max_i |u_i - u(x_i)|`` (NaN as soon as one difference is NaN, as ``np.max``)."""
     d = points.shape[1]
@@ -251,7 +251,7 @@ def nodal_pass(points, u):  # pragma: no cover - compiled
     return big
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def tetrahedron_pass(points, tets, bary, weights, u, l2, h1, fsq):  # pragma: no cover - compiled
     """Per tetrahedron ``volume * element_sums`` into ``l2``, ``h1``, ``fsq``, the volume and
     the gradient of ``u_h`` computed on the way (``D grad N_a`` by the assembly's
