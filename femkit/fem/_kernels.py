@@ -22,25 +22,6 @@ def _insert_sorted(indices, s, end, j):  # pragma: no cover - compiled
     return end + 1
 
 
-@numba.njit(cache=True, inline="always")
-def _row_columns(cells, inc, k0, k1, i, stamp, indices, s, write, pos):  # pragma: no cover - compiled
-    """The distinct vertices of the elements ``inc[k0:k1]`` around node ``i`` (``stamp[j] ==
-    i`` marks the ones seen); returns their count. With ``write`` they go sorted into
-    ``indices[s:]`` (insertion sort: rows are short) and ``pos[j]`` gets each one's position."""
-    q = s
-    for k in range(k0, k1):
-        e = inc[k]
-        for b in range(cells.shape[1]):
-            j = cells[e, b]
-            if stamp[j] != i:
-                stamp[j] = i
-                q = _insert_sorted(indices, s, q, j) if write else q + 1
-    if write:
-        for p in range(s, q):
-            pos[indices[p]] = p
-    return q - s
-
-
 @numba.njit(cache=True)
 def _vertex_starts(cells, n):  # pragma: no cover - compiled
     """Counting sort's offsets of the node -> element incidences: ``start[i]`` = the number of
@@ -67,23 +48,6 @@ def _incidences(cells, n, inc):  # pragma: no cover - compiled
             inc[fill[i]] = e
             fill[i] += 1
     return start
-
-
-@numba.njit(cache=True)
-def _row_lengths(cells, n, inc):  # pragma: no cover - compiled
-    """Node -> element incidences of ``cells`` (m, w) into ``inc`` (``w m``; counting sort:
-    elements in increasing order around each node) and the CSR row lengths of the P1 pattern:
-    ``(start, indptr, stamp)``, ``inc[start[i]:start[i + 1]]`` the elements around node ``i``,
-    ``stamp`` reset to -1 for the row pass of the caller."""
-    start = _incidences(cells, n, inc)
-    stamp = np.full(n, -1, np.int64)
-    indptr = np.zeros(n + 1, np.int64)
-    nothing = np.empty(0, inc.dtype)
-    for i in range(n):
-        indptr[i + 1] = indptr[i] + _row_columns(cells, inc, start[i], start[i + 1], i, stamp,
-                                                 nothing, 0, False, stamp)
-    stamp[:] = -1
-    return start, indptr, stamp
 
 
 @numba.njit(cache=True)
@@ -422,7 +386,6 @@ def warm_up() -> None:
     _, nnz, _, _ = _pattern(tri, 4, ind, slots, pts, np.ones(1), True, True)
     _stiffness(tri, pts, np.zeros(1, np.int64), False, np.ones(1), True, slots, nnz)
     _load_barycentric(tri, pts, np.zeros(1, np.int64), False, np.ones(1), True, 4)
-    _stiffness_rows(tri, 4, pts, np.ones(1), True, np.empty(6, np.int32))
     tet = np.array([[0, 1, 2, 3]], dtype=np.int64)
     p3 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
     ind3 = np.empty(4 + 12, np.int32)
@@ -430,58 +393,6 @@ def warm_up() -> None:
     _, nnz3, _, _ = _pattern_cells(tet, 4, ind3, slots3, p3, np.ones(1), True, True)
     _stiffness_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, slots3, nnz3)
     _load_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, 4)
-
-
-@numba.njit(cache=True)
-def _stiffness_rows(tri, n, points, kappa, scalar_kappa, inc):  # pragma: no cover - compiled
-    """The P1 stiffness as CSR, row by row, without a slot map: ``(indptr, indices, data, bad)``.
-
-    A node -> element incidence list (counting sort: elements in increasing order around each
-    node) is the only buffer besides the output. Row ``i`` is the sorted set of the vertices of
-    its elements; each element adds its local row ``a`` (``i`` its vertex ``a``), so every entry
-    is summed over its elements in increasing element order: the same sums, in the same order,
-    as the element-order scatter of :func:`_pattern` / :func:`_stiffness` (bit for bit). The
-    price is each element's geometry computed once per vertex; the memory is ``3 m`` element
-    ids instead of the (m, 9) slot map and the (3 m, 3) vertex copies. ``inc`` is the ``3 m``
-    buffer of the incidences; ``indices`` get its dtype. ``bad`` counts degenerate triangles
-    (then ``data`` is incomplete).
-    """
-    start, indptr, stamp = _row_lengths(tri, n, inc)
-    nnz = indptr[n]
-    indices = np.empty(nnz, inc.dtype)
-    data = np.zeros(nnz)
-    pos = np.empty(n, np.int64)
-    bad = 0
-    # pass 2: sorted columns (insertion sort: rows are short), then the local rows summed
-    for i in range(n):
-        _row_columns(tri, inc, start[i], start[i + 1], i, stamp, indices, indptr[i], True, pos)
-        for k in range(start[i], start[i + 1]):
-            e = inc[k]
-            i0, i1, i2, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(tri, points, e)
-            if not (area > 0.0 and area < np.inf):
-                bad += 1
-                continue
-            sc = (kappa[0] if scalar_kappa else kappa[e]) / (4.0 * area)
-            if i0 == i:
-                exa, eya = ex0, ey0
-            elif i1 == i:
-                exa, eya = ex1, ey1
-            else:
-                exa, eya = ex2, ey2
-            data[pos[i0]] += sc * (exa * ex0 + eya * ey0)
-            data[pos[i1]] += sc * (exa * ex1 + eya * ey1)
-            data[pos[i2]] += sc * (exa * ex2 + eya * ey2)
-    return indptr, indices, data, bad
-
-
-def stiffness_rows_kernel(mesh, kappa):
-    """``(indptr, indices, data)`` of the stiffness of a whole triangle mesh, built row by row
-    without a slot map (:func:`_stiffness_rows`), or None if some triangle is degenerate
-    (tetrahedra: :func:`femkit.fem._kernels3d.stiffness_rows_tet_kernel`)."""
-    m, n = mesh.n_cells, mesh.n_points
-    inc = np.empty(3 * m, np.int32 if max(3 * m, 8 * n) < np.iinfo(np.int32).max else np.int64)
-    indptr, indices, data, bad = _stiffness_rows(mesh.cells, n, mesh.points, *_values(kappa), inc)
-    return None if bad else (indptr, indices, data)
 
 
 @numba.njit(cache=True)

@@ -96,10 +96,9 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
         matrix in the same compiled pass (:meth:`SparsityPattern.with_stiffness`) and caches
         the pattern for later calls.
     keep_pattern : bool
-        ``False``: a whole-mesh numba assembly without a cached pattern builds the matrix
-        row by row (:func:`femkit.fem._kernels.stiffness_rows_kernel`; tetrahedra: rows from
-        a node -> element incidence list, then each element's geometry once,
-        :func:`femkit.fem._kernels3d.stiffness_rows_tet_kernel`: the same matrix bit for bit)
+        ``False``: a whole-mesh numba assembly without a cached pattern builds the matrix's
+        rows from a node -> element incidence list, then adds each element's geometry once
+        (:func:`femkit.fem._one_off.stiffness_rows_kernel`: the same matrix bit for bit)
         and caches nothing, so no (m, 9) or (m, 16) int slot map is ever allocated (the one-off
         assembly of a large run: a third of the memory of the fused pass).
 
@@ -117,10 +116,8 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
     if pattern is None:
         pattern = SparsityPattern.cached(mesh)
         if pattern is None and backend == "numba" and idx is None and not keep_pattern:
-            if mesh.dim == 3:
-                from ._kernels3d import stiffness_rows_tet_kernel as stiffness_rows_kernel
-            else:
-                from ._kernels import stiffness_rows_kernel
+            from ._one_off import stiffness_rows_kernel
+
             arrays = stiffness_rows_kernel(mesh, _kernel_coefficient(mesh, kappa, None))
             if arrays is not None:
                 indptr, indices, data = arrays

@@ -127,3 +127,20 @@ def test_one_off_assembly_names_a_degenerate_triangle():
     with pytest.raises(DegenerateMeshError) as info:
         assemble_stiffness(mesh, backend="numba", keep_pattern=False)
     assert info.value.element_ids == [1]
+
+
+@pytest.mark.parametrize("spokes", [254, 255, 400], ids=["row-of-255", "row-of-256", "row-of-401"])
+def test_one_off_long_rows_take_the_element_order_pass(spokes):
+    """A node in more triangles than a byte can index takes the element-order pass: the same
+    matrix either way."""
+    from femkit.fem._one_off import MAX_ROW, stiffness_rows_kernel
+
+    t = np.linspace(0.0, 2.0 * np.pi, spokes, endpoint=False)
+    pts = np.vstack([[0.0, 0.0], np.stack([np.cos(t), np.sin(t)], axis=1)])
+    k = 1 + np.arange(spokes)
+    fan = Mesh(pts, np.stack([np.zeros(spokes, int), k, 1 + k % spokes], axis=1))
+    assert (stiffness_rows_kernel(fan, 1.0) is None) == (spokes + 1 > MAX_ROW)
+    K = assemble_stiffness(fan, backend="numba", keep_pattern=False)
+    K_ref = assemble_stiffness(Mesh(fan.points, fan.cells), backend="numba")
+    assert np.array_equal(K.indices, K_ref.indices) and np.array_equal(K.data, K_ref.data)
+    assert K.indptr[1] - K.indptr[0] == spokes + 1

@@ -28,10 +28,10 @@ def test_rows_equal_the_fused_pass_bit_for_bit(kappa):
     assert np.array_equal(K.data, K_ref.data)
     assert K.indices.dtype == np.int32 and K.has_sorted_indices
 
-    from femkit.fem._kernels3d import stiffness_rows_tet_kernel
+    from femkit.fem._one_off import stiffness_rows_kernel
 
     # the column buffer reserved at its bound was shrunk, not sliced: no hidden tail kept alive
-    indptr, indices, data = stiffness_rows_tet_kernel(mesh, kap)
+    indptr, indices, data = stiffness_rows_kernel(mesh, kap)
     assert indices.base is None and indices.size == data.size == indptr[-1] == K.nnz
 
 
@@ -76,10 +76,10 @@ def _fan(spokes: int) -> Mesh:
 
 @pytest.mark.parametrize("spokes", [252, 253, 400], ids=["row-of-255", "row-of-256", "row-of-403"])
 def test_long_rows_take_the_element_order_pass(spokes):
-    from femkit.fem._kernels3d import MAX_ROW, stiffness_rows_tet_kernel
+    from femkit.fem._one_off import MAX_ROW, stiffness_rows_kernel
 
     mesh = _fan(spokes)
-    rows = stiffness_rows_tet_kernel(mesh, 1.0)
+    rows = stiffness_rows_kernel(mesh, 1.0)
     assert (rows is None) == (spokes + 3 > MAX_ROW)
     K = assemble_stiffness(mesh, backend="numba", keep_pattern=False)
     K_ref = assemble_stiffness(Mesh(mesh.points, mesh.cells), backend="numba")

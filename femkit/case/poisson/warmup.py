@@ -42,8 +42,8 @@ FAMILIES = {
                     ("femkit.mesh._refine_kernel", "interleaved_red"),
                     ("femkit.mesh._faces_kernel", "tet_faces")),
     "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
-                    ("femkit.fem._kernels", "_stiffness_rows"), ("femkit.fem._kernels", "_eliminate"),
-                    ("femkit.fem._kernels3d", "_tet_rows"), ("femkit.fem._kernels3d", "_tet_values")),
+                    ("femkit.fem._one_off", "_cell_rows"), ("femkit.fem._one_off", "_triangle_values"),
+                    ("femkit.fem._kernels", "_eliminate"), ("femkit.fem._one_off", "_tet_values")),
     "solver checks": (("femkit.solvers._check_kernels", "asymmetry_sums"),),
     "geometric multigrid": (("femkit.solvers.preconditioners._gmg_kernels", "_galerkin_rows"),
                             ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps")),
@@ -119,8 +119,7 @@ def needs_kernels(mesh, multigrid: bool) -> bool:
 #: The kernels only tetrahedra call: a run on triangles neither needs nor compiles them (a run on
 #: tetrahedra compiles every dimension's: its boundary and coarse passes share the 2D kernels).
 TETRAHEDRA_ONLY = frozenset({("femkit.mesh._faces_kernel", "tet_faces"),
-                             ("femkit.fem._kernels3d", "_tet_rows"),
-                             ("femkit.fem._kernels3d", "_tet_values"),
+                             ("femkit.fem._one_off", "_tet_values"),
                              ("femkit.fem.estimators._kernels3d", "residual_faces")})
 
 
