@@ -17,8 +17,11 @@ Memory and time
 ---------------
 Per stage (the names ``benchmarks/cost_probe.py`` measures): ``mesh`` (gmsh's
 peak per generated triangle plus the import of its library; or reading a file), ``refine``,
-``quality``, ``assembly`` (pattern, matrix, load; compiled kernels from 200,000 triangles),
-``boundary`` (Dirichlet elimination: a reduced copy), ``setup`` (preconditioner or sparse
+``quality``, ``assembly`` (pattern, matrix, load), ``boundary`` (Dirichlet elimination: a
+reduced copy); from 200,000 final triangles these four run compiled kernels (their own time
+laws, ``<stage>`` compiled and ``<stage>_numpy`` below), and numba's import and cached
+kernels are paid once, in the first stage after the mesh (``refine``, else ``quality``),
+``setup`` (preconditioner or sparse
 factorisation), ``solve``, ``errors``, ``estimate`` (the residual error estimate), ``output``
 (vtu / xdmf / png). Each stage's peak is
 ``bytes_per_triangle[stage] * m`` of everything alive then (the pipeline keeps the mesh and
@@ -126,9 +129,16 @@ def _solver_constants(key: str, c: dict) -> tuple[str, list[str]]:
     return like, [f"no calibration for solver {key!r}: costed as {like}"]
 
 
-#: Triangles from which assembly uses compiled kernels: ``femkit.fem.sparsity.NUMBA_THRESHOLD``
-#: (repeated, not imported, so that planning imports neither numpy nor scipy; a test checks it).
+#: Final triangles from which the mesh and assembly stages use compiled kernels: assembly
+#: (``femkit.fem.sparsity.NUMBA_THRESHOLD``), quality and edges (200,000 cells), red refinement
+#: (its last level's 50,000 input triangles), the Dirichlet elimination (100,000 rows, about
+#: 200,000 triangles); repeated, not imported, so that planning imports neither numpy nor scipy
+#: (a test checks the assembly's).
 COMPILED_FROM = 200_000
+
+#: Stages with a compiled path from :data:`COMPILED_FROM` and a NumPy one below: time laws
+#: ``seconds[stage]`` (compiled) and ``seconds[stage + "_numpy"]``.
+COMPILED_STAGES = ("refine", "quality", "assembly", "boundary")
 
 #: Stages in pipeline order (the names the probe measures).
 STAGES = ("mesh", "refine", "quality", "assembly", "boundary", "setup", "solve", "errors",
@@ -136,18 +146,20 @@ STAGES = ("mesh", "refine", "quality", "assembly", "boundary", "setup", "solve",
 
 
 def fixed_bytes(stage: str, *, gmsh: bool, compiled: bool, amg: bool, png: bool,
-                constants: dict, generated: float = 0.0) -> float:
+                constants: dict, generated: float = 0.0, ic0: bool = False) -> float:
     """Memory held by the time ``stage`` runs that does not scale with the final mesh.
 
-    Libraries stay resident once loaded: gmsh from ``mesh`` (when generating), numba from
-    ``assembly`` (compiled kernels), pyamg from ``setup`` (AMG), matplotlib at ``output`` (PNG).
+    Libraries stay resident once loaded: gmsh from ``mesh`` (when generating), numba from the
+    first stage after it (compiled kernels: refinement or quality numbers), or from ``setup``
+    with IC(0) (compiled factorisation and triangular solves, at any size), pyamg from ``setup``
+    (AMG), matplotlib at ``output`` (PNG).
     After generation a fraction ``bytes.gmsh_retained`` of gmsh's peak for the ``generated``
     triangles stays resident (freed to the allocator, not to the system).
     """
     b = constants["bytes"]
     i = STAGES.index(stage)
     retained = b["gmsh_retained"] * b["gmsh_per_triangle"] * generated if gmsh and i > 0 else 0.0
-    return (retained + b["gmsh_import"] * gmsh + b["numba_import"] * (compiled and i >= 3)
+    return (retained + b["gmsh_import"] * gmsh + b["numba_import"] * ((compiled and i >= 1) or (ic0 and i >= 5))
             + b["pyamg_import"] * (amg and i >= 5) + b["matplotlib_import"] * (png and i >= 9))
 
 
@@ -238,11 +250,22 @@ def plan_poisson(*, area: float | None = None, line_length: float | None = None,
         raise InputError(f"unknown output kind(s) {unknown_out}; valid: png, vtu, xdmf")
     pc_name = key.split("+", 1)[1] if "+" in key else "none"
     flags = dict(gmsh=source == "gmsh", compiled=compiled, amg=pc_name.startswith("amg"),
-                 png="png" in outs, constants=c, generated=m0)
+                 png="png" in outs, constants=c, generated=m0, ic0=pc_name == "ic0")
+
+    # numba's start-up: in the first stage after the mesh that runs compiled (IC(0)'s setup is
+    # compiled at every size)
+    numba_stage = (("refine" if refine else "quality") if compiled
+                   else "setup" if flags["ic0"] else None)
 
     def stage(name, seconds, per_triangle, detail, output=0.0, extra=0.0):
+        if name == numba_stage:
+            seconds += s["numba_load"]
+            detail += ", numba's start-up"
         return Stage(name, seconds, fixed_bytes(name, **flags) + per_triangle * m + extra,
                      output, detail)
+
+    def law(name):  # the stage's time law on the path it takes at this size
+        return s[name] if compiled or name not in COMPILED_STAGES else s[f"{name}_numpy"]
 
     if source == "gmsh":
         stages = [Stage("mesh", s["gmsh_fixed"] + _power(s["gmsh"], m0),
@@ -252,16 +275,14 @@ def plan_poisson(*, area: float | None = None, line_length: float | None = None,
         stages = [Stage("mesh", _power(s["read"], m0), b["read_per_triangle"] * m0,
                         detail=f"read {m0:,.0f} triangles")]
     if refine:
-        stages.append(stage("refine", _power(s["refine"], m), b["refine_per_triangle"],
+        stages.append(stage("refine", _power(law("refine"), m), b["refine_per_triangle"],
                             f"{refine} red refinement(s) -> {m:,.0f} triangles"))
-    stages.append(stage("quality", _power(s["quality"], m), b["quality_per_triangle"],
+    stages.append(stage("quality", _power(law("quality"), m), b["quality_per_triangle"],
                         "validation and quality"))
-    asm_s = (s["numba_load"] + _power(s["assembly"], m) if compiled
-             else _power(s["assembly_numpy"], m))
     asm_b = b["assembly_per_triangle"] if compiled else b["assembly_numpy_per_triangle"]
-    stages.append(stage("assembly", asm_s, asm_b,
+    stages.append(stage("assembly", _power(law("assembly"), m), asm_b,
                         f"{nnz:,.0f} nonzeros" + (" (compiled kernels)" if compiled else "")))
-    stages.append(stage("boundary", _power(s["boundary"], m), b["boundary_per_triangle"],
+    stages.append(stage("boundary", _power(law("boundary"), m), b["boundary_per_triangle"],
                         f"{unknowns:,.0f} unknowns"))
     solve_b = b["solve_per_triangle"][key]
     if key == "direct":
