@@ -297,10 +297,10 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = No
     def per_block(tri_vals, line_vals):
         return [tri_vals, line_vals] if with_lines else [tri_vals]
 
-    cdata = {
-        "gmsh:physical": per_block(mesh.cell_tags.astype(np.int32), mesh.boundary_tags.astype(np.int32)),
-        "gmsh:geometrical": per_block(mesh.cell_tags.astype(np.int32), mesh.boundary_tags.astype(np.int32)),
-    }
+    cell_tags = mesh.cell_tags.astype(np.int32, copy=False)  # written, never modified: no copies
+    facet_tags = mesh.boundary_tags.astype(np.int32, copy=False)
+    cdata = {"gmsh:physical": per_block(cell_tags, facet_tags),
+             "gmsh:geometrical": per_block(cell_tags, facet_tags)}
     for name, arr in (cell_data or {}).items():
         a = np.asarray(arr)
         if a.shape[0] != m:

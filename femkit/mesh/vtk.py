@@ -112,15 +112,17 @@ _VTK_TYPES = {np.dtype(t): name for t, name in (
 _ROWS = 1 << 20
 
 
-def _native(a: np.ndarray) -> np.ndarray:
-    """``a`` as a C-contiguous native-order array of one of VTK's types (booleans as UInt8,
-    other types as Int64 or Float64)."""
+def _native(a: np.ndarray, contiguous: bool = True) -> np.ndarray:
+    """``a`` as a native-order array of one of VTK's types (booleans as UInt8, other types as
+    Int64 or Float64), C-contiguous unless ``contiguous`` is false (a broadcast constant stays
+    a view: :func:`_write_appended` writes it a block of rows at a time)."""
     a = np.asarray(a)
     if a.dtype == bool:
         a = a.astype(np.uint8)
     elif a.dtype.newbyteorder("=") not in _VTK_TYPES:
         a = a.astype(np.int64 if a.dtype.kind in "iu" else np.float64)
-    return np.ascontiguousarray(a.astype(a.dtype.newbyteorder("="), copy=False))
+    a = a.astype(a.dtype.newbyteorder("="), copy=False)
+    return np.ascontiguousarray(a) if contiguous else a
 
 
 def _write_vtu_raw(path: str, points: np.ndarray, blocks: list, point_data: dict,
@@ -132,7 +134,7 @@ def _write_vtu_raw(path: str, points: np.ndarray, blocks: list, point_data: dict
     arrays = []          # (section, name, vtk type, components, [pieces], total bytes)
 
     def add(section, name, pieces, comps=None):
-        pieces = [_native(a) for a in pieces]
+        pieces = [_native(a, contiguous=False) for a in pieces]
         dtypes = {a.dtype for a in pieces}
         if len(dtypes) > 1:
             common = np.result_type(*dtypes)
@@ -219,12 +221,17 @@ def _appended_header(n_points: int, n_cells: int, declared: dict) -> bytes:
 
 def _write_appended(f, header: bytes, arrays: list) -> None:
     """Write ``header`` (:func:`_appended_header`) and each ``(bytes, pieces)`` of ``arrays``:
-    its UInt64 size, then the pieces' memory as it is (no copy, no encoding)."""
+    its UInt64 size, then the pieces' memory as it is (no copy, no encoding; a piece that is
+    not contiguous, e.g. a broadcast constant, a block of rows at a time)."""
     f.write(header)
     for nbytes, pieces in arrays:
         f.write(np.uint64(nbytes).tobytes())
         for a in pieces:
-            f.write(memoryview(np.ascontiguousarray(a)).cast("B"))
+            if a.flags.c_contiguous:
+                f.write(memoryview(a).cast("B"))
+                continue
+            for lo in range(0, len(a), _ROWS):
+                f.write(memoryview(np.ascontiguousarray(a[lo:lo + _ROWS])).cast("B"))
     f.write(b"\n</AppendedData>\n</VTKFile>\n")
 
 

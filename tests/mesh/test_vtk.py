@@ -41,6 +41,22 @@ def test_cell_ids_are_int32_and_read_back_across_blocks(tmp_path, monkeypatch, r
     assert np.array_equal(m.point_data["u"], np.arange(4.0))
 
 
+@pytest.mark.parametrize("rows", [1 << 20, 2], ids=["one-block", "blocks-of-2-rows"])
+def test_a_broadcast_constant_is_written_without_its_copies(tmp_path, monkeypatch, rows):
+    """A constant cell field (a constant coefficient) passed as a broadcast view is written a
+    block of rows at a time and reads back as the full array."""
+    import femkit.mesh.vtk as vtk
+
+    monkeypatch.setattr(vtk, "_ROWS", rows)
+    tris = np.array([[0, 1, 2], [0, 2, 3], [1, 2, 3]], np.int64)
+    kappa = np.broadcast_to(np.float64(2.5), (3,))
+    path = write_cells(tmp_path / "m.vtu", POINTS, [("triangle", tris)],
+                       cell_data={"kappa": [kappa], "tag": [np.array([4, 5, 6], np.int32)]})
+    m = meshio.read(path)
+    assert m.cell_data["kappa"][0].tolist() == [2.5, 2.5, 2.5]
+    assert m.cell_data["tag"][0].tolist() == [4, 5, 6]
+
+
 @pytest.mark.parametrize("kw, match", [
     (dict(point_data={"u": np.zeros(3)}), "point_data 'u' has 3 rows"),
     (dict(cell_data={"c": [np.zeros(2), np.zeros(2)]}), r"cell_data 'c' has \[2, 2\] rows"),

@@ -39,7 +39,8 @@ def write_solution(path: str | os.PathLike, mesh, u: np.ndarray,
     cell_data = {"tag": np.asarray(mesh.cell_tags, dtype=np.int32)}
     if kappa is not None:  # a constant coefficient is one number until here
         kappa = np.asarray(kappa, dtype=np.float64)
-        cell_data["kappa"] = np.full(mesh.n_cells, float(kappa)) if kappa.ndim == 0 else kappa
+        # a constant: a broadcast view, written a block at a time (no array of m copies)
+        cell_data["kappa"] = np.broadcast_to(kappa, (mesh.n_cells,)) if kappa.ndim == 0 else kappa
     # Written in place: sibling files (XDMF's .h5, a tag-name sidecar) are named after the
     # file, so a temporary name would orphan them. Callers write into an atomic directory.
     target = Path(path)
