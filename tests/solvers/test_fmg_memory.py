@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from femkit.errors import InputError
 from femkit.fem import apply_dirichlet, assemble_load, assemble_stiffness
 from femkit.mesh import Mesh, MeshHierarchy, boundary_nodes, generate, structured_box
 from femkit.mesh.hierarchy import _fixed_columns
@@ -175,3 +176,119 @@ def test_constant_coefficient_as_one_number_changes_no_result(tmp_path):
     assert num.error_estimate == expr.error_estimate
     cells = meshio.read(tmp_path / "number" / "solution.vtu").cell_data["kappa"][0]
     np.testing.assert_array_equal(cells, np.full(num.mesh.n_cells, 2.5))
+
+
+def _levels(H, g):
+    """The coarser levels' own systems (what the case pipeline passes fmg as ``levels``)."""
+    out = []
+    for m in H.meshes[:-1]:
+        nodes = boundary_nodes(m)
+        out.append(apply_dirichlet(assemble_stiffness(m), assemble_load(m, 1.0), nodes,
+                                   g(*m.points[nodes].T)))
+    return out
+
+
+@pytest.mark.parametrize("which", ["boundary", "random"], ids=["boundary-fixed", "random-fixed"])
+@pytest.mark.parametrize("kind", KINDS)
+def test_free_node_hierarchy_holds_the_same_transfers_without_the_full_ones(kind, which):
+    """``on_free_nodes`` restricts once and keeps the restricted matrices only: the same
+    free-node lists and matrices, the fixed-column parts as CSC with CSR's products bit for bit."""
+    H = _hierarchy(kind)
+    free = _free(H, which)
+    F = H.on_free_nodes(free)
+    assert not hasattr(F, "prolongations") and F.n_levels == H.n_levels and F.finest is H.finest
+    for a, b in zip(F.level_free(free), H.level_free(free)):
+        np.testing.assert_array_equal(a, b)
+    for a, b in zip(F.free_prolongations(free), H.free_prolongations(free)):
+        for name in ("indptr", "indices", "data"):
+            np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    rng = np.random.default_rng(2)
+    for (a, fa), (b, fb) in zip(F.fixed_prolongations(frees=F.frees), H.fixed_prolongations(free)):
+        assert a.format == "csc" and (a != b).nnz == 0 and np.array_equal(fa, fb)
+        g = rng.standard_normal(len(fb))
+        assert np.array_equal(a @ g, b @ g)               # the same sums
+    # a mask of the same nodes is the same set; fixed parts not built are refused by name
+    assert F.level_free(np.isin(np.arange(H.finest.n_points), free))[-1] is F.frees[-1]
+    with pytest.raises(InputError, match="fixed_parts=False"):
+        H.on_free_nodes(free, fixed_parts=False).fixed_prolongations(free)
+
+
+def test_free_node_hierarchy_refuses_other_free_nodes():
+    H = _hierarchy("triangles")
+    free = _free(H, "boundary")
+    F = H.on_free_nodes(free)
+    for other in (free[1:], _free(H, "random")):
+        for call in (F.level_free, F.free_prolongations, F.fixed_prolongations):
+            with pytest.raises(InputError, match="other free nodes"):
+                call(other)
+    with pytest.raises(InputError, match="out of range"):
+        F.level_free([H.finest.n_points])
+
+
+@pytest.mark.parametrize("coarse", ["levels", "dirichlet", "restricted"])
+def test_fmg_and_gmg_on_the_free_node_hierarchy_give_the_same_numbers(coarse):
+    g = lambda x, y: 1 + x * y  # noqa: E731  inhomogeneous: the fixed-column parts are used
+    H, sys_, m = _square_system(g)
+    kw = {"levels": {"levels": _levels(H, g)},
+          "dirichlet": {"dirichlet": sys_.expand(np.zeros(len(sys_.free)))},
+          "restricted": {}}[coarse]
+    F = H.on_free_nodes(sys_.free, fixed_parts=coarse != "restricted")
+    full = fmg(sys_.A, sys_.b, hierarchy=H, free=sys_.free, **kw)
+    lean = fmg(sys_.A, sys_.b, hierarchy=F, free=sys_.free, **kw)
+    assert np.array_equal(full.x, lean.x) and np.array_equal(full.residuals, lean.residuals)
+    assert full.info["discretisation_error_estimate"] == lean.info["discretisation_error_estimate"]
+    from femkit.solvers import pcg
+    from femkit.solvers.preconditioners.gmg import build
+
+    a, b = (pcg(sys_.A, sys_.b, M=build(sys_.A, hierarchy=h, free=sys_.free), rtol=1e-10)
+            for h in (H, F))
+    assert np.array_equal(a.x, b.x)
+
+
+def test_the_run_releases_the_full_prolongations_before_the_solve(tmp_path, monkeypatch):
+    """The case pipeline restricts its hierarchy's transfers at the start of the solve and
+    keeps the restricted ones only: no full prolongation is alive when the multigrid set-up
+    starts (61 MiB at 1.9M fine nodes, held through the solve before). The numbers are those of
+    a solve given the full hierarchy."""
+    import weakref
+
+    from femkit.case import case_from_dict
+    import femkit.case.poisson.run as run_module
+    import femkit.solvers.preconditioners.gmg as gmg_module
+
+    made, alive = [], []
+    refine = MeshHierarchy.from_refinement.__func__
+
+    def recording(cls, *args, **kwargs):
+        H = refine(cls, *args, **kwargs)
+        made.append([weakref.ref(P) for P in H.prolongations])
+        return H
+
+    init = gmg_module.Multigrid.__init__
+
+    def counting(self, *args, **kwargs):
+        alive.append(sum(ref() is not None for ref in made[-1]))
+        init(self, *args, **kwargs)
+
+    monkeypatch.setattr(MeshHierarchy, "from_refinement", classmethod(recording))
+    monkeypatch.setattr(gmg_module.Multigrid, "__init__", counting)
+    runs = []
+    for name in ("lean", "full"):
+        if name == "full":  # the solver given the whole hierarchy, as before
+            monkeypatch.setattr(run_module, "on_free_nodes", lambda overrides: overrides)
+        case = case_from_dict({
+            "problem": "poisson", "name": name,
+            "mesh": {"geometry": "unit_square", "h": 0.2, "refine": 3},
+            "coefficient": 1.0, "source": "1 + x * y",
+            "boundary": {"dirichlet": [{"tags": ["boundary"], "value": "1 + x * y"}]},
+            "exact": {"u": "1 + x * y", "grad": ["y", "x"]},
+            "estimator": "residual", "solver": {"method": "fmg"},
+            "output": {"dir": str(tmp_path / name), "vtu": False, "plot": False}})
+        runs.append(case.run(quiet=True, write=False))
+    assert alive == [0, len(made[-1])] and len(made[-1]) == 3
+    lean, full = runs
+    assert np.array_equal(lean.u, full.u)
+    assert lean.errors == full.errors and lean.error_estimate == full.error_estimate
+    assert lean.solve.info["discretisation_error_estimate"] == \
+        full.solve.info["discretisation_error_estimate"]
+

@@ -35,7 +35,8 @@ from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
 from .spec import BoundarySpec, MeshSpec, PoissonOutputSpec, PoissonSpec
 from .problem import (VARIABLES, CaseResult, build_mesh, build_mesh_levels, check_dimension,
                       compute_errors, element_kappa, exact_gradient, is_pure_neumann,
-                      multigrid_inputs, multigrid_overrides, nullspace_facts, poisson_problem)
+                      multigrid_inputs, multigrid_overrides, nullspace_facts, on_free_nodes,
+                      poisson_problem)
 
 __all__ = ["prepare_poisson", "run_poisson", "build_mesh", "build_mesh_levels",
            "multigrid_inputs", "multigrid_overrides", "element_kappa", "poisson_problem", "compute_errors", "CaseResult"]
@@ -233,7 +234,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
             mg = multigrid_inputs(case, hierarchy, system)
         del hierarchy  # the coarser meshes: mg holds the levels' transfers only
         with stage("solve"):
-            res = _solve(case, system, stop, **mg)
+            res = _solve(case, system, stop, **on_free_nodes(mg))  # the full transfers go first
             u = system.expand(res.x)
         del mg  # the coarser levels and their operators: not needed after the solve
         dofs, nnz = int(system.A.shape[0]), int(system.A.nnz)
