@@ -174,8 +174,27 @@ def interleave_permutation(n_coarse: int, edge_nodes: np.ndarray) -> np.ndarray:
     return perm
 
 
+class _Levels:
+    """What both hierarchies answer from their ``meshes`` (coarsest first)."""
+
+    meshes: tuple
+
+    @property
+    def n_levels(self) -> int:
+        """Number of meshes (refinements + 1)."""
+        return len(self.meshes)
+
+    @property
+    def finest(self) -> Mesh:
+        return self.meshes[-1]
+
+    @property
+    def coarsest(self) -> Mesh:
+        return self.meshes[0]
+
+
 @dataclass(frozen=True, eq=False)
-class MeshHierarchy:
+class MeshHierarchy(_Levels):
     """Nested meshes, coarsest first, and the prolongations between consecutive levels.
 
     Attributes
@@ -255,19 +274,6 @@ class MeshHierarchy:
             injs.append(inj)
             mesh = fine
         return cls(tuple(meshes), tuple(prols), tuple(injs), renumber)
-
-    @property
-    def n_levels(self) -> int:
-        """Number of meshes (refinements + 1)."""
-        return len(self.meshes)
-
-    @property
-    def finest(self) -> Mesh:
-        return self.meshes[-1]
-
-    @property
-    def coarsest(self) -> Mesh:
-        return self.meshes[0]
 
     def prolongate(self, u: np.ndarray, level: int) -> np.ndarray:
         """Interpolate full nodal values ``u`` on ``level`` to ``level + 1`` (``P_level @ u``)."""
@@ -381,7 +387,7 @@ class MeshHierarchy:
 
 
 @dataclass(frozen=True, eq=False)
-class FreeNodeHierarchy:
+class FreeNodeHierarchy(_Levels):
     """A :class:`MeshHierarchy`'s transfers restricted to one set of free nodes
     (:meth:`MeshHierarchy.on_free_nodes`): the matrices a multigrid solve on those nodes reads,
     without the full prolongations. It answers :meth:`level_free`, :meth:`free_prolongations`
@@ -406,19 +412,6 @@ class FreeNodeHierarchy:
     free_parts: tuple
     fixed_parts: tuple | None
     renumbering: str = "none"
-
-    @property
-    def n_levels(self) -> int:
-        """Number of meshes (refinements + 1)."""
-        return len(self.frees)
-
-    @property
-    def finest(self) -> Mesh:
-        return self.meshes[-1]
-
-    @property
-    def coarsest(self) -> Mesh:
-        return self.meshes[0]
 
     def level_free(self, free) -> list[np.ndarray]:
         """The free node ids of every level (coarsest first), as :meth:`MeshHierarchy.level_free`.
