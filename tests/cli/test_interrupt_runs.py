@@ -67,6 +67,31 @@ def test_signal_during_a_long_solve_writes_the_last_iterate_marked(tmp_path, sig
     assert result["solver"]["converged"] is False and result["solver"]["iterations"] > 0
 
 
+@SIGNALS
+def test_signal_during_the_errors_stops_the_solution_writer_and_writes_nothing(tmp_path, sig, code):
+    """After the solve, solution.vtu is being written by a writer thread beside the errors: a
+    stop there ends the run at once, waits for the writer and removes what it staged (nothing
+    is left beside the output directory either)."""
+    case = tmp_path / "case.yaml"
+    case.write_text(yaml.safe_dump({
+        "problem": "poisson",
+        "mesh": {"geometry": "unit_square", "h": 0.02, "refine": 4},
+        "source": "2 * pi**2 * sin(pi * x) * sin(pi * y)",
+        "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
+        "exact": {"u": "sin(pi * x) * sin(pi * y)",
+                  "grad": ["pi * cos(pi * x) * sin(pi * y)", "pi * sin(pi * x) * cos(pi * y)"]},
+        "solver": {"method": "fmg"},
+        "output": {"dir": "out", "vtu": True}}))
+    rc, elapsed, err = signal_inside("femkit.fem.poisson:PoissonProblem.errors",
+                                     ["solve", str(case), "--quiet"], sig, cwd=tmp_path,
+                                     settle=0.05)
+    assert rc == code, err
+    assert elapsed < SLACK, elapsed
+    assert f"interrupted by {sig.name}" in err and "nothing written" in err, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.yaml"]
+
+
 def _earlier_report(out: Path) -> dict:
     out.mkdir()
     files = {"results.json": '{"earlier": true}\n', "report.md": "# the earlier report\n"}
