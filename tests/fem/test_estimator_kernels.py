@@ -140,3 +140,16 @@ def test_compiled_estimator_allocates_its_outputs_and_a_few_bytes_per_edge():
     budget = 3 * 8 * m + 9 * n_edges + 16 * mesh.n_points + 200_000
     assert compiled <= budget, (compiled, budget)
     assert numpy_path > 3 * compiled, (numpy_path, compiled)
+
+
+def test_compiled_estimator_equals_numpy_on_an_unperturbed_structured_mesh(monkeypatch):
+    """Right isosceles triangles: two legs of exactly one length, the longest edge unique."""
+    mesh = structured_mesh(9, 9)
+    u = np.cos(2 * mesh.points[:, 0]) + mesh.points[:, 1] ** 3
+    results = []
+    for threshold in (10 ** 12, 0):
+        monkeypatch.setattr(geometry, "NUMBA_THRESHOLD", threshold)
+        monkeypatch.setattr(residual, "NUMBA_THRESHOLD", threshold)
+        results.append(residual_estimator(mesh, u, kappa=1.0, f=lambda x, y: x + 2 * y,
+                                          dirichlet_nodes=np.arange(mesh.n_points)))
+    np.testing.assert_array_equal(results[1].indicators, results[0].indicators)
