@@ -17,6 +17,12 @@ each row:
 3. each row's (column, value) pairs sorted by column (insertion sort, rows are short:
    :func:`femkit.mesh._edges_kernel.sort_buckets`).
 
+A mesh whose edges are known already (red refinement derives the fine mesh's from the coarse
+mesh's, :func:`femkit.mesh.edges.remember_edges`) takes a shorter route with no search and no sort
+(:func:`_edge_values`, :func:`_edge_matrix`): in the edges' lexicographic order the rows come
+out sorted, so the entries of each element are summed per edge and per node, then written
+once at their CSR positions.
+
 Every entry is the same products (``kappa (e_a . e_b) / (4 |T|)`` on a triangle, ``kappa (g_a .
 g_b) / (6 |D|)`` on a tetrahedron) summed over its elements in increasing element order, as the
 element-order pass sums them: the matrix is :func:`~femkit.fem._kernels._pattern` /
@@ -136,16 +142,116 @@ def _tet_values(tets, points, kappa, scalar_kappa, indptr, rel, diag, nnz):  # p
     return data, bad
 
 
+@numba.njit(cache=True)
+def _edge_values(cells, points, kappa, scalar_kappa, cell_edges, local, n, n_edges):  # pragma: no cover - compiled
+    """Pass 2 from the edges: each element's entries (the products of :func:`_triangle_values`
+    / :func:`_tet_values`, the same floats) summed in element order into ``diag`` (per node)
+    and ``off`` (per edge: ``cell_edges[e, k]`` joins the local vertices ``local[k]``).
+    Returns ``(diag, off, bad)``, ``bad`` the number of degenerate cells."""
+    m, w = cells.shape
+    diag = np.zeros(n)
+    off = np.zeros(n_edges)
+    bad = 0
+    if w == 3:  # edge k is opposite vertex k
+        for e in range(m):
+            i0, i1, i2, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(cells, points, e)
+            if not (area > 0.0 and area < np.inf):
+                bad += 1
+                continue
+            sc = (kappa[0] if scalar_kappa else kappa[e]) / (4.0 * area)
+            diag[i0] += sc * (ex0 * ex0 + ey0 * ey0)
+            diag[i1] += sc * (ex1 * ex1 + ey1 * ey1)
+            diag[i2] += sc * (ex2 * ex2 + ey2 * ey2)
+            off[cell_edges[e, 2]] += sc * (ex0 * ex1 + ey0 * ey1)
+            off[cell_edges[e, 1]] += sc * (ex0 * ex2 + ey0 * ey2)
+            off[cell_edges[e, 0]] += sc * (ex1 * ex2 + ey1 * ey2)
+        return diag, off, bad
+    g = np.empty((4, 3))
+    for e in range(m):
+        vol6 = abs(_tetrahedron(cells, points, e, g))
+        if not (vol6 > 0.0 and vol6 < np.inf):
+            bad += 1
+            continue
+        sc = (kappa[0] if scalar_kappa else kappa[e]) / (6.0 * vol6)
+        for a in range(4):
+            diag[cells[e, a]] += sc * (g[a, 0] * g[a, 0] + g[a, 1] * g[a, 1] + g[a, 2] * g[a, 2])
+        for k in range(local.shape[0]):
+            a, b = local[k, 0], local[k, 1]
+            off[cell_edges[e, k]] += sc * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
+    return diag, off, bad
+
+
+@numba.njit(cache=True)
+def _edge_matrix(edge_nodes, off, diag, index_type):  # pragma: no cover - compiled
+    """CSR ``(indptr, indices, data)`` of the matrix with diagonal ``diag`` and the value
+    ``off[e]`` at both ``(lo, hi)`` and ``(hi, lo)`` of every edge ``e`` (``edge_nodes``
+    sorted lexicographically, ``lo < hi``). Row ``i``: the lower ends of its edges to lower
+    nodes (ascending: they are met in edge order), ``i``, the higher ends of its own edges
+    (consecutive and ascending in edge order): sorted with no sort. A node in no edge (in no
+    cell) has an empty row, as the incidence rows give it."""
+    n = diag.shape[0]
+    lower = np.zeros(n, np.int64)   # edges to lower nodes, then the next free lower slot
+    upper = np.zeros(n, np.int64)   # edges to higher nodes, then the next free upper slot
+    for e in range(edge_nodes.shape[0]):
+        upper[edge_nodes[e, 0]] += 1
+        lower[edge_nodes[e, 1]] += 1
+    indptr = np.empty(n + 1, np.int64)
+    indptr[0] = 0
+    for i in range(n):
+        c = lower[i] + upper[i]
+        indptr[i + 1] = indptr[i] + (c + 1 if c > 0 else 0)
+    indices = np.empty(indptr[n], index_type.dtype)
+    data = np.empty(indptr[n])
+    for i in range(n):
+        if indptr[i + 1] > indptr[i]:
+            d = indptr[i] + lower[i]
+            indices[d] = i
+            data[d] = diag[i]
+            lower[i] = indptr[i]
+            upper[i] = d + 1
+    for e in range(edge_nodes.shape[0]):
+        lo, hi = edge_nodes[e, 0], edge_nodes[e, 1]
+        v = off[e]
+        p = upper[lo]
+        indices[p] = hi
+        data[p] = v
+        upper[lo] = p + 1
+        q = lower[hi]
+        indices[q] = lo
+        data[q] = v
+        lower[hi] = q + 1
+    return indptr, indices, data
+
+
+def _rows_from_edges(mesh, cells, kappa, known, index):
+    """``(indptr, indices, data)`` from the mesh's known edges, or None (a degenerate cell)."""
+    from ..mesh.mesh import LOCAL_EDGES
+
+    edge_nodes, cell_edges = known
+    w = cells.shape[1]
+    diag, off, bad = _edge_values(cells, mesh.points, *_values(kappa), cell_edges,
+                                  LOCAL_EDGES[w].astype(np.int64), mesh.n_points, len(edge_nodes))
+    if bad:
+        return None
+    return _edge_matrix(edge_nodes, off, diag, np.empty(0, index))
+
+
 def stiffness_rows_kernel(mesh, kappa):
     """``(indptr, indices, data)`` of the stiffness of a whole triangle or tetrahedral mesh
     (passes 1-3 of the module's docstring), or None if some cell is degenerate or some row has
     more than :data:`MAX_ROW` columns (the caller then takes the element-order pass, which says
-    which cells are degenerate); ``kappa`` a float or one value per element."""
+    which cells are degenerate); ``kappa`` a float or one value per element. From the mesh's
+    edges when they are known (:func:`femkit.mesh.edges.known_edges`): the same matrix."""
     m, n = mesh.n_cells, mesh.n_points
     w = mesh.cells.shape[1]
     pairs = w * (w - 1)
     index = np.int32 if max(w * m, n + pairs * m) < np.iinfo(np.int32).max else np.int64
     cells = np.ascontiguousarray(mesh.cells, dtype=np.int64)
+    from ..mesh.edges import known_edges
+
+    known = known_edges(mesh)
+    if known is not None:
+        return _rows_from_edges(mesh, cells, kappa, known, index)
     inc = np.empty(w * m, index)
     start = _incidences(cells, n, inc)
     indices = np.empty(n + pairs * m, index)  # the bound; pages past the entries are never touched
@@ -165,15 +271,22 @@ def stiffness_rows_kernel(mesh, kappa):
     return indptr, indices, data
 
 
-def warm_up() -> None:
+def warm_up(dims: tuple[int, ...] = (2, 3)) -> None:
     """Compile (or load from the on-disk cache) the kernels of this module on one triangle and
-    one tetrahedron, with the argument types of a large mesh (int64 cells, int32 incidences and
-    columns)."""
+    (``3 in dims``) one tetrahedron, with the argument types of a large mesh (int64 cells, int32
+    incidences, edges and columns): the incidence rows (a mesh read from a file), then the
+    route from the edges (a refined mesh)."""
     from ..mesh import Mesh
+    from ..mesh.edges import edges
 
     p2 = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     p3 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
-    for mesh in (Mesh(p2, np.array([[0, 1, 2]], dtype=np.int64)),
-                 Mesh(p3, np.array([[0, 1, 2, 3]], dtype=np.int64))):
+    meshes = [Mesh(p2, np.array([[0, 1, 2]], dtype=np.int64))]
+    if 3 in dims:
+        meshes.append(Mesh(p3, np.array([[0, 1, 2, 3]], dtype=np.int64)))
+    for mesh in meshes:
+        stiffness_rows_kernel(mesh, 1.0)
+        stiffness_rows_kernel(mesh, np.ones(1))
+        edges(mesh)                          # now known: the route from the edges
         stiffness_rows_kernel(mesh, 1.0)
         stiffness_rows_kernel(mesh, np.ones(1))

@@ -61,6 +61,15 @@ def edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     return hit
 
 
+def known_edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray] | None:
+    """The arrays :func:`edges` returns if they are known for ``mesh`` already (computed or
+    remembered), else None: nothing is computed."""
+    try:
+        return _CACHE.get(mesh)
+    except TypeError:
+        return None
+
+
 def remember_edges(mesh: Mesh, edge_nodes: np.ndarray, cell_edges: np.ndarray) -> None:
     """Give ``mesh`` the edges a caller derived without a search (red refinement derives the
     fine mesh's from the coarse mesh's): the arrays :func:`edges` would compute, which it then

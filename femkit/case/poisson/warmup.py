@@ -43,6 +43,7 @@ FAMILIES = {
                     ("femkit.mesh._faces_kernel", "tet_faces")),
     "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
                     ("femkit.fem._one_off", "_cell_rows"), ("femkit.fem._one_off", "_triangle_values"),
+                    ("femkit.fem._one_off", "_edge_values"), ("femkit.fem._one_off", "_edge_matrix"),
                     ("femkit.fem._kernels", "_eliminate"), ("femkit.fem._one_off", "_tet_values")),
     "solver checks": (("femkit.solvers._check_kernels", "asymmetry_sums"),),
     "geometric multigrid": (("femkit.solvers.preconditioners._gmg_kernels", "_galerkin_rows"),
@@ -172,6 +173,9 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True,
         for tiny in (_TINY, _TINY_3D)[:len(dims)]:  # triangles, then tetrahedra
             case_from_dict(dict(tiny, solver=solver)).run(write=False, quiet=True)
         from ...fem._kernels import warm_up as assembly_kernels
+        from ...fem._one_off import warm_up as one_off_kernels
+
+        one_off_kernels(dims)  # the incidence rows of a mesh read (the tiny case's are refined)
 
         assembly_kernels()  # the cached-pattern assembly, which a one-off run does not call
         from ...mesh._refine_kernel import warm_up as refinement_kernels
@@ -180,6 +184,10 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True,
         from ...fem.estimators._kernels import warm_up as estimator_kernels
 
         estimator_kernels()  # the estimator's Neumann and area passes, which the tiny case skips
+        from ...mesh import generate, quality
+
+        quality(generate("unit_square", 0.5))  # a mesh read or generated (a refined one's numbers
+        #                                        come from its root's, without the pass)
         _symmetry_check()   # fmg skips it on the pipeline's matrix; pcg, cg ... do not
     finally:
         _ACTIVE = False
