@@ -9,9 +9,77 @@
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from .mesh import Mesh
+
+#: Triangle meshes made by red refinement from a root mesh of at most this many triangles
+#: (:func:`note_red_refinement`) get their numbers from the root's, without a pass of their own.
+SIMILAR_ROOT_MAX = 200_000
+
+#: ``mesh -> (root, levels)``: ``mesh`` is ``root`` red-refined ``levels`` times (nodes maybe
+#: renumbered). Weakly keyed; the root (small) is kept alive by its descendants' entries.
+_SIMILAR: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def note_red_refinement(fine: Mesh, coarse: Mesh) -> None:
+    """Record that the triangle mesh ``fine`` is ``coarse`` after one red refinement, so that
+    :func:`quality` takes ``fine``'s numbers from its root's (nothing is computed now).
+
+    Red refinement cuts a triangle by its midsegments into four triangles similar to it, of
+    half its size (Bank, Sherman and Weiser 1983): the angles, the aspect ratios and the area are
+    the parent's, the longest and the shortest edges halve, and the ``E`` edges, ``T``
+    triangles and perimeter sum ``P`` become ``2 E + 3 T``, ``4 T`` and ``2 P``, with an
+    edge length sum ``S + P / 2``. Equal to the numbers of a pass over the fine mesh to
+    round-off (the midpoints are rounded once).
+    """
+    if coarse.dim != 2:
+        return  # Bey's tetrahedra are not all similar to their parent
+    try:
+        root, levels = _SIMILAR.get(coarse, (coarse, 0))
+        if root.n_cells <= SIMILAR_ROOT_MAX:
+            _SIMILAR[fine] = (root, levels + 1)
+    except TypeError:  # a mesh-like object that cannot be weakly referenced
+        pass
+
+
+def note_renumbered(new: Mesh, old: Mesh) -> None:
+    """``new`` is ``old`` with its nodes (and maybe its elements) renumbered: the same numbers."""
+    try:
+        hit = _SIMILAR.get(old)
+        if hit is not None:
+            _SIMILAR[new] = hit
+    except TypeError:
+        pass
+
+
+def _similar_numbers(mesh: Mesh) -> dict | None:
+    """:func:`quality` of a mesh noted by :func:`note_red_refinement`, from its root's; None
+    when it was not noted."""
+    try:
+        hit = _SIMILAR.get(mesh)
+    except TypeError:
+        return None
+    if hit is None:
+        return None
+    root, levels = hit
+    if root.n_cells * 4 ** levels != mesh.n_cells:
+        return None
+    from .edges import edges
+
+    q = quality(root)
+    p = root.points[root.triangles]
+    sides = np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2)
+    n_edges, n_tri, perim = len(edges(root)[0]), root.n_cells, float(sides.sum())
+    total = q["h_mean"] * n_edges
+    for _ in range(levels):
+        total, n_edges, n_tri, perim = total + perim / 2, 2 * n_edges + 3 * n_tri, 4 * n_tri, 2 * perim
+    scale = 0.5 ** levels
+    q.update(n_points=mesh.n_points, n_triangles=mesh.n_triangles, h_max=q["h_max"] * scale,
+             h_min=q["h_min"] * scale, h_mean=total / max(n_edges, 1))
+    return q
 
 
 def side_lengths_and_angles(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -133,9 +201,16 @@ def quality(mesh: Mesh) -> dict:
         ``max_aspect_ratio``, ``mean_aspect_ratio``: circumradius / (2 inradius), 1 for an
         equilateral triangle, infinite for a degenerate one;
         ``area`` (total area).
+
+    A triangle mesh red-refined from a small root (:func:`note_red_refinement`: what
+    :func:`~femkit.mesh.refine` and a hierarchy note) has its numbers from the root's and the
+    similarity of the children, without a pass over its triangles.
     """
     if mesh.dim == 3:
         return _quality_3d(mesh)
+    similar = _similar_numbers(mesh)
+    if similar is not None:
+        return similar
     from .edges import edges
 
     if mesh.n_cells >= NUMBA_THRESHOLD:

@@ -21,6 +21,7 @@ import numpy as np
 
 from .bey_tables import CORNERS, DIAGONAL_PAIRS, DIAGONALS, FACE_PAIRS, INNER
 from .edges import boundary_edge_ids, edge_ids, edges, remember_edges
+from .quality import note_red_refinement
 from .mesh import LOCAL_EDGES, Mesh
 
 #: Triangle meshes with at least this many cells are refined by compiled passes
@@ -68,6 +69,7 @@ def refine_once(mesh: Mesh, *, derive_edges: bool = True) -> tuple[Mesh, np.ndar
             np.stack([m0, m1, m2], axis=1),
         ], axis=1).reshape(-1, 3)
     fine = _fine_triangles(mesh, points, children, edge_nodes)
+    note_red_refinement(fine, mesh)
     if known is not None:  # what edges(fine) would find: the next refinement, quality, estimator
         remember_edges(fine, *known)
     return fine, edge_nodes
@@ -102,6 +104,7 @@ def refine_interleaved(mesh: Mesh) -> tuple[Mesh, np.ndarray, np.ndarray]:
         points, children, inv, fine_edges, fine_cells = kernel.interleaved_red(
             mesh.points, mesh.cells, edge_nodes, cell_edges, LOCAL_EDGES[3], *types)
         fine = _fine_triangles(mesh, points, children, edge_nodes, inv)
+        note_red_refinement(fine, mesh)
     else:
         points, children, inv, fine_edges, fine_cells = kernel.interleaved_bey(
             mesh.points, mesh.cells, edge_nodes, cell_edges, LOCAL_EDGES[4], *types, CORNERS,

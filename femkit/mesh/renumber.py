@@ -22,6 +22,7 @@ import scipy.sparse as sp
 
 from ..errors import MeshError
 from .mesh import Mesh
+from .quality import note_renumbered
 
 
 def node_graph(mesh: Mesh) -> sp.csr_matrix:
@@ -70,9 +71,11 @@ def permute_nodes(mesh: Mesh, perm: np.ndarray, *, sort_elements: bool = True) -
     if sort_elements:
         order = np.argsort(tri.min(axis=1), kind="stable")
         tri, cell_tags = tri[order], cell_tags[order]
-    return Mesh(points=mesh.points[perm], cells=tri, cell_tags=cell_tags,
-                boundary_facets=inv[mesh.boundary_facets], boundary_tags=mesh.boundary_tags,
-                tag_names=mesh.tag_names)
+    out = Mesh(points=mesh.points[perm], cells=tri, cell_tags=cell_tags,
+               boundary_facets=inv[mesh.boundary_facets], boundary_tags=mesh.boundary_tags,
+               tag_names=mesh.tag_names)
+    note_renumbered(out, mesh)  # the same shapes: the same quality numbers
+    return out
 
 
 def renumber(mesh: Mesh, method: str = "rcm") -> tuple[Mesh, np.ndarray]:
