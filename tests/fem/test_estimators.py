@@ -180,3 +180,14 @@ def test_registry_and_bad_input():
         residual_estimator(m, np.array([0., np.nan, 0., 0.]))
     with pytest.raises(InputError, match="unknown error estimator 'kelly'"):
         ESTIMATORS.get("kelly")
+
+
+@pytest.mark.parametrize("tags", [[3, 1, 3, 7], [0, 0, 0], [-2, 5, -2], [2 ** 21, 4, 4], []],
+                         ids=["small", "one-tag", "negative", "beyond-counting", "empty"])
+@pytest.mark.parametrize("dtype", [np.int32, np.int64])
+def test_region_tags_are_listed_as_np_unique_lists_them(tags, dtype):
+    from femkit.fem.estimators.base import _distinct
+
+    t = np.array(tags, dtype=dtype)
+    got, ref = _distinct(t), np.unique(t)
+    assert got.dtype == ref.dtype and np.array_equal(got, ref)

@@ -130,13 +130,18 @@ def _neumann_part(mesh, te, count, edge_nodes, fluxes, kap, neumann, dirichlet_n
     from ...mesh.edges import edge_ids
     from ..neumann import tagged_edges
 
+    is_dir = None
+    if dirichlet_nodes is not None:                  # both ends prescribed: a Dirichlet edge
+        is_dir = np.zeros(mesh.n_points, dtype=bool)
+        is_dir[np.asarray(dirichlet_nodes, dtype=np.int64)] = True
+        ends = edge_nodes[np.flatnonzero(count == 1)]
+        if (is_dir[ends[:, 0]] & is_dir[ends[:, 1]]).all():
+            return None                              # every boundary edge is a Dirichlet edge
     slots = np.flatnonzero(count[te.ravel()] == 1)   # (element, local edge) of the boundary
     bnd = te.ravel()[slots].astype(np.int64)
     order = np.argsort(bnd, kind="stable")           # by edge id
     bnd, slots = bnd[order], slots[order]
-    if dirichlet_nodes is not None:                  # both ends prescribed: a Dirichlet edge
-        is_dir = np.zeros(mesh.n_points, dtype=bool)
-        is_dir[np.asarray(dirichlet_nodes, dtype=np.int64)] = True
+    if is_dir is not None:
         keep = ~(is_dir[edge_nodes[bnd, 0]] & is_dir[edge_nodes[bnd, 1]])
         bnd, slots = bnd[keep], slots[keep]
     if not len(bnd):
