@@ -19,9 +19,10 @@ each row:
 
 A mesh whose edges are known already (red refinement derives the fine mesh's from the coarse
 mesh's, :func:`femkit.mesh.edges.remember_edges`) takes a shorter route with no search and no sort
-(:func:`_edge_values`, :func:`_edge_matrix`): in the edges' lexicographic order the rows come
-out sorted, so the entries of each element are summed per edge and per node, then written
-once at their CSR positions.
+(:func:`_edge_pattern`, :func:`_edge_values`, :func:`_edge_fill`): in the edges' lexicographic
+order the rows come out sorted, so their positions are known before any value, each element's
+entries are added at the diagonal and upper positions, and each edge's value is then copied
+to its lower entry.
 
 Every entry is the same products (``kappa (e_a . e_b) / (4 |T|)`` on a triangle, ``kappa (g_a .
 g_b) / (6 |D|)`` on a tetrahedron) summed over its elements in increasing element order, as the
@@ -143,14 +144,53 @@ def _tet_values(tets, points, kappa, scalar_kappa, indptr, rel, diag, nnz):  # p
 
 
 @numba.njit(cache=True)
-def _edge_values(cells, points, kappa, scalar_kappa, cell_edges, local, n, n_edges):  # pragma: no cover - compiled
+def _edge_pattern(edge_nodes, n, index_type):  # pragma: no cover - compiled
+    """The CSR rows of the P1 matrix of the edges ``edge_nodes`` (sorted lexicographically,
+    ``lo < hi``) over ``n`` nodes. Row ``i``: the lower ends of its edges to lower nodes
+    (ascending: they are met in edge order), ``i``, the higher ends of its own edges
+    (consecutive and ascending in edge order): sorted with no sort. A node in no edge (in no
+    cell) has an empty row, as the incidence rows give it.
+
+    Returns ``(indptr, indices, diag, shift)``: ``indices`` with the diagonal written (the rest
+    by :func:`_edge_fill`), ``diag[i]`` the position of ``(i, i)`` and ``shift[i]`` that of
+    ``(i, hi)`` minus the id of its edge, so edge ``e`` of lower node ``lo`` sits at
+    ``shift[lo] + e`` (``indptr`` and ``indices`` of ``index_type``'s dtype)."""
+    diag = np.zeros(n, np.int64)    # the number of edges to lower nodes, then the position
+    shift = np.zeros(n, np.int64)   # the number of edges to higher nodes, then the shift
+    for e in range(edge_nodes.shape[0]):
+        shift[edge_nodes[e, 0]] += 1
+        diag[edge_nodes[e, 1]] += 1
+    indptr = np.empty(n + 1, index_type.dtype)
+    indptr[0] = 0
+    q = 0                           # the end of the rows so far
+    first = 0                       # the first edge whose lower node is i
+    for i in range(n):
+        lower, upper = diag[i], shift[i]
+        d = q + lower
+        diag[i] = d
+        shift[i] = d + 1 - first
+        first += upper
+        if lower + upper > 0:
+            q = d + 1 + upper
+        indptr[i + 1] = q
+    indices = np.empty(q, index_type.dtype)
+    for i in range(n):
+        if indptr[i + 1] > indptr[i]:
+            indices[diag[i]] = i
+    return indptr, indices, diag, shift
+
+
+@numba.njit(cache=True)
+def _edge_values(cells, points, kappa, scalar_kappa, cell_edges, local, diag, shift, nnz):  # pragma: no cover - compiled
     """Pass 2 from the edges: each element's entries (the products of :func:`_triangle_values`
-    / :func:`_tet_values`, the same floats) summed in element order into ``diag`` (per node)
-    and ``off`` (per edge: ``cell_edges[e, k]`` joins the local vertices ``local[k]``).
-    Returns ``(diag, off, bad)``, ``bad`` the number of degenerate cells."""
+    / :func:`_tet_values`, the same floats) added in element order at the positions of
+    :func:`_edge_pattern`: ``(i, i)`` at ``diag[i]``, the upper entry of the edge
+    ``cell_edges[e, k]`` (joining the local vertices ``local[k]``, the lower of the two nodes
+    ``lo``) at ``shift[lo] + cell_edges[e, k]``.
+    Returns ``(data, bad)``, ``bad`` the number of degenerate cells (then ``data`` is
+    incomplete); the lower entries are copied by :func:`_edge_fill`."""
     m, w = cells.shape
-    diag = np.zeros(n)
-    off = np.zeros(n_edges)
+    data = np.zeros(nnz)
     bad = 0
     if w == 3:  # edge k is opposite vertex k
         for e in range(m):
@@ -159,13 +199,14 @@ def _edge_values(cells, points, kappa, scalar_kappa, cell_edges, local, n, n_edg
                 bad += 1
                 continue
             sc = (kappa[0] if scalar_kappa else kappa[e]) / (4.0 * area)
-            diag[i0] += sc * (ex0 * ex0 + ey0 * ey0)
-            diag[i1] += sc * (ex1 * ex1 + ey1 * ey1)
-            diag[i2] += sc * (ex2 * ex2 + ey2 * ey2)
-            off[cell_edges[e, 2]] += sc * (ex0 * ex1 + ey0 * ey1)
-            off[cell_edges[e, 1]] += sc * (ex0 * ex2 + ey0 * ey2)
-            off[cell_edges[e, 0]] += sc * (ex1 * ex2 + ey1 * ey2)
-        return diag, off, bad
+            data[diag[i0]] += sc * (ex0 * ex0 + ey0 * ey0)
+            data[diag[i1]] += sc * (ex1 * ex1 + ey1 * ey1)
+            data[diag[i2]] += sc * (ex2 * ex2 + ey2 * ey2)
+            # the edge opposite vertex 2 joins i0 and i1: its lower node is the smaller
+            data[shift[min(i0, i1)] + cell_edges[e, 2]] += sc * (ex0 * ex1 + ey0 * ey1)
+            data[shift[min(i0, i2)] + cell_edges[e, 1]] += sc * (ex0 * ex2 + ey0 * ey2)
+            data[shift[min(i1, i2)] + cell_edges[e, 0]] += sc * (ex1 * ex2 + ey1 * ey2)
+        return data, bad
     g = np.empty((4, 3))
     for e in range(m):
         vol6 = abs(_tetrahedron(cells, points, e, g))
@@ -174,53 +215,30 @@ def _edge_values(cells, points, kappa, scalar_kappa, cell_edges, local, n, n_edg
             continue
         sc = (kappa[0] if scalar_kappa else kappa[e]) / (6.0 * vol6)
         for a in range(4):
-            diag[cells[e, a]] += sc * (g[a, 0] * g[a, 0] + g[a, 1] * g[a, 1] + g[a, 2] * g[a, 2])
+            data[diag[cells[e, a]]] += sc * (g[a, 0] * g[a, 0] + g[a, 1] * g[a, 1] + g[a, 2] * g[a, 2])
         for k in range(local.shape[0]):
             a, b = local[k, 0], local[k, 1]
-            off[cell_edges[e, k]] += sc * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
-    return diag, off, bad
+            lo = min(cells[e, a], cells[e, b])
+            data[shift[lo] + cell_edges[e, k]] += sc * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1]
+                                                        + g[a, 2] * g[b, 2])
+    return data, bad
 
 
 @numba.njit(cache=True)
-def _edge_matrix(edge_nodes, off, diag, index_type):  # pragma: no cover - compiled
-    """CSR ``(indptr, indices, data)`` of the matrix with diagonal ``diag`` and the value
-    ``off[e]`` at both ``(lo, hi)`` and ``(hi, lo)`` of every edge ``e`` (``edge_nodes``
-    sorted lexicographically, ``lo < hi``). Row ``i``: the lower ends of its edges to lower
-    nodes (ascending: they are met in edge order), ``i``, the higher ends of its own edges
-    (consecutive and ascending in edge order): sorted with no sort. A node in no edge (in no
-    cell) has an empty row, as the incidence rows give it."""
-    n = diag.shape[0]
-    lower = np.zeros(n, np.int64)   # edges to lower nodes, then the next free lower slot
-    upper = np.zeros(n, np.int64)   # edges to higher nodes, then the next free upper slot
-    for e in range(edge_nodes.shape[0]):
-        upper[edge_nodes[e, 0]] += 1
-        lower[edge_nodes[e, 1]] += 1
-    indptr = np.empty(n + 1, np.int64)
-    indptr[0] = 0
-    for i in range(n):
-        c = lower[i] + upper[i]
-        indptr[i + 1] = indptr[i] + (c + 1 if c > 0 else 0)
-    indices = np.empty(indptr[n], index_type.dtype)
-    data = np.empty(indptr[n])
-    for i in range(n):
-        if indptr[i + 1] > indptr[i]:
-            d = indptr[i] + lower[i]
-            indices[d] = i
-            data[d] = diag[i]
-            lower[i] = indptr[i]
-            upper[i] = d + 1
+def _edge_fill(edge_nodes, indptr, indices, data, shift):  # pragma: no cover - compiled
+    """The off-diagonal columns of :func:`_edge_pattern`'s rows, and each edge's upper value
+    copied to its lower entry ``(hi, lo)``: the lower entries of row ``hi`` in edge order."""
+    fill = np.empty(indptr.shape[0] - 1, np.int64)
+    for i in range(fill.shape[0]):
+        fill[i] = indptr[i]
     for e in range(edge_nodes.shape[0]):
         lo, hi = edge_nodes[e, 0], edge_nodes[e, 1]
-        v = off[e]
-        p = upper[lo]
+        p = shift[lo] + e
         indices[p] = hi
-        data[p] = v
-        upper[lo] = p + 1
-        q = lower[hi]
+        q = fill[hi]
+        fill[hi] = q + 1
         indices[q] = lo
-        data[q] = v
-        lower[hi] = q + 1
-    return indptr, indices, data
+        data[q] = data[p]
 
 
 def _rows_from_edges(mesh, cells, kappa, known, index):
@@ -229,11 +247,14 @@ def _rows_from_edges(mesh, cells, kappa, known, index):
 
     edge_nodes, cell_edges = known
     w = cells.shape[1]
-    diag, off, bad = _edge_values(cells, mesh.points, *_values(kappa), cell_edges,
-                                  LOCAL_EDGES[w].astype(np.int64), mesh.n_points, len(edge_nodes))
+    indptr, indices, diag, shift = _edge_pattern(edge_nodes, mesh.n_points, np.empty(0, index))
+    data, bad = _edge_values(cells, mesh.points, *_values(kappa), cell_edges,
+                             LOCAL_EDGES[w].astype(np.int64), diag, shift, len(indices))
+    del diag
     if bad:
         return None
-    return _edge_matrix(edge_nodes, off, diag, np.empty(0, index))
+    _edge_fill(edge_nodes, indptr, indices, data, shift)
+    return indptr, indices, data
 
 
 def stiffness_rows_kernel(mesh, kappa):

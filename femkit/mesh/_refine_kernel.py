@@ -64,7 +64,8 @@ def pair_starts(tri_edges, n_edges, extra):  # pragma: no cover - compiled
 def bucket_pairs(tri_edges, bfill, b_hi, b_id, inv, n):  # pragma: no cover - compiled
     """Put the pair ``(p, q)``, ``p < q``, of midpoints of each triangle ``t`` other than that
     of its edge ``j`` in bucket ``p`` (next free slot ``bfill[p]``): key ``q`` (``inv[n + q]``
-    when ``inv`` is not empty: the new id of the midpoint), id ``3 t + j``."""
+    when ``inv`` is not empty: the new id of the midpoint), id ``3 t + j`` (unless ``b_id`` is
+    empty)."""
     for t in range(tri_edges.shape[0]):
         for j in range(3):
             p, q = tri_edges[t, (j + 1) % 3], tri_edges[t, (j + 2) % 3]
@@ -72,7 +73,8 @@ def bucket_pairs(tri_edges, bfill, b_hi, b_id, inv, n):  # pragma: no cover - co
             r = bfill[lo]
             bfill[lo] = r + 1
             b_hi[r] = max(p, q) if inv.shape[0] == 0 else inv[n + max(p, q)]
-            b_id[r] = 3 * t + j
+            if b_id.shape[0] > 0:
+                b_id[r] = 3 * t + j
 
 
 @numba.njit(cache=True)
@@ -186,11 +188,11 @@ def interleaved_red(points, tri, edge_nodes, tri_edges, local, node_type, edge_t
     # bucket of midpoint e (by its new id): the second half (e, hi end) and the pairs (e, q > e)
     bstart = pair_starts(tri_edges, n_edges, 1)
     bfill = bstart[:-1].copy()
-    b_hi = np.empty(bstart[n_edges], np.int64)   # the new id of the other end
+    b_hi = np.empty(bstart[n_edges], node_type.dtype)   # the new id of the other end
     for e in range(n_edges):
         b_hi[bfill[e]] = inv[edge_nodes[e, 1]]
         bfill[e] += 1
-    bucket_pairs(tri_edges, bfill, b_hi, np.empty(bstart[n_edges], np.int64), inv, n)
+    bucket_pairs(tri_edges, bfill, b_hi, np.empty(0, np.int64), inv, n)  # no ids: not needed
     children = np.empty((4 * m, 3), np.int64)
     for t in range(m):
         v0, v1, v2 = inv[tri[t, 0]], inv[tri[t, 1]], inv[tri[t, 2]]
@@ -415,7 +417,7 @@ def interleaved_bey(points, cells, edge_nodes, cell_edges, local, node_type, edg
     for e in range(n_edges):
         bstart[e + 1] += bstart[e]
     bfill = bstart[:-1].copy()
-    b_hi = np.empty(bstart[n_edges], np.int64)
+    b_hi = np.empty(bstart[n_edges], node_type.dtype)
     for e in range(n_edges):
         b_hi[bfill[e]] = inv[edge_nodes[e, 1]]
         bfill[e] += 1
