@@ -33,7 +33,9 @@ def note_red_refinement(fine: Mesh, coarse: Mesh) -> None:
     the parent's, the longest and the shortest edges halve, and the ``E`` edges, ``T``
     triangles and perimeter sum ``P`` become ``2 E + 3 T``, ``4 T`` and ``2 P``, with an
     edge length sum ``S + P / 2``. Equal to the numbers of a pass over the fine mesh to
-    round-off (the midpoints are rounded once).
+    round-off (the midpoints are rounded once). Like the cached edges
+    (:func:`femkit.mesh.edges.edges`), the note holds while the mesh's arrays are not changed in
+    place (a :class:`Mesh` is frozen: a moved mesh is a new Mesh, with no note).
     """
     if coarse.dim != 2:
         return  # Bey's tetrahedra are not all similar to their parent
