@@ -136,6 +136,11 @@ def _solver_constants(key: str, c: dict) -> tuple[str, list[str]]:
 #: (a test checks the assembly's).
 COMPILED_FROM = 200_000
 
+#: A red-refined triangle mesh whose root has at most this many triangles takes its quality
+#: numbers from the root's (``femkit.mesh.quality.SIMILAR_ROOT_MAX``: the children are similar to
+#: their parent): its quality stage is the root's. Repeated, not imported (a test checks it).
+SIMILAR_ROOT_MAX = 200_000
+
 #: Stages with a compiled path from :data:`COMPILED_FROM` and a NumPy one below: time laws
 #: ``seconds[stage]`` (compiled) and ``seconds[stage + "_numpy"]``.
 COMPILED_STAGES = ("refine", "quality", "assembly", "boundary")
@@ -278,8 +283,13 @@ def plan_poisson(*, area: float | None = None, line_length: float | None = None,
     if refine:
         stages.append(stage("refine", _power(law("refine"), m), b["refine_per_triangle"],
                             f"{refine} red refinement(s) -> {m:,.0f} triangles"))
-    stages.append(stage("quality", _power(law("quality"), m), b["quality_per_triangle"],
-                        "validation and quality"))
+    if refine and m0 <= SIMILAR_ROOT_MAX:  # the root's numbers, on the root's path
+        root_law = s["quality" if m0 >= COMPILED_FROM else "quality_numpy"]
+        stages.append(stage("quality", _power(root_law, m0), b["quality_per_triangle"],
+                            "validation and quality (the root's: red refinement keeps the shapes)"))
+    else:
+        stages.append(stage("quality", _power(law("quality"), m), b["quality_per_triangle"],
+                            "validation and quality"))
     asm_b = b["assembly_per_triangle"] if compiled else b["assembly_numpy_per_triangle"]
     stages.append(stage("assembly", _power(law("assembly"), m), asm_b,
                         f"{nnz:,.0f} nonzeros" + (" (compiled kernels)" if compiled else "")))

@@ -79,3 +79,12 @@ def test_compiled_threshold_matches_assembly():
     from femkit.fem.sparsity import NUMBA_THRESHOLD
 
     assert COMPILED_FROM == NUMBA_THRESHOLD
+
+
+def test_similar_root_bound_matches_the_quality_module():
+    import sys
+
+    import femkit.mesh.quality  # noqa: F401  (the package re-exports the function by this name)
+    from femkit.cost.poisson import SIMILAR_ROOT_MAX
+
+    assert SIMILAR_ROOT_MAX == sys.modules["femkit.mesh.quality"].SIMILAR_ROOT_MAX
