@@ -114,10 +114,10 @@ def _pattern(tri, n, indices, slots, points, kappa, scalar_kappa, with_data):  #
                 slots[e, 3 * a + b] = verts[k, b]
         if with_data:
             _, _, _, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(tri, points, e)
-            if not (area > 0.0 and area < np.inf):
+            ok, sc = _element_scale(area, 4.0, kappa, scalar_kappa, e)
+            if not ok:
                 bad += 1
                 continue
-            sc = (kappa[0] if scalar_kappa else kappa[e]) / (4.0 * area)
             _add_local_stiffness(data, slots, e, sc, ex0, ey0, ex1, ey1, ex2, ey2)
     return indptr, nnz, data, bad
 
@@ -176,10 +176,11 @@ def _pattern_cells(tri, n, indices, slots, points, kappa, scalar_kappa, with_dat
                 slots[e, w * a + b] = verts[k, b]
         if with_data:
             vol6 = abs(_tetrahedron(tri, points, e, g))
-            if not (vol6 > 0.0 and vol6 < np.inf):
+            ok, sc = _element_scale(vol6, 6.0, kappa, scalar_kappa, e)
+            if not ok:
                 bad += 1
                 continue
-            _add_tet_stiffness(data, slots, e, g, (kappa[0] if scalar_kappa else kappa[e]) / (6.0 * vol6))
+            _add_tet_stiffness(data, slots, e, g, sc)
     return indptr, nnz, data, bad
 
 
@@ -219,6 +220,16 @@ def _triangle(tri, points, e):  # pragma: no cover - compiled
     return i0, i1, i2, ex0, ey0, ex1, ey1, ex2, ey2, area
 
 
+@numba.njit(cache=True, inline="always")
+def _element_scale(measure, d, kappa, scalar_kappa, k):  # pragma: no cover - compiled
+    """``(ok, kappa_k / (d * measure))``: the stiffness scale of an element (``d = 4`` and its
+    area for a triangle, ``d = 6`` and ``6 |V|`` for a tetrahedron); ``ok`` is False, the element
+    degenerate, when ``measure`` is not positive and finite."""
+    if not (measure > 0.0 and measure < np.inf):
+        return False, 0.0
+    return True, (kappa[0] if scalar_kappa else kappa[k]) / (d * measure)
+
+
 @numba.njit(cache=True)
 def _add_local_stiffness(data, slots, e, s, ex0, ey0, ex1, ey1, ex2, ey2):  # pragma: no cover - compiled
     """``data[slots[e, 3 a + b]] += s (e_a . e_b)``: element e's local matrix into CSR data."""
@@ -245,10 +256,10 @@ def _stiffness(tri, points, idx, use_idx, kappa, scalar_kappa, slots, nnz):  # p
     for k in range(count):
         e = idx[k] if use_idx else k
         i0, i1, i2, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(tri, points, e)
-        if not (area > 0.0 and area < np.inf):
+        ok, s = _element_scale(area, 4.0, kappa, scalar_kappa, k)
+        if not ok:
             bad += 1
             continue
-        s = (kappa[0] if scalar_kappa else kappa[k]) / (4.0 * area)
         _add_local_stiffness(data, slots, e, s, ex0, ey0, ex1, ey1, ex2, ey2)
     return data, bad
 
@@ -329,10 +340,11 @@ def _stiffness_tet(tets, points, idx, use_idx, kappa, scalar_kappa, slots, nnz):
     for k in range(count):
         e = idx[k] if use_idx else k
         vol6 = abs(_tetrahedron(tets, points, e, g))
-        if not (vol6 > 0.0 and vol6 < np.inf):
+        ok, sc = _element_scale(vol6, 6.0, kappa, scalar_kappa, k)
+        if not ok:
             bad += 1
             continue
-        _add_tet_stiffness(data, slots, e, g, (kappa[0] if scalar_kappa else kappa[k]) / (6.0 * vol6))
+        _add_tet_stiffness(data, slots, e, g, sc)
     return data, bad
 
 

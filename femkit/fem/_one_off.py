@@ -41,7 +41,7 @@ import numba
 import numpy as np
 
 from ..mesh._edges_kernel import sort_buckets
-from ._kernels import _incidences, _tetrahedron, _triangle, _values
+from ._kernels import _element_scale, _incidences, _tetrahedron, _triangle, _values
 
 #: Row positions are stored in one byte: rows longer than this take the element-order pass.
 MAX_ROW = 255
@@ -94,10 +94,10 @@ def _triangle_values(tri, points, kappa, scalar_kappa, indptr, rel, diag, nnz): 
     bad = 0
     for e in range(tri.shape[0]):
         i0, i1, i2, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(tri, points, e)
-        if not (area > 0.0 and area < np.inf):
+        ok, sc = _element_scale(area, 4.0, kappa, scalar_kappa, e)
+        if not ok:
             bad += 1
             continue
-        sc = (kappa[0] if scalar_kappa else kappa[e]) / (4.0 * area)
         d01 = sc * (ex0 * ex1 + ey0 * ey1)
         d02 = sc * (ex0 * ex2 + ey0 * ey2)
         d12 = sc * (ex1 * ex2 + ey1 * ey2)
@@ -124,11 +124,10 @@ def _tet_values(tets, points, kappa, scalar_kappa, indptr, rel, diag, nnz):  # p
     g = np.empty((4, 3))
     bad = 0
     for e in range(tets.shape[0]):
-        vol6 = abs(_tetrahedron(tets, points, e, g))
-        if not (vol6 > 0.0 and vol6 < np.inf):
+        ok, sc = _element_scale(abs(_tetrahedron(tets, points, e, g)), 6.0, kappa, scalar_kappa, e)
+        if not ok:
             bad += 1
             continue
-        sc = (kappa[0] if scalar_kappa else kappa[e]) / (6.0 * vol6)
         for a in range(4):
             i = tets[e, a]
             base = indptr[i]
@@ -195,10 +194,10 @@ def _edge_values(cells, points, kappa, scalar_kappa, cell_edges, local, diag, sh
     if w == 3:  # edge k is opposite vertex k
         for e in range(m):
             i0, i1, i2, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(cells, points, e)
-            if not (area > 0.0 and area < np.inf):
+            ok, sc = _element_scale(area, 4.0, kappa, scalar_kappa, e)
+            if not ok:
                 bad += 1
                 continue
-            sc = (kappa[0] if scalar_kappa else kappa[e]) / (4.0 * area)
             data[diag[i0]] += sc * (ex0 * ex0 + ey0 * ey0)
             data[diag[i1]] += sc * (ex1 * ex1 + ey1 * ey1)
             data[diag[i2]] += sc * (ex2 * ex2 + ey2 * ey2)
@@ -209,11 +208,10 @@ def _edge_values(cells, points, kappa, scalar_kappa, cell_edges, local, diag, sh
         return data, bad
     g = np.empty((4, 3))
     for e in range(m):
-        vol6 = abs(_tetrahedron(cells, points, e, g))
-        if not (vol6 > 0.0 and vol6 < np.inf):
+        ok, sc = _element_scale(abs(_tetrahedron(cells, points, e, g)), 6.0, kappa, scalar_kappa, e)
+        if not ok:
             bad += 1
             continue
-        sc = (kappa[0] if scalar_kappa else kappa[e]) / (6.0 * vol6)
         for a in range(4):
             data[diag[cells[e, a]]] += sc * (g[a, 0] * g[a, 0] + g[a, 1] * g[a, 1] + g[a, 2] * g[a, 2])
         for k in range(local.shape[0]):
