@@ -222,19 +222,23 @@ _NUMBA_STARTED = False
 
 def start_numba(stage) -> None:
     """numba's start-up, once per process, in the stage :data:`NUMBA_STAGE` of ``stage`` (a
-    :class:`~femkit.timing.StageTimer`): its import (~0.2-0.3 s) and the typing and lowering
-    registries it loads before its first compiled or cached function (~0.4-0.6 s: numba's
-    ``BaseContext.refresh``, which imports ``numba.np.arraymath``, its BLAS check and the rest).
-    Without this the first kernel called paid it inside the stage that called it (the mesh
-    stage's refinement), and the import was "other" time. Not inside a warm-up; a numba whose
-    internals differ is only imported (the first kernel then loads the registries, as before)."""
+    :class:`~femkit.timing.StageTimer`): its import (~0.2-0.3 s) and what its first cached
+    kernel needs. femkit's cached kernels load without numba's compiler registries
+    (:func:`femkit.numba_cache.lean_cache_loads`); with a numba that was not checked for that,
+    the registries are loaded here (~0.2-0.6 s: numba's ``BaseContext.refresh``, which imports
+    ``numba.np.arraymath``, its BLAS check and the rest). Without this the first kernel called
+    paid it inside the stage that called it (the mesh stage's refinement), and the import was
+    "other" time. Not inside a warm-up; a numba whose internals differ is only imported (the
+    first kernel then loads the registries, as before)."""
     global _NUMBA_STARTED
     if _NUMBA_STARTED or _ACTIVE:
         return
     _NUMBA_STARTED = True
     with stage(NUMBA_STAGE):
-        import numba  # noqa: F401
+        from ...numba_cache import lean_cache_loads
 
+        if lean_cache_loads():
+            return
         try:
             from numba.core.registry import cpu_target
 
