@@ -436,7 +436,9 @@ def interleaved_bey(points, cells, edge_nodes, cell_edges, local, node_type, edg
 def warm_up(dims: tuple[int, ...] = (2, 3)) -> None:
     """Compile (or load from the on-disk cache) the kernels of the dimensions ``dims``, with
     the argument types of a run (int64 cells, the 32-bit edge arrays of
-    :func:`femkit.mesh.edges.edges`)."""
+    :func:`femkit.mesh.edges.edges`; the interleaved refinements also with the read-only edge
+    arrays a mesh keeps, which numba types apart: the hierarchy refines each level with the
+    edges the previous refinement left on it)."""
     from .mesh import LOCAL_EDGES
 
     if 2 in dims:
@@ -446,8 +448,9 @@ def warm_up(dims: tuple[int, ...] = (2, 3)) -> None:
         red_children(tri, tri_edges, 3)
         with_midpoints(np.zeros((3, 2)), edge_nodes)
         child_edges(3, edge_nodes, tri, tri_edges)
-        interleaved_red(np.zeros((3, 2)), tri, edge_nodes, tri_edges, LOCAL_EDGES[3],
-                        np.zeros(0, np.int32), np.zeros(0, np.int32))
+        for nodes, cell_edges in ((edge_nodes, tri_edges), _read_only(edge_nodes, tri_edges)):
+            interleaved_red(np.zeros((3, 2)), tri, nodes, cell_edges, LOCAL_EDGES[3],
+                            np.zeros(0, np.int32), np.zeros(0, np.int32))
         interleaved_rows(3, edge_nodes, np.arange(6), np.zeros(0, np.int32))
     if 3 in dims:
         from .bey_tables import CORNERS, DIAGONAL_PAIRS, DIAGONALS, FACE_PAIRS, INNER
@@ -459,6 +462,15 @@ def warm_up(dims: tuple[int, ...] = (2, 3)) -> None:
         with_midpoints(points, tet_edges)
         red_tetrahedra(np.vstack([points, points[tet_edges].mean(axis=1)]), tet, cell_edges, 4,
                        CORNERS, INNER, DIAGONALS)
-        interleaved_bey(points, tet, tet_edges, cell_edges, LOCAL_EDGES[4], np.zeros(0, np.int32),
-                        np.zeros(0, np.int32), CORNERS, INNER, DIAGONALS, FACE_PAIRS,
-                        DIAGONAL_PAIRS)
+        for nodes, edges_of in ((tet_edges, cell_edges), _read_only(tet_edges, cell_edges)):
+            interleaved_bey(points, tet, nodes, edges_of, LOCAL_EDGES[4], np.zeros(0, np.int32),
+                            np.zeros(0, np.int32), CORNERS, INNER, DIAGONALS, FACE_PAIRS,
+                            DIAGONAL_PAIRS)
+
+
+def _read_only(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Read-only copies of ``arrays`` (as :func:`femkit.mesh.edges.remember_edges` keeps them)."""
+    out = tuple(a.copy() for a in arrays)
+    for a in out:
+        a.flags.writeable = False
+    return out
