@@ -150,16 +150,60 @@ def test_non_finite_values_and_degenerate_cells_are_reported_as_by_numpy(monkeyp
         error_norms(flat, np.zeros(4), ok)
 
 
+def _equilateral(n: int) -> Mesh:
+    """A lattice of ``2 n^2`` equilateral triangles: every edge the same length up to rounding."""
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    points = np.stack([i + 0.5 * j, (np.sqrt(3) / 2) * j], axis=-1).reshape(-1, 2) / n
+    v = (i[:-1, :-1] * (n + 1) + j[:-1, :-1]).ravel()
+    up = np.stack([v, v + n + 1, v + 1], axis=1)
+    down = np.stack([v + n + 1, v + n + 2, v + 1], axis=1)
+    return Mesh(points, np.concatenate([up, down]))
+
+
+def test_longest_edge_is_hypots_maximum_where_squares_order_edges_otherwise():
+    """``h_T`` by hypot of the edges whose squares nearly tie equals NumPy's ``max`` of every
+    edge's hypot, also for pairs of edges whose rounded squares and hypots disagree on which is
+    longer (about one pair in a thousand of equal exact length)."""
+    from femkit.fem.estimators._kernels import _longest
+
+    rng = np.random.default_rng(0)
+    a = rng.uniform(0.1, 1.0, (200_000, 2))
+    turn = rng.uniform(-0.9, 0.9, len(a))               # < 60 degrees: the third edge is shorter
+    c, s_ = np.cos(turn), np.sin(turn)
+    b = np.stack([c * a[:, 0] - s_ * a[:, 1], s_ * a[:, 0] + c * a[:, 1]], axis=1)
+    sq = lambda v: v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1]  # noqa: E731
+    h = lambda v: np.hypot(v[:, 0], v[:, 1])  # noqa: E731
+    disagree = np.flatnonzero((sq(a) > sq(b)) != (h(a) > h(b)))
+    assert len(disagree) > 20
+    for k in disagree[:200]:
+        e = np.array([b[k] - a[k], -b[k], a[k]])
+        assert _longest(e) == np.hypot(e[:, 0], e[:, 1]).max()
+
+
+#: Meshes of the bit-for-bit estimator test: perturbed, equilateral (the three edges tie for the
+#: longest within rounding), and scaled so far that the squared edge lengths underflow or
+#: overflow (the longest edge then by hypot of every edge).
+ESTIMATOR_MESHES = {
+    "perturbed": lambda: _mesh("sin-2d"),
+    "equilateral": lambda: _equilateral(13),
+    "scaled-1e-160": lambda: Mesh(1e-160 * _mesh("sin-2d").points, _mesh("sin-2d").triangles),
+    "scaled-1e152": lambda: Mesh(1e152 * _mesh("sin-2d").points, _mesh("sin-2d").triangles),
+}
+
+
+@pytest.mark.parametrize("where", list(ESTIMATOR_MESHES))
 @pytest.mark.parametrize("kappa", [1.0, "regions"], ids=["kappa-1", "kappa-per-region"])
-def test_compiled_residual_estimator_gives_the_same_bits(kappa, monkeypatch):
+def test_compiled_residual_estimator_gives_the_same_bits(kappa, where, monkeypatch):
     """The estimator's element and edge terms compiled (large meshes) equal NumPy's exactly."""
     import femkit.fem.estimators.geometry as geometry
     import femkit.fem.estimators.residual as residual
 
-    mesh = _mesh("sin-2d")
-    k = np.where(mesh.centroids()[:, 0] < 0.5, 1.0, 1e3) if kappa == "regions" else kappa
-    u = np.sin(3 * mesh.points[:, 0]) * mesh.points[:, 1]
-    bottom = np.flatnonzero(mesh.points[:, 1] < 1e-12)
+    mesh = ESTIMATOR_MESHES[where]()
+    k = (np.where(mesh.centroids()[:, 0] < 0.5 * mesh.points[:, 0].max(), 1.0, 1e3)
+         if kappa == "regions" else kappa)
+    x, y = (mesh.points / np.abs(mesh.points).max()).T
+    u = np.sin(3 * x) * y
+    bottom = np.flatnonzero(y < 1e-12)
     results = []
     for threshold in (10 ** 12, 0):
         monkeypatch.setattr(geometry, "NUMBA_THRESHOLD", threshold)

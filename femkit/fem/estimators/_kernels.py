@@ -34,6 +34,38 @@ def _triangle(points, tri, u, k, e, grad):  # pragma: no cover - compiled
     return signed
 
 
+#: Squared lengths below ``(1 - _TIE) x`` the largest are of edges shorter than the longest by
+#: more than hypot's rounding (< 1 ulp) and the squares' (< 2 ulp) can hide.
+_TIE = 1e-14
+
+
+@numba.njit(cache=True, inline="always", error_model="numpy")
+def _longest(e):  # pragma: no cover - compiled
+    """``max_j hypot(e[j])`` of the three edge vectors ``e`` (3, 2) (``h_T``), with ``hypot`` only
+    for the edges whose squared length is within :data:`_TIE` of the largest: the same value
+    (the others' ``hypot`` is smaller), usually one call instead of three. All three when a
+    square may have overflowed or lost digits to underflow, or is not a number (then the
+    first edge's, as the loop over the edges that took the first and any longer one)."""
+    s0 = e[0, 0] * e[0, 0] + e[0, 1] * e[0, 1]
+    s1 = e[1, 0] * e[1, 0] + e[1, 1] * e[1, 1]
+    s2 = e[2, 0] * e[2, 0] + e[2, 1] * e[2, 1]
+    big = max(s0, max(s1, s2))
+    if not (big > 1e-280 and big < 1e280):
+        h = math.hypot(e[0, 0], e[0, 1])
+        for j in range(1, 3):
+            length = math.hypot(e[j, 0], e[j, 1])
+            if length > h:
+                h = length
+        return h
+    cut = big * (1.0 - _TIE)
+    h = math.hypot(e[0, 0], e[0, 1]) if s0 >= cut else 0.0
+    if s1 >= cut:
+        h = max(h, math.hypot(e[1, 0], e[1, 1]))
+    if s2 >= cut:
+        h = max(h, math.hypot(e[2, 0], e[2, 1]))
+    return h
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def triangle_fields(points, tri, u, e, area, grad):  # pragma: no cover - compiled
     """Fill ``e`` (m, 3, 2), ``area`` and ``grad`` (m, 2) as
@@ -75,11 +107,8 @@ def residual_pass(points, tri, u, kappa, te, n_edges, fsq, f_sq, c_volume_sq, ju
         kk = kappa[0] if uniform else kappa[k]
         s0 = kk * grad[0]
         s1 = kk * grad[1]
-        h = 0.0
+        h = _longest(e)
         for j in range(3):
-            length = math.hypot(e[j, 0], e[j, 1])
-            if j == 0 or length > h:                         # h_T: the longest edge
-                h = length
             i = te[k, j]
             jump_len[i] += s0 * e[j, 1] - s1 * e[j, 0]       # outward flux times the length
             if count[i] < 255:
