@@ -149,10 +149,19 @@ def slot_fluxes(points, tri, u, kappa, elem, local):  # pragma: no cover - compi
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def squares_by_tag(tags, uniq, ind):  # pragma: no cover - compiled
     """``sum ind^2`` per value of ``uniq`` (sorted, every tag among them), element by element:
-    ``np.bincount(inverse, weights=ind ** 2)`` without the inverse map and the squares."""
+    ``np.bincount(inverse, weights=ind ** 2)`` without the inverse map and the squares (each tag
+    found by bisection: no call into numba's array library, whose import a cached load would pay)."""
     out = np.zeros(uniq.shape[0])
     for k in range(tags.shape[0]):
-        out[np.searchsorted(uniq, tags[k])] += ind[k] * ind[k]
+        t = tags[k]
+        lo, hi = 0, uniq.shape[0] - 1                  # bisection: the first uniq[i] >= t
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if uniq[mid] < t:
+                lo = mid + 1
+            else:
+                hi = mid
+        out[lo] += ind[k] * ind[k]
     return out
 
 
