@@ -103,6 +103,12 @@ def _load_numba(mesh, f, quad, idx):
     (the numpy path then raises naming them)."""
     from ._kernels import load_kernel
 
+    if callable(f) and idx is None:  # compiled source: the whole vector in one fused pass
+        from .fused import barycentric_load
+
+        F = barycentric_load(mesh, f, quad)
+        if F is not None:
+            return F
     if callable(f):
         tri = mesh.cells if idx is None else mesh.cells[idx]
         fvals = _source_values(mesh, f, quad, tri, idx)[:, 0]

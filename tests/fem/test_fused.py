@@ -238,7 +238,47 @@ def test_load_vector_of_a_compiled_source_matches_the_numpy_path(name, rule, mon
                          quad) is None                                # not the case's source
 
 
-def test_load_of_a_non_finite_compiled_source_is_refused_as_by_numpy(monkeypatch):
+@pytest.mark.parametrize("name", list(SETS))
+def test_one_pass_load_equals_the_two_passes_bit_for_bit(name, monkeypatch):
+    """The one-point load in one fused pass is what the source values then the load kernel give."""
+    from femkit.fem._kernels import load_kernel
+    from femkit.fem.fused import barycentric_load, source_values
+    from femkit.fem.quadrature import get_rule
+
+    monkeypatch.setattr(fused_kernels, "NUMBA_THRESHOLD", 0)
+    mesh = _mesh(name)
+    _, _, f, _ = _functions(name)
+    quad = get_rule("barycentric", dim=mesh.dim)
+    two = load_kernel(mesh, None, source_values(mesh, f, quad)[:, 0])
+    np.testing.assert_array_equal(barycentric_load(mesh, f, quad), two)
+
+
+def test_one_pass_load_leaves_degenerate_cells_and_non_finite_sources_to_the_two_passes(
+        monkeypatch):
+    """A cell of zero area, or a source that is NaN somewhere: the pass counts them and the
+    caller gets None (the two passes then name them, as the NumPy path does)."""
+    from femkit.fem.fused import barycentric_load
+    from femkit.fem.quadrature import get_rule
+
+    monkeypatch.setattr(fused_kernels, "NUMBA_THRESHOLD", 0)
+    mesh = _mesh("sin-2d")
+    quad = get_rule("barycentric", dim=2)
+    points = mesh.points.copy()
+    points[mesh.cells[5, 0]] = points[mesh.cells[5, 1]]      # a cell of zero area
+    flat = Mesh(points, mesh.cells)
+    _, _, f, kernels = _functions("sin-2d")
+    args = (np.ascontiguousarray(quad.points), mesh.n_points)
+    assert kernels.module.barycentric_load(flat.points, flat.cells, *args)[1:] == (1, 0)
+    assert barycentric_load(flat, f, quad) is None
+    nan_f = compile_expression("sqrt(x - 0.5)", V, check_finite=False)   # NaN for x < 1/2
+    nan_kernels = expression_kernels(None, (), nan_f)
+    bad, nonfinite = nan_kernels.module.barycentric_load(mesh.points, mesh.cells, *args)[1:]
+    assert bad == 0 and 0 < nonfinite < mesh.n_cells
+    assert barycentric_load(mesh, nan_f, quad) is None
+
+
+@pytest.mark.parametrize("rule", ["gauss3", "barycentric"])
+def test_load_of_a_non_finite_compiled_source_is_refused_as_by_numpy(rule, monkeypatch):
     from femkit.errors import InputError
     from femkit.fem import assemble_load
 
@@ -249,6 +289,6 @@ def test_load_of_a_non_finite_compiled_source_is_refused_as_by_numpy(monkeypatch
     for threshold in (10 ** 12, 0):
         monkeypatch.setattr(fused_kernels, "NUMBA_THRESHOLD", threshold)
         with pytest.raises(InputError) as info:
-            assemble_load(mesh, f, rule="gauss3")
+            assemble_load(mesh, f, rule=rule)
         messages.append(str(info.value))
     assert messages[0] == messages[1] and "source f is not finite" in messages[0]

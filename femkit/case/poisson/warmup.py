@@ -263,7 +263,7 @@ def _passes(kernels, dim: int) -> list[str]:
     if kernels.source is not None and (kernels.exact is None or not kernels.module.HAS_SOURCE):
         names.append("source_pass")
     if kernels.source is not None:
-        names.append("source_values")  # the load vector's source
+        names += ["source_values", "barycentric_load"]  # the load vector (any rule, one-point)
     return names
 
 
@@ -299,6 +299,8 @@ def _compile_passes(kernels, mesh) -> None:
             mod.nodal_pass(points, u)
         elif name == "source_values":
             mod.source_values(points, cells, bary, np.empty((2, len(bary))))
+        elif name == "barycentric_load":
+            mod.barycentric_load(points, cells, bary[:1], len(points))
         else:
             mod.source_pass(points, cells, bary, weights, np.ones(2), out[0])
 

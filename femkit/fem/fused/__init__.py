@@ -8,7 +8,8 @@ here as :class:`FusedKernels`: numba passes generated from :mod:`.templates` tha
 function at once (common subexpressions shared) over a block of cells' quadrature points, in one
 loop LLVM vectorises, and add each value to every integral from that small buffer. The passes are used by :func:`femkit.fem.error_norms`,
 :func:`~femkit.fem.energy_error`, the residual estimator and the load vector
-(:func:`~femkit.fem.assemble_load`, the source at its rule's points) when
+(:func:`~femkit.fem.assemble_load`: the source at its rule's points, or the whole one-point
+load in one pass) when
 
 - the callables opt in: each has the kernels as its ``fused`` attribute, and the kernels stand
   for exactly these callables (``kernels.exact is exact``, ``kernels.source is f``; the gradient
@@ -25,7 +26,7 @@ where the generated functions inline them; tests/fem/test_fused.py).
 from __future__ import annotations
 
 from .kernels import FusedKernels, kernels_for
-from .passes import error_sums, nodal_error, source_norm_sq, source_values
+from .passes import barycentric_load, error_sums, nodal_error, source_norm_sq, source_values
 
 __all__ = ["FusedKernels", "kernels_for", "error_sums", "nodal_error",
-           "source_norm_sq", "source_values"]
+           "source_norm_sq", "source_values", "barycentric_load"]

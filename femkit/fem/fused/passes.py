@@ -1,5 +1,5 @@
 """The fused passes run on a mesh: error norms, the source norm, the largest nodal error, the
-load's source values.
+load's source values and the one-point load vector itself.
 
 Each returns None when the NumPy path must run instead: no kernels for these callables, or a
 non-finite value or a degenerate cell met on the way (the NumPy path then reports it as it
@@ -85,6 +85,19 @@ def source_values(mesh, f: Callable, rule) -> np.ndarray | None:
     out = np.empty((len(cells), len(bary)))
     kernels.module.source_values(points, cells, bary, out)
     return out
+
+
+def barycentric_load(mesh, f: Callable, rule) -> np.ndarray | None:
+    """The one-point (centroid) load vector of every cell in one compiled pass: the vector
+    :func:`source_values` and :func:`femkit.fem._kernels.load_kernel` give, the same bits; None
+    when those two passes must run (no kernels for ``f``, a degenerate cell or a non-finite
+    source value, which they name)."""
+    kernels = kernels_for(mesh, source=f)
+    if kernels is None:
+        return None
+    points, cells, bary, _ = _arrays(mesh, rule)
+    F, bad, nonfinite = kernels.module.barycentric_load(points, cells, bary, mesh.n_points)
+    return F if bad == 0 and nonfinite == 0 else None
 
 
 def nodal_error(mesh, u: np.ndarray, exact: Callable) -> float | None:

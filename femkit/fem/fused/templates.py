@@ -30,7 +30,7 @@ from llvmlite import ir
 from numba.core import types
 from numba.extending import intrinsic
 
-from .._kernels import _tetrahedron
+from .._kernels import _tetrahedron, _triangle, _volume6
 
 #: Components of the exact gradient ``exact_point`` gives after ``u`` (0: none).
 N_GRAD = 0
@@ -308,6 +308,50 @@ def source_values(points, cells, bary, out):  # pragma: no cover - compiled
         for t in range(nt):
             for q in range(nq):
                 out[k0 + t, q] = vals[0, q * nt + t]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def barycentric_load(points, cells, bary, n):  # pragma: no cover - compiled
+    """The one-point load ``F_j += |T| (f(c_T) / (d + 1))`` over every cell ``T``: ``f`` at the
+    centroid ``bary`` as :func:`source_values` gives it, the measure and the sums in cell order
+    as :func:`femkit.fem._kernels._load_barycentric` / ``_load_tet`` form them (the same bits),
+    in one pass without the array of source values between those two. Returns ``(F, bad,
+    nonfinite)``, the numbers of cells of zero or non-finite measure and of non-finite ``f``:
+    when either is not 0, ``F`` is incomplete and the caller takes the two passes, which name
+    them."""
+    nv = cells.shape[1]
+    xs, ys, zs, vals, corner = block_buffers(1, 1, nv)
+    out = np.zeros(n)
+    bad = 0
+    nonfinite = 0
+    for k0 in range(0, cells.shape[0], BLOCK):
+        nt = min(BLOCK, cells.shape[0] - k0)
+        block_points(points, cells, k0, nt, bary, xs, ys, zs, corner)
+        source_block_libm(xs, ys, zs, nt, vals)
+        for t in range(nt):
+            e = k0 + t
+            f = vals[0, t]
+            if not abs(f) < np.inf:
+                nonfinite += 1
+                continue
+            if nv == 3:
+                i0, i1, i2, _, _, _, _, _, _, area = _triangle(cells, points, e)
+                if not (area > 0.0 and area < np.inf):
+                    bad += 1
+                    continue
+                w = area * (f / 3.0)
+                out[i0] += w
+                out[i1] += w
+                out[i2] += w
+            else:
+                vol = abs(_volume6(cells, points, e)) / 6.0
+                if not (vol > 0.0 and vol < np.inf):
+                    bad += 1
+                    continue
+                w = vol * (f / 4.0)
+                for a in range(4):
+                    out[cells[e, a]] += w
+    return out, bad, nonfinite
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
