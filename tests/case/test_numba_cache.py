@@ -37,7 +37,7 @@ COUNT = "; ".join(["refreshed = []", "refresh = numba.core.base.BaseContext.refr
 #: checked.
 PROBE = textwrap.dedent("""
     import json, sys
-    import numba.core.base
+    import numba.core.base, numba.core.registry
     import femkit.numba_cache as numba_cache
     if sys.argv[1] == "off":
         numba_cache.CHECKED = ()
@@ -45,17 +45,28 @@ PROBE = textwrap.dedent("""
     from femkit.case import case_from_dict
     result = case_from_dict(json.loads(sys.argv[2])).run(write=False, quiet=True)
     d = result.to_dict()
+    misses = [n for m, mod in list(sys.modules.items()) if m.startswith("femkit")
+              for n, fn in vars(mod).items()
+              if isinstance(fn, numba.core.registry.CPUDispatcher) and fn.stats.cache_misses]
     print(json.dumps({"lean": numba_cache._INSTALLED, "registries": bool(refreshed),
+                      "compiled": misses,
                       "errors": d["errors"], "estimate": d["error_estimate"],
                       "residual": d["solver"]["true_residual"]}))
 """).replace("{COUNT}", COUNT)
 
 
 def _probe(mode: str) -> dict:
-    proc = subprocess.run([sys.executable, "-c", PROBE, mode, json.dumps(CASE)],
-                          capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stderr
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+    """The probe's report from a run that compiled nothing: the first run of a fresh cache
+    compiles, and so may a run while another process rewrites a cache index (the suite's
+    parallel workers); those runs are repeated."""
+    for _ in range(3):
+        proc = subprocess.run([sys.executable, "-c", PROBE, mode, json.dumps(CASE)],
+                              capture_output=True, text=True, timeout=600)
+        assert proc.returncode == 0, proc.stderr
+        report = json.loads(proc.stdout.strip().splitlines()[-1])
+        if not report["compiled"]:
+            return report
+    raise AssertionError(f"every run compiled kernels: {report['compiled']}")
 
 
 def _installed_numba() -> str:
@@ -66,7 +77,6 @@ def _installed_numba() -> str:
 
 @pytest.mark.slow
 def test_cached_kernels_load_without_the_registries_and_give_the_same_numbers():
-    _probe("on")                           # fills the cache if this install has not yet
     lean, full = _probe("on"), _probe("off")
     assert full["lean"] is False and full["registries"] is True
     if _installed_numba() in CHECKED:
