@@ -171,8 +171,10 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True,
         for mod, name in saved:
             setattr(mod, name, 0)
         solver = {"method": "fmg"} if multigrid else {"method": "pcg", "preconditioner": "jacobi"}
-        for tiny in (_TINY, _TINY_3D)[:len(dims)]:  # triangles, then tetrahedra
-            case_from_dict(dict(tiny, solver=solver)).run(write=False, quiet=True)
+        for dim, tiny in zip((2, 3), (_TINY, _TINY_3D)[:len(dims)]):  # triangles, tetrahedra
+            case = case_from_dict(dict(tiny, solver=solver))
+            case.run(write=False, quiet=True)
+            _compile_all_passes(case, dim)
         from ...fem._kernels import warm_up as assembly_kernels
         from ...fem._one_off import warm_up as one_off_kernels
 
@@ -279,15 +281,26 @@ def expressions_cached(kernels, dim: int) -> bool:
     return True
 
 
-def _compile_passes(kernels, mesh) -> None:
-    """Call each pass a run on ``mesh`` calls once, on two cells of the same array types."""
+def _compile_all_passes(case, dim: int) -> None:
+    """Every fused pass of ``case``'s expressions on a ``dim``-D mesh, not only those its tiny
+    run called: a larger run or another load rule calls the others (the one-pass load for the
+    centroid rule, the source values for a rule of several points)."""
+    from ..compiled_expressions import case_kernels
+
+    kernels = case_kernels(case)
+    if kernels is not None and kernels.dim <= dim:
+        _compile_passes(kernels, dim)
+
+
+def _compile_passes(kernels, d: int, cell_type=None) -> None:
+    """Call each pass a run on a ``d``-D mesh calls once, on two cells of the same array types
+    (cells of ``cell_type``, default int64 as a mesh's)."""
     import numpy as np
 
     from ...fem.quadrature import rule_for_degree
 
-    d = mesh.dim
     points = np.vstack([np.zeros(d), np.eye(d), np.ones((1, d))])
-    cells = np.array([np.arange(d + 1), np.arange(1, d + 2)], dtype=mesh.cells.dtype)
+    cells = np.array([np.arange(d + 1), np.arange(1, d + 2)], dtype=cell_type or np.int64)
     rule = rule_for_degree(5, d)
     bary, weights = np.ascontiguousarray(rule.points), np.ascontiguousarray(rule.weights)
     u, out = np.zeros(len(points)), [np.empty(2) for _ in range(3)]
@@ -320,4 +333,4 @@ def compile_expressions(case, mesh, stage, echo: Callable[[str], object] | None 
     with stage("compile"):
         if echo is not None:
             echo(EXPRESSIONS_MESSAGE)
-        _compile_passes(kernels, mesh)
+        _compile_passes(kernels, mesh.dim, mesh.cells.dtype)
