@@ -44,13 +44,13 @@ def _longest(e):  # pragma: no cover - compiled
     """``max_j hypot(e[j])`` of the three edge vectors ``e`` (3, 2) (``h_T``), with ``hypot`` only
     for the edges whose squared length is within :data:`_TIE` of the largest: the same value
     (the others' ``hypot`` is smaller), usually one call instead of three. All three when a
-    square may have overflowed or lost digits to underflow, or is not a number (then the
+    square overflowed or may have lost digits to underflow, or is not a number (then the
     first edge's, as the loop over the edges that took the first and any longer one)."""
     s0 = e[0, 0] * e[0, 0] + e[0, 1] * e[0, 1]
     s1 = e[1, 0] * e[1, 0] + e[1, 1] * e[1, 1]
     s2 = e[2, 0] * e[2, 0] + e[2, 1] * e[2, 1]
     big = max(s0, max(s1, s2))
-    if not (big > 1e-280 and big < 1e280):
+    if not (big > 1e-280 and big < np.inf):
         h = math.hypot(e[0, 0], e[0, 1])
         for j in range(1, 3):
             length = math.hypot(e[j, 0], e[j, 1])
