@@ -54,10 +54,12 @@ def lean_cache_loads() -> bool:
         from numba.core import caching
         from numba.core.runtime import rtsys
 
-        numba_load = caching.Cache.load_overload
-        caching.Cache._load_overload, caching.Cache._guard_against_spurious_io_errors  # noqa: B018
-    except (ImportError, AttributeError):  # pragma: no cover - a checked version has them
+    except ImportError:  # pragma: no cover - a checked version has them
         return False
+    parts = ("load_overload", "_load_overload", "_guard_against_spurious_io_errors")
+    if not all(hasattr(caching.Cache, name) for name in parts):  # pragma: no cover - as above
+        return False
+    numba_load = caching.Cache.load_overload
     roots = _roots()
 
     def load_overload(self, sig, target_context):

@@ -292,15 +292,15 @@ def _compile_all_passes(case, dim: int) -> None:
         _compile_passes(kernels, dim)
 
 
-def _compile_passes(kernels, d: int, cell_type=None) -> None:
+def _compile_passes(kernels, d: int, cell_type="int64") -> None:
     """Call each pass a run on a ``d``-D mesh calls once, on two cells of the same array types
-    (cells of ``cell_type``, default int64 as a mesh's)."""
+    (cells of ``cell_type``, a mesh's)."""
     import numpy as np
 
     from ...fem.quadrature import rule_for_degree
 
     points = np.vstack([np.zeros(d), np.eye(d), np.ones((1, d))])
-    cells = np.array([np.arange(d + 1), np.arange(1, d + 2)], dtype=cell_type or np.int64)
+    cells = np.array([np.arange(d + 1), np.arange(1, d + 2)], dtype=cell_type)
     rule = rule_for_degree(5, d)
     bary, weights = np.ascontiguousarray(rule.points), np.ascontiguousarray(rule.weights)
     u, out = np.zeros(len(points)), [np.empty(2) for _ in range(3)]
