@@ -7,8 +7,6 @@ so studies are timed with BLAS pinned to one thread. The variables must be set b
 is first imported; ``femkit study`` does so (:func:`pin_blas_threads` is called by the
 command-line entry before anything imports numpy, and respects values the user already set).
 From Python, set ``OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1`` in the environment yourself.
-If ``threadpoolctl`` happens to be installed, :func:`blas_thread_limit` also limits an already
-loaded BLAS; femkit does not depend on it.
 
 >>> t = StageTimer()
 >>> with t("assembly"):
@@ -19,7 +17,6 @@ True
 
 from __future__ import annotations
 
-import contextlib
 import os
 import statistics
 import time
@@ -28,7 +25,7 @@ from typing import Any, Callable
 
 from ..timing import StageTimer  # noqa: F401  (re-exported: the studies time stages with it)
 
-__all__ = ["BLAS_ENV", "pin_blas_threads", "blas_thread_limit", "StageTimer", "Timing", "time_call"]
+__all__ = ["BLAS_ENV", "pin_blas_threads", "StageTimer", "Timing", "time_call"]
 
 #: Environment variables that pin BLAS / OpenMP thread pools.
 BLAS_ENV = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
@@ -42,18 +39,6 @@ def pin_blas_threads(threads: int = 1) -> dict:
     for name in BLAS_ENV:
         os.environ.setdefault(name, str(threads))
     return {name: os.environ[name] for name in BLAS_ENV}
-
-
-@contextlib.contextmanager
-def blas_thread_limit(threads: int = 1):
-    """Limit a loaded BLAS to ``threads`` with threadpoolctl when it is installed; else a no-op."""
-    try:
-        from threadpoolctl import threadpool_limits  # optional, not a dependency
-    except ImportError:
-        yield False
-        return
-    with threadpool_limits(limits=threads, user_api="blas"):
-        yield True
 
 
 @dataclass

@@ -48,7 +48,7 @@ def run_poisson_petsc(case: Case, output_dir: str | os.PathLike | None = None, q
 
 def _run(case, comm, output_dir, quiet, write, echo):
     import numpy as np
-    from mpi4py import MPI
+    from mpi4py import MPI  # femkit[petsc]: reached only after require_petsc() succeeded
 
     from ...fem.distributed.poisson import broadcast_mesh, solve_poisson
     from ...mesh import quality

@@ -148,7 +148,7 @@ def solve_poisson(problem, *, method: str = "pcg", preconditioner: str | None = 
 
 
 def _max_op():
-    from mpi4py import MPI
+    from mpi4py import MPI  # femkit[petsc]: reached only after require_petsc() succeeded
 
     return MPI.MAX
 
@@ -160,7 +160,7 @@ def parallel_errors(mesh, u_vec, layout, comm, exact, grad_exact=None, order: in
     own are fetched with a VecScatter. ``modulo_constant`` (pure Neumann): errors of
     ``u - c`` with ``int (u - c - exact) = 0``, the integrals summed over ranks
     (:func:`femkit.fem.poisson.mean_shift_parts`), as :meth:`PoissonProblem.errors` does."""
-    from mpi4py import MPI
+    from mpi4py import MPI  # femkit[petsc]: reached only after require_petsc() succeeded
 
     mpi = comm.tompi4py()
     nodes = np.unique(mesh.cells[layout.elements])

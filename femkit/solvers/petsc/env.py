@@ -7,7 +7,7 @@ import sys
 from ...errors import BackendUnavailableError
 
 #: What to do when petsc4py is missing (the path is relative to the femkit checkout).
-INSTALL_HINT = ("run scripts/install-petsc.sh (Debian's PETSc 3.18 + Open MPI in .venv-petsc) and "
+INSTALL_HINT = ("pip install 'femkit[petsc]' (builds PETSc from source), or run scripts/install-petsc.sh (Debian's PETSc 3.18 + Open MPI in .venv-petsc) and "
                 "use .venv-petsc/bin/python or .venv-petsc/bin/femkit")
 
 
