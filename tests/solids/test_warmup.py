@@ -1,6 +1,7 @@
 """``femkit warmup`` generates and compiles the built-in materials' kernels: afterwards a fresh
 process evaluates a body from the cache -- numba loads every kernel it calls (no compile) and
-SymPy is never imported."""
+SymPy is never imported; and a bundled solid case then runs through the command in that cache
+(the first thing a newcomer does after the README's first command)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -40,3 +42,12 @@ def test_warmup_compiles_the_builtin_materials_once(tmp_path):
     assert probe.returncode == 0, probe.stderr
     out = json.loads(probe.stdout.strip().splitlines()[-1])
     assert out == {"hits": 1, "misses": 0, "sympy": False}
+
+    # a newcomer's next step: a bundled solid case through the command, in the same fresh cache
+    case = Path(__file__).resolve().parents[2] / "cases" / "solid_cantilever.yaml"
+    solve = subprocess.run([sys.executable, "-m", "femkit", "solve", str(case), "--output",
+                            str(tmp_path / "out")], env=env, capture_output=True, text=True,
+                           timeout=900)
+    assert solve.returncode == 0, solve.stderr
+    result = json.loads((tmp_path / "out" / "result.json").read_text())
+    assert result["verdict"] == "converged"
