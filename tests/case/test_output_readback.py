@@ -329,3 +329,22 @@ def test_distributed_pieces_and_pvtu_index_read_back(tmp_path, monkeypatch):
     assert g.GetNumberOfPoints() == sum(len(np.unique(mesh.cells[h])) for h in halves)
     np.testing.assert_array_equal(np.sort(_vtk_array(g.GetCellData(), "rank")),
                                   np.repeat([0, 1], [len(h) for h in halves]))
+
+
+def test_a_poisson_case_takes_its_own_solution_vtu_as_its_mesh(tmp_path):
+    """The issue's run: a 5 x 5-point .msh with no boundary lines, ``u = 0`` on the whole
+    boundary; its solution.vtu given back as the mesh of the same case gives the same ``u``."""
+    from femkit.mesh import write_mesh
+
+    write_mesh(tmp_path / "grid.msh", _grid(4, 4, False))
+    case = {"problem": "poisson", "name": "grid", "mesh": {"file": "grid.msh"},
+            "source": "2*pi**2*sin(pi*x)*sin(pi*y)", "solver": {"method": "direct"},
+            "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]},
+            "output": {"dir": "first", "vtu": True, "plot": False}}
+    first = case_from_dict(case, tmp_path).run(quiet=True)
+    case.update(mesh={"file": "first/solution.vtu"}, output={**case["output"], "dir": "second"})
+    second = case_from_dict(case, tmp_path).run(quiet=True)
+    assert second.mesh.n_cells == first.mesh.n_cells == 32
+    np.testing.assert_array_equal(second.mesh.points, first.mesh.points)
+    np.testing.assert_allclose(second.u, first.u, rtol=0, atol=1e-14)
+    assert meshio.read(tmp_path / "second" / "solution.vtu").point_data["u"].shape == (25,)
