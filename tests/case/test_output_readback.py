@@ -11,6 +11,7 @@ before the writer appended its arrays in reverse (femkit.mesh.vtk._appended_head
 from __future__ import annotations
 
 import json
+import sys
 import types
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -23,6 +24,9 @@ vtk_xml = pytest.importorskip("vtkmodules.vtkIOXML",
                               reason="vtk (test extra) is not installed: pip install -e '.[test]'")
 from vtkmodules import vtkCommonDataModel as vtk_cells  # noqa: E402
 from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared case
+from _cloth import CLOTH as CLOTH_BASE  # noqa: E402
 
 from femkit.case import case_from_dict  # noqa: E402
 from femkit.case.poisson.output import write_solution  # noqa: E402
@@ -190,18 +194,9 @@ def test_femkit_reads_its_own_solution_vtu_as_a_mesh(tmp_path, which):
 
 # ----------------------------------------------------------------------------- scenes
 
-CLOTH = {
-    "problem": "mass_spring",
-    "name": "cloth",
-    "system": {"type": "cloth", "nx": 7, "ny": 6, "width": 1.0, "height": 1.0, "plane": "xy",
-               "k_structural": 400.0, "k_shear": 100.0, "k_bending": 10.0, "total_mass": 0.5,
-               "pinned": "top_corners"},
-    "forces": {"gravity": 9.81},
-    "integrator": {"method": "fast_mass_spring", "options": {"iterations": 5}},
-    "dt": 0.02,
-    "t_end": 0.2,
-    "output": {"dir": "out", "every": 2, "xdmf": True, "png": False, "gif": False},
-}
+#: the scene-output tests' cloth (tests/case/_cloth.py), 6 frames, with its XDMF series
+CLOTH = {**CLOTH_BASE, "t_end": 0.2,
+         "output": {**CLOTH_BASE["output"], "xdmf": True, "png": False, "gif": False}}
 
 
 #: a 2D scene with triangles: a gmsh disk falling onto the ground (cases/scenes/soft_disk.yaml, coarser)
