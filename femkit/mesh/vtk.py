@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import MeshError
 
 __all__ = ["write_cells", "write_collection", "write_parallel_index", "pad3", "vtu_header",
-           "COMPRESSIONS", "DEFAULT_COMPRESSION"]
+           "reappended", "COMPRESSIONS", "DEFAULT_COMPRESSION"]
 
 #: Compression of the binary arrays of a ``.vtu`` file (VTK's ``compressor`` attribute):
 #: ``none`` writes at disk speed (about 2x the bytes of ``zlib``), ``zlib`` is VTK's usual
@@ -288,6 +288,52 @@ def _attr(text: str) -> str:
     for raw, escaped in _ATTR_ESCAPES:
         s = s.replace(raw, escaped)
     return s
+
+
+#: numpy types of the block-size headers of appended data (VTKFile's ``header_type``)
+_HEADER_TYPES = {"UInt32": np.uint32, "UInt64": np.uint64}
+
+
+def reappended(raw: bytes, reverse: bool = True) -> bytes | None:
+    """The bytes of a ``.vtu`` file with its raw appended arrays re-appended in the reverse of
+    their declaration (the layout meshio reads at every size, see :func:`_appended_header`;
+    ``reverse=False``: in their declared order), the offsets rewritten to match; ``None`` when
+    ``raw`` holds no uncompressed raw appended data or cannot be parsed.
+
+    It lets femkit read the ``.vtu`` files written before it appended in reverse (and any other
+    writer's raw appended file that meshio misreads): the arrays' bytes are moved, not decoded.
+    """
+    import xml.etree.ElementTree as ET
+
+    start = raw.find(b"<AppendedData")
+    opened = raw.find(b">", start) + 1
+    if start < 0 or b'"raw"' not in raw[start:opened]:
+        return None
+    first = raw.find(b"_", opened) + 1
+    try:
+        root = ET.fromstring(raw[:start] + b"</VTKFile>")
+        if root.get("compressor"):
+            return None
+        size = np.dtype(_HEADER_TYPES[root.get("header_type", "UInt32")]).newbyteorder(
+            ">" if root.get("byte_order") == "BigEndian" else "<")
+        arrays = [a for a in root.iter("DataArray") if a.get("format") == "appended"]
+        blocks = []
+        for a in arrays:
+            at = first + int(a.get("offset"))
+            n = int(np.frombuffer(raw, size, 1, at)[0])
+            if at + size.itemsize + n > len(raw):
+                return None
+            blocks.append(raw[at:at + size.itemsize + n])
+    except (ET.ParseError, KeyError, ValueError, TypeError):
+        return None
+    order = list(range(len(arrays)))[::-1 if reverse else 1]
+    offset = 0
+    for j in order:
+        arrays[j].set("offset", str(offset))
+        offset += len(blocks[j])
+    head = ET.tostring(root).rsplit(b"</VTKFile>", 1)[0]
+    return b"".join([b'<?xml version="1.0"?>\n', head, b'<AppendedData encoding="raw">\n_']
+                    + [blocks[j] for j in order] + [b"\n</AppendedData>\n</VTKFile>\n"])
 
 
 def vtu_header(path: str | os.PathLike):

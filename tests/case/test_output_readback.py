@@ -192,6 +192,37 @@ def test_femkit_reads_its_own_solution_vtu_as_a_mesh(tmp_path, which):
     assert back.tag_names == mesh.tag_names
 
 
+def test_a_vtu_in_the_old_layout_that_meshio_refuses_is_read_by_femkit(tmp_path):
+    """The issue's solution.vtu as femkit wrote it before (arrays appended in declared order):
+    meshio refuses it, VTK reads it, and femkit's mesh reader reads it (re-appended)."""
+    from femkit.mesh.vtk import reappended
+
+    mesh = _grid(4, 4, False)
+    new = write_solution(tmp_path / "solution.vtu", mesh, mesh.points[:, 1], 1.0)
+    old = tmp_path / "old.vtu"
+    old.write_bytes(reappended(new.read_bytes(), reverse=False))
+    with pytest.raises((Exception, SystemExit)):
+        meshio.read(old)
+    assert _vtk_read(old).GetNumberOfCells() == 32
+    back = read_mesh(old)
+    np.testing.assert_array_equal(back.points, mesh.points)
+    np.testing.assert_array_equal(back.cells, mesh.cells)
+    assert reappended(old.read_bytes()) == reappended(new.read_bytes())
+
+
+@pytest.mark.parametrize("compression", ["zlib", None])
+def test_reappended_leaves_files_without_raw_arrays_alone(tmp_path, compression):
+    mesh = _grid(2, 2, True)
+    if compression:
+        path = write_solution(tmp_path / "s.vtu", mesh, mesh.points[:, 0], 1.0, compression="zlib")
+    else:
+        path = tmp_path / "s.vtu"
+        meshio.write(path, meshio.Mesh(mesh.points, [("triangle", mesh.cells)]), binary=False)
+    from femkit.mesh.vtk import reappended
+
+    assert reappended(path.read_bytes()) is None
+
+
 # ----------------------------------------------------------------------------- scenes
 
 #: the scene-output tests' cloth (tests/case/_cloth.py), 6 frames, with its XDMF series
