@@ -52,6 +52,9 @@ def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
     compact : drop nodes used by no cell (e.g. geometry points such as circle centres that
         gmsh writes) and renumber, keeping the order of the rest
 
+    A ``.vtu`` whose raw appended arrays meshio misreads (femkit's own solution files before
+    :func:`femkit.mesh.vtk.reappended`'s layout) is read re-appended.
+
     Triangles are made counter-clockwise; a 3D point array whose z is zero is reduced to 2D.
 
     Raises
@@ -65,17 +68,7 @@ def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
     p = os.fspath(path)
     if not os.path.isfile(p):
         raise MeshError(f"mesh file not found: {p}")
-    import meshio
-
-    fmt = "gmsh" if p.lower().endswith(".msh") else None
-    try:
-        # meshio prints its own complaints and calls sys.exit() when a reader fails: keep
-        # its output off the user's terminal and turn every failure into one MeshError line
-        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-            mio = meshio.read(p, file_format=fmt)
-    except (Exception, SystemExit):  # ReadError, KeyError, ValueError, UnicodeDecodeError, exit
-        raise MeshError(unreadable_message(p)) from None
-
+    mio = _meshio_read(p)
     types = [c.type for c in mio.cells]
     dim = 3 if "tetra" in types else 2
     cell_type, facet_type = _CELL_TYPE[dim]
@@ -174,6 +167,41 @@ def _check_volume_file(p: str, tets, tet_tags, tri, names, groups) -> None:
     if groups and untagged:
         raise MeshError(f"{p}: {untagged} of {len(tets)} tetrahedra belong to no physical "
                         "volume; add them to a Physical Volume (or remove the other groups)")
+
+
+def _meshio_read(p: str):
+    """meshio's reading of the file ``p``, a ``.vtu`` that meshio misreads (raw appended arrays
+    in declared order, as femkit wrote them before :func:`femkit.mesh.vtk.reappended`'s
+    layout) read again re-appended; any failure is one :class:`MeshError` line."""
+    import meshio
+
+    fmt = "gmsh" if p.lower().endswith(".msh") else None
+
+    def attempt(path: str):
+        # meshio prints its own complaints and calls sys.exit() when a reader fails: keep
+        # its output off the user's terminal and turn every failure into one MeshError line
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            return meshio.read(path, file_format=fmt)
+
+    try:
+        return attempt(p)
+    except (Exception, SystemExit):  # ReadError, KeyError, ValueError, UnicodeDecodeError, exit
+        pass
+    if p.lower().endswith(".vtu"):
+        import tempfile
+
+        from .vtk import reappended
+
+        with open(p, "rb") as fh:
+            fixed = reappended(fh.read())
+        if fixed is not None:
+            with tempfile.TemporaryDirectory(prefix="femkit-vtu-") as tmp:
+                again = os.path.join(tmp, "reappended.vtu")
+                with open(again, "wb") as fh:
+                    fh.write(fixed)
+                with contextlib.suppress(Exception, SystemExit):
+                    return attempt(again)
+    raise MeshError(unreadable_message(p))
 
 
 #: What each extension must hold, for the messages of unreadable files.

@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import MeshError
 
 __all__ = ["write_cells", "write_collection", "write_parallel_index", "pad3", "vtu_header",
-           "COMPRESSIONS", "DEFAULT_COMPRESSION"]
+           "reappended", "COMPRESSIONS", "DEFAULT_COMPRESSION"]
 
 #: Compression of the binary arrays of a ``.vtu`` file (VTK's ``compressor`` attribute):
 #: ``none`` writes at disk speed (about 2x the bytes of ``zlib``), ``zlib`` is VTK's usual
@@ -197,34 +197,59 @@ def _appended_header(n_points: int, n_cells: int, declared: dict) -> bytes:
     """The XML part of a ``.vtu`` whose arrays are appended raw (VTK's ``<AppendedData
     encoding="raw">``, UInt64 size headers; Kitware, "VTK File Formats", "XML File Formats").
     ``declared``: ``{section: [(name, VTK type, components or None, bytes), ...]}`` for the
-    sections ``Points``, ``Cells``, ``PointData``, ``CellData``, in the order written."""
-    offset = 0
+    sections ``Points``, ``Cells``, ``PointData``, ``CellData``, in the order declared.
+
+    The arrays are appended in the *reverse* of the order they are declared (the last
+    declared at offset 0, the ``Points`` last; :func:`_write_appended` writes them so), the
+    layout meshio's reader of raw appended data needs to read every file. That reader (meshio
+    5.3.0 to 5.3.5 and its main branch alike, ``meshio/vtu/_vtu.py``, ``_parse_raw_binary``)
+    walks the appended bytes in file order; for the array at raw offset ``i`` it looks up
+    ``root.find(".//DataArray[@offset='i']")``, the first such ``DataArray`` *in document
+    order*, then rewrites that element's offset to the array's position in a base64 string it
+    builds. Declared in file order, an array read earlier (earlier in the document) whose
+    rewritten offset happens to equal a later array's raw offset is found instead of it, and
+    the file is refused or misread: a coincidence of sizes (a Poisson solution on 5 x 5
+    points with no boundary lines; 17 of the 450 grids of up to 15 x 15 squares, with and
+    without boundary lines). Appended in reverse, when the array at ``i`` is looked up the
+    elements carrying ``offset="i"`` are that array (raw offsets strictly increase: every
+    array has an 8-byte size header) and arrays already read, each of which lies *after* it in
+    the document; ``find`` returns it. VTK seeks each array by its offset, in any order. The
+    bytes written are the same as in file order: the layout costs nothing.
+    """
+    items = [(section, entry) for section in ("Points", "Cells", "PointData", "CellData")
+             for entry in declared.get(section, ())]
+    offsets, end = [0] * len(items), 0
+    for j in range(len(items) - 1, -1, -1):   # the last declared first in the file
+        offsets[j] = end
+        end += items[j][1][3] + 8              # + the UInt64 size header
     order = "LittleEndian" if sys.byteorder == "little" else "BigEndian"
     xml = ['<?xml version="1.0"?>',
            f'<VTKFile type="UnstructuredGrid" version="1.0" byte_order="{order}" '
            'header_type="UInt64">',
            "<UnstructuredGrid>",
            f'<Piece NumberOfPoints="{n_points}" NumberOfCells="{n_cells}">']
+    j = 0
     for section in ("Points", "Cells", "PointData", "CellData"):
         if not declared.get(section) and section not in ("Points", "Cells"):
             continue
         xml.append(f"<{section}>")
-        for name, vtype, comps, nbytes in declared.get(section, ()):
+        for name, vtype, comps, _ in declared.get(section, ()):
             nc = f' NumberOfComponents="{comps}"' if comps else ""
             xml.append(f'<DataArray type="{vtype}" Name="{_attr(name)}"{nc} '
-                       f'format="appended" offset="{offset}"/>')
-            offset += nbytes + 8  # + the UInt64 size header
+                       f'format="appended" offset="{offsets[j]}"/>')
+            j += 1
         xml.append(f"</{section}>")
     xml += ["</Piece>", "</UnstructuredGrid>", '<AppendedData encoding="raw">', "_"]
     return "\n".join(xml).encode()
 
 
 def _write_appended(f, header: bytes, arrays: list) -> None:
-    """Write ``header`` (:func:`_appended_header`) and each ``(bytes, pieces)`` of ``arrays``:
-    its UInt64 size, then the pieces' memory as it is (no copy, no encoding; a piece that is
+    """Write ``header`` (:func:`_appended_header`) and each ``(bytes, pieces)`` of ``arrays``
+    (given in the order declared, written in reverse: see :func:`_appended_header`): its
+    UInt64 size, then the pieces' memory as it is (no copy, no encoding; a piece that is
     not contiguous, e.g. a broadcast constant, a block of rows at a time)."""
     f.write(header)
-    for nbytes, pieces in arrays:
+    for nbytes, pieces in reversed(arrays):
         f.write(np.uint64(nbytes).tobytes())
         for a in pieces:
             if a.flags.c_contiguous:
@@ -263,6 +288,52 @@ def _attr(text: str) -> str:
     for raw, escaped in _ATTR_ESCAPES:
         s = s.replace(raw, escaped)
     return s
+
+
+#: numpy types of the block-size headers of appended data (VTKFile's ``header_type``)
+_HEADER_TYPES = {"UInt32": np.uint32, "UInt64": np.uint64}
+
+
+def reappended(raw: bytes, reverse: bool = True) -> bytes | None:
+    """The bytes of a ``.vtu`` file with its raw appended arrays re-appended in the reverse of
+    their declaration (the layout meshio reads at every size, see :func:`_appended_header`;
+    ``reverse=False``: in their declared order), the offsets rewritten to match; ``None`` when
+    ``raw`` holds no uncompressed raw appended data or cannot be parsed.
+
+    It lets femkit read the ``.vtu`` files written before it appended in reverse (and any other
+    writer's raw appended file that meshio misreads): the arrays' bytes are moved, not decoded.
+    """
+    import xml.etree.ElementTree as ET
+
+    start = raw.find(b"<AppendedData")
+    opened = raw.find(b">", start) + 1
+    if start < 0 or b'"raw"' not in raw[start:opened]:
+        return None
+    first = raw.find(b"_", opened) + 1
+    try:
+        root = ET.fromstring(raw[:start] + b"</VTKFile>")
+        if root.get("compressor"):
+            return None
+        size = np.dtype(_HEADER_TYPES[root.get("header_type", "UInt32")]).newbyteorder(
+            ">" if root.get("byte_order") == "BigEndian" else "<")
+        arrays = [a for a in root.iter("DataArray") if a.get("format") == "appended"]
+        blocks = []
+        for a in arrays:
+            at = first + int(a.get("offset"))
+            n = int(np.frombuffer(raw, size, 1, at)[0])
+            if at + size.itemsize + n > len(raw):
+                return None
+            blocks.append(raw[at:at + size.itemsize + n])
+    except (ET.ParseError, KeyError, ValueError, TypeError):
+        return None
+    order = list(range(len(arrays)))[::-1 if reverse else 1]
+    offset = 0
+    for j in order:
+        arrays[j].set("offset", str(offset))
+        offset += len(blocks[j])
+    head = ET.tostring(root).rsplit(b"</VTKFile>", 1)[0]
+    return b"".join([b'<?xml version="1.0"?>\n', head, b'<AppendedData encoding="raw">\n_']
+                    + [blocks[j] for j in order] + [b"\n</AppendedData>\n</VTKFile>\n"])
 
 
 def vtu_header(path: str | os.PathLike):

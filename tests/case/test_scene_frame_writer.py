@@ -15,26 +15,15 @@ import numpy as np
 import pytest
 import yaml
 
+sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared case
+from _cloth import CLOTH  # noqa: E402
+
 from femkit.case import case_from_dict
 from femkit.case.scene.output import FrameStream, write_frames_vtu
 from femkit.case.scene.run import build_system
 from femkit.errors import FemkitError, MeshError
 from femkit.io.background import BackgroundWriter
 from femkit.mesh.vtk import VtuFrames, write_cells
-
-CLOTH = {
-    "problem": "mass_spring",
-    "name": "frames",
-    "system": {"type": "cloth", "nx": 7, "ny": 6, "width": 1.0, "height": 1.0, "plane": "xy",
-               "k_structural": 400.0, "k_shear": 100.0, "k_bending": 10.0, "total_mass": 0.5,
-               "pinned": "top_corners"},
-    "forces": {"gravity": 9.81},
-    "integrator": {"method": "fast_mass_spring", "options": {"iterations": 5}},
-    "dt": 0.02,
-    "t_end": 0.4,
-    "output": {"dir": "out", "every": 2},
-}
-
 
 def _cloth_case(tmp_path, **over):
     return case_from_dict({**CLOTH, **over}, base_dir=tmp_path)

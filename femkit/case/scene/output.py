@@ -136,10 +136,11 @@ def write_frames_xdmf(path: str | os.PathLike, system, traj, triangles=None) -> 
     """An XDMF time series (``.xdmf`` + ``.h5``): the first frame's mesh, positions per step.
 
     Point data per time: ``position`` (3D), ``displacement`` from the first frame and
-    ``velocity`` (ParaView's "Warp By Vector" on ``displacement`` animates it).
+    ``velocity`` (ParaView's "Warp By Vector" on ``displacement`` animates it). The springs
+    are ``line`` cells; a scene with triangles (a cloth) gets XDMF's ``Mixed`` topology of
+    both (:func:`_series_writer`), which meshio's ``TimeSeriesReader`` reads back as the two
+    blocks.
     """
-    import meshio
-
     cells = _frame_cells(system, triangles)
     x0 = pad3(traj.x[0])
     path = Path(path).resolve()
@@ -148,7 +149,7 @@ def write_frames_xdmf(path: str | os.PathLike, system, traj, triangles=None) -> 
     cwd = os.getcwd()
     os.chdir(path.parent)
     try:
-        with meshio.xdmf.TimeSeriesWriter(str(path)) as w:
+        with _series_writer()(str(path)) as w:
             w.write_points_cells(x0, cells)
             for k, t in enumerate(traj.times):
                 x = pad3(traj.x[k])
@@ -157,6 +158,51 @@ def write_frames_xdmf(path: str | os.PathLike, system, traj, triangles=None) -> 
     finally:
         os.chdir(cwd)
     return path
+
+
+def _mixed_topology(cells: Sequence[tuple[str, np.ndarray]]) -> np.ndarray:
+    """The one-dimensional ``Mixed`` topology of XDMF's model: per cell its type index, for a
+    ``line`` (XDMF's polyline) its node count 2, then its node ids ("XDMF Model and Format",
+    section "Topology", arbitrary; the layout meshio's ``translate_mixed_cells`` reads).
+
+    >>> _mixed_topology([("line", np.array([[0, 1]])), ("triangle", np.array([[0, 1, 2]]))])
+    array([2, 2, 0, 1, 4, 0, 1, 2])
+    """
+    from meshio.xdmf.common import meshio_type_to_xdmf_index
+
+    rows = []
+    for kind, conn in cells:
+        conn = np.asarray(conn, dtype=np.int64).reshape(len(conn), -1)
+        lead = [meshio_type_to_xdmf_index[kind]] + ([conn.shape[1]] if kind == "line" else [])
+        rows.append(np.column_stack([np.tile(np.array(lead, np.int64), (len(conn), 1)), conn]).ravel())
+    return np.concatenate(rows) if rows else np.zeros(0, np.int64)
+
+
+def _series_writer():
+    """meshio's XDMF ``TimeSeriesWriter`` whose mesh of several cell blocks is written as
+    :func:`_mixed_topology`: meshio's own (5.3.0 to 5.3.5, ``xdmf/time_series.py``) prefixes
+    the line count in place (``c.data[:] = np.insert(c.data, 0, 2, axis=1)``), which cannot
+    fit an ``(n, 2)`` block, so any mesh with lines and another cell type fails after the run
+    ("could not broadcast (n,3) into (n,2)"). One block: meshio's writer unchanged."""
+    from xml.etree import ElementTree as ET
+
+    import meshio
+    from meshio.xdmf.common import numpy_to_xdmf_dtype
+
+    class _Writer(meshio.xdmf.TimeSeriesWriter):
+        def cells(self, cells, grid):
+            if len(cells) < 2:
+                return super().cells(cells, grid)
+            data = _mixed_topology(cells)
+            topo = ET.SubElement(grid, "Topology", TopologyType="Mixed",
+                                 NumberOfElements=str(sum(len(c) for _, c in cells)))
+            dt, prec = numpy_to_xdmf_dtype[data.dtype.name]
+            item = ET.SubElement(topo, "DataItem", DataType=dt, Dimensions=str(len(data)),
+                                 Format=self.data_format, Precision=prec)
+            item.text = self.numpy_to_xml_string(data)
+            return None
+
+    return _Writer
 
 
 def energy_columns(dim: int) -> list[str]:
