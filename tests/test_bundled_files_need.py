@@ -89,12 +89,6 @@ def test_every_bundled_file_plans_with_the_default_install(path, default_install
         assert first.startswith("#") and "need" in first.lower(), (code, err, first)
 
 
-def test_no_bundled_file_needs_an_extra():
-    """The default install runs every bundled file (README's promise); the CHOLMOD fast path is
-    a ``--set`` away, named in the files' comments."""
-    assert {_id(p): sorted(_needs(p)) for p in BUNDLED if _needs(p)} == {}
-
-
 def test_the_cloth_study_runs_with_the_default_install(default_install, tmp_path):
     """The study of the implicit cloth methods, whose linear solves are the point, runs quick
     without CHOLMOD (SuperLU)."""
