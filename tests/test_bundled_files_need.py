@@ -5,7 +5,6 @@ naming how to install it (exit 2, nothing written).
 "The default install" is simulated in-process: the optional solver packages (scikit-sparse /
 CHOLMOD, cholespy, petsc4py, mpi4py) cannot be imported (``sys.modules[name] = None``)."""
 
-import re
 import sys
 from pathlib import Path
 
