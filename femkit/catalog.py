@@ -104,13 +104,22 @@ GROUPS: dict[str, tuple[str, Callable]] = {
 def _first_line(text: str | None) -> str:
     """The first sentence of a docstring's first paragraph, without reST markup.
 
+    A sentence ends at ``.`` or ``:`` before a capital, but not after an abbreviation or an
+    initial (``St.``, ``B.``).
+
     >>> _first_line("``kind: x``: does y with :func:`~a.b` (see\\n  there). More.\\n\\nBody")
     'does y with b (see there).'
+    >>> _first_line("St. Venant-Kirchhoff after B. de Saint-Venant (1844). More.")
+    'St. Venant-Kirchhoff after B. de Saint-Venant (1844).'
     """
     para = " ".join((text or "").strip().split("\n\n")[0].split())
     para = re.sub(r"^``[^`]*``: ", "", para)  # the ``kind: name``: heading of a kind's module
     para = re.sub(r":\w+:`~?(?:[\w.]*\.)?([^`]+)`", r"\1", para).replace("``", "")
-    return re.split(r"(?<=[.:])\s+(?=[A-Z])", para)[0].split(", registered as")[0]
+    return _SENTENCE_END.split(para)[0].split(", registered as")[0]
+
+
+#: a sentence end: ``.`` or ``:``, then a capital, not after ``St.``-like abbreviations or initials
+_SENTENCE_END = re.compile(r"(?<=[.:])(?<!\b[A-Z][a-z]\.)(?<!\b[A-Z]\.)\s+(?=[A-Z])")
 
 
 def describe(obj) -> str:

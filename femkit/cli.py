@@ -239,7 +239,8 @@ def _add_check(sub) -> None:
         sub, "check", help="cross-check a Poisson case against scikit-fem and pyamg",
         description=(
             "Build the case's mesh and compare, on that same mesh: femkit's stiffness matrix "
-            "and one-point (barycentric) load vector with scikit-fem's (its Basis given the same centroid rule), "
+            "and load vector with scikit-fem's (the case's quadrature.load rule on both sides: "
+            "scikit-fem's Basis is given its points and weights), "
             "femkit's solution with scikit-fem's (condense + direct solve), and the reduced "
             "system solved with pyamg's own smoothed-aggregation solver (accel='cg'). "
             "Prints each relative difference next to its tolerance; nothing is written. "

@@ -384,7 +384,11 @@ def rectangle(h: float, x0: float = 0.0, y0: float = 0.0, x1: float = 1.0, y1: f
 @register_geometry("unit_square", measure=lambda: (1.0, 4.0), boundary_tags=_SIDES,
                    cell_tags=("domain",))
 def unit_square(h: float) -> Mesh:
-    """Unit square ``[0, 1]^2``; tags as :func:`rectangle` (left/right/bottom/top/boundary, domain)."""
+    """Unit square ``[0, 1]^2``, the origin at its lower-left corner.
+
+    Edge tags: ``left`` (x = 0), ``right`` (x = 1), ``bottom`` (y = 0), ``top`` (y = 1),
+    ``boundary`` (all four). Cell tag: ``domain``.
+    """
     return rectangle(h, 0.0, 0.0, 1.0, 1.0)
 
 
@@ -480,7 +484,8 @@ def _checkerboard_measure(n: int = 4):
 @register_geometry("checkerboard", measure=_checkerboard_measure, boundary_tags=_SIDES,
                    cell_tags=("high", "low"))
 def checkerboard(h: float, n: int = 4) -> Mesh:
-    """Unit square split into ``n x n`` equal squares tagged alternately ``high`` and ``low``.
+    """Unit square ``[0, 1]^2`` split into ``n x n`` equal squares tagged alternately ``high`` and
+    ``low``.
 
     Square ``(i, j)`` (column i, row j, from the origin) is ``high`` when ``i + j`` is even.
     Every square boundary is a mesh line, so a per-region coefficient jumps exactly across
@@ -527,7 +532,8 @@ def _inclusion_measure(centre: Sequence[float] = (0.5, 0.5), radius: float = 0.2
                    cell_tags=("matrix", "inclusion"))
 def square_with_inclusion(h: float, centre: Sequence[float] = (0.5, 0.5), radius: float = 0.25,
                           shape: str = "disk") -> Mesh:
-    """Unit square with a centred inclusion (a disk of ``radius`` or a square of half-side ``radius``).
+    """Unit square ``[0, 1]^2`` with an inclusion about ``centre``: ``shape`` ``disk`` (of
+    ``radius``) or ``square`` (of half-side ``radius``).
 
     The inclusion boundary is a mesh line (the two regions are conforming). Edge tags: ``left``,
     ``right``, ``bottom``, ``top``, ``boundary`` (outer square only). Cell tags: ``matrix``

@@ -59,10 +59,11 @@ def _box_groups(gmsh, lo: Sequence[float], hi: Sequence[float], first_tag: int =
     lx * ly * lz, 2 * (lx * ly + ly * lz + lz * lx)), boundary_tags=('xmin', 'xmax', 'ymin', 'ymax', 'zmin', 'zmax', 'boundary'), cell_tags=("domain",))
 def box(h: float, lx: float = 1.0, ly: float = 1.0, lz: float = 1.0,
         origin: Sequence[float] = (0.0, 0.0, 0.0)) -> Mesh:
-    """Box ``[x0, x0 + lx] x [y0, y0 + ly] x [z0, z0 + lz]`` (volume ``lx ly lz``).
+    """Box ``[x0, x0 + lx] x [y0, y0 + ly] x [z0, z0 + lz]``, ``(x0, y0, z0) = origin`` (volume
+    ``lx ly lz``).
 
-    Face tags: ``xmin``, ``xmax``, ``ymin``, ``ymax``, ``zmin``, ``zmax``, ``boundary``.
-    Cell tag: ``domain``.
+    Face tags: ``xmin`` (x = x0), ``xmax`` (x = x0 + lx), ``ymin``, ``ymax``, ``zmin``, ``zmax``
+    likewise, ``boundary`` (all six). Cell tag: ``domain``.
     """
     h = _check_h(h)
     lx, ly, lz = (_positive(n, v) for n, v in (("lx", lx), ("ly", ly), ("lz", lz)))
@@ -78,7 +79,11 @@ def box(h: float, lx: float = 1.0, ly: float = 1.0, lz: float = 1.0,
 @register_geometry("unit_cube", dim=3, measure=lambda: (1.0, 6.0), boundary_tags=('xmin', 'xmax', 'ymin', 'ymax', 'zmin', 'zmax', 'boundary'),
                    cell_tags=("domain",))
 def unit_cube(h: float) -> Mesh:
-    """Unit cube ``[0, 1]^3``; tags as :func:`box` (xmin ... zmax, boundary, domain)."""
+    """Unit cube ``[0, 1]^3``, the origin at a corner.
+
+    Face tags: ``xmin`` (x = 0), ``xmax`` (x = 1), ``ymin``, ``ymax``, ``zmin``, ``zmax``
+    likewise, ``boundary`` (all six). Cell tag: ``domain``.
+    """
     return box(h, 1.0, 1.0, 1.0)
 
 
@@ -87,10 +92,12 @@ def unit_cube(h: float) -> Mesh:
     boundary_tags=("xmin", "xmax", "ymin", "ymax", "zmin", "zmax", "boundary", "clamped", "tip"),
     cell_tags=("domain",))
 def beam(h: float, length: float = 5.0, width: float = 1.0, height: float = 1.0) -> Mesh:
-    """Beam ``[0, length] x [0, width] x [0, height]`` along x (volume ``length width height``).
+    """Beam ``[0, length] x [0, width] x [0, height]``: its axis along x, the origin at a corner of
+    the clamped end (volume ``length width height``).
 
-    Face tags: as :func:`box`, plus ``clamped`` (x = 0, the same faces as ``xmin``) and ``tip``
-    (x = length, as ``xmax``). Cell tag: ``domain``.
+    Face tags: ``xmin`` (x = 0), ``xmax`` (x = length), ``ymin`` (y = 0), ``ymax`` (y = width),
+    ``zmin`` (z = 0), ``zmax`` (z = height), ``boundary`` (all six), and ``clamped`` (x = 0, the
+    same faces as ``xmin``) and ``tip`` (x = length, as ``xmax``). Cell tag: ``domain``.
     """
     h = _check_h(h)
     L, W, H = (_positive(n, v) for n, v in (("length", length), ("width", width), ("height", height)))

@@ -41,8 +41,13 @@ def _cubes_per_unit(h: float) -> int:
                    boundary_tags=("xmin", "xmax", "ymin", "ymax", "zmin", "zmax", "boundary"),
                    cell_tags=("domain",))
 def kuhn_cube(h: float) -> Mesh:
-    """The unit cube of Kuhn cubes of side ``h`` (``1 / h`` whole): :func:`structured_box`
-    with the cell tag ``domain``."""
+    """Unit cube ``[0, 1]^3``, the origin at a corner, of Kuhn cubes of side ``h`` (``1 / h`` a
+    whole number; each cube cut into six tetrahedra about its main diagonal, as
+    :func:`structured_box`): a start mesh for adaptive bisection.
+
+    Face tags: ``xmin`` (x = 0), ``xmax`` (x = 1), ``ymin``, ``ymax``, ``zmin``, ``zmax``
+    likewise, ``boundary`` (all six). Cell tag: ``domain``.
+    """
     n = _cubes_per_unit(h)
     box = structured_box(n, n, n)
     domain = max(SIDES_3D.values()) + 1
@@ -54,10 +59,12 @@ def kuhn_cube(h: float) -> Mesh:
 @register_geometry("kuhn_fichera", dim=3, measure=lambda: (7.0, 24.0),
                    boundary_tags=("reentrant", "outer", "boundary"), cell_tags=("domain",))
 def kuhn_fichera(h: float) -> Mesh:
-    """Fichera corner ``(-1, 1)^3 \\ [0, 1]^3`` of Kuhn cubes of side ``h`` (``1 / h`` whole).
+    """Fichera corner: the cube ``(-1, 1)^3`` minus the octant ``[0, 1]^3`` (volume 7), of Kuhn
+    cubes of side ``h`` (``1 / h`` a whole number): a start mesh for adaptive bisection.
 
-    Face tags ``reentrant`` (1), ``outer`` (2), ``boundary`` (3, every face again); cell tag
-    ``domain`` (4). The re-entrant vertex is the origin.
+    The re-entrant vertex is the origin. Face tags: ``reentrant`` (the three faces of the
+    removed octant; tag number 1), ``outer`` (the rest; 2), ``boundary`` (every face again; 3).
+    Cell tag: ``domain`` (4).
     """
     n = _cubes_per_unit(h)
     box = structured_box(2 * n, 2 * n, 2 * n, (2.0, 2.0, 2.0), origin=(-1.0, -1.0, -1.0))

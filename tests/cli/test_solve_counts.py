@@ -11,7 +11,7 @@ from femkit.cli import main
 
 
 @pytest.mark.parametrize("iterations, steps", [(10, 6), (3, 4)], ids=["10-it", "3-it"])
-@pytest.mark.parametrize("method", ["cholesky", "direct"])
+@pytest.mark.parametrize("method", [pytest.param("cholesky", marks=pytest.mark.cholmod), "direct"])
 def test_fast_mass_spring_counts_one_solve_per_iteration(tmp_path, capsys, iterations, steps, method):
     case = tmp_path / "scene.yaml"
     case.write_text(yaml.safe_dump({

@@ -9,8 +9,6 @@ import pytest
 from femkit.errors import CaseFileError
 from femkit.study import load_study, run_study, study_from_dict
 
-pytestmark = pytest.mark.cholmod  # the cholesky solver: optional scikit-sparse
-
 ROOT = Path(__file__).resolve().parents[2]
 STUDY = ROOT / "studies" / "cloth_work_precision.yaml"
 
@@ -69,6 +67,7 @@ def _small(methods, linear_solver=None):
     return data
 
 
+@pytest.mark.cholmod  # the study-wide solver here is the default, cholesky (optional CHOLMOD)
 def test_a_method_family_takes_its_own_linear_solver_spec(tmp_path):
     """methods[i].linear_solver is validated like every solver spec, recorded per run and used:
     the same steps with an explicit SuperLU (direct) as with the study's Cholesky."""

@@ -68,7 +68,17 @@ class StVenantKirchhoff(StretchMaterial):
 @register_material("stable_neo_hookean")
 @dataclass(frozen=True)
 class StableNeoHookean(StretchMaterial):
-    """Stable neo-Hookean (Smith, de Goes & Kim 2018), rest-stable and inversion-safe."""
+    """Rest-stable neo-Hookean, the log-free form of Smith, de Goes & Kim 2018:
+    ``mu/2 (I_C - 3) - mu (J - 1) + (lam + mu)/2 (J - 1)^2``.
+
+    That is Smith et al.'s ``mu/2 (I_C - 3) + lam'/2 (J - alpha)^2`` with ``alpha = 1 + mu / lam'``
+    (no stress at rest) and ``lam' = lam + mu`` (its linearisation at rest is linear elasticity
+    with ``(mu, lam)``), less the constant ``mu^2 / (2 lam')`` so that ``W(I) = 0``. It is not
+    their final energy: their ``- mu/2 log(I_C + 1)`` term, and the re-matched Lamé parameters
+    that term needs, are left out. Polynomial in the stretches and ``J = s1 s2 s3``, so finite
+    for inverted elements. (B. Smith, F. de Goes, T. Kim, "Stable neo-Hookean flesh
+    simulation", ACM Trans. Graph. 37(2), 2018.)
+    """
 
     code: ClassVar[int] = 3
     energy_expression: ClassVar[Energy] = Energy(
