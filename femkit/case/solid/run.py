@@ -589,7 +589,7 @@ def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = F
 
         with timer("output"):
             write_solid_outputs(result, output_dir or case.spec.output.dir)
-    if failure is not None:
+    if failure is not None and (write or not quiet):  # a caller keeping nothing says it itself
         print(f"femkit: {result.verdict.replace('_', ' ')}: {failure}", file=sys.stderr)
     if not quiet:
         for line in result.summary_lines() + [clock.summary(result.timings)]:
