@@ -18,9 +18,13 @@ Time integration holds every fixed or roller component (per component: rollers s
 prescribed displacement from ``t = 0`` (:class:`~femkit.dynamics.system.MassSpringSystem`'s
 ``(n, d)`` pin mask).
 
-Static runs take load step ``k`` of ``K`` by :func:`femkit.solids.solve_static` from the
-previous equilibrium with ``k/K`` of the loads and prescribed displacements (what
-``solve_static(load_steps=K)`` does inside), keeping each equilibrium as a frame.
+Static runs are one :func:`femkit.solids.solve_static` with ``load_steps=K``: load step ``k``
+applies ``k/K`` of the loads and prescribed displacements from the previous equilibrium (the
+prescribed increment spread into the body by a linear solve, the step cut when that start still
+inverts elements); each equilibrium is kept as a frame (its ``on_step``), and a stop request is
+seen between Newton iterations (its ``stop``).
+
+SIGINT / SIGTERM (``case.run_options["stop"]``): see :func:`run_solid`.
 """
 
 from __future__ import annotations
