@@ -215,3 +215,33 @@ def test_beam_picture_is_magnified_framed_and_its_colour_bar_clear(tmp_path):
     lo = body_ax.get_zlim()[0]
     assert lo < (rest_z + factor * u_z).min()
     assert lo < (rest_z + u_z).min() + 0.5 * (factor - 1) * u_z.min()
+
+
+def test_a_stop_between_load_steps_keeps_them_marked_without_pictures(tmp_path, monkeypatch):
+    """A stop request (the flag ``femkit solve`` sets on SIGINT) after the first of three load
+    steps: that step's frame is written, marked interrupted, and no picture is drawn."""
+    from femkit.case.solid import run as solid_run
+    from femkit.interrupt import StopFlag
+
+    flag = StopFlag()
+    real = solid_run.frame_energies
+
+    calls = []
+
+    def energies_then_stop(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:          # the rest frame, then the first load step's: then Ctrl-C
+            flag.request()
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(solid_run, "frame_energies", energies_then_stop)
+    data = {**LOG_J, "static": {"load_steps": 3}, "output": {"png": True, "gif": True}}
+    case = femkit.load_case(_write(tmp_path, data))
+    case.run_options["stop"] = flag
+    result = case.run(output_dir=tmp_path / "out", quiet=True)
+    assert result.interrupted == "SIGINT" and not result.converged
+    d = json.loads((tmp_path / "out" / "result.json").read_text())
+    assert d["interrupted"] is True and d["verdict"] == "interrupted"
+    assert d["steps"] == 1 and d["steps_planned"] == 3 and d["frames"] == 2
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
+        "frames", "result.json", "solid.pvd"]

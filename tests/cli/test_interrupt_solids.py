@@ -94,9 +94,10 @@ def _kept(tmp_path) -> tuple[dict, list]:
 def test_signal_during_the_time_steps_writes_the_frames_so_far_marked(tmp_path, sig, code):
     (tmp_path / "out").mkdir()   # an earlier complete run there: replaced by the marked one
     (tmp_path / "out" / "result.json").write_text('{"verdict": "converged"}\n')
-    rc, elapsed, err = signal_inside("femkit.dynamics.simulate:simulate",
+    # signalled once the first time step is done (its progress update), while the next go on
+    rc, elapsed, err = signal_inside("femkit.progress:Progress.update",
                                      ["solve", str(_case(tmp_path, BEAM)), "--quiet"], sig,
-                                     cwd=tmp_path, settle=1.0)
+                                     cwd=tmp_path)
     assert rc == code, err
     assert elapsed < SLACK, elapsed
     assert f"interrupted by {sig.name}" in err and "Traceback" not in err

@@ -64,7 +64,8 @@ def write_solid_outputs(result, directory: str | os.PathLike) -> Path:
     final = Path(directory).resolve()
     result.output_dir = final
     files: list[str] = []
-    flag = active_flag()
+    flag = result.case.run_options.get("stop")   # the run's flag (femkit solve: the active one)
+    flag = active_flag() if flag is None else flag
     stop = None if flag else flag   # a stop already answered by the solve: write every frame
     with atomic_directory(final, EARLIER_RUN) as tmp:
         if opts.vtu:
@@ -73,7 +74,7 @@ def write_solid_outputs(result, directory: str | os.PathLike) -> Path:
             files += ["solid.pvd", *frames]
             if len(frames) < len(result.x):
                 result.frames_written = len(frames)
-        files += _pictures(tmp, result, opts, skip=bool(flag))
+        files += _pictures(tmp, result, opts, flag)
         if flag and flag.name != result.stopped:
             result.output_stop = flag.name
         files.append("result.json")
@@ -82,15 +83,16 @@ def write_solid_outputs(result, directory: str | os.PathLike) -> Path:
     return final
 
 
-def _pictures(tmp: Path, result, opts, skip: bool) -> list[str]:
-    """``deformed.png`` and ``animation.gif`` as asked, in ``tmp``; none when ``skip`` (the solve
-    was stopped) or once a stop request arrives (the picture under way abandoned at once)."""
+def _pictures(tmp: Path, result, opts, flag) -> list[str]:
+    """``deformed.png`` and ``animation.gif`` as asked, in ``tmp``; none once ``flag`` (a
+    :class:`~femkit.interrupt.StopFlag` or None) is set: before (the solve was stopped) or
+    while one is drawn (abandoned at once)."""
     from .plot import write_solid_gif, write_solid_png
 
     files: list[str] = []
     wanted = [(opts.png, "deformed.png", write_solid_png), (opts.gif, "animation.gif", write_solid_gif)]
     for on, name, write in wanted:
-        if not on or skip or active_flag():
+        if not on or flag:
             continue
         try:
             with raising(f"writing {name}"):
