@@ -397,6 +397,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     from_environment()  # FEMKIT_RETURN_MEMORY=1: freed arrays go back to the system at once
     speaks = _mpi_rank() == 0  # under mpirun every rank raises the same error: rank 0 says it
+    import warnings
+
+    shown = warnings.showwarning
+    warnings.showwarning = _one_line_warning
     try:
         args.overrides = parse_sets(getattr(args, "sets", ()))
         return int(handler(args))
@@ -414,6 +418,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("femkit: interrupted", file=sys.stderr)
         return 130
+    finally:
+        warnings.showwarning = shown
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """How the command line shows a Python warning: ``femkit: warning: <message>`` on one line
+    (no file name, line number or source line: the user did not write that code)."""
+    text = _one_line(message)
+    if not issubclass(category, UserWarning):
+        text = f"{text} ({category.__name__})"  # e.g. numpy's RuntimeWarning: say what it is
+    print(f"femkit: warning: {text}", file=file or sys.stderr)
 
 
 def _mpi_rank() -> int:

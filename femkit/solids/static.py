@@ -2,26 +2,37 @@
 method with a backtracking line search and load stepping.
 
 Load step ``k = 1..K`` applies ``k/K`` of the external forces and of the prescribed
-displacements; each is solved from the previous equilibrium (prescribed dofs moved to their new
-values) by Newton iterations on the free dofs: ``H_ff dx = -r_f`` with the element-wise
+displacements, starting from the previous equilibrium. The prescribed increment is not applied
+to the held nodes alone (their jump would crush, and with a ``log J`` energy invert, the layer of
+elements next to them): it is spread into the body by one linear solve, the linear elastic
+response ``H_ff dx_f = -H_fc dx_c`` of the projected tangent at the previous equilibrium to the
+increment ``dx_c`` of the held dofs (the increment as Dirichlet data of the linearised problem).
+When that start still has an element of non-finite energy, the step's increment is halved (up
+to :data:`MAX_CUTS` times) and the step is taken in those sub-steps, each from the equilibrium of
+the one before; the record's ``substeps`` says how many.
+
+From that start Newton iterates on the free dofs: ``H_ff dx = -r_f`` with the element-wise
 PSD-projected Hessian (Teran et al. 2005; ``project=True`` by default, so ``dx`` is a descent
 direction), then Armijo backtracking on the total potential (Nocedal & Wright, Numerical
 Optimization, section 3.1), as :mod:`femkit.dynamics.integrators.newton` does for implicit
-Euler; the Armijo test allows the round-off level of the potential
+Euler; a trial point with an element of non-finite energy counts as no decrease. The Armijo
+test allows the round-off level of the potential
 (``64 eps (|E| + |f.x| + sum (mu + |lam|) vol)``, the last term the size of the terms an energy
 density sums before they cancel near rest), and when even that finds no decrease, a full step
 that lowers the residual norm is taken: without these Newton stalls where energy differences
-drown in rounding while the residual is still ~1e-8 relative. Converged when ``|r_f| <= rtol max(|f_k|, |r_0|)`` (``r_0``: residual at the start of
-the load step) or the step ``|dx|_inf <= xtol L`` (``L`` the bounding-box diagonal).
+drown in rounding while the residual is still ~1e-8 relative. Converged when
+``|r_f| <= rtol max(|f_k|, |r_0|)`` (``r_0``: residual at the start of the (sub-)step) or the
+step ``|dx|_inf <= xtol L`` (``L`` the bounding-box diagonal).
 
-Failure -- a line search that finds no decrease, the iteration limit, an energy that is not
-finite -- raises :class:`~femkit.errors.EquilibriumError` carrying the record so far (load steps
-done, iterations, residual histories) and the last equilibrium.
+Failure -- a line search that finds no decrease, the iteration limit, an increment that inverts
+elements however cut -- raises :class:`~femkit.errors.EquilibriumError` carrying the record so
+far (load steps done, iterations, residual histories) and the last equilibrium.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any, Callable
 
 import numpy as np
 
@@ -37,7 +48,8 @@ __all__ = ["StaticResult", "LoadStepRecord", "solve_static"]
 class LoadStepRecord:
     """One load step: its factor, Newton iterations, residual norms (one per iterate, the first
     before any step), accepted step lengths ``t`` of the line search, whether it converged and
-    (``project="auto"``) how many iterations fell back to the projected Hessian."""
+    (``project="auto"``) how many iterations fell back to the projected Hessian; ``substeps``:
+    how many pieces the step was cut into (1: solved whole; see :func:`solve_static`)."""
 
     load_factor: float
     iterations: int = 0
@@ -45,6 +57,7 @@ class LoadStepRecord:
     step_lengths: list = field(default_factory=list)
     converged: bool = False
     projected: int = 0
+    substeps: int = 1
 
 
 @dataclass
@@ -70,11 +83,17 @@ class StaticResult:
         return [r for s in self.steps for r in s.residuals]
 
 
+#: Halvings of a load step's increment allowed before the step is given up (1/1024 of it).
+MAX_CUTS = 10
+
+
 def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=None, *,
                  load_steps: int = 1, project: bool | str = True, rtol: float = 1e-12,
                  xtol: float = 1e-13, max_iterations: int = 50, armijo: float = 1e-4,
                  shrink: float = 0.5, max_backtracks: int = 40,
-                 linear_solver: SolverSpec | str = "direct", x0=None) -> StaticResult:
+                 linear_solver: SolverSpec | str = "direct", x0=None,
+                 on_step: Callable[[LoadStepRecord, np.ndarray], Any] | None = None,
+                 stop: Callable[[], bool] | None = None) -> StaticResult:
     """Static equilibrium of ``body`` under nodal ``forces`` ``(n, d)`` and ``dirichlet`` data.
 
     Parameters
@@ -98,11 +117,17 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
         How each Newton system is solved (default a sparse direct solve).
     x0 : (n, d), optional
         Starting configuration (default the rest positions).
+    on_step : callable, optional
+        ``on_step(record, x)`` after each converged load step (``x`` ``(n, d)``, a copy).
+    stop : callable, optional
+        Checked before each Newton iteration; once it returns true the solve ends, returning
+        the load steps completed so far (the one under way is dropped).
 
     Raises
     ------
     EquilibriumError
-        Newton failed in a load step (record and last equilibrium attached).
+        Newton failed in a load step, or its increment, halved :data:`MAX_CUTS` times, still
+        inverts elements (record and last equilibrium attached).
     """
     if project not in (True, False, "auto"):
         raise InputError(f"solve_static: project must be True, False or 'auto', got {project!r}")
@@ -114,94 +139,177 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
     if (dirichlet.n, dirichlet.dim) != (body.n, body.dim):
         raise InputError(f"Dirichlet data for {dirichlet.n} nodes in {dirichlet.dim}D, body has "
                          f"{body.n} in {body.dim}D")
-    spec = SolverSpec(linear_solver) if isinstance(linear_solver, str) else linear_solver
-    X = body.rest_positions.reshape(-1)
     f_ext = np.zeros(body.ndof) if forces is None else np.asarray(forces, dtype=float).reshape(-1)
     if f_ext.shape != (body.ndof,) or not np.all(np.isfinite(f_ext)):
         raise InputError(f"forces must be finite with shape ({body.n}, {body.dim})")
-    fixed, u_fixed = dirichlet.dofs, dirichlet.values
-    free = dirichlet.free()
-    length = float(np.linalg.norm(np.ptp(body.rest_positions, axis=0)))
-    x = X.copy() if x0 is None else np.array(x0, dtype=float).reshape(-1)
+    newton = _Newton(body, dirichlet, f_ext, project, rtol, xtol, max_iterations, armijo, shrink,
+                     max_backtracks, SolverSpec(linear_solver) if isinstance(linear_solver, str)
+                     else linear_solver, stop)
+    x = body.rest_positions.reshape(-1).copy() if x0 is None else \
+        np.array(x0, dtype=float).reshape(-1)
     records: list[LoadStepRecord] = []
-    # the size of the terms an energy density sums before they cancel near rest: (mu + lam) vol
-    stored = float(sum((m.mu + abs(m.lam)) * body.rest.volumes[e].sum() for e, m in body.groups))
-
-    def potential(xf, f):
-        """Total potential and its round-off level (energies near equilibrium stop changing
-        above it: Armijo's test gets that much slack, else Newton stalls at ~1e-8 residuals)."""
+    for k in range(1, load_steps + 1):
+        rec = LoadStepRecord(k / load_steps)
+        records.append(rec)
         try:
-            e = float(body.evaluate(xf, 0)[0].sum())
+            x_new = newton.load_step(x, (k - 1) / load_steps, k / load_steps, rec)
+        except _Stopped:
+            records.pop()
+            break
+        except EquilibriumError as exc:
+            exc.record, exc.load_step = _result(body, x, records), k
+            exc.x = x.reshape(body.n, body.dim).copy()
+            raise
+        x = x_new
+        if on_step is not None:
+            on_step(rec, x.reshape(body.n, body.dim).copy())
+    return _result(body, x, records)
+
+
+class _Stopped(Exception):
+    """A stop request seen between Newton iterations."""
+
+
+class _Newton:
+    """Newton's method with a line search on ``E(x) - f . x`` for one load step at a time, the
+    step's increment spread into the body first and cut when it still inverts elements."""
+
+    def __init__(self, body, dirichlet, f_ext, project, rtol, xtol, max_iterations, armijo,
+                 shrink, max_backtracks, spec, stop):
+        self.body, self.f_ext, self.project, self.spec, self.stop = body, f_ext, project, spec, stop
+        self.rtol, self.xtol, self.max_iterations = rtol, xtol, max_iterations
+        self.armijo, self.shrink, self.max_backtracks = armijo, shrink, max_backtracks
+        self.X = body.rest_positions.reshape(-1)
+        self.fixed, self.u_fixed, self.free = dirichlet.dofs, dirichlet.values, dirichlet.free()
+        self.length = float(np.linalg.norm(np.ptp(body.rest_positions, axis=0)))
+        # the size of the terms an energy density sums before they cancel near rest: (mu + lam) vol
+        self.stored = float(sum((m.mu + abs(m.lam)) * body.rest.volumes[e].sum()
+                                for e, m in body.groups))
+
+    def potential(self, xf, f) -> tuple[float, float]:
+        """Total potential and its round-off level (energies near equilibrium stop changing
+        above it: Armijo's test gets that much slack, else Newton stalls at ~1e-8 residuals);
+        ``inf`` where an element's energy is not finite (an inverted element of a ``log J``
+        energy)."""
+        try:
+            e = float(self.body.evaluate(xf, 0)[0].sum())
         except SolverError:
             return np.inf, 0.0
         work = float(f @ xf)
-        return e - work, 64 * np.finfo(float).eps * (abs(e) + abs(work) + stored)
+        return e - work, 64 * np.finfo(float).eps * (abs(e) + abs(work) + self.stored)
 
-    for k in range(1, load_steps + 1):
-        lf = k / load_steps
-        f = lf * f_ext
-        rec = LoadStepRecord(lf)
-        records.append(rec)
-        x_start = x.copy()
-        x[fixed] = X[fixed] + lf * u_fixed
-        pot, noise = potential(x, f)
-        r_ref = None
-        for it in range(max_iterations + 1):
-            _, g, H, _ = body.evaluate(x, 2, project=project is True)
+    def spread(self, x: np.ndarray, lf: float) -> np.ndarray:
+        """``x`` with the prescribed dofs moved to ``lf`` of their values and the free dofs
+        moved with them: the linear elastic response ``H_ff dx_f = -H_fc dx_c`` of the projected
+        tangent ``H`` at ``x`` (the previous equilibrium) to that increment ``dx_c``, so the
+        layer of elements next to the held nodes is not crushed by their jump alone. Loads are
+        left to Newton's line search. Without a prescribed increment: ``x`` unchanged."""
+        fixed, free = self.fixed, self.free
+        out = x.copy()
+        dc = self.X[fixed] + lf * self.u_fixed - x[fixed]
+        out[fixed] += dc
+        if not np.any(dc) or not len(free):
+            return out
+        try:
+            H = self.body.evaluate(x, 2, project=True)[2].tocsr()
+            sol = self.spec.solve(H[free][:, free].tocsr(), -(H[free][:, fixed] @ dc))
+        except SolverError:   # the jump of the held nodes alone, cut below if it inverts
+            return out
+        if np.all(np.isfinite(sol.x)):
+            out[free] += sol.x
+        return out
+
+    def load_step(self, x: np.ndarray, lf0: float, lf1: float, rec: LoadStepRecord) -> np.ndarray:
+        """The equilibrium at load factor ``lf1`` from the one at ``lf0``: sub-steps, the first
+        the whole increment, each halved (``rec.substeps`` counts them) while its spread start
+        has an element of non-finite energy."""
+        a, h, cuts = lf0, lf1 - lf0, 0
+        rec.substeps = 0
+        while a < lf1:
+            b = lf1 if a + h >= lf1 * (1 - 1e-12) else a + h
+            start = self.spread(x, b)
+            if not np.isfinite(self.potential(start, b * self.f_ext)[0]):
+                if cuts == MAX_CUTS:
+                    raise EquilibriumError(
+                        f"static Newton: the increment of the load step to load factor {lf1:g} "
+                        f"inverts elements even cut {2 ** MAX_CUTS} times (energy not finite "
+                        f"from load factor {a:g} to {b:g})")
+                h, cuts = h / 2, cuts + 1
+                continue
+            x = self.newton(start, b * self.f_ext, rec)
+            rec.substeps += 1
+            a = b
+        rec.converged = True
+        return x
+
+    def newton(self, x: np.ndarray, f: np.ndarray, rec: LoadStepRecord) -> np.ndarray:
+        """Newton iterations on the free dofs from the admissible ``x`` (prescribed dofs in
+        place) to the equilibrium under ``f``; raises :class:`EquilibriumError`."""
+        body, free, spec = self.body, self.free, self.spec
+        pot, noise = self.potential(x, f)
+        r_ref, step = None, np.inf
+        for it in range(self.max_iterations + 1):
+            if self.stop is not None and self.stop():
+                raise _Stopped
+            _, g, H, _ = body.evaluate(x, 2, project=self.project is True)
             r = g.reshape(-1) - f
             res = float(np.linalg.norm(r[free]))
             rec.residuals.append(res)
             if r_ref is None:
                 r_ref = max(float(np.linalg.norm(f[free])), res, 1e-300)
-            if res <= rtol * r_ref or (it and step <= xtol * length):
-                rec.converged = True
-                break
-            if it == max_iterations:
+            if res <= self.rtol * r_ref or step <= self.xtol * self.length:
+                return x
+            if it == self.max_iterations:
                 break
             rec.iterations += 1
             sol = spec.solve(H[free][:, free].tocsr(), -r[free])
             slope = float(r[free] @ sol.x)
-            if project == "auto" and not (slope < 0.0 and np.all(np.isfinite(sol.x))):
+            if self.project == "auto" and not (slope < 0.0 and np.all(np.isfinite(sol.x))):
                 H = body.evaluate(x, 2, project=True)[2]
                 sol = spec.solve(H[free][:, free].tocsr(), -r[free])
                 slope = float(r[free] @ sol.x)
                 rec.projected += 1
             dx = np.zeros_like(x)
             dx[free] = sol.x
-            t = 1.0
-            if slope < 0.0:
-                for _ in range(max_backtracks):
-                    p_try, noise_try = potential(x + t * dx, f)
-                    if p_try <= pot + armijo * t * slope + max(noise, noise_try):
-                        break
-                    t *= shrink
-                else:
-                    # energy differences below rounding: accept a full step that lowers |r|
-                    g_try = body.evaluate(x + dx, 1)[1].reshape(-1) - f
-                    t = 1.0
-                    p_try, noise_try = potential(x + dx, f)
-                    if not np.linalg.norm(g_try[free]) < (1.0 - armijo) * res:
-                        raise EquilibriumError(
-                            f"static Newton: line search found no decrease in load step "
-                            f"{k}/{load_steps} (iteration {it + 1}, residual {res:.3e}; residuals "
-                            f"{', '.join(f'{v:.2e}' for v in rec.residuals[-6:])})",
-                            _result(body, x_start, records), k, x_start.reshape(body.n, body.dim))
-            else:  # not a descent direction (projection off): the full Newton step
-                p_try, noise_try = potential(x + dx, f)
-            if not np.isfinite(p_try):
-                raise EquilibriumError(f"static Newton: energy not finite in load step {k}",
-                                       _result(body, x_start, records), k,
-                                       x_start.reshape(body.n, body.dim))
+            t, p_try, noise_try = self.line_search(x, dx, f, pot, noise, slope, res, rec)
             rec.step_lengths.append(t)
             x = x + t * dx
             pot, noise = p_try, noise_try
             step = float(np.abs(dx).max(initial=0.0))      # the Newton step, not t * dx
-        if not rec.converged:
-            raise EquilibriumError(
-                f"static Newton: no convergence in {max_iterations} iterations in load step "
-                f"{k}/{load_steps} (residual {rec.residuals[-1]:.3e}, start {rec.residuals[0]:.3e})",
-                _result(body, x_start, records), k, x_start.reshape(body.n, body.dim))
-    return _result(body, x, records)
+        raise EquilibriumError(
+            f"static Newton: no convergence in {self.max_iterations} iterations in the load step "
+            f"to load factor {rec.load_factor:g} (residual {rec.residuals[-1]:.3e}, start "
+            f"{rec.residuals[0]:.3e})")
+
+    def line_search(self, x, dx, f, pot, noise, slope, res, rec) -> tuple[float, float, float]:
+        """Armijo backtracking (Nocedal & Wright, section 3.1) with the round-off slack; when it
+        finds no decrease, the full step if it lowers the residual norm; ``(t, potential, noise)``
+        of the accepted step; :class:`EquilibriumError` when there is none."""
+        t = 1.0
+        if slope < 0.0:
+            for _ in range(self.max_backtracks):
+                p_try, noise_try = self.potential(x + t * dx, f)
+                if p_try <= pot + self.armijo * t * slope + max(noise, noise_try):
+                    return t, p_try, noise_try
+                t *= self.shrink
+            # energy differences below rounding: accept a full step that lowers |r|
+            p_try, noise_try = self.potential(x + dx, f)
+            lowers = False
+            if np.isfinite(p_try):
+                g_try = self.body.evaluate(x + dx, 1)[1].reshape(-1) - f
+                lowers = bool(np.linalg.norm(g_try[self.free]) < (1.0 - self.armijo) * res)
+            if not lowers:
+                raise EquilibriumError(
+                    f"static Newton: line search found no decrease in the load step to load "
+                    f"factor {rec.load_factor:g} (iteration {rec.iterations}, residual {res:.3e}; "
+                    f"residuals {', '.join(f'{v:.2e}' for v in rec.residuals[-6:])})")
+            return 1.0, p_try, noise_try
+        # not a descent direction (projection off): the full Newton step
+        p_try, noise_try = self.potential(x + dx, f)
+        if not np.isfinite(p_try):
+            raise EquilibriumError(f"static Newton: energy not finite in the load step to load "
+                                   f"factor {rec.load_factor:g}")
+        return 1.0, p_try, noise_try
 
 
 def _result(body: ElasticBody, x: np.ndarray, records) -> StaticResult:

@@ -23,6 +23,7 @@ co-rotational and neo-Hookean, or loses equilibrium.
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 
@@ -161,6 +162,10 @@ def run_solid_load(study, progress_enabled=None) -> dict:
         if res.failure:
             notes.append(f"{name}: no equilibrium beyond load factor "
                          f"{res.times[-1]:.3g}: {res.failure}")
+            if progress_enabled is not False:
+                print(f"femkit: note: {name}: no equilibrium beyond load factor "
+                      f"{res.times[-1]:.3g} ({res.verdict.replace('_', ' ')}); the study records "
+                      "this as a result and goes on", file=sys.stderr)
         bar.update()
     bar.close()
     linear = {r["load_factor"]: r["tip_deflection"] for r in records if r["material"] == "linear"}

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...interrupt import Interrupted, active_flag, raising
 from ...io.atomic import EARLIER_RUN, atomic_directory
 from ...io.writers import write_json
 from ...mesh.vtk import pad3, write_cells, write_collection
@@ -25,14 +26,19 @@ from ...mesh.vtk import pad3, write_cells, write_collection
 __all__ = ["write_solid_outputs", "write_solid_frames"]
 
 
-def write_solid_frames(directory: str | os.PathLike, result) -> list[str]:
-    """One VTU per frame in ``directory/frames``; returns their relative names."""
+def write_solid_frames(directory: str | os.PathLike, result, stop=None) -> list[str]:
+    """One VTU per frame in ``directory/frames``; returns their relative names.
+
+    ``stop`` (a :class:`~femkit.interrupt.StopFlag`) is checked before each frame: once set,
+    the names of the frames written so far are returned."""
     body = result.problem.body
     ctype = "tetra" if body.dim == 3 else "triangle"
     cells = [(ctype, np.asarray(body.rest.cells, dtype=np.int64))]
     region = np.asarray(result.problem.mesh.cell_tags, dtype=np.int32)
     names = []
     for k in range(len(result.x)):
+        if stop:
+            break
         f = result.fields(k)
         s = np.ones((body.rest.n_cells, 3))
         s[:, :body.dim] = f["principal_stretches"]
@@ -47,27 +53,51 @@ def write_solid_frames(directory: str | os.PathLike, result) -> list[str]:
 
 
 def write_solid_outputs(result, directory: str | os.PathLike) -> Path:
-    """Every requested output of ``result`` (a SolidResult) into ``directory``, atomically."""
+    """Every requested output of ``result`` (a SolidResult) into ``directory``, atomically.
+
+    Under a stop request (:func:`femkit.interrupt.active_flag`): when the solve itself was
+    stopped, every frame it computed is written and the pictures are skipped; a stop during
+    the frames keeps those written so far, a stop during a picture abandons it at once
+    (:func:`femkit.interrupt.raising`); either way ``result.output_stop`` names the signal and
+    result.json is written with ``interrupted: true``."""
     opts = result.case.spec.output
     final = Path(directory).resolve()
     result.output_dir = final
     files: list[str] = []
+    flag = result.case.run_options.get("stop")   # the run's flag (femkit solve: the active one)
+    flag = active_flag() if flag is None else flag
+    stop = None if flag else flag   # a stop already answered by the solve: write every frame
     with atomic_directory(final, EARLIER_RUN) as tmp:
         if opts.vtu:
-            frames = write_solid_frames(tmp, result)
-            write_collection(tmp / "solid.pvd", result.times, frames)
+            frames = write_solid_frames(tmp, result, stop=stop)
+            write_collection(tmp / "solid.pvd", result.times[:len(frames)], frames)
             files += ["solid.pvd", *frames]
-        if opts.png:
-            from .plot import write_solid_png
-
-            write_solid_png(tmp / "deformed.png", result)
-            files.append("deformed.png")
-        if opts.gif:
-            from .plot import write_solid_gif
-
-            write_solid_gif(tmp / "animation.gif", result)
-            files.append("animation.gif")
+            if len(frames) < len(result.x):
+                result.frames_written = len(frames)
+        files += _pictures(tmp, result, opts, flag)
+        if flag and flag.name != result.stopped:
+            result.output_stop = flag.name
         files.append("result.json")
         result.files = files
         write_json(tmp / "result.json", result.to_dict())
     return final
+
+
+def _pictures(tmp: Path, result, opts, flag) -> list[str]:
+    """``deformed.png`` and ``animation.gif`` as asked, in ``tmp``; none once ``flag`` (a
+    :class:`~femkit.interrupt.StopFlag` or None) is set: before (the solve was stopped) or
+    while one is drawn (abandoned at once)."""
+    from .plot import write_solid_gif, write_solid_png
+
+    files: list[str] = []
+    wanted = [(opts.png, "deformed.png", write_solid_png), (opts.gif, "animation.gif", write_solid_gif)]
+    for on, name, write in wanted:
+        if not on or flag:
+            continue
+        try:
+            with raising(f"writing {name}"):
+                write(tmp / name, result)
+        except Interrupted:
+            break
+        files.append(name)
+    return files

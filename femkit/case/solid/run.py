@@ -18,9 +18,13 @@ Time integration holds every fixed or roller component (per component: rollers s
 prescribed displacement from ``t = 0`` (:class:`~femkit.dynamics.system.MassSpringSystem`'s
 ``(n, d)`` pin mask).
 
-Static runs take load step ``k`` of ``K`` by :func:`femkit.solids.solve_static` from the
-previous equilibrium with ``k/K`` of the loads and prescribed displacements (what
-``solve_static(load_steps=K)`` does inside), keeping each equilibrium as a frame.
+Static runs are one :func:`femkit.solids.solve_static` with ``load_steps=K``: load step ``k``
+applies ``k/K`` of the loads and prescribed displacements from the previous equilibrium (the
+prescribed increment spread into the body by a linear solve, the step cut when that start still
+inverts elements); each equilibrium is kept as a frame (its ``on_step``), and a stop request is
+seen between Newton iterations (its ``stop``).
+
+SIGINT / SIGTERM (``case.run_options["stop"]``): see :func:`run_solid`.
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ import math
 import os
 import sys
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -339,13 +344,22 @@ class SolidResult:
     stats: dict = field(default_factory=dict)
     output_dir: Any = None
     files: list = field(default_factory=list)
+    steps: int = 0                   # time or load steps done
+    stopped: str | None = None       # the signal that stopped the solve ("SIGINT" ...), if one did
+    output_stop: str | None = None   # the signal that stopped the output, if one did
+    frames_written: int | None = None  # frames written before that stop (None: all)
+    warnings: list = field(default_factory=list)
     _fields: dict = field(default_factory=dict, repr=False)
 
     @property
     def converged(self) -> bool:
-        return self.failure is None
+        """False when the solve failed or was stopped before its end."""
+        return self.failure is None and self.stopped is None
 
-    interrupted = None
+    @property
+    def interrupted(self) -> str | None:
+        """The signal that stopped the solve or the writing of its outputs, else None."""
+        return self.stopped or self.output_stop
 
     def fields(self, k: int) -> dict:
         """Per-element fields of frame ``k`` (:meth:`femkit.solids.ElasticBody.element_fields`)."""
@@ -380,11 +394,13 @@ class SolidResult:
             "static": None if spec.static is None else {
                 "load_steps": spec.static.load_steps, "project": spec.static.project},
             "linear_solver": spec.solver.to_dict(),
-            "dt": spec.dt, "t_end": spec.t_end, "steps_planned": spec.steps,
-            "frames": len(self.x),
+            "dt": spec.dt, "t_end": spec.t_end, "steps": int(self.steps),
+            "steps_planned": spec.steps,
+            "frames": len(self.x) if self.frames_written is None else self.frames_written,
             "times": [float(t) for t in self.times],
             "energies": [dict(e) for e in self.energies],
             "load_steps": [{"load_factor": r.load_factor, "iterations": r.iterations,
+                            "substeps": r.substeps,
                             "residuals": list(map(float, r.residuals)),
                             "converged": r.converged} for r in self.records],
             "max_displacement": float(np.linalg.norm(u, axis=1).max()),
@@ -396,7 +412,9 @@ class SolidResult:
             "stretch_range": [float(fields["principal_stretches"].min()),
                               float(fields["principal_stretches"].max())],
             "inverted_elements": int(len(inverted)),
+            "interrupted": self.interrupted is not None,
             "verdict": self.verdict, "converged": self.converged, "failure": self.failure,
+            "warnings": list(self.warnings),
             "residual_history": self.residual_history,
             "stats": dict(self.stats),
             "wall_time": float(self.wall_time), "timings": dict(self.timings),
@@ -407,10 +425,15 @@ class SolidResult:
         d = self.to_dict()
         m = d["mesh"]
         mats = ", ".join(f"{x['model']} (E {x['E']:.4g}, nu {x['nu']:.3g})" for x in d["materials"])
+        cut = [f"{i} in {r['substeps']}" for i, r in enumerate(d["load_steps"], 1)
+               if r["substeps"] > 1]
         how = (f"static, {d['static']['load_steps']} load steps, "
                f"{sum(r['iterations'] for r in d['load_steps'])} Newton iterations"
+               + (f"; cut into sub-steps where the whole increment inverted elements: load step "
+                  f"{', '.join(cut)}" if cut else "")
                if d["mode"] == "static" else
                f"{d['integrator']['method']}, dt {d['dt']:.4g}, t_end {d['t_end']:.4g}")
+        stopped = f" (interrupted by {self.interrupted})" if self.interrupted else ""
         e = d["energies"][-1]
         lines = [f"solid     {self.case.name}: {m['cells']} {m['cell_type']} cells, {m['points']} "
                  f"nodes ({m['dim']}D), {mats}",
@@ -422,7 +445,11 @@ class SolidResult:
                     "- (every element inverted)"),
                  f"energy    elastic {e['elastic']:.6g}, kinetic {e['kinetic']:.6g}, gravity "
                  f"{e['gravity']:.6g}, load {e['load']:.6g} (last frame of {d['frames']})",
-                 f"verdict   {self.verdict}" + (f": {self.failure}" if self.failure else "")]
+                 f"steps     {d['steps']} of {d['steps_planned']} "
+                 f"{'load' if d['mode'] == 'static' else 'time'} steps{stopped}, "
+                 f"{d['frames']} frames",
+                 f"verdict   {self.verdict}" + (f": {self.failure}" if self.failure else ""),
+                 "time      " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timings.items())]
         if self.output_dir is not None:
             lines.append(f"output    {self.output_dir} ({len(self.files)} files)")
         return lines
@@ -431,37 +458,38 @@ class SolidResult:
 # ----------------------------------------------------------------------------- run
 
 def _run_static(case, problem: SolidProblem, stop) -> dict:
+    """The load steps by :func:`femkit.solids.solve_static`, each equilibrium kept as a frame;
+    a failure (Newton, a linear solve) keeps the frames before it."""
     from ...solids import solve_static
 
     spec, body = case.spec, problem.body
     st = spec.static
     K = st.load_steps
-    f = problem.traction + problem.weight
     x = body.rest_positions.copy()
     out = {"times": [0.0], "x": [x], "v": [np.zeros_like(x)],
            "energies": [frame_energies(problem, x)], "records": []}
-    for k in range(1, K + 1):
-        if stop:
-            break
-        bc = problem.dirichlet(k / K)
-        try:
-            res = solve_static(body, bc, f * (k / K), load_steps=1, project=st.project,
-                               rtol=st.rtol, max_iterations=st.max_iterations,
-                               linear_solver=spec.solver, x0=x)
-        except EquilibriumError as exc:
-            history = [float(r) for s in (exc.record.steps if exc.record else []) for r in s.residuals]
-            out["failure"] = (f"load step {k}/{K} (load factor {k / K:g}): "
-                              + " ".join(str(exc).split()))
-            out["residual_history"] = history or None
-            break
-        rec = res.steps[0]
-        rec.load_factor = k / K
+
+    def keep(rec, x):
         out["records"].append(rec)
-        x = res.x
-        out["times"].append(k / K)
+        out["times"].append(rec.load_factor)
         out["x"].append(x)
         out["v"].append(np.zeros_like(x))
-        out["energies"].append(frame_energies(problem, x, load_factor=k / K))
+        out["energies"].append(frame_energies(problem, x, load_factor=rec.load_factor))
+
+    try:
+        solve_static(body, problem.dirichlet(1.0), problem.traction + problem.weight,
+                     load_steps=K, project=st.project, rtol=st.rtol,
+                     max_iterations=st.max_iterations, linear_solver=spec.solver,
+                     on_step=keep, stop=stop)
+    except SolverError as exc:   # Newton or a linear solve failed: the load steps before are kept
+        k = len(out["records"]) + 1
+        out["failure"] = (f"load step {k}/{K} (load factor {k / K:g}): " + " ".join(str(exc).split()))
+        out["verdict"] = "newton_failed" if isinstance(exc, EquilibriumError) else "solver_failed"
+        record = getattr(exc, "record", None)
+        history = [float(r) for s in (record.steps if record else []) for r in s.residuals]
+        out["residual_history"] = history or None
+    out["stopped"] = "failure" not in out and len(out["records"]) < K
+    out["steps"] = len(out["records"])
     return out
 
 
@@ -505,7 +533,8 @@ def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
         out["residual_history"] = getattr(exc, "residuals", None)
     out.update(times=list(traj.times), x=list(traj.x), v=list(traj.v),
                energies=[frame_energies(problem, x, v) for x, v in zip(traj.x, traj.v)],
-               records=[], stats=dict(traj.stats))
+               records=[], stats=dict(traj.stats), stopped=bool(traj.interrupted),
+               steps=int(traj.steps))
     return out
 
 
@@ -513,46 +542,67 @@ def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = F
               write: bool = True, echo: Callable[[str], Any] | None = None) -> SolidResult:
     """Run a prepared solid case: build, solve (static or dynamic), write, print the summary.
 
+    A stop request (``case.run_options["stop"]``, set by SIGINT/SIGTERM under ``femkit solve``)
+    during the meshing stops at once (nothing written); during the solve it ends the run after
+    the current time step or Newton iteration, and the frames so far are written with
+    ``interrupted: true`` (no pictures); during the output the frames written so far are kept,
+    the pictures skipped. Warnings raised during the solve are kept in ``result.json`` and
+    printed as ``femkit: warning: ...`` lines.
+
     Returns
     -------
     SolidResult
         ``converged`` false when Newton failed in a load step or the integration became
-        unstable; the frames before are kept and written.
+        unstable; the frames before are kept and written. ``interrupted`` names the signal that
+        stopped it.
     """
+    from ...interrupt import raising
     from ...progress import Progress
+    from ...timing import WallClock
     from .cost import check_solid_fits
 
+    clock = WallClock()
     if write:
         check_output_dir(output_dir or case.spec.output.dir, EARLIER_RUN)
     check_solid_fits(case)
     timer = StageTimer()
     t0 = time.perf_counter()
-    with timer("build"):
+    with raising("meshing"), timer("build"):
         problem = build_problem(case)
     stop = case.run_options.get("stop")
-    with timer("solve"):
+    with timer("solve"), warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         if case.spec.static is not None:
             run = _run_static(case, problem, stop)
         else:
             progress = Progress(case.spec.steps, f"solid {case.name}", unit="step", quiet=quiet)
             run = _run_dynamic(case, problem, stop, progress)
+    messages = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     failure = run.get("failure")
     result = SolidResult(case=case, problem=problem, times=np.asarray(run["times"], float),
                          x=run["x"], v=run["v"], energies=run["energies"],
                          records=run["records"], failure=failure,
                          residual_history=run.get("residual_history"),
-                         verdict="converged" if failure is None else run.get("verdict") or (
-                             "newton_failed" if case.spec.static else "unstable"),
-                         wall_time=time.perf_counter() - t0, timings=timer.times,
-                         stats=run.get("stats", {}))
+                         verdict=_verdict(case, run, stop), wall_time=time.perf_counter() - t0,
+                         timings=timer.times, stats=run.get("stats", {}),
+                         steps=run["steps"], stopped=stop.name if run.get("stopped") else None, warnings=messages)
+    for w in () if quiet else messages:
+        print(f"femkit: warning: {w}", file=sys.stderr)
     if write:
         from .output import write_solid_outputs
 
         with timer("output"):
             write_solid_outputs(result, output_dir or case.spec.output.dir)
-    if failure is not None:
+    if failure is not None and (write or not quiet):  # a caller keeping nothing says it itself
         print(f"femkit: {result.verdict.replace('_', ' ')}: {failure}", file=sys.stderr)
     if not quiet:
-        for line in result.summary_lines():
+        for line in result.summary_lines() + [clock.summary(result.timings)]:
             (echo or print)(line)
     return result
+
+
+def _verdict(case, run: dict, stop) -> str:
+    """``converged``, the failure's verdict, or ``interrupted`` (a solve stopped early)."""
+    if run.get("failure") is not None:
+        return run.get("verdict") or ("newton_failed" if case.spec.static else "unstable")
+    return "interrupted" if run.get("stopped") else "converged"
