@@ -240,7 +240,7 @@ def test_the_cycle_checker_finds_cycles_and_resolves_submodule_imports():
              "femkit.a.y": {"femkit.a.x"}, "femkit.a.z": set()}
     assert _cycles(graph, "femkit.a") == [["femkit.a.x", "femkit.a.y"]]
     g = _module_graph()
-    assert "femkit.solvers.defaults" in g["femkit.solvers.registry"]   # `from . import defaults`
+    assert "femkit.solvers.core.defaults" in g["femkit.solvers.registry"]   # `from . import defaults`
     assert "femkit.solvers" not in g["femkit.solvers.registry"]        # ... not the package
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import copy
 
 from ..case.specs import INTEGRATOR_SCHEMA, solver_schema
-from ..solvers.defaults import COMPARISON_RTOL
+from ..solvers.core.defaults import COMPARISON_RTOL
 
 POS = {"type": "number", "exclusiveMinimum": 0}
 POSINT = {"type": "integer", "minimum": 1}

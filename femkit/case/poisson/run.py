@@ -73,7 +73,7 @@ def prepare_poisson(case: Case) -> None:
             raise CaseFileError(f"mesh.{bad}: only used with mesh.geometry, not with mesh.file")
     else:
         check_geometry_spec(mesh, "mesh")
-    from ...solvers.defaults import DEFAULT_METHOD
+    from ...solvers.core.defaults import DEFAULT_METHOD
     from ..specs import solver_spec
 
     case.solver = solver_spec(d["solver"], "solver", default_method=DEFAULT_METHOD["poisson"])
@@ -304,7 +304,7 @@ def _solve(case: Case, system, stop, **mg):
     if stop is None:
         return case.solver.solve(system.A, system.b, **mg)
     from ...interrupt import stopping_callback
-    from ...solvers.result import SolveResult
+    from ...solvers.core.result import SolveResult
 
     try:
         return case.solver.solve(system.A, system.b, callback=stopping_callback(stop), **mg)

@@ -53,7 +53,7 @@ from ...errors import (
 )
 from ...io.atomic import EARLIER_RUN, atomic_directory, check_output_dir
 from ...progress import Progress
-from ...solvers.defaults import DEFAULT_METHOD
+from ...solvers.core.defaults import DEFAULT_METHOD
 from ...timing import StageTimer
 from ..cost import check_scene_fits
 from ..expressions import compile_expression
