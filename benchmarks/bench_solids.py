@@ -99,7 +99,7 @@ def newton_iteration(quick: bool) -> None:
     import warnings
 
     from femkit.dynamics.forces import Gravity
-    from femkit.dynamics.forces.elastic import elastic_system
+    from femkit.dynamics.system import elastic_system
     from femkit.dynamics.integrators import StepContext, get_integrator
     from femkit.mesh.structured import structured_box
     from femkit.solids import ElasticBody, material, tagged_nodes
