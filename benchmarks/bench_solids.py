@@ -3,7 +3,7 @@
 Gradient + element-wise projected Hessian of a stable neo-Hookean tetrahedral box (~100k
 tetrahedra; ``--quick``: ~10k), randomly perturbed, three ways in one run:
 
-* femkit's compiled element pass (:func:`femkit.solids.compiled.element_pass`: Jacobi + Givens-QR
+* femkit's compiled element pass (:func:`femkit.elements.compiled.element_pass`: Jacobi + Givens-QR
   signed SVD, principal-frame eigensystem, values written straight into the CSR data);
 * the same formulas vectorised in plain NumPy (batched ``np.linalg.svd``/``eigh``, ``einsum``,
   one ``np.bincount`` into the same CSR pattern): the honest baseline a user would write;
