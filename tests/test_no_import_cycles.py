@@ -4,7 +4,8 @@ The module import graph is read from the AST of every module: an edge ``a -> b``
 ``import`` or ``from ... import`` in ``a`` (at module level or inside a function), ``b`` being
 the module named (``from pkg import name`` names the submodule ``pkg.name`` when there is one,
 else the package ``pkg``), and for every string constant naming a femkit module for importlib to
-load: ``"femkit.x.y"`` or ``"femkit.x.y:attr"`` (an import in all but syntax). Imports under
+load: ``"femkit.x.y"`` or ``"femkit.x.y:attr"`` (an import in all but syntax; a module's string
+naming itself is not). Imports under
 ``if TYPE_CHECKING:`` never run and are left out. A cycle is a strongly connected component of
 more than one node (Tarjan 1972), or a node importing itself; the tests list every component, so
 one run shows every cycle to break.
@@ -77,7 +78,10 @@ def import_graph(root: Path, package: str) -> dict[str, set[str]]:
         is_pkg = path.name == "__init__.py"
         here = name.split(".") if is_pkg else name.split(".")[:-1]
         for node in _import_nodes(ast.parse(path.read_text(encoding="utf-8"))):
-            for target in _targets(node, here, files):
+            targets = _targets(node, here, files)
+            if isinstance(node, ast.Constant) and targets == [name]:
+                continue  # a module naming itself (femkit.plugins: its entry-point group)
+            for target in targets:
                 while target and target not in files:  # import a.b.c of a non-module attribute
                     target = target.rpartition(".")[0]
                 if target:

@@ -108,7 +108,7 @@ def _partial(node: dict) -> None:
 
 def schema_for(kind: str) -> dict:
     """The full schema of a study of ``kind`` (with its ``quick:`` block)."""
-    from ..case.kinds import KINDS
+    from ..kinds import KINDS
 
     props = {**copy.deepcopy(COMMON), **copy.deepcopy(KINDS.get(kind, "kind").get_schema())}
     quick = _obj({k: copy.deepcopy(v) for k, v in props.items() if k != "kind"})

@@ -156,7 +156,7 @@ def _section(text: str, title: str) -> list[str]:
 
 
 def test_study_help_lists_every_registered_kind_exit_codes_and_examples(capsys):
-    from femkit.case.kinds import KINDS
+    from femkit.kinds import KINDS
 
     text = _help(["study"], capsys)
     kinds = [line.split()[0] for line in _section(text, "study kinds")]

@@ -1,6 +1,6 @@
 """Run a ``problem: mass_spring`` scene end to end: system, forces, integrator, outputs.
 
-``femkit solve SCENE.yaml`` dispatches here through :data:`femkit.case.kinds.KINDS`:
+``femkit solve SCENE.yaml`` dispatches here through :data:`femkit.kinds.KINDS`:
 :func:`prepare_scene` checks everything at load time (integrator, linear solver and
 preconditioner names against their registries, integrator options, mesh geometry and file,
 expressions, output cadence), so bad input fails before anything is computed or written;

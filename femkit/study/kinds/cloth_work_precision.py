@@ -6,7 +6,7 @@ this module registers it. Cost plan :func:`femkit.study.cost.plan_cloth_study`.
 
 from __future__ import annotations
 
-from ...case.kinds import Kind, register_kind
+from ...kinds import Kind, register_kind
 
 
 def _schema() -> dict:
