@@ -221,3 +221,32 @@ def test_the_checker_finds_cycles_in_a_tiny_package(tmp_path):
     graph["toy.c"].discard("toy.a")
     graph["toy.selfish"].clear()
     assert cycles(graph) == []
+
+
+def test_the_package_graph_folds_folders_and_sees_string_imports(tmp_path):
+    """Two folders that import each other through different modules (no module cycle) are a
+    package cycle; an ``__init__`` re-exporting its subtree is not an edge; the root folder's
+    modules are nodes of their own; an importlib string is an edge, a module's own name is not."""
+    _write(tmp_path, {
+        "toy/__init__.py": "from .low import base\n",
+        "toy/cli.py": "import importlib\ndef main():\n    importlib.import_module('toy.app.run')\n",
+        "toy/leaf.py": "NAME = 'toy.leaf'\n",
+        "toy/low/__init__.py": "from .base import thing\n",
+        "toy/low/base.py": "thing = 1\n",
+        "toy/low/helper.py": "from ..high import user\n",
+        "toy/high/__init__.py": "",
+        "toy/high/user.py": "from ..low.base import thing\n",
+        "toy/app/__init__.py": "",
+        "toy/app/run.py": "X = 'toy.cli:main'\n",
+    })
+    graph = import_graph(tmp_path, "toy")
+    assert graph["toy.cli"] == {"toy.app.run"} and graph["toy.leaf"] == set()
+    assert cycles(graph) == [["toy.app.run", "toy.cli"]]
+    packages = {"toy", "toy.low", "toy.high", "toy.app"}
+    folded = package_graph(graph, packages, "toy")
+    assert folded["toy"] == set() and folded["toy.low"] == {"toy.high"}
+    assert folded["toy.high"] == {"toy.low"} and folded["toy.app"] == {"toy.cli"}
+    assert cycles(folded) == [["toy.app", "toy.cli"], ["toy.high", "toy.low"]]
+    graph["toy.low.helper"].clear()
+    graph["toy.app.run"].clear()
+    assert cycles(package_graph(graph, packages, "toy")) == []
