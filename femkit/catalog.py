@@ -13,7 +13,6 @@ record itself says (a geometry's dimension, parameters and tags).
 
 from __future__ import annotations
 
-import inspect
 import re
 import sys
 from typing import Callable
@@ -118,6 +117,8 @@ def _first_line(text: str | None) -> str:
 
 def describe(obj) -> str:
     """One line saying what a registered ``obj`` is (see the module docstring)."""
+    import inspect
+
     from .mesh.geometries import Geometry
 
     if isinstance(obj, Geometry):
