@@ -78,6 +78,11 @@ class Kind:
         Studies: ``report(report, study, result, data, stage)`` fills the report.
     summary : callable, optional
         Studies: ``summary(result) -> list[str]``, the lines ``femkit study`` prints.
+    default_solver : str, optional
+        The solver method of the kind's linear solves when the file names none (``solver:`` /
+        ``linear_solver:`` without ``method``): the one home of that default (``pcg`` for
+        Poisson, ``direct`` for scenes, ``cholesky`` for the cloth study). None: the kind takes no
+        solver mapping of its own.
     """
 
     name: str
@@ -88,6 +93,7 @@ class Kind:
     plan: Callable | None = None
     report: Callable | None = None
     summary: Callable | None = None
+    default_solver: str | None = None
 
     def __post_init__(self):
         if self.key not in FAMILIES:

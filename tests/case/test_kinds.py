@@ -104,3 +104,18 @@ def test_a_registered_problem_kind_is_dispatched_and_its_data_is_read_only(tmp_p
     finally:
         KINDS.remove("toy")
     assert "toy" not in KINDS
+
+
+def test_each_kind_declares_its_default_solver_and_a_file_without_one_gets_it():
+    """The default method of a kind's solves lives on the kind (no table keyed by kind names
+    elsewhere): a registered solver, and what a file without ``method`` runs with."""
+    from femkit.solvers import SOLVERS
+    from femkit.solvers.core import defaults
+
+    assert not hasattr(defaults, "DEFAULT_METHOD")
+    declared = {n: KINDS.get(n).default_solver for n in KINDS.names() if KINDS.get(n).default_solver}
+    assert {"poisson", "mass_spring", "cloth_work_precision"} <= set(declared)
+    assert all(m in SOLVERS.names() for m in declared.values()), declared
+    case = case_from_dict({"problem": "poisson", "mesh": {"geometry": "unit_square", "h": 0.5},
+                           "source": "1", "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]}})
+    assert case.solver.method == declared["poisson"] == "pcg"

@@ -73,10 +73,11 @@ def prepare_poisson(case: Case) -> None:
             raise CaseFileError(f"mesh.{bad}: only used with mesh.geometry, not with mesh.file")
     else:
         check_geometry_spec(mesh, "mesh")
-    from ...solvers.core.defaults import DEFAULT_METHOD
+    from ...kinds import KINDS
     from ..specs import solver_spec
 
-    case.solver = solver_spec(d["solver"], "solver", default_method=DEFAULT_METHOD["poisson"])
+    case.solver = solver_spec(d["solver"], "solver",
+                              default_method=KINDS.get(case.problem, "problem").default_solver)
     d["solver"] = case.solver.to_dict()
     from ..specs import limits_spec
 

@@ -44,4 +44,5 @@ def _plan(case, measure: bool = True):
     return plan_scene_case(case, system_size(case.spec.system), build=build, measure=measure)
 
 
-KIND = register_kind(Kind("mass_spring", "problem", _schema, _prepare, _run, _plan))
+KIND = register_kind(Kind("mass_spring", "problem", _schema, _prepare, _run, _plan,
+                          default_solver="direct"))

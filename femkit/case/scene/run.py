@@ -52,8 +52,8 @@ from ...errors import (
     with_prefix,
 )
 from ...io.atomic import EARLIER_RUN, atomic_directory, check_output_dir
+from ...kinds import KINDS
 from ...progress import Progress
-from ...solvers.core.defaults import DEFAULT_METHOD
 from ...timing import StageTimer
 from ..cost import check_scene_fits
 from ..expressions import compile_expression
@@ -130,8 +130,8 @@ def prepare_scene(case: Case) -> None:
         raise CaseFileError(str(exc)) from None
 
     # linear solver
-    case.solver = ls_spec = solver_spec(d["linear_solver"], "linear_solver",
-                                        default_method=DEFAULT_METHOD["mass_spring"])
+    default = KINDS.get(case.problem, "problem").default_solver
+    case.solver = ls_spec = solver_spec(d["linear_solver"], "linear_solver", default_method=default)
     case.run_options["limits"] = limits_spec(d.get("limits"))
     if integ.options.get("matrix_free"):  # caught at load time, before anything runs
         try:
