@@ -94,7 +94,8 @@ def solvers(H, sys_):
 
     from femkit.solvers import pcg
     from femkit.solvers.fmg import fmg
-    from femkit.solvers.preconditioners import amg, gmg
+    from femkit.solvers import gmg
+    from femkit.solvers.preconditioners import amg
 
     A, b, free = sys_.A, sys_.b, sys_.free
 
@@ -129,7 +130,7 @@ def max_nodal(sys_, mesh, x):
 
 def bench(levels: int, repeat: int, renumber: str = "none"):
     from femkit.solvers import pcg
-    from femkit.solvers.preconditioners import gmg
+    from femkit.solvers import gmg
 
     H, sys_, t_h, t_asm = problem(levels, renumber)
     A, b, mesh = sys_.A, sys_.b, H.finest
@@ -213,7 +214,7 @@ def locality(levels: int, repeat: int):
     from femkit.fem import apply_dirichlet, assemble_load, assemble_stiffness
     from femkit.mesh import MeshHierarchy, boundary_nodes, generate
     from femkit.solvers.fmg import fmg
-    from femkit.solvers.preconditioners import gmg
+    from femkit.solvers import gmg
 
     coarse = generate("unit_square", 0.5)
     rows = {}
@@ -337,7 +338,7 @@ def vcycle_factors(omegas, levels=(3, 7), steps: int = 30):
 
     from femkit.fem import apply_dirichlet, assemble_stiffness
     from femkit.mesh import MeshHierarchy, boundary_nodes, generate
-    from femkit.solvers.preconditioners.gmg import Multigrid
+    from femkit.solvers.gmg import Multigrid
 
     print(f"\n=== V(2,2) energy-norm factor, {steps} power steps ===")
     print(f"{'geometry':12s} {'levels':>6s} " + " ".join(f"{'w=' + str(w):>7s}" for w in omegas))

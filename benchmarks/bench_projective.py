@@ -48,7 +48,7 @@ def _median_time(fn, repeat: int = 3):
 
 def scene(cells, mu: float = 2e4, rho: float = 1000.0):
     from femkit.dynamics.forces import Gravity
-    from femkit.dynamics.forces.elastic import elastic_system
+    from femkit.dynamics.system import elastic_system
     from femkit.mesh.structured import structured_box
     from femkit.solids import Corotational, ElasticBody
 

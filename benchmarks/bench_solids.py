@@ -3,7 +3,7 @@
 Gradient + element-wise projected Hessian of a stable neo-Hookean tetrahedral box (~100k
 tetrahedra; ``--quick``: ~10k), randomly perturbed, three ways in one run:
 
-* femkit's compiled element pass (:func:`femkit.solids.compiled.element_pass`: Jacobi + Givens-QR
+* femkit's compiled element pass (:func:`femkit.elements.compiled.element_pass`: Jacobi + Givens-QR
   signed SVD, principal-frame eigensystem, values written straight into the CSR data);
 * the same formulas vectorised in plain NumPy (batched ``np.linalg.svd``/``eigh``, ``einsum``,
   one ``np.bincount`` into the same CSR pattern): the honest baseline a user would write;
@@ -99,7 +99,7 @@ def newton_iteration(quick: bool) -> None:
     import warnings
 
     from femkit.dynamics.forces import Gravity
-    from femkit.dynamics.forces.elastic import elastic_system
+    from femkit.dynamics.system import elastic_system
     from femkit.dynamics.integrators import StepContext, get_integrator
     from femkit.mesh.structured import structured_box
     from femkit.solids import ElasticBody, material, tagged_nodes

@@ -13,7 +13,6 @@ record itself says (a geometry's dimension, parameters and tags).
 
 from __future__ import annotations
 
-import inspect
 import re
 import sys
 from typing import Callable
@@ -70,20 +69,23 @@ def _materials():
 
 
 class _Family:
-    """One family of :data:`femkit.case.kinds.KINDS` seen as a registry (``names``/``get``)."""
+    """One family of :data:`femkit.kinds.KINDS` seen as a registry (``names``/``get``)."""
 
     def __init__(self, key: str):
         self.key = key
 
-    def names(self) -> list[str]:
-        from .case.kinds import KINDS
+    @staticmethod
+    def _kinds():
+        from . import case, study  # noqa: F401  each hands KINDS the finder of its own kinds
+        from .kinds import KINDS
 
-        return KINDS.names(self.key)
+        return KINDS
+
+    def names(self) -> list[str]:
+        return self._kinds().names(self.key)
 
     def get(self, name: str):
-        from .case.kinds import KINDS
-
-        return KINDS.get(name, self.key)
+        return self._kinds().get(name, self.key)
 
 
 #: group name -> (what it is, function returning its registry). Order = ``femkit list`` order.
@@ -124,6 +126,8 @@ _SENTENCE_END = re.compile(r"(?<=[.:])(?<!\b[A-Z][a-z]\.)(?<!\b[A-Z]\.)\s+(?=[A-
 
 def describe(obj) -> str:
     """One line saying what a registered ``obj`` is (see the module docstring)."""
+    import inspect
+
     from .mesh.geometries import Geometry
 
     if isinstance(obj, Geometry):
@@ -158,7 +162,7 @@ def entries(group: str) -> list[tuple[str, str]]:
 
 def render(groups=None) -> str:
     """The text ``femkit list [GROUP ...]`` prints."""
-    from .case.plugins import load_plugins
+    from .plugins import load_plugins
 
     load_plugins()  # a plugin's entries are listed too
     blocks = []

@@ -329,18 +329,14 @@ def _add_study(sub) -> None:
 
 # ----------------------------------------------------------------------------- list
 
-#: the groups of ``femkit list`` (kept equal to femkit.catalog.GROUPS by a test; listed here so
-#: that ``femkit list --help`` imports nothing)
-LIST_GROUPS = ("geometries", "solvers", "preconditioners", "backends", "integrators", "forces",
-               "systems", "materials", "problems", "studies")
-
-
 def _add_list(sub) -> None:
+    from .catalog import GROUPS  # the groups themselves; importing it loads no registry
+
     p = sub.add_parser(
         "list", help="list the names case and study files may use (geometries, solvers, ...)",
         description=(
             "Print every registered name of each GROUP with one line on what it is: "
-            + ", ".join(LIST_GROUPS) + " (default: all). Read from the live registries, "
+            + ", ".join(GROUPS) + " (default: all). Read from the live registries, "
             "plugins included, so it is never out of date. Nothing is written."),
         epilog="exit codes:\n  0  listed\n  2  unknown group (the valid ones are named)\n\n"
                "examples:\n  femkit list\n  femkit list solvers preconditioners\n",
@@ -351,7 +347,9 @@ def _add_list(sub) -> None:
 
 def _list_group(name: str) -> str:
     """``solver`` -> ``solvers``, ``geometry`` -> ``geometries``, ``study`` -> ``studies``."""
-    for group in LIST_GROUPS:
+    from .catalog import GROUPS
+
+    for group in GROUPS:
         if name in (group, group[:-1], group[:-3] + "y"):
             return group
     return name  # unknown: femkit.catalog names the valid groups

@@ -1,13 +1,28 @@
 """Case files: schema validation, safe expressions, loading and running.
 
 ``load_case(path, **overrides) -> Case``; ``Case.run(output_dir=None, quiet=True, write=True)``.
-Kinds of file (``problem: poisson``, ``problem: mass_spring``, and the study kinds) are
-dispatched through the one registry :data:`femkit.case.kinds.KINDS`; a new kind is one module
-calling :func:`femkit.case.kinds.register_kind`.
+Kinds of file (``problem: poisson``, ``problem: mass_spring``, ``problem: solid``) are
+dispatched through the one registry :data:`femkit.kinds.KINDS` (a leaf below this package); a
+new kind is one module calling :func:`femkit.kinds.register_kind`. This package hands the
+registry the finder of its built-in kinds: the ``kind.py`` of each of its folders.
 """
 
+import importlib
+import importlib.util
+import pkgutil
+
+from ..kinds import KINDS, Kind, register_kind
 from .load import Case, apply_overrides, case_from_dict, load_case
-from .kinds import KINDS, Kind, register_kind
+
+
+def _find_problem_kinds() -> None:
+    """Import ``femkit/case/<folder>/kind.py`` of every folder here: each registers its kind."""
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda i: i.name):
+        if info.ispkg and importlib.util.find_spec(f"{__name__}.{info.name}.kind"):
+            importlib.import_module(f"{__name__}.{info.name}.kind")
+
+
+KINDS.add_finder("problem", _find_problem_kinds)
 
 __all__ = ["Case", "load_case", "case_from_dict", "apply_overrides", "KINDS", "Kind",
            "register_kind", "compile_expression"]

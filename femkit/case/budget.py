@@ -34,7 +34,7 @@ RAISE_TIME = f"{OVERRIDE} or a larger limits: {{time: ...}}"
 
 def plan_case(case, *, measure: bool = True) -> Plan:
     """The plan of any case, through its kind (``KINDS[case.problem].plan``)."""
-    from .kinds import KINDS
+    from ..kinds import KINDS
 
     kind = KINDS.get(case.problem, "problem")
     if kind.plan is None:  # a kind without a cost model runs unchecked, and the plan says so

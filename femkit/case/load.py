@@ -24,7 +24,7 @@ from typing import Any, Mapping
 
 from ..errors import CaseFileError, UnknownNameError
 from .frozen import freeze
-from .kinds import KINDS
+from ..kinds import KINDS
 from .schema import fill_defaults, validate_against
 
 __all__ = ["Case", "load_case", "case_from_dict", "read_yaml", "apply_overrides"]
@@ -40,7 +40,7 @@ class Case:
         The validated case, defaults filled, relative paths resolved against ``base_dir``;
         read-only once loaded (:func:`femkit.case.frozen.freeze`).
     problem : str
-        The ``problem`` key (dispatch key of :data:`femkit.case.kinds.KINDS`).
+        The ``problem`` key (dispatch key of :data:`femkit.kinds.KINDS`).
     name : str
         ``name`` key, else the file stem.
     base_dir : Path

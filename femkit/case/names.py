@@ -31,7 +31,7 @@ def lookup(registry, name: str, where: str):
 
 def check_options(fn, options: dict, where: str, exclude=()) -> None:
     """Unknown keyword options of ``fn`` are a CaseFileError naming ``where`` and the valid ones."""
-    from ..solvers.checks import check_options as _check
+    from ..solvers.core.checks import check_options as _check
 
     try:
         _check(fn, options, what=where.rsplit(".", 1)[0], exclude=exclude)

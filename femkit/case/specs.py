@@ -2,7 +2,7 @@
 
 A spec is built once, after schema validation, from the mapping a file gives; the names in it
 are checked against the live registries (so a newly registered solver is accepted without
-touching a schema) and every default comes from one table, :mod:`femkit.solvers.defaults`.
+touching a schema) and every default comes from one table, :mod:`femkit.solvers.core.defaults`.
 The records themselves belong to the library layers (:class:`femkit.solvers.SolverSpec`,
 :class:`IntegratorSpec` here); this module adds the schema fragments (:data:`SOLVER_SCHEMA`,
 :data:`INTEGRATOR_SCHEMA`), the same objects in every file schema, and :func:`solver_spec`,

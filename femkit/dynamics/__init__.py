@@ -11,7 +11,7 @@ from __future__ import annotations
 
 #: submodule -> the names it exports here (imported on first access, by plain relative imports)
 _EXPORTS = {
-    "system": ("MassSpringSystem",),
+    "system": ("MassSpringSystem", "elastic_system"),
     "forces": ("Gravity", "ViscousDamping", "RayleighDamping", "GroundContact", "SphereContact"),
     "topology": ("rope", "cloth_grid", "mesh_springs", "single_spring"),
     "stability": ("estimate_omega_max", "critical_dt"),

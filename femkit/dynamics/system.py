@@ -37,9 +37,10 @@ import scipy.sparse as sp
 
 from ..errors import InputError, UnknownNameError
 from .forces.base import Force
+from .forces.elastic import ElasticForce
 from .forces.rayleigh import RayleighDamping
 from .forces.springs import dashpot_forces, geometry_from_difference, hooke_forces, spring_energy
-from .jacobian import (
+from .forces.jacobian import (
     FIXES,
     _transverse_factor,
     SpringPattern,
@@ -49,7 +50,7 @@ from .jacobian import (
     spring_blocks,
 )
 
-__all__ = ["MassSpringSystem", "COMPILED_SPRINGS"]
+__all__ = ["MassSpringSystem", "COMPILED_SPRINGS", "elastic_system"]
 
 #: From this many springs on, :meth:`MassSpringSystem.spring_forces` (Hooke only) runs the
 #: compiled one-pass kernel (:func:`femkit.dynamics.kernels.spring_kernels.spring_forces`)
@@ -391,7 +392,7 @@ class MassSpringSystem:
             raise UnknownNameError("definiteness fix", str(fix), [f for f in FIXES if f])
 
     def regularization_shift(self, x) -> float:
-        """The ``mu`` of ``fix="regularize"`` at ``x`` (see :func:`femkit.dynamics.jacobian.regularization_shift`)."""
+        """The ``mu`` of ``fix="regularize"`` at ``x`` (see :func:`femkit.dynamics.forces.jacobian.regularization_shift`)."""
         x = self._state(x)
         _, l, _ = self._geometry(x)
         extra = None
@@ -599,3 +600,22 @@ class MassSpringSystem:
         from .stability import estimate_omega_max
 
         return estimate_omega_max(self, x, **options)
+
+
+def elastic_system(body, *, x0=None, v0=None, pinned=None, forces: Iterable[Force] = ()):
+    """A :class:`MassSpringSystem` whose only internal force is the
+    elastic ``body`` (no springs), lumped masses from its density, plus the declared ``forces``
+    (gravity, damping, contact) and ``pinned`` nodes; starts at rest positions unless ``x0``.
+
+    >>> from femkit.solids import ElasticBody, StableNeoHookean
+    >>> body = ElasticBody([[0., 0.], [1., 0.], [0., 1.]], [[0, 1, 2]], StableNeoHookean(1., 1.))
+    >>> s = elastic_system(body, pinned=[0])
+    >>> s.force(s.x0, s.v0).tolist()
+    [[0.0, 0.0], [0.0, 0.0], [0.0, 0.0]]
+    """
+    x = body.rest_positions if x0 is None else np.asarray(x0, dtype=float)
+    if x.shape != body.rest_positions.shape:
+        raise InputError(f"x0 must have the body's shape {body.rest_positions.shape} "
+                         f"({body.n} nodes), got {x.shape}")
+    return MassSpringSystem(x, body.lumped_masses(), np.zeros((0, 2), dtype=np.int64), 0.0,
+                            v0=v0, pinned=pinned, forces=[ElasticForce(body), *forces])

@@ -41,7 +41,8 @@ import numba
 import numpy as np
 
 from ..mesh._edges_kernel import sort_buckets
-from ._kernels import _element_scale, _incidences, _tetrahedron, _triangle, _values
+from ._kernels import _element_scale, _incidences, _values
+from .cells.kernels import _tetrahedron, _triangle
 
 #: Row positions are stored in one byte: rows longer than this take the element-order pass.
 MAX_ROW = 255
@@ -88,7 +89,7 @@ def _cell_rows(cells, n, inc, start, indices, rel, diag):  # pragma: no cover - 
 @numba.njit(cache=True)
 def _triangle_values(tri, points, kappa, scalar_kappa, indptr, rel, diag, nnz):  # pragma: no cover - compiled
     """Pass 2 on triangles: each element's ``kappa (e_a . e_b) / (4 |T|)`` (the edge vectors of
-    :func:`~femkit.fem._kernels._triangle`, once per element) added at the positions of pass 1,
+    :func:`~femkit.fem.cells.kernels._triangle`, once per element) added at the positions of pass 1,
     in element order. Returns ``(data, bad)`` as :func:`_tet_values`."""
     data = np.zeros(nnz)
     bad = 0
@@ -117,7 +118,7 @@ def _triangle_values(tri, points, kappa, scalar_kappa, indptr, rel, diag, nnz): 
 @numba.njit(cache=True)
 def _tet_values(tets, points, kappa, scalar_kappa, indptr, rel, diag, nnz):  # pragma: no cover - compiled
     """Pass 2: each element's ``kappa (g_a . g_b) / (6 |D|)`` (``g = D grad N``, the geometry of
-    :func:`~femkit.fem._kernels._tetrahedron`, once per element) added at the positions of pass
+    :func:`~femkit.fem.cells.kernels._tetrahedron`, once per element) added at the positions of pass
     1, in element order. Returns ``(data, bad)``, ``bad`` the number of degenerate
     tetrahedra (then ``data`` is incomplete)."""
     data = np.zeros(nnz)

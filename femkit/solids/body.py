@@ -3,7 +3,7 @@
 ``ElasticBody(points, cells, material)`` precomputes the rest data once
 (:func:`~femkit.solids.kinematics.rest_shape`) and, on the first Hessian, the CSR pattern
 (:class:`~femkit.solids.pattern.BlockPattern`); each evaluation is one compiled pass per material
-group (:mod:`femkit.solids.compiled`). Positions are node-major ``(n, d)`` arrays, the flat
+group (:mod:`femkit.elements.compiled`). Positions are node-major ``(n, d)`` arrays, the flat
 dof index ``i*d + a`` as in :mod:`femkit.dynamics`.
 
 >>> import numpy as np

@@ -8,9 +8,16 @@ solver, a sparse Cholesky (CHOLMOD) for SPD systems, and Jacobi / IC(0) / AMG pr
 True
 
 Importing this package imports numpy and scipy only (pyamg and numba load on first use).
+
+Layout (no import cycle between these folders): :mod:`femkit.solvers.core` (defaults, results,
+checks, norms, pairing) below everything; :mod:`femkit.solvers.preconditioners` and
+:mod:`femkit.solvers.petsc` on it; the solver modules of this folder (and :mod:`.gmg`, geometric
+multigrid, which factorises its coarsest level through :mod:`.kept`) on top, with the registry.
+``femkit.solvers.defaults`` is :mod:`femkit.solvers.core.defaults` (the one table of defaults).
 """
 
 from .backend import LinearSolverBackend
+from .core import defaults
 from .cg import cg
 from .cholesky import CholeskyFactor, cholesky, factorize_spd
 from .direct import direct, factorize
@@ -20,7 +27,7 @@ from .pcg import pcg
 from .preconditioners.base import Preconditioner
 from .registry import (BACKENDS, PRECONDITIONERS, SOLVERS, FemkitBackend, get_preconditioner,
                        get_solver, solve)
-from .result import REASONS, SolveResult
+from .core.result import REASONS, SolveResult
 from .session import LinearSession
 from .spec import SolverSpec
 from .steepest_descent import steepest_descent

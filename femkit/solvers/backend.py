@@ -11,7 +11,7 @@ The PETSc backend maps femkit names onto KSP/PC types (``cg``/``pcg`` -> ``KSPCG
 ``PCHYPRE`` BoomerAMG),
 set ``KSPSetTolerances(rtol, atol, maxits)`` with the same unpreconditioned-residual norm
 (``KSP_NORM_UNPRECONDITIONED``) so the stopping rule ``||b - A x|| <= max(rtol ||b||, atol)``
-matches, and translate ``KSPConvergedReason`` into :data:`femkit.solvers.result.REASONS`
+matches, and translate ``KSPConvergedReason`` into :data:`femkit.solvers.core.result.REASONS`
 (``DIVERGED_INDEFINITE_MAT``/``_PC`` -> ``breakdown``, ``DIVERGED_ITS`` -> ``maxiter``,
 ``DIVERGED_NANORINF`` -> ``non-finite``, ``DIVERGED_BREAKDOWN`` -> ``breakdown``). It
 recomputes the true residual at exit and sets ``converged`` from it.
@@ -23,7 +23,7 @@ from typing import Callable, Protocol, runtime_checkable
 
 import numpy as np
 
-from .result import SolveResult
+from .core.result import SolveResult
 
 
 @runtime_checkable
@@ -45,6 +45,6 @@ class LinearSolverBackend(Protocol):
               atol: float | None = None, maxiter: int | None = None,
               callback: Callable | None = None, **options) -> SolveResult:
         """Same contract as :func:`femkit.solvers.solve` (``rtol``/``atol`` ``None``: the
-        defaults of :mod:`femkit.solvers.defaults`); unknown names raise
+        defaults of :mod:`femkit.solvers.core.defaults`); unknown names raise
         :class:`~femkit.errors.UnknownNameError`."""
         ...

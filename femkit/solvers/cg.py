@@ -7,10 +7,10 @@ values, stagnation, and the true residual at exit.
 
 from __future__ import annotations
 
-from .defaults import DEFAULT_RTOL
+from .core.defaults import DEFAULT_RTOL
 
 from .pcg import pcg
-from .result import SolveResult
+from .core.result import SolveResult
 
 
 def cg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,

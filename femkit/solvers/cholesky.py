@@ -49,11 +49,11 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
 from ..errors import InputError, NotSPDError
-from .checks import (SYMMETRY_TOL, as_operator, asymmetry, dependency_boundary, finish, prepare,
+from .core.checks import (SYMMETRY_TOL, as_operator, asymmetry, dependency_boundary, finish, prepare,
                      zero_rhs_result)
-from .defaults import DEFAULT_ATOL, DEFAULT_ENGINE, DEFAULT_RTOL
+from .core.defaults import DEFAULT_ATOL, DEFAULT_ENGINE, DEFAULT_RTOL
 from .factor import NOT_SPD_ADVICE, Factor
-from .result import SolveResult
+from .core.result import SolveResult
 
 __all__ = ["CholeskyFactor", "cholesky", "factorize_spd", "clear_symbolic_cache",
            "symbolic_cache_info", "ORDERINGS", "DEFAULT_ORDERING", "MODES", "ENGINES"]
@@ -375,6 +375,6 @@ def cholesky(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT
     return res
 
 
-#: Option values checked when a case, scene or study is loaded (:func:`femkit.solvers.checks.check_options`).
+#: Option values checked when a case, scene or study is loaded (:func:`femkit.solvers.core.checks.check_options`).
 cholesky.option_choices = {"engine": ("cholesky engine", ENGINES),
                            "ordering": ("cholesky ordering", ORDERINGS)}

@@ -19,7 +19,7 @@ Time-stepping code factors once and reuses the factor::
 
 from __future__ import annotations
 
-from .defaults import DEFAULT_ATOL, DEFAULT_RTOL
+from .core.defaults import DEFAULT_ATOL, DEFAULT_RTOL
 
 import time
 
@@ -28,10 +28,10 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
 from ..errors import InputError
-from .checks import (SYMMETRY_TOL, as_operator, asymmetry, dependency_boundary, finish, prepare,
+from .core.checks import (SYMMETRY_TOL, as_operator, asymmetry, dependency_boundary, finish, prepare,
                      zero_rhs_result)
 from .factor import Factor
-from .result import SolveResult
+from .core.result import SolveResult
 
 #: SuperLU ``diag_pivot_thresh`` in symmetric mode: the diagonal is the pivot unless it is below
 #: this fraction of the largest entry of its column.

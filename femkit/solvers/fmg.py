@@ -55,10 +55,10 @@ import time
 import numpy as np
 
 from ..errors import InputError
-from .checks import dependency_boundary, finish, prepare, zero_rhs_result
-from .defaults import DEFAULT_ATOL, DEFAULT_RTOL
-from .norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
-from .result import SolveResult
+from .core.checks import dependency_boundary, finish, prepare, zero_rhs_result
+from .core.defaults import DEFAULT_ATOL, DEFAULT_RTOL
+from .core.norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
+from .core.result import SolveResult
 
 #: Default ratio of algebraic to estimated discretisation error (energy norm) at which FMG stops.
 #: The energy norm is dominated by the high frequencies of the discretisation error, while the
@@ -177,7 +177,7 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
         problems then get these boundary values and consistent right-hand sides without level
         systems (module docstring); not together with ``levels``.
     sweeps, omega : int, float
-        Smoothing of the V(sweeps, sweeps)-cycle (:func:`femkit.solvers.preconditioners.gmg.build`);
+        Smoothing of the V(sweeps, sweeps)-cycle (:func:`femkit.solvers.gmg.build`);
         default :func:`default_sweeps` (2 on triangles, 1 on tetrahedra given ``levels`` or
         ``dirichlet``).
     fraction : float
@@ -209,7 +209,7 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
     >>> res.converged, res.iterations <= 2, res.info["stopped_by"]
     (True, True, 'discretisation-error estimate')
     """
-    from .preconditioners.gmg import DEFAULT_OMEGA, Multigrid, _hierarchy_error
+    from .gmg import DEFAULT_OMEGA, Multigrid, _hierarchy_error
 
     t_setup = time.perf_counter()
     if target not in ("discretisation", "residual"):

@@ -11,7 +11,7 @@ minimum for ``max(1000, n)`` iterations stops with ``reason="stagnation"`` at th
 
 from __future__ import annotations
 
-from .defaults import DEFAULT_RTOL
+from .core.defaults import DEFAULT_RTOL
 
 import math
 import numbers
@@ -19,11 +19,11 @@ import numbers
 import numpy as np
 
 from ..errors import InputError
-from .checks import (as_apply, check_positive_diagonal, dependency_boundary, diagonal_of,
+from .core.checks import (as_apply, check_positive_diagonal, dependency_boundary, diagonal_of,
                      finish, nonfinite_initial_residual, prepare, zero_rhs_result)
-from .norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
+from .core.norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
 from .pcg import STAGNATION_WINDOW
-from .result import SolveResult
+from .core.result import SolveResult
 
 
 #: Growth of the residual over the initial one at which the iteration is declared divergent
@@ -76,7 +76,7 @@ def jacobi(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxi
         scale = float(omega)
     if prob.b_is_zero:
         return zero_rhs_result(prob, method="jacobi")
-    # the normalised system 2^-e b (femkit.solvers.norms): exact scaling, so the iterates are
+    # the normalised system 2^-e b (femkit.solvers.core.norms): exact scaling, so the iterates are
     # those on b; the residual is the true one every iteration, so there is no stagnation verdict
     e = prob.exponent
     matvec, b, x = prob.matvec, scaled(prob.b, -e), scaled(prob.x, -e)

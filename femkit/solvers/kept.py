@@ -2,7 +2,7 @@
 
 :meth:`femkit.solvers.session.LinearSession.factorize` (the integrators' and the Poisson
 pipeline's kept factors) and geometric multigrid's coarsest level
-(:class:`femkit.solvers.preconditioners.gmg.Multigrid`, so also ``fmg``'s coarse solve) both
+(:class:`femkit.solvers.gmg.Multigrid`, so also ``fmg``'s coarse solve) both
 call it: SuperLU in symmetric mode (:func:`femkit.solvers.direct.factorize`) by default, the
 sparse Cholesky engines (CHOLMOD, PARDISO: :func:`femkit.solvers.cholesky.factorize_spd`) for
 ``method="cholesky"``. It sits below the session and the registry (it imports neither), so the

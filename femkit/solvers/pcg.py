@@ -15,7 +15,7 @@ updates, with no temporaries for the vector updates.
 
 from __future__ import annotations
 
-from .defaults import DEFAULT_RTOL
+from .core.defaults import DEFAULT_RTOL
 
 import math
 from typing import Callable
@@ -23,9 +23,9 @@ from typing import Callable
 import numpy as np
 from scipy.linalg.blas import daxpy
 
-from .checks import Problem, Replacement, as_apply, dependency_boundary, prepare, zero_rhs_result
-from .norms import curvature_check, inner_rounding, norm2
-from .result import SolveResult
+from .core.checks import Problem, Replacement, as_apply, dependency_boundary, prepare, zero_rhs_result
+from .core.norms import curvature_check, inner_rounding, norm2
+from .core.result import SolveResult
 
 #: Smallest stagnation window: iterations without a new best residual after which the iteration
 #: is declared stagnant. The default window is ``max(STAGNATION_WINDOW, n)``: CG's residual norm is
@@ -42,7 +42,7 @@ def _krylov_loop(prob: Problem, apply_M: Callable | None, *, method: str, callba
     """Shared CG / PCG loop (``apply_M=None``: plain CG, ``z = r`` without a copy).
 
     Runs on the normalised system in cycles with residual replacement
-    (:class:`~femkit.solvers.checks.Replacement`): a cycle ends when the recursive residual meets
+    (:class:`~femkit.solvers.core.checks.Replacement`): a cycle ends when the recursive residual meets
     the tolerance or has not reached a new minimum for ``stagnation_window`` iterations; the
     true residual then decides between converged, stagnation and a restart of the recursion.
     """

@@ -21,21 +21,21 @@ from typing import Callable
 
 from ..errors import InputError
 from ..registry import Registry
-from . import defaults
-from .defaults import default_preconditioner
-from .pairing import PRECONDITIONED_METHOD, check_pairing
+from .core import defaults
+from .core.defaults import default_preconditioner
+from .core.pairing import PRECONDITIONED_METHOD, check_pairing
 from .cg import cg
-from .checks import check_options
+from .core.checks import check_options
 from .cholesky import cholesky
 from .direct import direct
 from .fmg import fmg
 from .jacobi import jacobi
 from .pcg import pcg
 from .preconditioners import amg as _amg
-from .preconditioners import gmg as _gmg
+from . import gmg as _gmg
 from .preconditioners import ic0 as _ic0
 from .preconditioners import jacobi as _pjacobi
-from .result import SolveResult
+from .core.result import SolveResult
 from .steepest_descent import steepest_descent
 
 SOLVERS: Registry = Registry("solver")
@@ -144,7 +144,7 @@ def lookup(method: str, preconditioner: str | None) -> tuple[Callable, str, Call
     UnknownNameError
         Unknown method or preconditioner (``exc.kind`` says which; the valid names are listed).
     InputError
-        A preconditioner with a method other than ``pcg`` (:func:`~femkit.solvers.pairing.check_pairing`).
+        A preconditioner with a method other than ``pcg`` (:func:`~femkit.solvers.core.pairing.check_pairing`).
     """
     fn = SOLVERS.get(method)
     if preconditioner is None:
@@ -181,11 +181,11 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
         A name in :data:`SOLVERS`.
     preconditioner : str, optional
         A name in :data:`PRECONDITIONERS`; only valid with ``method="pcg"``. ``None`` means
-        ``amg`` for ``pcg`` and nothing for the others (:mod:`femkit.solvers.defaults`).
+        ``amg`` for ``pcg`` and nothing for the others (:mod:`femkit.solvers.core.defaults`).
         A preconditioner object/callable may be passed instead of a name (``pcg`` only).
     rtol, atol, maxiter, callback
         As in every method; ``rtol``/``atol`` ``None``: the defaults of
-        :mod:`femkit.solvers.defaults`, read at call time.
+        :mod:`femkit.solvers.core.defaults`, read at call time.
     preconditioner_options : dict, optional
         Keyword arguments of the preconditioner factory (e.g. ``{"shift": 1e-2}`` for ic0);
         an unknown name raises :class:`~femkit.errors.InputError` listing the valid ones.

@@ -53,10 +53,10 @@ from typing import Any, Callable
 import numpy as np
 
 from ..errors import InputError, SolverError
-from . import defaults
+from .core import defaults
 from .factor import Factor, PermutedFactor
-from .norms import norm2
-from .pairing import PRECONDITIONED_METHOD
+from .core.norms import norm2
+from .core.pairing import PRECONDITIONED_METHOD
 from .registry import PRECONDITIONERS, SOLVERS, matrix_free_names, traits
 
 __all__ = ["LinearSession", "check_matrix_free", "matrix_free_message", "MATRIX_FREE_MESSAGE",

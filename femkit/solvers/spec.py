@@ -4,7 +4,7 @@ The one description of "how to solve" in femkit: case files (``solver:``), scene
 (``linear_solver:``), studies (``solvers:``) and the implicit integrators all hold a
 :class:`SolverSpec`; :meth:`SolverSpec.session` opens a
 :class:`~femkit.solvers.session.LinearSession` for a sequence of solves (the one translator to
-:func:`femkit.solvers.solve`). Defaults come from :mod:`femkit.solvers.defaults`, read when a
+:func:`femkit.solvers.solve`). Defaults come from :mod:`femkit.solvers.core.defaults`, read when a
 spec is made.
 
 >>> import numpy as np, scipy.sparse as sp
@@ -22,7 +22,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, Callable, Mapping
 
 from ..errors import InputError, UnknownNameError, with_prefix
-from . import defaults
+from .core import defaults
 
 __all__ = ["SolverSpec"]
 
@@ -71,7 +71,7 @@ class SolverSpec:
         InputError
             A preconditioner with a method other than ``pcg``; an unknown option name.
         """
-        from .checks import check_options
+        from .core.checks import check_options
         from .registry import BACKENDS, lookup
 
         def names(method, pc):

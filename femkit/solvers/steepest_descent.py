@@ -9,16 +9,16 @@ stagnation is declared only when the true residual stops decreasing across a rep
 
 from __future__ import annotations
 
-from .defaults import DEFAULT_RTOL
+from .core.defaults import DEFAULT_RTOL
 
 import math
 
 import numpy as np
 from scipy.linalg.blas import daxpy
 
-from .checks import Replacement, as_apply, dependency_boundary, prepare, zero_rhs_result
-from .norms import curvature_check
-from .result import SolveResult
+from .core.checks import Replacement, as_apply, dependency_boundary, prepare, zero_rhs_result
+from .core.norms import curvature_check
+from .core.result import SolveResult
 
 
 def steepest_descent(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0,

@@ -6,11 +6,14 @@
     result = run_study(load_study("studies/poisson_convergence.yaml", quick=True))
     result.fit(norm="L2", solver="direct", quadrature="barycentric")["slope"]
 
-Kinds: ``poisson_convergence``, ``dynamics_work_precision``, ``stability``; see docs/studies.md.
+Kinds: one module each in :mod:`femkit.study.kinds` (this package hands :data:`femkit.kinds.KINDS`
+the finder that imports them); see docs/studies.md.
 Importing this package is cheap (numpy only); the sweeps import what they need.
 """
 
 from __future__ import annotations
+
+from ..kinds import KINDS as _KINDS
 
 __all__ = ["load_study", "study_from_dict", "run_study", "Study", "StudyResult", "fit_rate", "RateFit",
            "pareto_front", "cli_main", "add_parser"]
@@ -38,3 +41,18 @@ def __getattr__(name):  # lazy: keep `import femkit.study` light
 
         return getattr(cli, name)
     raise AttributeError(f"module 'femkit.study' has no attribute {name!r}")
+
+
+def _find_study_kinds() -> None:
+    """Import every module of :mod:`femkit.study.kinds`: each registers one study kind."""
+    import importlib
+    import pkgutil
+
+    from . import kinds
+
+    for info in sorted(pkgutil.iter_modules(kinds.__path__), key=lambda i: i.name):
+        if not info.name.startswith("_"):
+            importlib.import_module(f"{kinds.__name__}.{info.name}")
+
+
+_KINDS.add_finder("kind", _find_study_kinds)

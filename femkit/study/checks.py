@@ -30,7 +30,7 @@ def check_nested(study, not_nested: bool, why: str) -> None:
     if not not_nested:
         return
     from ..errors import HierarchyError
-    from ..solvers.preconditioners.gmg import ALTERNATIVE
+    from ..solvers.gmg import ALTERNATIVE
 
     for i, s in enumerate(study.solvers):
         if s.needs_hierarchy:

@@ -97,7 +97,7 @@ def cli_main(args) -> int:
                   "kept as it was", file=sys.stderr)
             return 128 + int(exc.flag.signum or 2)
         print(f"{study.kind} '{study.name}': {len(result.records)} runs in {result.elapsed:.1f} s")
-        from ..case.kinds import KINDS
+        from ..kinds import KINDS
 
         summary = KINDS.get(study.kind, "kind").summary
         for line in (summary(result) if summary else ()):

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..case.specs import SOLVER_SCHEMA
 from ..errors import CaseFileError, InputError
+from ..kinds import KINDS
 
 __all__ = ["cloth_schema", "check_cloth_study", "run_cloth_study", "build_cloth_report",
            "cloth_summary", "family_styles"]
@@ -89,12 +90,13 @@ def check_cloth_study(study) -> None:
     from .spec import ClothStudySpec
 
     d = study.data
-    methods = _methods(d["methods"])
+    default = KINDS.get(study.kind, "kind").default_solver
+    methods = _methods(d["methods"], default)
     try:
         expand_methods(methods)
     except InputError as exc:
         raise CaseFileError(f"methods: {exc}") from None
-    ls = solver_spec(d["linear_solver"], "linear_solver", default_method="cholesky")
+    ls = solver_spec(d["linear_solver"], "linear_solver", default_method=default)
     study.spec = spec = ClothStudySpec.from_data(d, ls, methods)
     for i, p in enumerate(spec.scenes):
         path = study.resolve(p)
@@ -106,13 +108,14 @@ def check_cloth_study(study) -> None:
             raise CaseFileError(f"scenes[{i}]: {path.name} is not a cloth scene (system.type: cloth)")
 
 
-def _methods(methods: list) -> list:
+def _methods(methods: list, default: str) -> list:
     """The method list with each family's own ``linear_solver`` mapping as a SolverSpec
-    (validated like every solver spec: a typo names the key and the valid ones)."""
+    (validated like every solver spec: a typo names the key and the valid ones; ``default``: the
+    method when a mapping names none, the kind's ``default_solver``)."""
     from ..case.specs import solver_spec
 
     return [{**m, "linear_solver": solver_spec(m["linear_solver"], f"methods[{i}].linear_solver",
-                                               default_method="cholesky")}
+                                               default_method=default)}
             if "linear_solver" in m else m for i, m in enumerate(methods)]
 
 

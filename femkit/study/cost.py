@@ -114,7 +114,7 @@ def plan_study(study, *, speed: float = 1.0) -> Plan:
     """The plan of any study, through its kind (``KINDS[study.kind].plan``), its seconds
     multiplied by ``speed`` (:func:`femkit.cost.machine_speed`: this machine against the one the
     constants were fitted on); a kind without a cost model gets a plan that says so."""
-    from ..case.kinds import KINDS
+    from ..kinds import KINDS
 
     kind = KINDS.get(study.kind, "kind")
     if kind.plan is not None:
@@ -259,7 +259,7 @@ def plan_cloth_study(study) -> Plan:
 def plan_solid_load_study(study) -> Plan:
     """The plan of a ``solid_load`` study: each material's run priced by the solid kind's plan
     (:func:`femkit.case.solid.cost.plan_solid_case`) of the case it runs."""
-    from ..case.kinds import KINDS
+    from ..kinds import KINDS
     from .solid_load import material_cases
 
     stages, assumptions = [], []

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..case.frozen import freeze
-from ..case.kinds import KINDS
+from ..kinds import KINDS
 from ..errors import CaseFileError
 from .schema import schema_for
 

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..case.kinds import KINDS
+from ..kinds import KINDS
 from ..interrupt import raising
 from .cache import fingerprint
 from .report import Report, staged_output, write_csv, write_json

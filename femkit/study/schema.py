@@ -11,7 +11,7 @@ from __future__ import annotations
 import copy
 
 from ..case.specs import INTEGRATOR_SCHEMA, solver_schema
-from ..solvers.defaults import COMPARISON_RTOL
+from ..solvers.core.defaults import COMPARISON_RTOL
 
 POS = {"type": "number", "exclusiveMinimum": 0}
 POSINT = {"type": "integer", "minimum": 1}
@@ -108,7 +108,7 @@ def _partial(node: dict) -> None:
 
 def schema_for(kind: str) -> dict:
     """The full schema of a study of ``kind`` (with its ``quick:`` block)."""
-    from ..case.kinds import KINDS
+    from ..kinds import KINDS
 
     props = {**copy.deepcopy(COMMON), **copy.deepcopy(KINDS.get(kind, "kind").get_schema())}
     quick = _obj({k: copy.deepcopy(v) for k, v in props.items() if k != "kind"})

@@ -61,7 +61,7 @@ def deformed_area(triangles: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 def build_system(method: MethodSpec, mesh, pinned, forces, E: float, nu: float, density: float):
     """The dynamics system of ``method`` on ``mesh`` (springs or an elastic body)."""
-    from ..dynamics.forces.elastic import elastic_system
+    from ..dynamics.system import elastic_system
     from ..dynamics.system import MassSpringSystem
     from ..solids import ElasticBody, material
     from .spring_layouts import SPRING_LAYOUTS, plane_strain_modulus

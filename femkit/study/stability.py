@@ -37,7 +37,7 @@ from ..interrupt import active_flag
 from ..mesh.structured import structured_mesh
 from ..progress import progress
 from ..registry import Registry
-from ..solvers.defaults import COMPARISON_RTOL
+from ..solvers.core.defaults import COMPARISON_RTOL
 from .schema import INTEGRATOR, POS, POSINT, SOLVER, _obj
 
 # ----------------------------------------------------------------------------- meshes

@@ -1,11 +1,15 @@
 """The one registry of file kinds: every problem and study kind resolves to a schema and callables,
 unknown names list the valid ones of their family, a registered kind is dispatched."""
 
+import subprocess
+import sys
+
 import pytest
 
-from femkit.case.kinds import KINDS, Kind, register_kind
+import femkit.study  # noqa: F401  hands KINDS the finder of the study kinds
 from femkit.case.load import Case, case_from_dict
 from femkit.errors import CaseFileError, UnknownNameError
+from femkit.kinds import KINDS, Kind, register_kind
 
 PROBLEMS = KINDS.names("problem")
 STUDIES = KINDS.names("kind")
@@ -15,6 +19,24 @@ def test_builtin_kinds_are_discovered():
     assert {"poisson", "mass_spring"} <= set(PROBLEMS)
     assert {"poisson_convergence", "dynamics_work_precision", "stability", "adaptive",
             "cloth_work_precision"} <= set(STUDIES)
+
+
+def test_the_case_layer_loads_no_study_module():
+    """Every problem kind, and a case file loaded, without one femkit.study module imported: the
+    registry is a leaf (femkit.kinds) and each family's package finds its own kinds."""
+    code = ("import sys, femkit.case; from femkit.kinds import KINDS; "
+            "assert KINDS.names('problem') == ['mass_spring', 'poisson', 'solid'], KINDS.names('problem'); "
+            "femkit.case.case_from_dict({'problem': 'poisson', 'mesh': {'geometry': 'unit_square', "
+            "'h': 0.5}, 'source': '1', 'boundary': {'dirichlet': [{'tags': ['boundary'], 'value': 0}]}}); "
+            "bad = sorted(m for m in sys.modules if m.startswith('femkit.study')); assert not bad, bad")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr[-2000:]
+
+
+def test_the_former_module_name_is_the_same_registry():
+    from femkit.case import kinds as former
+
+    assert former.KINDS is KINDS and former.register_kind is register_kind and former.Kind is Kind
 
 
 @pytest.mark.parametrize("name", PROBLEMS, ids=PROBLEMS)
@@ -82,3 +104,18 @@ def test_a_registered_problem_kind_is_dispatched_and_its_data_is_read_only(tmp_p
     finally:
         KINDS.remove("toy")
     assert "toy" not in KINDS
+
+
+def test_each_kind_declares_its_default_solver_and_a_file_without_one_gets_it():
+    """The default method of a kind's solves lives on the kind (no table keyed by kind names
+    elsewhere): a registered solver, and what a file without ``method`` runs with."""
+    from femkit.solvers import SOLVERS
+    from femkit.solvers.core import defaults
+
+    assert not hasattr(defaults, "DEFAULT_METHOD")
+    declared = {n: KINDS.get(n).default_solver for n in KINDS.names() if KINDS.get(n).default_solver}
+    assert {"poisson", "mass_spring", "cloth_work_precision"} <= set(declared)
+    assert all(m in SOLVERS.names() for m in declared.values()), declared
+    case = case_from_dict({"problem": "poisson", "mesh": {"geometry": "unit_square", "h": 0.5},
+                           "source": "1", "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]}})
+    assert case.solver.method == declared["poisson"] == "pcg"

@@ -1,9 +1,9 @@
-"""The default ``rtol`` has one home (femkit.solvers.defaults.DEFAULT_RTOL): changing it there
+"""The default ``rtol`` has one home (femkit.solvers.core.defaults.DEFAULT_RTOL): changing it there
 changes it for case files, scene files and study files that do not give one."""
 
 import pytest
 
-import femkit.solvers.defaults as defaults
+import femkit.solvers.core.defaults as defaults
 from femkit.case.load import case_from_dict
 from femkit.study.load import study_from_dict
 

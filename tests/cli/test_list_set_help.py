@@ -13,7 +13,7 @@ sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shar
 from _small import SMALL  # noqa: E402
 
 from femkit.catalog import GROUPS, entries
-from femkit.cli import LIST_GROUPS, main, parse_sets
+from femkit.cli import build_parser, main, parse_sets
 from femkit.errors import InputError
 
 
@@ -22,8 +22,21 @@ def _registry(group):
     return GROUPS[group][1]()
 
 
-def test_list_groups_of_the_parser_are_the_catalog_groups():
-    assert tuple(GROUPS) == LIST_GROUPS
+LIST_GROUPS = tuple(GROUPS)
+
+
+def test_list_groups_of_the_parser_are_the_catalog_groups(capsys):
+    """The groups ``femkit list --help`` names are the catalog's, in its order (no second list),
+    and each one's singular resolves to it."""
+    from femkit.cli import _list_group
+
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["list", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    named = text.split("with one line on what it is: ")[1].split(" (default: all)")[0]
+    assert tuple(named.split(", ")) == LIST_GROUPS and len(LIST_GROUPS) >= 10
+    assert [_list_group(g) for g in ("geometry", "solver", "study", "material")] == [
+        "geometries", "solvers", "studies", "materials"]
 
 
 @pytest.mark.parametrize("group", LIST_GROUPS)
@@ -156,7 +169,7 @@ def _section(text: str, title: str) -> list[str]:
 
 
 def test_study_help_lists_every_registered_kind_exit_codes_and_examples(capsys):
-    from femkit.case.kinds import KINDS
+    from femkit.kinds import KINDS
 
     text = _help(["study"], capsys)
     kinds = [line.split()[0] for line in _section(text, "study kinds")]

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from femkit.dynamics.forces import Gravity
-from femkit.dynamics.forces.elastic import elastic_system
+from femkit.dynamics.system import elastic_system
 from femkit.dynamics.integrators import INTEGRATORS, StepContext
 from femkit.dynamics.simulate import simulate
 from femkit.dynamics.system import MassSpringSystem

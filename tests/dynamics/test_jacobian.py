@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from femkit.dynamics.forces import GroundContact, Gravity, SphereContact
-from femkit.dynamics.jacobian import spring_blocks
+from femkit.dynamics.forces.jacobian import spring_blocks
 from femkit.dynamics.system import MassSpringSystem
 from femkit.errors import UnknownNameError
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from femkit.dynamics.forces import Gravity
-from femkit.dynamics.forces.elastic import elastic_system
+from femkit.dynamics.system import elastic_system
 from femkit.dynamics.integrators import StepContext, get_integrator
 from femkit.errors import InputError
 from femkit.mesh.structured import structured_box

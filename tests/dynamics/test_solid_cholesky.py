@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from femkit.dynamics.forces import Gravity, RayleighDamping
-from femkit.dynamics.forces.elastic import elastic_system
+from femkit.dynamics.system import elastic_system
 from femkit.dynamics.integrators import StepContext
 from femkit.dynamics.integrators.base import NewtonStepError
 from femkit.dynamics.kernels.assembly import assemble_with_forces, free_pattern

@@ -17,7 +17,7 @@ import pytest
 from femkit.fem import apply_dirichlet, assemble_load, assemble_stiffness, error_norms
 from femkit.mesh import MeshHierarchy, boundary_nodes, structured_box
 from femkit.solvers import solve
-from femkit.solvers.preconditioners.gmg import Multigrid
+from femkit.solvers.gmg import Multigrid
 
 from ._tets import exact, source
 
@@ -107,7 +107,7 @@ def test_fmg_dirichlet_data_gives_the_level_systems_coarse_problems(hierarchy):
     cn = boundary_nodes(coarse_mesh)
     ref = apply_dirichlet(Kc, Fc, cn, g(*coarse_mesh.points[cn].T))
     from femkit.solvers.fmg import _coarse_dirichlet
-    from femkit.solvers.preconditioners.gmg import Multigrid
+    from femkit.solvers.gmg import Multigrid
 
     mg = Multigrid(sys.A, sub, free=sys.free)
     gl = _coarse_dirichlet(mg, sys.expand(np.zeros(len(sys.free))))

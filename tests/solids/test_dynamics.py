@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from femkit.dynamics.forces import Gravity, RayleighDamping
-from femkit.dynamics.forces.elastic import ElasticForce, elastic_system
+from femkit.dynamics.forces.elastic import ElasticForce
+from femkit.dynamics.system import elastic_system
 from femkit.dynamics.integrators import INTEGRATORS
 from femkit.dynamics.simulate import simulate
 from femkit.errors import InputError, InstabilityError

@@ -9,7 +9,7 @@ import warnings
 import numpy as np
 import pytest
 
-from femkit.dynamics.forces.elastic import elastic_system
+from femkit.dynamics.system import elastic_system
 from femkit.dynamics.forces.gravity import Gravity
 from femkit.dynamics.forces.rayleigh import RayleighDamping
 from femkit.dynamics.simulate import simulate

@@ -1,4 +1,4 @@
-"""The default ``rtol`` has one home, :data:`femkit.solvers.defaults.DEFAULT_RTOL`: changing it
+"""The default ``rtol`` has one home, :data:`femkit.solvers.core.defaults.DEFAULT_RTOL`: changing it
 there changes it for the Python API, case files, scene files and study files alike.
 
 Each route is tested with the default patched to a value no file or signature names

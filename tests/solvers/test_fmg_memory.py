@@ -20,7 +20,7 @@ from femkit.fem import apply_dirichlet, assemble_load, assemble_stiffness
 from femkit.mesh import Mesh, MeshHierarchy, boundary_nodes, generate, structured_box
 from femkit.mesh.hierarchy import _fixed_columns
 from femkit.solvers.fmg import fmg
-from femkit.solvers.preconditioners.gmg import Multigrid, transpose_csr
+from femkit.solvers.gmg import Multigrid, transpose_csr
 
 SQUARE = Mesh(points=[[0, 0], [1, 0], [1, 1], [0, 1]], triangles=[[0, 1, 2], [0, 2, 3]])
 
@@ -238,7 +238,7 @@ def test_fmg_and_gmg_on_the_free_node_hierarchy_give_the_same_numbers(coarse):
     assert np.array_equal(full.x, lean.x) and np.array_equal(full.residuals, lean.residuals)
     assert full.info["discretisation_error_estimate"] == lean.info["discretisation_error_estimate"]
     from femkit.solvers import pcg
-    from femkit.solvers.preconditioners.gmg import build
+    from femkit.solvers.gmg import build
 
     a, b = (pcg(sys_.A, sys_.b, M=build(sys_.A, hierarchy=h, free=sys_.free), rtol=1e-10)
             for h in (H, F))
@@ -254,7 +254,7 @@ def test_the_run_releases_the_full_prolongations_before_the_solve(tmp_path, monk
 
     from femkit.case import case_from_dict
     import femkit.case.poisson.run as run_module
-    import femkit.solvers.preconditioners.gmg as gmg_module
+    import femkit.solvers.gmg as gmg_module
 
     made, alive = [], []
     refine = MeshHierarchy.from_refinement.__func__

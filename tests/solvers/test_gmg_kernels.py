@@ -13,7 +13,7 @@ import scipy.sparse as sp
 
 from femkit.fem import apply_dirichlet, assemble_stiffness
 from femkit.mesh import Mesh, MeshHierarchy, boundary_nodes, generate
-from femkit.solvers.preconditioners.gmg import Multigrid, galerkin_product, transpose_csr
+from femkit.solvers.gmg import Multigrid, galerkin_product, transpose_csr
 
 SQUARE = Mesh(points=[[0, 0], [1, 0], [1, 1], [0, 1]], triangles=[[0, 1, 2], [0, 2, 3]])
 
@@ -208,8 +208,8 @@ def test_galerkin_output_growth_is_invisible(name, capacity):
     """The compiled pass stops at a row that does not fit and the buffers grow between calls:
     whatever the starting capacity, the same arrays (and rows longer than 32 entries, sorted by
     the Shell sort, in canonical order as SciPy's)."""
-    from femkit.solvers.preconditioners import _gmg_kernels
-    from femkit.solvers.preconditioners.gmg import _kernel_index
+    from femkit.solvers import _gmg_kernels
+    from femkit.solvers.gmg import _kernel_index
 
     A, P = _case(name)
     A, P = A.tocsr(), P.tocsr()

@@ -17,7 +17,7 @@ from femkit.fem import (apply_dirichlet, assemble_load, assemble_stiffness, diri
                         error_norms)
 from femkit.mesh import Mesh, MeshHierarchy, boundary_nodes, generate
 from femkit.solvers import get_preconditioner, pcg, solve
-from femkit.solvers.preconditioners.gmg import Multigrid
+from femkit.solvers.gmg import Multigrid
 
 GEOMETRIES = ["unit_square", "l_shape", "annulus"]
 

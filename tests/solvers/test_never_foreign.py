@@ -16,7 +16,7 @@ import scipy.sparse as sp
 
 from femkit.errors import FemkitError, NotSPDError, SingularSystemError
 from femkit.solvers import PRECONDITIONERS, REASONS, SOLVERS, solve
-from femkit.solvers.checks import dependency_boundary
+from femkit.solvers.core.checks import dependency_boundary
 
 from .conftest import poisson_2d
 

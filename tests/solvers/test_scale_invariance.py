@@ -24,7 +24,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from femkit.solvers import PRECONDITIONERS, SOLVERS, solve
-from femkit.solvers.norms import curvature_failure, is_zero, norm2
+from femkit.solvers.core.norms import curvature_failure, is_zero, norm2
 
 #: Names that need a nested mesh hierarchy: their invariance is tested on a Poisson hierarchy
 #: below (test_multigrid_scale_invariance).

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from femkit.solvers import checks
+from femkit.solvers.core import checks
 
 
 def _random(n, per_row, state):

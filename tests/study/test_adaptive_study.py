@@ -9,7 +9,7 @@ import pytest
 
 from femkit.errors import CaseFileError, InputError
 from femkit.study import load_study
-from femkit.case.kinds import KINDS
+from femkit.kinds import KINDS
 
 ROOT = Path(__file__).parents[2]
 

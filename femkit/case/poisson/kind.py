@@ -1,4 +1,4 @@
-"""``problem: poisson``: a P1 Poisson case file, registered as a :class:`~femkit.case.kinds.Kind`.
+"""``problem: poisson``: a P1 Poisson case file, registered as a :class:`~femkit.kinds.Kind`.
 
 Schema :data:`femkit.case.poisson.schema.POISSON_SCHEMA`; load-time checks
 :func:`femkit.case.poisson.run.prepare_poisson`; the run :func:`femkit.case.poisson.run.run_poisson`;
@@ -8,7 +8,7 @@ first use, so discovering this kind imports nothing heavy.
 
 from __future__ import annotations
 
-from ..kinds import Kind, register_kind
+from ...kinds import Kind, register_kind
 
 
 def _schema() -> dict:
@@ -35,4 +35,5 @@ def _plan(case, **kwargs):
     return plan_poisson_case(case, **kwargs)
 
 
-KIND = register_kind(Kind("poisson", "problem", _schema, _prepare, _run, _plan))
+KIND = register_kind(Kind("poisson", "problem", _schema, _prepare, _run, _plan,
+                          default_solver="pcg"))

@@ -73,10 +73,11 @@ def prepare_poisson(case: Case) -> None:
             raise CaseFileError(f"mesh.{bad}: only used with mesh.geometry, not with mesh.file")
     else:
         check_geometry_spec(mesh, "mesh")
-    from ...solvers.defaults import DEFAULT_METHOD
+    from ...kinds import KINDS
     from ..specs import solver_spec
 
-    case.solver = solver_spec(d["solver"], "solver", default_method=DEFAULT_METHOD["poisson"])
+    case.solver = solver_spec(d["solver"], "solver",
+                              default_method=KINDS.get(case.problem, "problem").default_solver)
     d["solver"] = case.solver.to_dict()
     from ..specs import limits_spec
 
@@ -304,7 +305,7 @@ def _solve(case: Case, system, stop, **mg):
     if stop is None:
         return case.solver.solve(system.A, system.b, **mg)
     from ...interrupt import stopping_callback
-    from ...solvers.result import SolveResult
+    from ...solvers.core.result import SolveResult
 
     try:
         return case.solver.solve(system.A, system.b, callback=stopping_callback(stop), **mg)

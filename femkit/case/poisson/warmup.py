@@ -46,9 +46,9 @@ FAMILIES = {
                     ("femkit.fem._one_off", "_edge_pattern"), ("femkit.fem._one_off", "_edge_values"),
                     ("femkit.fem._one_off", "_edge_fill"),
                     ("femkit.fem._kernels", "_eliminate"), ("femkit.fem._one_off", "_tet_values")),
-    "solver checks": (("femkit.solvers._check_kernels", "asymmetry_sums"),),
-    "geometric multigrid": (("femkit.solvers.preconditioners._gmg_kernels", "_galerkin_rows"),
-                            ("femkit.solvers.preconditioners._gmg_kernels", "gs_sweeps")),
+    "solver checks": (("femkit.solvers.core._check_kernels", "asymmetry_sums"),),
+    "geometric multigrid": (("femkit.solvers._gmg_kernels", "_galerkin_rows"),
+                            ("femkit.solvers._gmg_kernels", "gs_sweeps")),
 }
 
 #: The module constants that choose the compiled paths by size (lowered during a warm-up).
@@ -57,7 +57,7 @@ _THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiff
                ("femkit.mesh.quality", "NUMBA_THRESHOLD"), ("femkit.mesh.refine", "NUMBA_THRESHOLD"),
                ("femkit.mesh.quality", "NUMBA_THRESHOLD_3D"), ("femkit.mesh.refine", "NUMBA_THRESHOLD_3D"),
                ("femkit.fem.dirichlet", "NUMBA_THRESHOLD"),
-               ("femkit.solvers.checks", "SYMMETRY_NUMBA_NNZ"))
+               ("femkit.solvers.core.checks", "SYMMETRY_NUMBA_NNZ"))
 
 #: The tetrahedral tiny case (run after :data:`_TINY`): the 3D kernels of the same families
 #: (the tetrahedron assembly, the face numbering, the estimator's face jumps); a constant source
@@ -204,7 +204,7 @@ def _symmetry_check() -> None:
     argument types of a large run)."""
     from ...fem import PoissonProblem
     from ...mesh import generate, refine
-    from ...solvers.checks import check_symmetric
+    from ...solvers.core.checks import check_symmetric
 
     problem = PoissonProblem(refine(generate("unit_square", 0.5), 1), kappa=1.0, f=1.0,
                              dirichlet=[(["boundary"], 0.0)])

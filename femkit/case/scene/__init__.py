@@ -2,6 +2,6 @@
 runner (:mod:`.run`), outputs (:mod:`.output`) and pictures (:mod:`.plot`).
 
 This is the application layer over :mod:`femkit.dynamics` (which knows nothing of files);
-:data:`femkit.case.kinds.KINDS` dispatches ``femkit solve SCENE.yaml`` here through
+:data:`femkit.kinds.KINDS` dispatches ``femkit solve SCENE.yaml`` here through
 :func:`femkit.case.scene.run.prepare_scene` and :func:`femkit.case.scene.run.run_scene`.
 """

@@ -2,7 +2,7 @@
 
 Each entry is a :class:`ForceType`: the JSON schema of its parameters and the builder of the
 force object. The scene schema's ``forces`` enum and per-type branches are derived from this
-registry, so a force registered here (or by a plugin, :mod:`femkit.case.plugins`) is accepted
+registry, so a force registered here (or by a plugin, :mod:`femkit.plugins`) is accepted
 by scene files without touching the schema::
 
     from femkit.case.scene.forces import FORCES, ForceType

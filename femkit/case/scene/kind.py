@@ -1,4 +1,4 @@
-"""``problem: mass_spring``: a mass-spring scene file, registered as a :class:`~femkit.case.kinds.Kind`.
+"""``problem: mass_spring``: a mass-spring scene file, registered as a :class:`~femkit.kinds.Kind`.
 
 Schema :func:`femkit.case.scene.schema.scene_schema` (its force and system enums come from
 :data:`~femkit.case.scene.forces.FORCES` and :data:`~femkit.case.scene.systems.SYSTEMS`);
@@ -10,7 +10,7 @@ The dynamics modules are imported on first use only.
 
 from __future__ import annotations
 
-from ..kinds import Kind, register_kind
+from ...kinds import Kind, register_kind
 
 
 def _schema() -> dict:
@@ -44,4 +44,5 @@ def _plan(case, measure: bool = True):
     return plan_scene_case(case, system_size(case.spec.system), build=build, measure=measure)
 
 
-KIND = register_kind(Kind("mass_spring", "problem", _schema, _prepare, _run, _plan))
+KIND = register_kind(Kind("mass_spring", "problem", _schema, _prepare, _run, _plan,
+                          default_solver="direct"))

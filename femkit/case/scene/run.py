@@ -1,6 +1,6 @@
 """Run a ``problem: mass_spring`` scene end to end: system, forces, integrator, outputs.
 
-``femkit solve SCENE.yaml`` dispatches here through :data:`femkit.case.kinds.KINDS`:
+``femkit solve SCENE.yaml`` dispatches here through :data:`femkit.kinds.KINDS`:
 :func:`prepare_scene` checks everything at load time (integrator, linear solver and
 preconditioner names against their registries, integrator options, mesh geometry and file,
 expressions, output cadence), so bad input fails before anything is computed or written;
@@ -52,8 +52,8 @@ from ...errors import (
     with_prefix,
 )
 from ...io.atomic import EARLIER_RUN, atomic_directory, check_output_dir
+from ...kinds import KINDS
 from ...progress import Progress
-from ...solvers.defaults import DEFAULT_METHOD
 from ...timing import StageTimer
 from ..cost import check_scene_fits
 from ..expressions import compile_expression
@@ -130,8 +130,8 @@ def prepare_scene(case: Case) -> None:
         raise CaseFileError(str(exc)) from None
 
     # linear solver
-    case.solver = ls_spec = solver_spec(d["linear_solver"], "linear_solver",
-                                        default_method=DEFAULT_METHOD["mass_spring"])
+    default = KINDS.get(case.problem, "problem").default_solver
+    case.solver = ls_spec = solver_spec(d["linear_solver"], "linear_solver", default_method=default)
     case.run_options["limits"] = limits_spec(d.get("limits"))
     if integ.options.get("matrix_free"):  # caught at load time, before anything runs
         try:

@@ -1,4 +1,4 @@
-"""``problem: solid``: an elastic-solid case file, registered as a :class:`~femkit.case.kinds.Kind`.
+"""``problem: solid``: an elastic-solid case file, registered as a :class:`~femkit.kinds.Kind`.
 
 Schema :func:`femkit.case.solid.schema.solid_schema` (enums from the material, geometry and
 integrator registries); load-time checks and the spec :func:`femkit.case.solid.run.prepare_solid`;
@@ -8,7 +8,7 @@ the run :func:`femkit.case.solid.run.run_solid`; the plan
 
 from __future__ import annotations
 
-from ..kinds import Kind, register_kind
+from ...kinds import Kind, register_kind
 
 
 def _schema() -> dict:

@@ -494,7 +494,8 @@ def _run_static(case, problem: SolidProblem, stop) -> dict:
 
 
 def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
-    from ...dynamics.forces.elastic import DeadLoad, elastic_system
+    from ...dynamics.forces.elastic import DeadLoad
+    from ...dynamics.system import elastic_system
     from ...dynamics.forces.gravity import Gravity
     from ...dynamics.integrators import StepContext
     from ...dynamics.simulate import simulate

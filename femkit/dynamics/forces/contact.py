@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..jacobian import nodal_block_matrix
+from .jacobian import nodal_block_matrix
 from .base import Force, as_vector, nonnegative
 
 

@@ -7,7 +7,7 @@ Teran et al. 2005) and, for ``fix="regularize"``, the per-node bound of the nega
 ``K`` (:meth:`~femkit.solids.ElasticBody.negative_bound`). So every registered integrator runs an
 elastic solid unchanged, with the system's pinning, gravity, damping and contact.
 
-:func:`elastic_system` builds that system: lumped masses from the density
+:func:`femkit.dynamics.system.elastic_system` builds that system: lumped masses from the density
 (:meth:`~femkit.solids.ElasticBody.lumped_masses`), no springs.
 
 The last evaluation is kept (positions and result), because an implicit step asks for the
@@ -16,13 +16,11 @@ force, the energy and the stiffness at the same positions.
 
 from __future__ import annotations
 
-from typing import Iterable
-
 import numpy as np
 
 from .base import Force
 
-__all__ = ["ElasticForce", "DeadLoad", "elastic_system"]
+__all__ = ["ElasticForce", "DeadLoad"]
 
 
 class ElasticForce(Force):
@@ -127,26 +125,3 @@ class DeadLoad(Force):
 
     def __repr__(self) -> str:
         return f"DeadLoad({len(self.forces)} nodes)"
-
-
-def elastic_system(body, *, x0=None, v0=None, pinned=None, forces: Iterable[Force] = ()):
-    """A :class:`~femkit.dynamics.system.MassSpringSystem` whose only internal force is the
-    elastic ``body`` (no springs), lumped masses from its density, plus the declared ``forces``
-    (gravity, damping, contact) and ``pinned`` nodes; starts at rest positions unless ``x0``.
-
-    >>> from femkit.solids import ElasticBody, StableNeoHookean
-    >>> body = ElasticBody([[0., 0.], [1., 0.], [0., 1.]], [[0, 1, 2]], StableNeoHookean(1., 1.))
-    >>> s = elastic_system(body, pinned=[0])
-    >>> s.force(s.x0, s.v0).tolist()
-    [[0.0, 0.0], [0.0, 0.0], [0.0, 0.0]]
-    """
-    from ..system import MassSpringSystem
-
-    x = body.rest_positions if x0 is None else np.asarray(x0, dtype=float)
-    if x.shape != body.rest_positions.shape:
-        from ...errors import InputError
-
-        raise InputError(f"x0 must have the body's shape {body.rest_positions.shape} "
-                         f"({body.n} nodes), got {x.shape}")
-    return MassSpringSystem(x, body.lumped_masses(), np.zeros((0, 2), dtype=np.int64), 0.0,
-                            v0=v0, pinned=pinned, forces=[ElasticForce(body), *forces])

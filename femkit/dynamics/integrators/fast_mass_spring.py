@@ -101,7 +101,7 @@ def damping_split(system, L=None):
     Laplacian of the dashpot coefficients and ``beta`` times the spring Laplacian ``L``."""
     import scipy.sparse as sp
 
-    from ..jacobian import SpringPattern
+    from ..forces.jacobian import SpringPattern
 
     n, d = system.n, system.dim
     alpha, beta = system.rayleigh

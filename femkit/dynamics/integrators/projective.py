@@ -65,7 +65,7 @@ def _elastic_force(system):
     found = [f for f in system.forces if isinstance(f, ElasticForce)]
     if len(found) != 1 or system.n_springs:
         raise InputError(f"projective dynamics needs a system with exactly one elastic solid and "
-                         f"no springs (femkit.dynamics.forces.elastic_system); got "
+                         f"no springs (femkit.dynamics.system.elastic_system); got "
                          f"{len(found)} elastic force(s) and {system.n_springs} springs "
                          "(use fast_mass_spring for springs)")
     return found[0]

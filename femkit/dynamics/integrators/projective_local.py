@@ -1,7 +1,7 @@
 """The compiled local step of projective dynamics (:mod:`.projective`).
 
 One pass over the elements: each deformation gradient ``F = U diag(s) V^T`` (the signed SVD of
-:func:`femkit.solids.compiled.signed_svd`, ``det U = det V = 1``) is projected onto the
+:func:`femkit.elements.compiled.signed_svd`, ``det U = det V = 1``) is projected onto the
 rotations, ``R = U V^T`` (as-rigid-as-possible strain), and, with a volume weight, onto the band
 ``J_min <= det F <= J_max`` (the nearest ``U diag(s') V^T`` with ``prod s'`` clamped into the
 band: a few Gauss-Newton steps on the constraint's linearisation, Bouaziz et al. 2014, section
@@ -17,7 +17,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ...solids.compiled import add_nodal_forces, deformation_gradient, signed_svd
+from ...elements.compiled import add_nodal_forces, deformation_gradient, signed_svd
 
 
 @numba.njit(cache=False)

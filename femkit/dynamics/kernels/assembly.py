@@ -2,7 +2,7 @@
 
 :class:`FreePattern` is built once per system (topology and pinned set): the CSR pattern of the
 spring matrices (every spring's four ``d x d`` blocks plus the full diagonal, as
-:class:`~femkit.dynamics.jacobian.SpringPattern`) restricted to the free dofs, and for every
+:class:`~femkit.dynamics.forces.jacobian.SpringPattern`) restricted to the free dofs, and for every
 spring block entry its slot in that CSR ``data`` array (``-1`` where the row or column is
 pinned). A step then only writes values: :meth:`FreePattern.assemble` fills ``data`` with the
 diagonal, adds every spring's Hessian (with the definiteness fix) and dashpot blocks in one

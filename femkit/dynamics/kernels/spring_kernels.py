@@ -3,7 +3,7 @@
 Each kernel reads every spring once (its two end positions, stiffness, rest length) and does
 all the per-spring work of one step in that pass, scattering to the nodes directly, instead of
 the several NumPy passes of the sparse-product formulation (``G x``, lengths, scaling,
-``G^T``). Conventions as in :mod:`femkit.dynamics.jacobian`: spring ``s = (i, j)``,
+``G^T``). Conventions as in :mod:`femkit.dynamics.forces.jacobian`: spring ``s = (i, j)``,
 ``x_ij = x_j - x_i``, ``l = |x_ij|`` floored at ``floor`` (where ``u = 0``), ``u = x_ij / l``,
 
 * Hooke force on ``i``: ``k (l - L) u`` (``j`` gets the opposite);

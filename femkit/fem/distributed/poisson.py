@@ -20,11 +20,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...solvers.defaults import DEFAULT_RTOL
+from ...solvers.core.defaults import DEFAULT_RTOL
 from ...solvers.petsc.backend import ksp_solve
 from ...solvers.petsc.env import require_petsc
 from ...solvers.petsc.failure import collective, from_root
-from ...solvers.result import SolveResult
+from ...solvers.core.result import SolveResult
 from ...timing import StageTimer
 from ..norms import error_norms
 from ..poisson import mean_shift_parts

@@ -13,7 +13,7 @@ import math
 import numba
 import numpy as np
 
-from .._kernels import _tetrahedron
+from ..cells.kernels import _tetrahedron
 
 
 @numba.njit(cache=True, inline="always")

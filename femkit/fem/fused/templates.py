@@ -30,7 +30,7 @@ from llvmlite import ir
 from numba.core import types
 from numba.extending import intrinsic
 
-from .._kernels import _tetrahedron, _triangle, _volume6
+from ..cells.kernels import _tetrahedron, _triangle, _volume6
 
 #: Components of the exact gradient ``exact_point`` gives after ``u`` (0: none).
 N_GRAD = 0
@@ -380,7 +380,7 @@ def nodal_pass(points, u):  # pragma: no cover - compiled
 def tetrahedron_pass(points, tets, bary, weights, u, l2, h1, fsq):  # pragma: no cover - compiled
     """Per tetrahedron ``volume * block_sums`` into ``l2``, ``h1``, ``fsq``, the volume and
     the gradient of ``u_h`` computed on the way (``D grad N_a`` by the assembly's
-    :func:`femkit.fem._kernels._tetrahedron`, ``D = 6 V_signed``), so no (m, 4, 3) array of
+    :func:`femkit.fem.cells.kernels._tetrahedron`, ``D = 6 V_signed``), so no (m, 4, 3) array of
     gradients is formed (the gradients agree with the NumPy path's to round-off); returns the
     number of tetrahedra of zero or non-finite volume (then the caller reports them by the NumPy
     path)."""

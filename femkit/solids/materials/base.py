@@ -2,7 +2,7 @@
 
 A hyperelastic isotropic material is fully described by its energy density as a function of the
 principal stretches ``W(s_1, .., s_d)`` (Xu, Sin, Zhu & Barbic 2015); forces and Hessians then
-follow from the SVD derivative (:mod:`femkit.solids.compiled`) with only ``dW/ds`` and
+follow from the SVD derivative (:mod:`femkit.elements.compiled`) with only ``dW/ds`` and
 ``d^2W/ds^2``. So a material here *is* that function and its constants:
 
 * :class:`StretchMaterial` subclasses carry that function as an expression: the built-ins
@@ -10,9 +10,9 @@ follow from the SVD derivative (:mod:`femkit.solids.compiled`) with only ``dW/ds
   as its ``energy``. Derivatives are generated symbolically and compiled into numba kernels by
   one path (:mod:`femkit.solids.energy.codegen`; the built-ins share one module,
   :mod:`.builtin`); the material names its energy there by number, ``code``, and the element
-  kernels (SVD, SVD derivative, projection, assembly: :mod:`femkit.solids.compiled`) are shared.
+  kernels (SVD, SVD derivative, projection, assembly: :mod:`femkit.elements.compiled`) are shared.
 * The linear (small-strain) material is not a function of the stretches (not rotation
-  invariant); its point function of ``F`` is :func:`femkit.solids.compiled._linear_frame`
+  invariant); its point function of ``F`` is :func:`femkit.elements.compiled._linear_frame`
   (``code`` 0).
 
 Constants are the Lame moduli ``mu``, ``lam`` of the material *linearised at rest*: at ``F = I``
@@ -117,7 +117,7 @@ class Material:
         return np.array([self.mu, self.lam])
 
     #: number of the material's point function in the compiled element pass
-    #: (:func:`femkit.solids.compiled.point`)
+    #: (:func:`femkit.elements.compiled.point`)
     code: ClassVar[int] = -1
 
     def kernels(self):

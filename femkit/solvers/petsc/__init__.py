@@ -7,7 +7,7 @@ when it cannot. Modules:
 
 - ``env``: importing petsc4py/mpi4py, the communicator, rank helpers;
 - ``names``: femkit method/preconditioner names -> KSP/PC types;
-- ``reasons``: ``KSPConvergedReason`` -> :data:`femkit.solvers.result.REASONS`;
+- ``reasons``: ``KSPConvergedReason`` -> :data:`femkit.solvers.core.result.REASONS`;
 - ``options``: ``petsc_options`` pass-through (PETSc's options database, per solve prefix);
 - ``coo``: ``MatSetPreallocationCOO`` / ``MatSetValuesCOO`` (pattern once, values many);
 - ``backend``: :class:`PetscBackend`, the :class:`~femkit.solvers.backend.LinearSolverBackend`;

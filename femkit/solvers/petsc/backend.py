@@ -20,10 +20,10 @@ from typing import Callable
 import numpy as np
 
 from ...errors import InputError
-from .. import defaults
-from ..defaults import DEFAULT_RTOL
-from ..checks import check_symmetric, check_tolerances, explicit_csr, real_array, unknown_options
-from ..result import SolveResult
+from ..core import defaults
+from ..core.defaults import DEFAULT_RTOL
+from ..core.checks import check_symmetric, check_tolerances, explicit_csr, real_array, unknown_options
+from ..core.result import SolveResult
 from . import names, options as popts
 from .env import require_petsc
 from .failure import collective

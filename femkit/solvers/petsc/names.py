@@ -24,8 +24,8 @@ for this operator (6 CG iterations at 1e6 unknowns against 22 for GAMG).
 from __future__ import annotations
 
 from ...errors import UnknownNameError
-from ..defaults import default_preconditioner
-from ..pairing import check_pairing
+from ..core.defaults import default_preconditioner
+from ..core.pairing import check_pairing
 
 #: method -> KSP type
 KSP_TYPES = {"cg": "cg", "pcg": "cg", "jacobi": "richardson", "direct": "preonly"}

@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from ..checks import dependency_boundary, explicit_csr, unknown_options
+from ..core.checks import dependency_boundary, explicit_csr, unknown_options
 from .base import Preconditioner
 
 
@@ -72,7 +72,7 @@ def _setup(build, A, what: str, opts: dict):
     entry; an exact scaling): LAPACK, behind pyamg's coarse ``pinv``, rescales matrices whose
     norm is below ~1e-138 or above ~1e138 by a factor that is not a power of two, so without it
     the same system in other units got a different preconditioner."""
-    from ..norms import binary_exponent
+    from ..core.norms import binary_exponent
 
     e = binary_exponent(A.data)
     if e:

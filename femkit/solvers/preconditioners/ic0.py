@@ -21,7 +21,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...errors import InputError, NotSPDError
-from ..checks import check_positive_diagonal, check_symmetric, explicit_csr
+from ..core.checks import check_positive_diagonal, check_symmetric, explicit_csr
 from .base import Preconditioner
 
 

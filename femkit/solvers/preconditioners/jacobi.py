@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 
-from ..checks import as_operator, check_positive_diagonal, diagonal_of
+from ..core.checks import as_operator, check_positive_diagonal, diagonal_of
 from .base import Preconditioner
 
 

@@ -6,7 +6,7 @@ Sweep :func:`femkit.study.adaptive.run_adaptive_study`, report
 
 from __future__ import annotations
 
-from ...case.kinds import Kind, register_kind
+from ...kinds import Kind, register_kind
 from ...errors import CaseFileError
 from ..checks import check_base_case, check_nested, check_problem_source
 from ..schema import ADAPTIVE

@@ -6,7 +6,7 @@ this module registers it. Cost plan :func:`femkit.study.cost.plan_cloth_study`.
 
 from __future__ import annotations
 
-from ...case.kinds import Kind, register_kind
+from ...kinds import Kind, register_kind
 
 
 def _schema() -> dict:
@@ -46,4 +46,4 @@ def _summary(result) -> list[str]:
 
 
 KIND = register_kind(Kind("cloth_work_precision", "kind", _schema, _check, _run,
-                          plan=_plan, report=_report, summary=_summary))
+                          plan=_plan, report=_report, summary=_summary, default_solver="cholesky"))

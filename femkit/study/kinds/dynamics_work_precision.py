@@ -7,7 +7,7 @@ Sweep :func:`femkit.study.dynamics.run_dynamics_study`, report
 
 from __future__ import annotations
 
-from ...case.kinds import Kind, register_kind
+from ...kinds import Kind, register_kind
 from ...errors import CaseFileError
 from ..schema import DYNAMICS
 from ..spec import DynamicsStudySpec

@@ -7,7 +7,7 @@ Sweep :func:`femkit.study.poisson.run_poisson_study`, report
 
 from __future__ import annotations
 
-from ...case.kinds import Kind, register_kind
+from ...kinds import Kind, register_kind
 from ...errors import CaseFileError
 from ..checks import check_base_case, check_nested, check_problem_source
 from ..schema import POISSON

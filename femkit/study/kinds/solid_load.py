@@ -6,7 +6,7 @@ summary); this module registers it. No cost model (the plan counts runs).
 
 from __future__ import annotations
 
-from ...case.kinds import Kind, register_kind
+from ...kinds import Kind, register_kind
 
 
 def _schema() -> dict:

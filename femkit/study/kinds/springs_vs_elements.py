@@ -8,7 +8,7 @@ summary), :mod:`femkit.study.report_springs` (figures and report) and
 
 from __future__ import annotations
 
-from ...case.kinds import Kind, register_kind
+from ...kinds import Kind, register_kind
 
 
 def _schema() -> dict:

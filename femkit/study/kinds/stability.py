@@ -8,7 +8,7 @@ Sweep :func:`femkit.study.stability.run_stability_study` over the stress-case ty
 
 from __future__ import annotations
 
-from ...case.kinds import Kind, register_kind
+from ...kinds import Kind, register_kind
 from ...errors import CaseFileError
 from ..spec import StabilityStudySpec
 from ..summary import fit_lines

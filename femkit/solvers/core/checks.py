@@ -7,7 +7,7 @@ decide ``converged``), so the stopping rule::
     ||b - A x||_2 <= max(rtol * ||b||_2, atol)
 
 and the error messages are the same for all of them. Norms are scaled 2-norms and ``b = 0`` is
-decided by ``b``'s entries (:mod:`femkit.solvers.norms`), so the verdict does not change when
+decided by ``b``'s entries (:mod:`femkit.solvers.core.norms`), so the verdict does not change when
 ``A`` and ``b`` are scaled together.
 
 Tolerance policy: ``rtol`` and ``atol`` must be finite and non-negative, and at least one
@@ -29,7 +29,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
-from ..errors import InputError, NotSPDError
+from ...errors import InputError, NotSPDError
 from .norms import binary_exponent, is_zero, norm2
 from .result import SolveResult
 
@@ -146,7 +146,7 @@ def check_options(fn: Callable, options: dict, *, what: str, exclude=()) -> None
     (e.g. ``options: {engine: mumps}`` of the ``cholesky`` solver), before any mesh is built."""
     import inspect
 
-    from ..errors import UnknownNameError
+    from ...errors import UnknownNameError
 
     for name, (kind, valid_values) in getattr(fn, "option_choices", {}).items():
         if name in options and options[name] not in valid_values:
@@ -170,7 +170,7 @@ def unknown_options(bad, valid, *, what: str) -> None:
 
 def check_tolerances(rtol: float, atol: float) -> None:
     """Raise :class:`InputError` unless ``rtol, atol >= 0`` are finite and not both zero."""
-    from ..validation import finite_nonnegative
+    from ...validation import finite_nonnegative
 
     for label, val in (("rtol", rtol), ("atol", atol)):
         finite_nonnegative(val, label)
@@ -403,7 +403,7 @@ class Replacement:
     "Residual replacement strategies for Krylov subspace iterative methods for the convergence
     of true residuals", SIAM J. Sci. Comput. 22(3), 2000).
 
-    The iteration runs on ``b' = 2^-e b``, ``x' = 2^-e x0`` (:mod:`femkit.solvers.norms`: exact
+    The iteration runs on ``b' = 2^-e b``, ``x' = 2^-e x0`` (:mod:`femkit.solvers.core.norms`: exact
     scaling, inner products far from under- and overflow) in *cycles*. Every cycle starts with
     :meth:`start`, which recomputes the true residual ``r = b' - A x'``: the solve is converged
     when it meets the tolerance, stagnant only when it did not decrease since the previous cycle
@@ -532,7 +532,7 @@ def dependency_error(exc: BaseException, package: str, *, what: str, A=None):
     non-finite diagonal entry (the dependency broke down on a matrix that is not SPD),
     :class:`~femkit.errors.SingularSystemError` when the dependency says singular, else
     :class:`~femkit.errors.SolverError` (breakdown). The message keeps the dependency's own."""
-    from ..errors import SingularSystemError, SolverError
+    from ...errors import SingularSystemError, SolverError
 
     said = f"{package} raised {type(exc).__name__}: {exc}"
     if A is not None and (sp.issparse(A) or isinstance(A, np.ndarray)) and A.ndim == 2 \
@@ -573,7 +573,7 @@ class dependency_boundary:
         return self
 
     def __exit__(self, kind, exc, tb):
-        from ..errors import FemkitError
+        from ...errors import FemkitError
 
         if exc is None or not isinstance(exc, Exception) or isinstance(exc, FemkitError):
             return False

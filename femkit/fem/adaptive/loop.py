@@ -31,9 +31,9 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ..errors import AdaptivityError
-from .estimators import ESTIMATORS, ErrorEstimate, problem_data
-from .marking import check_theta, dorfler_mark
+from ...errors import AdaptivityError
+from ..estimators import ESTIMATORS, ErrorEstimate, problem_data
+from ..marking import check_theta, dorfler_mark
 
 REFINEMENTS = ("adaptive", "uniform")
 
@@ -171,8 +171,8 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
         Hitting a budget before ``target`` is not an error: ``target_met`` is False and
         ``stop_reason`` says which budget.
     """
-    from ..mesh.bisect import bisect, label_longest_edge
-    from .norms import energy_error
+    from ...mesh.bisect import bisect, label_longest_edge
+    from ..norms import energy_error
 
     settings = check_settings(theta=theta, target=target, max_dofs=max_dofs, max_time=max_time,
                               max_levels=max_levels, estimator=estimator, refinement=refinement)
@@ -183,7 +183,7 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
     settings["target_on"] = target_on
     state = None                                   # tetrahedra: the bisection state (Maubach)
     if refinement == "adaptive" and mesh.dim == 3:
-        from ..mesh.bisect3d import TetBisection
+        from ...mesh.bisect3d import TetBisection
 
         state = TetBisection.start(mesh)
     elif refinement == "adaptive":
@@ -243,7 +243,7 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
 
 def _min_angle(mesh) -> float:
     """Smallest triangle angle (2D) or dihedral angle (3D) of ``mesh``, in degrees."""
-    from ..mesh.quality import dihedral_angles, side_lengths_and_angles
+    from ...mesh.quality import dihedral_angles, side_lengths_and_angles
 
     p = mesh.points[mesh.cells]
     return float(np.min(dihedral_angles(p) if mesh.dim == 3 else side_lengths_and_angles(p)[1]))
@@ -262,9 +262,9 @@ def _stop_reason(settings: dict, rec: LevelRecord, n_levels: int) -> str | None:
 
 def _uniform_step(mesh):
     """Uniform red refinement as a :class:`~femkit.mesh.bisect.Bisection` (same prolongation)."""
-    from ..mesh.bisect import Bisection
-    from ..mesh.edges import edges
-    from ..mesh.refine import refine
+    from ...mesh.bisect import Bisection
+    from ...mesh.edges import edges
+    from ...mesh.refine import refine
 
     edge_nodes, _ = edges(mesh)
     return Bisection(mesh=refine(mesh), parent=np.repeat(np.arange(mesh.n_cells), 2 ** mesh.dim),
@@ -308,8 +308,8 @@ def poisson_solver(kappa=1.0, f=0.0, *, dirichlet: Sequence = ((None, 0.0),), ne
     a callable). ``x0`` (full nodal vector) is restricted to the unknowns of the reduced system and
     handed to the solver as its initial guess.
     """
-    from ..solvers import solve
-    from .poisson import PoissonProblem
+    from ...solvers import solve
+    from ..poisson import PoissonProblem
 
     if isinstance(kappa, np.ndarray) and kappa.ndim > 0:
         raise AdaptivityError("kappa must be a number, a region table or a callable for adaptive "

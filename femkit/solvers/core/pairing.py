@@ -13,7 +13,7 @@ femkit.errors.InputError: preconditioner 'ic0' is only valid with method 'pcg', 
 
 from __future__ import annotations
 
-from ..errors import InputError
+from ...errors import InputError
 
 __all__ = ["PRECONDITIONED_METHOD", "check_pairing"]
 

@@ -1,4 +1,4 @@
-"""Every compiled (numba) piece of the elastic solids, in one module.
+"""Every compiled (numba) piece of the elastic solids, in one module (also used by dynamics).
 
 numba's on-disk cache is invalidated only by the source file of the cached function itself, not
 by the files of the compiled functions it calls: kernels spread over several files would keep

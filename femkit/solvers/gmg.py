@@ -34,9 +34,9 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from ...errors import HierarchyError, InputError
-from ..checks import check_positive_diagonal, check_symmetric, dependency_boundary, explicit_csr
-from .base import Preconditioner
+from ..errors import HierarchyError, InputError
+from .core.checks import check_positive_diagonal, check_symmetric, dependency_boundary, explicit_csr
+from .preconditioners.base import Preconditioner
 
 #: Over-relaxation of the smoothing sweeps. Measured V(2,2) energy-norm factors (asymptotic, 7
 #: levels from gmsh meshes of h = 0.5): unit square 0.114 / 0.100 / 0.102, L-shape 0.170 / 0.133 /
@@ -252,7 +252,7 @@ class Multigrid:
 
     def __init__(self, A, hierarchy, *, free=None, sweeps: int = 2, coarse_operators=None,
                  omega: float = DEFAULT_OMEGA, check_symmetry: bool = True):
-        from ..kept import factorize_kept
+        from .kept import factorize_kept
 
         if hierarchy is None:
             raise _hierarchy_error("geometric multigrid")

@@ -1,7 +1,7 @@
 """Third-party extensions: modules that register kinds, forces, geometries, solvers, ...
 
 A plugin is an ordinary Python module that registers what it adds when imported (a
-:class:`~femkit.case.kinds.Kind` through :func:`~femkit.case.kinds.register_kind`, a force in
+:class:`~femkit.kinds.Kind` through :func:`~femkit.kinds.register_kind`, a force in
 :data:`femkit.case.scene.forces.FORCES`, a geometry in :data:`femkit.mesh.GEOMETRIES`, ...).
 femkit imports plugins once, at the first look-up of a file kind (every ``load_case``,
 ``load_study``, ``femkit solve`` and ``femkit study`` does one), from two places:
@@ -21,7 +21,7 @@ import functools
 import importlib
 import os
 
-from ..errors import InputError
+from .errors import InputError
 
 __all__ = ["ENTRY_POINT_GROUP", "ENV_VAR", "load_plugins", "plugin_names"]
 

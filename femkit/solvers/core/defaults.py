@@ -8,8 +8,9 @@ key                    default
 ``atol``               ``0.0``
 ``maxiter``            ``None``: each method's own bound (e.g. ``10 n`` for CG)
 ``preconditioner``     ``amg`` for ``pcg`` (smoothed aggregation), ``none`` otherwise
-``method``             per problem type: ``pcg`` for Poisson, ``direct`` for the linear
-                       systems of implicit mass-spring integrators
+``method``             per kind of file, declared by the kind itself
+                       (:attr:`femkit.kinds.Kind.default_solver`): ``pcg`` for Poisson,
+                       ``direct`` for scenes and solids, ``cholesky`` for the cloth study
 ``engine``             ``cholmod``: the factorisation library of ``cholesky``
 ``comparison rtol``    ``1e-8``: the solvers a study compares by cost (adaptive,
                        stability) stop here unless the study file names its own
@@ -30,8 +31,6 @@ DEFAULT_PRECONDITIONER: str = "amg"
 DEFAULT_ENGINE: str = "cholmod"
 #: Relative tolerance of the default solver lists of the studies that compare solvers' cost.
 COMPARISON_RTOL: float = 1e-8
-#: Default method per problem type.
-DEFAULT_METHOD: dict[str, str] = {"poisson": "pcg", "mass_spring": "direct"}
 
 
 def default_preconditioner(method: str) -> str:
