@@ -4,7 +4,7 @@ The cloth scenes named in ``scenes:`` (scene files, built by the scene layer; ``
 merged into their ``system:`` block, e.g. a smaller grid) run with every method of ``methods:``
 (fast mass-spring at 1..k iterations, its Chebyshev variant, Baraff-Witkin, Newton stopped after
 1..k iterations) for ``frames`` steps of the scene's ``dt`` (or ``dt:``), through the linear solver
-``linear_solver`` (default ``cholesky``). The computation is
+``linear_solver`` (default ``direct``, SuperLU; ``cholesky`` with the optional CHOLMOD is faster). The computation is
 :func:`femkit.dynamics.work_precision.cloth_work_precision`: solve error against implicit Euler
 solved by Newton to ``reference.tol`` at the same ``dt``, trajectory error against a small-``dt``
 run (``reference.trajectory``, ``reference.substeps`` steps per frame), both per frame; cost = the
@@ -42,7 +42,7 @@ def _schema(families: list) -> dict:
     "system_overrides": {"type": "object", "description": "merged into every scene's system block"},
     "frames": {"type": "integer", "minimum": 1, "default": 30},
     "dt": {**_POS, "description": "frame length (default: each scene's dt)"},
-    "linear_solver": {**SOLVER_SCHEMA, "default": {"method": "cholesky"}},
+    "linear_solver": {**SOLVER_SCHEMA, "default": {}},  # method: the kind's default_solver
     "methods": {"type": "array", "minItems": 1, "items": {
         "type": "object", "additionalProperties": False, "required": ["family"],
         "properties": {"family": {"enum": families},

@@ -67,7 +67,7 @@ def _small(methods, linear_solver=None):
     return data
 
 
-@pytest.mark.cholmod  # the study-wide solver here is the default, cholesky (optional CHOLMOD)
+@pytest.mark.cholmod  # the study-wide solver here is cholesky (optional CHOLMOD)
 def test_a_method_family_takes_its_own_linear_solver_spec(tmp_path):
     """methods[i].linear_solver is validated like every solver spec, recorded per run and used:
     the same steps with an explicit SuperLU (direct) as with the study's Cholesky."""
@@ -76,7 +76,8 @@ def test_a_method_family_takes_its_own_linear_solver_spec(tmp_path):
         study_from_dict(bad, base_dir=tmp_path)
     res = run_study(study_from_dict(_small([
         {"family": "newton", "iterations": [2]},
-        {"family": "newton", "iterations": [2], "linear_solver": {"method": "direct"}}]),
+        {"family": "newton", "iterations": [2], "linear_solver": {"method": "direct"}}],
+        linear_solver={"method": "cholesky"}),
         base_dir=tmp_path), tmp_path / "r")
     a, b = res.records
     assert a["linear_solver"] == "" and b["linear_solver"] == "direct"

@@ -35,4 +35,5 @@ def _plan(case, **kwargs):
     return plan_solid_case(case, **kwargs)
 
 
-KIND = register_kind(Kind("solid", "problem", _schema, _prepare, _run, _plan))
+KIND = register_kind(Kind("solid", "problem", _schema, _prepare, _run, _plan,
+                          default_solver="direct"))

@@ -42,6 +42,7 @@ import numpy as np
 from ...errors import (CaseFileError, DegenerateMeshError, EquilibriumError, InputError,
                        InstabilityError, SolverError, with_prefix)
 from ...io.atomic import EARLIER_RUN, check_output_dir
+from ...kinds import KINDS
 from ...timing import StageTimer
 from ..frozen import freeze
 from ..names import check_geometry_spec, resolve_file
@@ -139,7 +140,8 @@ def prepare_solid(case) -> None:
     if not dynamic and all(b.kind == "traction" for b in boundaries):
         raise CaseFileError("boundaries: no fixed or roller condition (a free body has "
                             "rigid-body motions and no unique equilibrium)")
-    case.solver = solver = solver_spec(d["linear_solver"], "linear_solver", default_method="direct")
+    case.solver = solver = solver_spec(d["linear_solver"], "linear_solver", 
+                                         default_method=KINDS.get(case.problem, "problem").default_solver)
     case.run_options["limits"] = limits_spec(d.get("limits"))
     out = d["output"]
     if dynamic:

@@ -10,7 +10,7 @@ key                    default
 ``preconditioner``     ``amg`` for ``pcg`` (smoothed aggregation), ``none`` otherwise
 ``method``             per kind of file, declared by the kind itself
                        (:attr:`femkit.kinds.Kind.default_solver`): ``pcg`` for Poisson,
-                       ``direct`` for scenes and solids, ``cholesky`` for the cloth study
+                       ``direct`` for scenes, solids and the cloth study
 ``engine``             ``cholmod``: the factorisation library of ``cholesky``
 ``comparison rtol``    ``1e-8``: the solvers a study compares by cost (adaptive,
                        stability) stop here unless the study file names its own

@@ -46,4 +46,4 @@ def _summary(result) -> list[str]:
 
 
 KIND = register_kind(Kind("cloth_work_precision", "kind", _schema, _check, _run,
-                          plan=_plan, report=_report, summary=_summary, default_solver="cholesky"))
+                          plan=_plan, report=_report, summary=_summary, default_solver="direct"))
