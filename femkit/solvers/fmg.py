@@ -209,9 +209,32 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
     >>> res.converged, res.iterations <= 2, res.info["stopped_by"]
     (True, True, 'discretisation-error estimate')
     """
-    from .gmg import DEFAULT_OMEGA, Multigrid, _hierarchy_error
-
     t_setup = time.perf_counter()
+    _check_options(target, fraction)
+    prob = prepare(A, b, None, rtol=rtol, atol=atol, maxiter=50 if maxiter is None else maxiter,
+                   method="fmg", symmetric=True, check_symmetry=check_symmetry)
+    prob.x = None  # FMG starts from the coarsest level: no zero start vector of n floats
+    mg = _multigrid(prob, M, hierarchy, free, sweeps, omega,
+                    consistent=levels is not None or dirichlet is not None)
+    coarse = _CoarseData(mg, levels, dirichlet)
+    rho0 = max(_contraction(mg), RHO_FLOOR)
+    setup_time = time.perf_counter() - t_setup
+    if prob.b_is_zero:
+        res = zero_rhs_result(prob, method="fmg")
+        res.setup_time = setup_time
+        return res
+    run = _Run(prob, mg, rho0, target=target, fraction=fraction, callback=callback)
+    _cycle_levels(run, _LevelProblems(run, coarse))  # its right-hand sides go on return
+    res = _certify(run, fraction)
+    res.info.update(mg.info)
+    res.info.update(_run_info(run, rho0, fraction, coarse))
+    res.setup_time = setup_time
+    res.solve_time = time.perf_counter() - prob.t_start - setup_time
+    return res
+
+
+def _check_options(target: str, fraction) -> None:
+    """Reject a ``target`` other than the two stopping rules and a ``fraction`` outside (0, 1]."""
     if target not in ("discretisation", "residual"):
         raise InputError(f"fmg: target must be 'discretisation' or 'residual', got {target!r}")
     try:
@@ -220,9 +243,13 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
         frac_ok = False
     if not frac_ok:
         raise InputError(f"fmg: fraction must be a number in (0, 1], got {fraction!r}")
-    prob = prepare(A, b, None, rtol=rtol, atol=atol, maxiter=50 if maxiter is None else maxiter,
-                   method="fmg", symmetric=True, check_symmetry=check_symmetry)
-    prob.x = None  # FMG starts from the coarsest level: no zero start vector of n floats
+
+
+def _multigrid(prob, M, hierarchy, free, sweeps, omega, *, consistent: bool):
+    """The multigrid set-up: the one a ``gmg`` preconditioner ``M`` holds (checked against the
+    system), else built here on ``hierarchy`` (:func:`default_sweeps` unless ``sweeps``)."""
+    from .gmg import DEFAULT_OMEGA, Multigrid, _hierarchy_error
+
     mg = getattr(M, "info", {}).get("hierarchy") if M is not None else None
     if M is not None and not isinstance(mg, Multigrid):
         raise InputError("fmg: M must be a 'gmg' preconditioner of this system (or None)")
@@ -231,193 +258,258 @@ def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL
             raise _hierarchy_error("method 'fmg'")
         with dependency_boundary("fmg (multigrid set-up)", prob.A):
             if sweeps is None:
-                sweeps = default_sweeps(hierarchy, levels is not None or dirichlet is not None)
+                sweeps = default_sweeps(hierarchy, consistent)
             mg = Multigrid(prob.A, hierarchy, free=free, sweeps=sweeps,  # symmetry checked above
                            omega=DEFAULT_OMEGA if omega is None else omega, check_symmetry=False)
     elif mg.levels[-1].A.shape != prob.A.shape:
         raise InputError(f"fmg: M was built for {mg.levels[-1].A.shape}, A is {prob.A.shape}")
-    top = mg.n_levels - 1
-    if levels is not None:
-        levels = list(levels)
-        if len(levels) != top:
-            raise InputError(f"fmg: levels must hold the {top} systems below the finest "
-                             f"(coarsest first), got {len(levels)}")
-        for lvl, s in enumerate(levels):
-            if len(s.b) != len(mg.frees[lvl]):
-                raise InputError(f"fmg: level {lvl} system has {len(s.b)} unknowns, the "
-                                 f"hierarchy's level {lvl} has {len(mg.frees[lvl])} free nodes")
-    if dirichlet is not None:
-        if levels is not None:
-            raise InputError("fmg: give either levels (the coarse systems) or dirichlet (the "
-                             "finest level's Dirichlet values), not both")
-        dirichlet = _coarse_dirichlet(mg, dirichlet)
-    # the coarse Dirichlet values reach the finer free nodes through the few entries of the
-    # prolongations with a fixed column (not the full matrices and nodal vectors)
-    fixed_parts = (mg.hierarchy.fixed_prolongations(frees=mg.frees)
-                   if levels is not None or dirichlet is not None else None)
-    if levels is not None:
-        # each level's Dirichlet values at its fixed nodes (None where all are zero: nothing to add)
-        lifted = [sy.expand(np.zeros(len(sy.free)))[fx] for sy, (_, fx) in zip(levels, fixed_parts)]
-        lifted = [g if np.any(g) else None for g in lifted]
-    rho0 = max(_contraction(mg), RHO_FLOOR)
-    setup_time = time.perf_counter() - t_setup
-    if prob.b_is_zero:
-        res = zero_rhs_result(prob, method="fmg")
-        res.setup_time = setup_time
-        return res
+    return mg
 
-    # right-hand sides of every level, coarsest first, normalised by 2^-e (norms.binary_exponent:
-    # exact, so the cycles are those on b and the energy norms stay far from under/overflow)
-    e = prob.exponent
-    tol = ldexp_saturating(prob.tolerance, -e)
-    rhs = [None] * (top + 1)
-    rhs[top] = scaled(prob.b, -e)
-    for lvl in range(top - 1, -1, -1):
-        if levels is not None:
-            rhs[lvl] = scaled(levels[lvl].b, -e)
-        elif dirichlet is not None:
-            Pd, fixed = fixed_parts[lvl]
-            w = Pd @ scaled(dirichlet[lvl][fixed], -e)
-            rhs[lvl] = mg.restrictions[lvl] @ (rhs[lvl + 1] - mg.levels[lvl + 1].A @ w)
-        else:
-            rhs[lvl] = mg.restrictions[lvl] @ rhs[lvl + 1]
-    # the finest right-hand side is b times 2^-e (exact): formed when needed, not kept beside b
-    rhs[top] = None
 
-    def start(lvl: int, xc: np.ndarray) -> np.ndarray:
+class _CoarseData:
+    """What the coarse problems are made of besides ``P^T``: the caller's level systems
+    (``levels``) or the finest level's Dirichlet data injected to every level (``dirichlet``),
+    checked against the hierarchy, with the prolongations' fixed columns that carry either."""
+
+    def __init__(self, mg, levels, dirichlet) -> None:
+        top = mg.n_levels - 1
+        if levels is not None:
+            levels = list(levels)
+            if len(levels) != top:
+                raise InputError(f"fmg: levels must hold the {top} systems below the finest "
+                                 f"(coarsest first), got {len(levels)}")
+            for lvl, s in enumerate(levels):
+                if len(s.b) != len(mg.frees[lvl]):
+                    raise InputError(f"fmg: level {lvl} system has {len(s.b)} unknowns, the "
+                                     f"hierarchy's level {lvl} has {len(mg.frees[lvl])} free "
+                                     f"nodes")
+        if dirichlet is not None:
+            if levels is not None:
+                raise InputError("fmg: give either levels (the coarse systems) or dirichlet (the "
+                                 "finest level's Dirichlet values), not both")
+            dirichlet = _coarse_dirichlet(mg, dirichlet)
+        self.levels, self.dirichlet = levels, dirichlet
+        # the coarse Dirichlet values reach the finer free nodes through the few entries of the
+        # prolongations with a fixed column (not the full matrices and nodal vectors)
+        self.fixed_parts = (mg.hierarchy.fixed_prolongations(frees=mg.frees)
+                            if levels is not None or dirichlet is not None else None)
+        self.lifted = None
+        if levels is not None:
+            # each level's Dirichlet values at its fixed nodes (None where all are zero)
+            lifted = [sy.expand(np.zeros(len(sy.free)))[fx]
+                      for sy, (_, fx) in zip(levels, self.fixed_parts)]
+            self.lifted = [g if np.any(g) else None for g in lifted]
+
+    def describe(self) -> str:
+        """How the coarse right-hand sides were made (``info["coarse_rhs"]``)."""
+        return ("level systems" if self.levels is not None else
+                "restricted, Dirichlet data injected" if self.dirichlet is not None
+                else "restricted (P^T b)")
+
+
+class _Run:
+    """The state of one FMG solve across its levels: cycles, contraction, estimates, the finest
+    level's residual history and the verdict so far (all norms in the normalised units)."""
+
+    def __init__(self, prob, mg, rho0: float, *, target: str, fraction,
+                 callback) -> None:
+        self.prob, self.mg, self.top = prob, mg, mg.n_levels - 1
+        self.target, self.fraction, self.callback = target, fraction, callback
+        # right-hand sides normalised by 2^-e (norms.binary_exponent: exact, so the cycles are
+        # those on b and the energy norms stay far from under/overflow)
+        self.e = prob.exponent
+        self.tol = ldexp_saturating(prob.tolerance, -self.e)
+        self.cycles, self.rho = [0] * (self.top + 1), rho0
+        self.etas = [float("nan")] * (self.top + 1)
+        self.credible = True
+        self.alg = self.eta = float("nan")
+        self.residuals: list[float] = []
+        self.stopped_by, self.reason, self.message = "maxiter", "maxiter", ""
+        self.met = False
+
+
+class _LevelProblems:
+    """The right-hand side and the interpolated start of every level, coarsest first."""
+
+    def __init__(self, run: _Run, coarse: _CoarseData) -> None:
+        mg, e, top = run.mg, run.e, run.top
+        self.mg, self.b, self.e, self.top, self.coarse = mg, run.prob.b, e, top, coarse
+        rhs = [None] * (top + 1)
+        rhs[top] = scaled(self.b, -e)
+        for lvl in range(top - 1, -1, -1):
+            if coarse.levels is not None:
+                rhs[lvl] = scaled(coarse.levels[lvl].b, -e)
+            elif coarse.dirichlet is not None:
+                Pd, fixed = coarse.fixed_parts[lvl]
+                w = Pd @ scaled(coarse.dirichlet[lvl][fixed], -e)
+                rhs[lvl] = mg.restrictions[lvl] @ (rhs[lvl + 1] - mg.levels[lvl + 1].A @ w)
+            else:
+                rhs[lvl] = mg.restrictions[lvl] @ rhs[lvl + 1]
+        # the finest right-hand side is b times 2^-e (exact): formed when needed, not kept beside b
+        rhs[top] = None
+        self.rhs = rhs
+
+    def start(self, lvl: int, xc: np.ndarray) -> np.ndarray:
         """Level ``lvl``'s start interpolated from the coarser level's ``xc``: ``(P u)[free] =
         P xc + Pd g`` for ``u = (xc on the free nodes, g on the fixed ones)``, the same sums as
         the full product (a row has at most two entries), ``g`` in b's units times 2^-e. Formed
         again where it is needed (the same numbers), not kept."""
-        x0 = mg.prolongations[lvl - 1] @ xc
-        if levels is not None and lifted[lvl - 1] is not None:
-            x0 += fixed_parts[lvl - 1][0] @ scaled(lifted[lvl - 1], -e)
-        elif dirichlet is not None:
-            Pd, fixed = fixed_parts[lvl - 1]
-            x0 += Pd @ scaled(dirichlet[lvl - 1][fixed], -e)
+        c, e = self.coarse, self.e
+        x0 = self.mg.prolongations[lvl - 1] @ xc
+        if c.levels is not None and c.lifted[lvl - 1] is not None:
+            x0 += c.fixed_parts[lvl - 1][0] @ scaled(c.lifted[lvl - 1], -e)
+        elif c.dirichlet is not None:
+            Pd, fixed = c.fixed_parts[lvl - 1]
+            x0 += Pd @ scaled(c.dirichlet[lvl - 1][fixed], -e)
         return x0
 
-    def level_rhs(lvl: int) -> np.ndarray:
+    def level_rhs(self, lvl: int) -> np.ndarray:
         """A new array holding level ``lvl``'s right-hand side (the caller may overwrite it)."""
-        return np.ldexp(prob.b, -e) if lvl == top else rhs[lvl].copy()
+        return np.ldexp(self.b, -self.e) if lvl == self.top else self.rhs[lvl].copy()
 
-    cycles, rho = [0] * (top + 1), rho0
-    etas = [float("nan")] * (top + 1)
-    credible = True
-    x = mg.vcycle(rhs[0], 0) if top > 0 else None
-    alg = eta = float("nan")
-    residuals: list[float] = []
-    stopped_by, reason, message = "maxiter", "maxiter", ""
+
+def _cycle_levels(run: _Run, problems: _LevelProblems) -> None:
+    """Nested iteration: the coarsest level solved, every finer level started from the coarser
+    solution and cycled until its stopping test; the finest level's solution in ``prob.x``."""
+    mg, prob, top = run.mg, run.prob, run.top
+    x = mg.vcycle(problems.rhs[0], 0) if top > 0 else None
     if top == 0:  # one level: the coarse factorisation is a direct solve
         prob.x = mg.vcycle(prob.b, 0)
-        residuals = [norm2(prob.b - prob.A @ prob.x)]
-        stopped_by, reason = "direct coarse solve", "converged"
+        run.residuals = [norm2(prob.b - prob.A @ prob.x)]
+        run.stopped_by, run.reason = "direct coarse solve", "converged"
     for lvl in range(1, top + 1):
-        x_coarse = x    # the start x0 of this level is start(lvl, x_coarse)
-        x = start(lvl, x_coarse)
-        r = level_rhs(lvl)
-        r -= mg.matvec(x, lvl)
-        # ||x - x0||_A^2 = (x - x0).(r0 - r) = x.r0 - x.r - x0.r0 + x0.r: dot products
-        r0 = r.copy()
-        s00 = float(x @ r0)
-        started = bool(np.any(x))  # else eta measures the solution, not an error
-        finest = lvl == top
+        x = _cycle_level(run, problems, lvl, x)
+
+
+def _cycle_level(run: _Run, problems: _LevelProblems, lvl: int,
+                 x_coarse: np.ndarray) -> np.ndarray:
+    """V-cycles on level ``lvl`` from the start interpolated from ``x_coarse`` until the level's
+    stopping test (the finest: the verdict tests of :func:`_finest_test`); returns its solution."""
+    mg, e = run.mg, run.e
+    x = problems.start(lvl, x_coarse)    # the start x0 of this level
+    r = problems.level_rhs(lvl)
+    r -= mg.matvec(x, lvl)
+    # ||x - x0||_A^2 = (x - x0).(r0 - r) = x.r0 - x.r - x0.r0 + x0.r: dot products
+    r0 = r.copy()
+    s00 = float(x @ r0)
+    started = bool(np.any(x))  # else eta measures the solution, not an error
+    finest = lvl == run.top
+    if finest:
+        run.residuals.append(norm2(r))
+    last_true = None    # true residual at the last residual replacement (finest level)
+    limit = run.prob.maxiter if finest else MAX_LEVEL_CYCLES
+    prev_d = None
+    while run.cycles[lvl] < limit:
+        d = mg.vcycle(r, lvl)
+        Ad = mg.matvec(d, lvl)   # in the level's work vector: free until the next cycle
+        x += d
+        r -= Ad
+        run.cycles[lvl] += 1
+        dA = math.sqrt(max(float(d @ Ad), 0.0))
+        d = Ad = None  # released before the next cycle, the start or the true residual
+        if prev_d is not None and prev_d > 0:
+            run.rho = max(run.rho, min(dA / prev_d, 0.99))
+        prev_d = dA
+        run.alg = run.rho / (1.0 - run.rho) * dA
+        x0_r = float(problems.start(lvl, x_coarse) @ r)
+        run.eta = math.sqrt(max(float(x @ r0) - float(x @ r) - s00 + x0_r, 0.0) / 3.0)
         if finest:
-            residuals.append(norm2(r))
-            last_true = None    # true residual at the last residual replacement
-        limit = prob.maxiter if finest else MAX_LEVEL_CYCLES
-        prev_d = None
-        met = False
-        while cycles[lvl] < limit:
-            d = mg.vcycle(r, lvl)
-            Ad = mg.matvec(d, lvl)   # in the level's work vector: free until the next cycle
-            x += d
-            r -= Ad
-            cycles[lvl] += 1
-            dA = math.sqrt(max(float(d @ Ad), 0.0))
-            d = Ad = None  # released before the next cycle, the start or the true residual
-            if prev_d is not None and prev_d > 0:
-                rho = max(rho, min(dA / prev_d, 0.99))
-            prev_d = dA
-            alg = rho / (1.0 - rho) * dA
-            x0_r = float(start(lvl, x_coarse) @ r)
-            eta = math.sqrt(max(float(x @ r0) - float(x @ r) - s00 + x0_r, 0.0) / 3.0)
-            if finest:
-                res_norm = norm2(r)
-                residuals.append(res_norm)
-                if callback is not None:
-                    callback(scaled(x, e))
-                if not math.isfinite(res_norm):
-                    reason, message = "non-finite", f"residual became {res_norm} at cycle {cycles[lvl]}"
-                    break
-                estimate_met = (target == "discretisation" and credible and started
-                                and alg <= fraction * eta)
-                if res_norm <= tol or estimate_met:
-                    # residual replacement (van der Vorst and Ye 2000) before any verdict
-                    true_r = level_rhs(lvl)
-                    true_r -= mg.matvec(x, lvl)
-                    true_norm = norm2(true_r)
-                    if true_norm <= tol or (estimate_met and true_norm <= 2.0 * res_norm + tol):
-                        stopped_by = ("residual rule" if res_norm <= tol and true_norm <= tol
-                                      else "discretisation-error estimate")
-                        reason, met = "converged", True
-                        break
-                    if last_true is not None and not true_norm < last_true:
-                        reason = "stagnation"
-                        message = (f"the true residual {unscale(true_norm, e):.3e} did not "
-                                   f"decrease across a residual replacement (it was "
-                                   f"{unscale(last_true, e):.3e}); tolerance "
-                                   f"{prob.tolerance:.3e}: rounding errors limit the attainable "
-                                   f"accuracy")
-                        break
-                    last_true, r = true_norm, true_r
-                    continue
-            if not finest and (target == "residual" or not credible or not started) \
-                    and cycles[lvl] >= 2:
-                break  # a start for the next level is all a lower level is for here
-            if not finest and target == "discretisation" and credible and started \
-                    and alg <= fraction * eta:
+            stop, r, last_true = _finest_test(run, problems, x, r, last_true, started)
+            if stop:
                 break
-        # a start of zeros (the coarser level had no free node) estimates nothing
-        etas[lvl] = eta if started else float("nan")
-        if math.isfinite(etas[lvl - 1]) and not eta <= ESTIMATE_DECAY * etas[lvl - 1]:
-            credible = False  # from now on only the residual rule stops
-        if finest:
-            prob.x = scaled(x, e)
-            if not met and reason == "maxiter":
-                message = (f"maxiter = {prob.maxiter} V-cycles on the finest level reached; "
-                           f"algebraic error bound {unscale(alg, e):.3e}, estimated "
-                           f"discretisation error {unscale(eta, e):.3e}")
-    rhs = r = r0 = x_coarse = None  # the finest level's vectors, before finish() forms b - A x
-    alg, eta = unscale(alg, e), unscale(eta, e)   # energy norms in the units of b
-    etas = [unscale(v, e) for v in etas]
+        elif _lower_level_done(run, lvl, started):
+            break
+    # a start of zeros (the coarser level had no free node) estimates nothing
+    run.etas[lvl] = run.eta if started else float("nan")
+    if math.isfinite(run.etas[lvl - 1]) and not run.eta <= ESTIMATE_DECAY * run.etas[lvl - 1]:
+        run.credible = False  # from now on only the residual rule stops
+    if finest:
+        run.prob.x = scaled(x, e)
+        if not run.met and run.reason == "maxiter":
+            run.message = (f"maxiter = {run.prob.maxiter} V-cycles on the finest level reached; "
+                           f"algebraic error bound {unscale(run.alg, e):.3e}, estimated "
+                           f"discretisation error {unscale(run.eta, e):.3e}")
+    return x
+
+
+def _lower_level_done(run: _Run, lvl: int, started: bool) -> bool:
+    """Whether level ``lvl`` below the finest has cycled enough: it only gives the next level a
+    start (two cycles when the estimate cannot stop it, else the estimate test)."""
+    if (run.target == "residual" or not run.credible or not started) and run.cycles[lvl] >= 2:
+        return True
+    return (run.target == "discretisation" and run.credible and started
+            and run.alg <= run.fraction * run.eta)
+
+
+def _finest_test(run: _Run, problems: _LevelProblems, x: np.ndarray, r: np.ndarray,
+                 last_true: float | None, started: bool):
+    """The finest level's tests after a V-cycle: residual history and callback, a non-finite
+    residual, and the residual rule or estimate test confirmed by a residual replacement (van der
+    Vorst and Ye 2000). Returns ``(stop, r, last_true)``: ``r`` the replaced residual if any."""
+    mg, e, lvl = run.mg, run.e, run.top
+    res_norm = norm2(r)
+    run.residuals.append(res_norm)
+    if run.callback is not None:
+        run.callback(scaled(x, e))
+    if not math.isfinite(res_norm):
+        run.reason = "non-finite"
+        run.message = f"residual became {res_norm} at cycle {run.cycles[lvl]}"
+        return True, r, last_true
+    estimate_met = (run.target == "discretisation" and run.credible and started
+                    and run.alg <= run.fraction * run.eta)
+    if not (res_norm <= run.tol or estimate_met):
+        return False, r, last_true
+    # residual replacement before any verdict
+    true_r = problems.level_rhs(lvl)
+    true_r -= mg.matvec(x, lvl)
+    true_norm = norm2(true_r)
+    if true_norm <= run.tol or (estimate_met and true_norm <= 2.0 * res_norm + run.tol):
+        run.stopped_by = ("residual rule" if res_norm <= run.tol and true_norm <= run.tol
+                          else "discretisation-error estimate")
+        run.reason, run.met = "converged", True
+        return True, r, last_true
+    if last_true is not None and not true_norm < last_true:
+        run.reason = "stagnation"
+        run.message = (f"the true residual {unscale(true_norm, e):.3e} did not decrease across a "
+                       f"residual replacement (it was {unscale(last_true, e):.3e}); tolerance "
+                       f"{run.prob.tolerance:.3e}: rounding errors limit the attainable accuracy")
+        return True, r, last_true
+    return False, true_r, true_norm
+
+
+def _certify(run: _Run, fraction) -> SolveResult:
+    """The result from the true residual recomputed at exit (:func:`finish`); a stop by the
+    estimate test is certified when that residual agrees with the tracked one (factor 2)."""
+    prob, e, top = run.prob, run.e, run.top
+    run.alg, run.eta = unscale(run.alg, e), unscale(run.eta, e)   # energy norms in b's units
+    run.etas = [unscale(v, e) for v in run.etas]
     if top:
-        residuals = list(unscale_all(residuals, e))
-    res = finish(prob, iterations=cycles[top] if top else 0, residuals=residuals,
-                 reason="converged" if stopped_by == "residual rule" else reason,
-                 message=message, method="fmg", recursive_met=stopped_by == "residual rule")
-    if stopped_by == "discretisation-error estimate" and not res.converged:
-        tracked = residuals[-1]
+        run.residuals = list(unscale_all(run.residuals, e))
+    by_residual = run.stopped_by == "residual rule"
+    res = finish(prob, iterations=run.cycles[top] if top else 0, residuals=run.residuals,
+                 reason="converged" if by_residual else run.reason,
+                 message=run.message, method="fmg", recursive_met=by_residual)
+    if run.stopped_by == "discretisation-error estimate" and not res.converged:
+        tracked = run.residuals[-1]
         if math.isfinite(res.true_residual) and res.true_residual <= 2.0 * tracked + prob.tolerance:
             res.converged, res.reason = True, "converged"
-            res.message = (f"algebraic error bound {alg:.3e} <= {fraction:g} x estimated "
-                           f"discretisation error {eta:.3e} (energy norm) after "
-                           f"{cycles[top]} V-cycle(s) on the finest level; true residual "
+            res.message = (f"algebraic error bound {run.alg:.3e} <= {fraction:g} x estimated "
+                           f"discretisation error {run.eta:.3e} (energy norm) after "
+                           f"{run.cycles[top]} V-cycle(s) on the finest level; true residual "
                            f"{res.true_residual:.3e}")
         else:
             res.reason = "stagnation"
             res.message = (f"the estimate test passed but the true residual "
                            f"{res.true_residual:.3e} disagrees with the tracked {tracked:.3e}")
-    res.info.update(mg.info)
-    res.info.update({
-        "cycles_per_level": cycles, "rho": float(rho), "rho_setup": float(rho0),
-        "discretisation_error_estimates": etas, "estimate_credible": credible,
-        "algebraic_error_estimate": float(alg), "discretisation_error_estimate": float(eta),
-        "target": target, "fraction": float(fraction), "stopped_by": stopped_by,
-        "coarse_rhs": ("level systems" if levels is not None else
-                       "restricted, Dirichlet data injected" if dirichlet is not None
-                       else "restricted (P^T b)"),
-    })
-    res.setup_time = setup_time
-    res.solve_time = time.perf_counter() - prob.t_start - setup_time
     return res
+
+
+def _run_info(run: _Run, rho0: float, fraction, coarse: _CoarseData) -> dict:
+    """FMG's facts for ``SolveResult.info`` (norms already in the units of b)."""
+    return {
+        "cycles_per_level": run.cycles, "rho": float(run.rho), "rho_setup": float(rho0),
+        "discretisation_error_estimates": run.etas, "estimate_credible": run.credible,
+        "algebraic_error_estimate": float(run.alg), "discretisation_error_estimate": float(run.eta),
+        "target": run.target, "fraction": float(fraction), "stopped_by": run.stopped_by,
+        "coarse_rhs": coarse.describe(),
+    }
