@@ -225,20 +225,7 @@ def plan_poisson(*, area: float | None = None, line_length: float | None = None,
     """
     c = constants or load_constants()
     refine = _check_refine(refine)
-    if triangles is not None:
-        m0 = float(triangles)
-        if not (math.isfinite(m0) and m0 > 0):
-            raise InputError(f"triangles must be a positive number, got {triangles!r}")
-        lines_h = 4.0 * math.sqrt(m0)  # a square-ish domain: boundary ~ 4 sqrt(m / 2.3) sizes
-        source, title = "file", f"mesh file ({m0:,.0f} triangles)"
-    elif area is not None and line_length is not None and h is not None:
-        hv = _check_h(h)
-        m0 = predict_triangles(area, line_length, hv, constants=c)
-        lines_h = float(line_length) / hv
-        source = "gmsh"
-        title = f"{name} h={hv:g}" + (f" {params}" if params else "")
-    else:
-        raise InputError("plan_poisson needs area, line_length and h, or triangles (a mesh file)")
+    m0, lines_h, source, title = _mesh_source(area, line_length, h, triangles, name, params, c)
     if refine:
         title += f" refine={refine}"
     m = m0 * 4.0 ** refine
@@ -247,78 +234,15 @@ def plan_poisson(*, area: float | None = None, line_length: float | None = None,
     unknowns = max(n - sz["boundary_edges"], 1.0)
     key, notes = _solver_constants(solver_key(method, preconditioner), c)
     its = predict_iterations(key, unknowns, rtol, constants=c)
-    b, s = c["bytes"], c["seconds"]
     speed = float(speed)
-    compiled = m >= COMPILED_FROM
     outs = tuple(outputs or ())
     unknown_out = sorted(set(outs) - {"vtu", "xdmf", "png"})
     if unknown_out:
         raise InputError(f"unknown output kind(s) {unknown_out}; valid: png, vtu, xdmf")
-    pc_name = key.split("+", 1)[1] if "+" in key else "none"
-    flags = dict(gmsh=source == "gmsh", compiled=compiled, amg=pc_name.startswith("amg"),
-                 png="png" in outs, constants=c, generated=m0, ic0=pc_name == "ic0")
-
-    # numba's start-up: in the first stage after the mesh that runs compiled (IC(0)'s setup is
-    # compiled at every size)
-    numba_stage = (("refine" if refine else "quality") if compiled
-                   else "setup" if flags["ic0"] else None)
-
-    def stage(name, seconds, per_triangle, detail, output=0.0, extra=0.0):
-        if name == numba_stage:
-            seconds += s["numba_load"]
-            detail += ", numba's start-up"
-        return Stage(name, seconds, fixed_bytes(name, **flags) + per_triangle * m + extra,
-                     output, detail)
-
-    def law(name):  # the stage's time law on the path it takes at this size
-        return s[name] if compiled or name not in COMPILED_STAGES else s[f"{name}_numpy"]
-
-    if source == "gmsh":
-        stages = [Stage("mesh", s["gmsh_fixed"] + _power(s["gmsh"], m0),
-                        b["gmsh_import"] + b["gmsh_per_triangle"] * m0,
-                        detail=f"gmsh, {m0:,.0f} triangles")]
-    else:
-        stages = [Stage("mesh", _power(s["read"], m0), b["read_per_triangle"] * m0,
-                        detail=f"read {m0:,.0f} triangles")]
-    if refine:
-        stages.append(stage("refine", _power(law("refine"), m), b["refine_per_triangle"],
-                            f"{refine} red refinement(s) -> {m:,.0f} triangles"))
-    if refine and m0 <= SIMILAR_ROOT_MAX:  # the root's numbers, on the root's path
-        root_law = s["quality" if m0 >= COMPILED_FROM else "quality_numpy"]
-        stages.append(stage("quality", _power(root_law, m0), b["quality_per_triangle"],
-                            "validation and quality (the root's: red refinement keeps the shapes)"))
-    else:
-        stages.append(stage("quality", _power(law("quality"), m), b["quality_per_triangle"],
-                            "validation and quality"))
-    asm_b = b["assembly_per_triangle"] if compiled else b["assembly_numpy_per_triangle"]
-    stages.append(stage("assembly", _power(law("assembly"), m), asm_b,
-                        f"{nnz:,.0f} nonzeros" + (" (compiled kernels)" if compiled else "")))
-    stages.append(stage("boundary", _power(law("boundary"), m), b["boundary_per_triangle"],
-                        f"{unknowns:,.0f} unknowns"))
-    solve_b = b["solve_per_triangle"][key]
-    if key == "direct":
-        fill = c["fill"]["direct_coefficient"] * unknowns ** c["fill"]["direct_exponent"]
-        lu = _power(b["direct"], unknowns)
-        stages.append(stage("setup", s["direct_coefficient"] * unknowns ** s["direct_exponent"],
-                            solve_b, f"sparse LU, ~{fill:,.0f} factor entries", extra=lu))
-        stages.append(stage("solve", s["direct_solve_per_fill"] * fill, solve_b,
-                            "two triangular solves", extra=lu))
-    else:
-        setup_s = s["setup_per_nonzero"][pc_name] * nnz + (s["pyamg_import"] if flags["amg"] else 0.0)
-        stages.append(stage("setup", setup_s, solve_b, f"preconditioner {pc_name}"))
-        stages.append(stage("solve", s["iteration_per_nonzero"][key] * nnz * its, solve_b,
-                            f"{key}, ~{its:,.0f} iterations"))
-    if errors:
-        stages.append(stage("errors", _power(s["errors"], m), b["errors_per_triangle"],
-                            "error norms"))
-    if estimate:
-        stages.append(stage("estimate", _power(s["estimate"], m), b["estimate_per_triangle"],
-                            "a posteriori error estimate (residual)"))
-    if outs:
-        secs = sum(_power(s[k], m) for k in outs) + (s["png_fixed"] if "png" in outs else 0.0)
-        out = sum(c["output_bytes"][f"{k}_per_triangle"] * m for k in outs if k != "png")
-        out += c["output_bytes"]["png"] if "png" in outs else 0.0
-        stages.append(stage("output", secs, b["output_per_triangle"], ", ".join(outs), output=out))
+    px = _Pricer(c, m, m0, refine=refine, source=source, key=key, png="png" in outs)
+    stages = (_mesh_stages(px, source, refine) + _assembly_stages(px, nnz, unknowns)
+              + _solve_stages(px, key, unknowns, nnz, its)
+              + _result_stages(px, errors, estimate, outs))
     if _stages is not None:
         stages = [st for st in stages if st.name in _stages]
     for st in stages:
@@ -329,21 +253,7 @@ def plan_poisson(*, area: float | None = None, line_length: float | None = None,
         sizes["iterations"] = its
     if source == "gmsh" and refine:
         sizes["triangles_generated"] = m0
-    mc = c["mesh"]
-    assumptions = [
-        (f"gmsh makes {mc['triangles_per_area_h2']:.3g} A/h^2 + {mc['triangles_per_length_h']:.3g} L/h "
-         f"triangles (A area, L line length), x4 per refinement" if source == "gmsh"
-         else "the triangle count of the mesh file, x4 per refinement"),
-        f"~{nnz / max(n, 1):.1f} nonzeros per row (P1); memory and time per stage calibrated by "
-        "benchmarks/calibrate_cost.py (constants: femkit/cost/constants.json, overridable)",
-    ]
-    if _stages is None and key != "direct":
-        it = c["iterations"][key]
-        assumptions.append(f"{key}: iterations ~ {it['coefficient']:.3g} n^{it['exponent']:.2g} "
-                           f"at rtol 1e-8, x log(1/rtol)/log(1e8) for rtol {rtol:g}")
-    if speed != 1.0:
-        assumptions.append(f"this machine now takes {speed:.2f}x the calibration machine's time (speed probe)")
-    assumptions += notes
+    assumptions = _assumptions(c, source, n, nnz, key, rtol, speed, full=_stages is None) + notes
     plan = Plan("poisson", title + (f", {key}" if _stages is None else ""), sizes, stages,
                 c["bytes"]["baseline"], assumptions)
     plan.suggest = _suggester(dict(area=area, line_length=line_length, h=h, refine=refine,
@@ -352,6 +262,149 @@ def plan_poisson(*, area: float | None = None, line_length: float | None = None,
                                    preconditioner=preconditioner, rtol=rtol, outputs=outs,
                                    errors=errors, estimate=estimate, constants=c, speed=speed, _stages=_stages))
     return plan
+
+
+def _mesh_source(area, line_length, h, triangles, name, params,
+                 c: dict) -> tuple[float, float, str, str]:
+    """Where the mesh comes from: ``(m0, lines_h, source, title)``, the triangles before
+    refinement, the mesh lines' length in sizes ``h``, ``"file"`` or ``"gmsh"`` and the title."""
+    if triangles is not None:
+        m0 = float(triangles)
+        if not (math.isfinite(m0) and m0 > 0):
+            raise InputError(f"triangles must be a positive number, got {triangles!r}")
+        lines_h = 4.0 * math.sqrt(m0)  # a square-ish domain: boundary ~ 4 sqrt(m / 2.3) sizes
+        return m0, lines_h, "file", f"mesh file ({m0:,.0f} triangles)"
+    if area is not None and line_length is not None and h is not None:
+        hv = _check_h(h)
+        m0 = predict_triangles(area, line_length, hv, constants=c)
+        lines_h = float(line_length) / hv
+        return m0, lines_h, "gmsh", f"{name} h={hv:g}" + (f" {params}" if params else "")
+    raise InputError("plan_poisson needs area, line_length and h, or triangles (a mesh file)")
+
+
+class _Pricer:
+    """A stage's seconds and bytes at ``m`` final triangles: the time law of the path it takes
+    at this size, the fixed bytes resident by then and numba's start-up where it is paid."""
+
+    def __init__(self, c: dict, m: float, m0: float, *, refine: int, source: str, key: str,
+                 png: bool) -> None:
+        self.c, self.b, self.s, self.m, self.m0 = c, c["bytes"], c["seconds"], m, m0
+        self.compiled = compiled = m >= COMPILED_FROM
+        self.pc_name = pc_name = key.split("+", 1)[1] if "+" in key else "none"
+        self.flags = dict(gmsh=source == "gmsh", compiled=compiled,
+                          amg=pc_name.startswith("amg"), png=png, constants=c, generated=m0,
+                          ic0=pc_name == "ic0")
+        # numba's start-up: in the first stage after the mesh that runs compiled (IC(0)'s setup
+        # is compiled at every size)
+        self.numba_stage = (("refine" if refine else "quality") if compiled
+                            else "setup" if self.flags["ic0"] else None)
+
+    def stage(self, name, seconds, per_triangle, detail, output=0.0, extra=0.0) -> Stage:
+        """The stage ``name`` with the fixed bytes of its time, ``per_triangle * m`` and ``extra``."""
+        if name == self.numba_stage:
+            seconds += self.s["numba_load"]
+            detail += ", numba's start-up"
+        return Stage(name, seconds, fixed_bytes(name, **self.flags) + per_triangle * self.m + extra,
+                     output, detail)
+
+    def law(self, name) -> dict:
+        """The stage's time law on the path it takes at this size."""
+        s = self.s
+        return s[name] if self.compiled or name not in COMPILED_STAGES else s[f"{name}_numpy"]
+
+
+def _mesh_stages(px: _Pricer, source: str, refine: int) -> list[Stage]:
+    """``mesh`` (gmsh or reading), ``refine`` and ``quality``."""
+    b, s, m, m0 = px.b, px.s, px.m, px.m0
+    if source == "gmsh":
+        stages = [Stage("mesh", s["gmsh_fixed"] + _power(s["gmsh"], m0),
+                        b["gmsh_import"] + b["gmsh_per_triangle"] * m0,
+                        detail=f"gmsh, {m0:,.0f} triangles")]
+    else:
+        stages = [Stage("mesh", _power(s["read"], m0), b["read_per_triangle"] * m0,
+                        detail=f"read {m0:,.0f} triangles")]
+    if refine:
+        stages.append(px.stage("refine", _power(px.law("refine"), m), b["refine_per_triangle"],
+                               f"{refine} red refinement(s) -> {m:,.0f} triangles"))
+    if refine and m0 <= SIMILAR_ROOT_MAX:  # the root's numbers, on the root's path
+        root_law = s["quality" if m0 >= COMPILED_FROM else "quality_numpy"]
+        stages.append(px.stage("quality", _power(root_law, m0), b["quality_per_triangle"],
+                               "validation and quality (the root's: red refinement keeps the "
+                               "shapes)"))
+    else:
+        stages.append(px.stage("quality", _power(px.law("quality"), m), b["quality_per_triangle"],
+                               "validation and quality"))
+    return stages
+
+
+def _assembly_stages(px: _Pricer, nnz: float, unknowns: float) -> list[Stage]:
+    """``assembly`` and ``boundary`` (Dirichlet elimination)."""
+    b, m = px.b, px.m
+    asm_b = b["assembly_per_triangle"] if px.compiled else b["assembly_numpy_per_triangle"]
+    return [px.stage("assembly", _power(px.law("assembly"), m), asm_b,
+                     f"{nnz:,.0f} nonzeros" + (" (compiled kernels)" if px.compiled else "")),
+            px.stage("boundary", _power(px.law("boundary"), m), b["boundary_per_triangle"],
+                     f"{unknowns:,.0f} unknowns")]
+
+
+def _solve_stages(px: _Pricer, key: str, unknowns: float, nnz: float,
+                  its: float) -> list[Stage]:
+    """``setup`` and ``solve``: a sparse LU and two triangular solves, or a preconditioner and
+    the predicted iterations."""
+    c, s, pc_name = px.c, px.s, px.pc_name
+    solve_b = px.b["solve_per_triangle"][key]
+    if key == "direct":
+        fill = c["fill"]["direct_coefficient"] * unknowns ** c["fill"]["direct_exponent"]
+        lu = _power(px.b["direct"], unknowns)
+        return [px.stage("setup", s["direct_coefficient"] * unknowns ** s["direct_exponent"],
+                         solve_b, f"sparse LU, ~{fill:,.0f} factor entries", extra=lu),
+                px.stage("solve", s["direct_solve_per_fill"] * fill, solve_b,
+                         "two triangular solves", extra=lu)]
+    setup_s = (s["setup_per_nonzero"][pc_name] * nnz
+               + (s["pyamg_import"] if px.flags["amg"] else 0.0))
+    return [px.stage("setup", setup_s, solve_b, f"preconditioner {pc_name}"),
+            px.stage("solve", s["iteration_per_nonzero"][key] * nnz * its, solve_b,
+                     f"{key}, ~{its:,.0f} iterations")]
+
+
+def _result_stages(px: _Pricer, errors: bool, estimate: bool, outs: tuple) -> list[Stage]:
+    """``errors``, ``estimate`` and ``output`` (the files ``outs``), those the run has."""
+    c, b, s, m = px.c, px.b, px.s, px.m
+    stages = []
+    if errors:
+        stages.append(px.stage("errors", _power(s["errors"], m), b["errors_per_triangle"],
+                               "error norms"))
+    if estimate:
+        stages.append(px.stage("estimate", _power(s["estimate"], m), b["estimate_per_triangle"],
+                               "a posteriori error estimate (residual)"))
+    if outs:
+        secs = sum(_power(s[k], m) for k in outs) + (s["png_fixed"] if "png" in outs else 0.0)
+        out = sum(c["output_bytes"][f"{k}_per_triangle"] * m for k in outs if k != "png")
+        out += c["output_bytes"]["png"] if "png" in outs else 0.0
+        stages.append(px.stage("output", secs, b["output_per_triangle"], ", ".join(outs),
+                               output=out))
+    return stages
+
+
+def _assumptions(c: dict, source: str, n: float, nnz: float, key: str, rtol: float,
+                 speed: float, *, full: bool) -> list[str]:
+    """The plan's stated assumptions: the mesh model, the calibration, the iteration law (a
+    full plan with an iterative solver) and this machine's speed."""
+    mc = c["mesh"]
+    assumptions = [
+        (f"gmsh makes {mc['triangles_per_area_h2']:.3g} A/h^2 + {mc['triangles_per_length_h']:.3g} L/h "
+         f"triangles (A area, L line length), x4 per refinement" if source == "gmsh"
+         else "the triangle count of the mesh file, x4 per refinement"),
+        f"~{nnz / max(n, 1):.1f} nonzeros per row (P1); memory and time per stage calibrated by "
+        "benchmarks/calibrate_cost.py (constants: femkit/cost/constants.json, overridable)",
+    ]
+    if full and key != "direct":
+        it = c["iterations"][key]
+        assumptions.append(f"{key}: iterations ~ {it['coefficient']:.3g} n^{it['exponent']:.2g} "
+                           f"at rtol 1e-8, x log(1/rtol)/log(1e8) for rtol {rtol:g}")
+    if speed != 1.0:
+        assumptions.append(f"this machine now takes {speed:.2f}x the calibration machine's time (speed probe)")
+    return assumptions
 
 
 def _measure(plan: Plan, what: str) -> float:
