@@ -10,8 +10,6 @@ from .bisect3d import TetBisection
 from .edges import boundary_edges_topological, boundary_nodes, edges
 from .faces import boundary_faces_topological, faces
 from .geometries import GEOMETRIES, generate, geo_file
-from . import geometries3d  # noqa: F401  (registers the solid geometries in GEOMETRIES)
-from . import kuhn_geometries  # noqa: F401  (registers the Kuhn-type ones for 3D bisection)
 from .hierarchy import MeshHierarchy
 from .io import read_mesh, write_mesh
 from .mesh import Mesh

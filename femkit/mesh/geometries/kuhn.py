@@ -22,11 +22,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
-from .faces import boundary_faces_topological
-from .geometries import register_geometry
-from .mesh import Mesh
-from .structured import SIDES_3D, structured_box
+from ...errors import InputError
+from ..faces import boundary_faces_topological
+from ..mesh import Mesh
+from ..structured import SIDES_3D, structured_box
+from .registry import register_geometry
 
 
 def _cubes_per_unit(h: float) -> int:

@@ -18,20 +18,20 @@ from __future__ import annotations
 import math
 from typing import Sequence
 
-from ..errors import InputError
-from ..validation import mesh_size as _check_h
-from .geometries import (_generate, _gmsh_session, _group, _mesh_from_gmsh, _positive, _set_size,
-                         register_geometry)
-from .mesh import Mesh
+from ...errors import InputError
+from ...validation import mesh_size as _check_h
+from ..mesh import Mesh
+from .gmsh_session import gmsh_session, mesh_from_gmsh, physical_group, run_mesher, set_size
+from .registry import positive, register_geometry
 
 _SIDES = ("xmin", "xmax", "ymin", "ymax", "zmin", "zmax")
 
 
 def _finish3d(gmsh, h: float) -> Mesh:
     gmsh.model.occ.synchronize()
-    _set_size(gmsh, h)
-    _generate(gmsh, 3)
-    return _mesh_from_gmsh(gmsh, dim=3)
+    set_size(gmsh, h)
+    run_mesher(gmsh, 3)
+    return mesh_from_gmsh(gmsh, dim=3)
 
 
 def _surfaces_by_box(gmsh) -> dict[int, tuple[float, ...]]:
@@ -49,9 +49,9 @@ def _box_groups(gmsh, lo: Sequence[float], hi: Sequence[float], first_tag: int =
         d, upper = divmod(k, 2)
         plane = hi[d] if upper else lo[d]
         faces = [s for s, b in boxes.items() if abs(b[d] - plane) < tol and abs(b[d + 3] - plane) < tol]
-        _group(gmsh, 2, faces, name, tag)
+        physical_group(gmsh, 2, faces, name, tag)
         tag += 1
-    _group(gmsh, 2, list(boxes), "boundary", tag)
+    physical_group(gmsh, 2, list(boxes), "boundary", tag)
     return tag + 1
 
 
@@ -66,13 +66,13 @@ def box(h: float, lx: float = 1.0, ly: float = 1.0, lz: float = 1.0,
     likewise, ``boundary`` (all six). Cell tag: ``domain``.
     """
     h = _check_h(h)
-    lx, ly, lz = (_positive(n, v) for n, v in (("lx", lx), ("ly", ly), ("lz", lz)))
+    lx, ly, lz = (positive(n, v) for n, v in (("lx", lx), ("ly", ly), ("lz", lz)))
     x0, y0, z0 = map(float, origin)
-    with _gmsh_session("box") as gmsh:
+    with gmsh_session("box") as gmsh:
         vol = gmsh.model.occ.addBox(x0, y0, z0, lx, ly, lz)
         gmsh.model.occ.synchronize()
         nxt = _box_groups(gmsh, (x0, y0, z0), (x0 + lx, y0 + ly, z0 + lz))
-        _group(gmsh, 3, [vol], "domain", nxt)
+        physical_group(gmsh, 3, [vol], "domain", nxt)
         return _finish3d(gmsh, h)
 
 
@@ -100,16 +100,16 @@ def beam(h: float, length: float = 5.0, width: float = 1.0, height: float = 1.0)
     same faces as ``xmin``) and ``tip`` (x = length, as ``xmax``). Cell tag: ``domain``.
     """
     h = _check_h(h)
-    L, W, H = (_positive(n, v) for n, v in (("length", length), ("width", width), ("height", height)))
-    with _gmsh_session("beam") as gmsh:
+    L, W, H = (positive(n, v) for n, v in (("length", length), ("width", width), ("height", height)))
+    with gmsh_session("beam") as gmsh:
         vol = gmsh.model.occ.addBox(0.0, 0.0, 0.0, L, W, H)
         gmsh.model.occ.synchronize()
         nxt = _box_groups(gmsh, (0.0, 0.0, 0.0), (L, W, H))
         boxes = _surfaces_by_box(gmsh)
         tol = 1e-5 * L
-        _group(gmsh, 2, [s for s, b in boxes.items() if abs(b[3]) < tol], "clamped", nxt)
-        _group(gmsh, 2, [s for s, b in boxes.items() if abs(b[0] - L) < tol], "tip", nxt + 1)
-        _group(gmsh, 3, [vol], "domain", nxt + 2)
+        physical_group(gmsh, 2, [s for s, b in boxes.items() if abs(b[3]) < tol], "clamped", nxt)
+        physical_group(gmsh, 2, [s for s, b in boxes.items() if abs(b[0] - L) < tol], "tip", nxt + 1)
+        physical_group(gmsh, 3, [vol], "domain", nxt + 2)
         return _finish3d(gmsh, h)
 
 
@@ -122,7 +122,7 @@ def l_shape_3d(h: float) -> Mesh:
     removed octant), ``outer`` (the rest), ``boundary`` (all). Cell tag: ``domain``.
     """
     h = _check_h(h)
-    with _gmsh_session("l_shape_3d") as gmsh:
+    with gmsh_session("l_shape_3d") as gmsh:
         occ = gmsh.model.occ
         cube = occ.addBox(-1.0, -1.0, -1.0, 2.0, 2.0, 2.0)
         octant = occ.addBox(0.0, 0.0, 0.0, 1.0, 1.0, 1.0)
@@ -131,10 +131,10 @@ def l_shape_3d(h: float) -> Mesh:
         boxes = _surfaces_by_box(gmsh)
         inner = [s for s, b in boxes.items() if min(b[:3]) > -1e-5]
         outer = [s for s in boxes if s not in inner]
-        _group(gmsh, 2, inner, "reentrant", 1)
-        _group(gmsh, 2, outer, "outer", 2)
-        _group(gmsh, 2, list(boxes), "boundary", 3)
-        _group(gmsh, 3, [t for _, t in out], "domain", 4)
+        physical_group(gmsh, 2, inner, "reentrant", 1)
+        physical_group(gmsh, 2, outer, "outer", 2)
+        physical_group(gmsh, 2, list(boxes), "boundary", 3)
+        physical_group(gmsh, 3, [t for _, t in out], "domain", 4)
         return _finish3d(gmsh, h)
 
 
@@ -148,15 +148,15 @@ def sphere(h: float, radius: float = 1.0, centre: Sequence[float] = (0.0, 0.0, 0
     Face tags: ``outer`` and ``boundary`` (the same faces). Cell tag: ``domain``.
     """
     h = _check_h(h)
-    r = _positive("radius", radius)
+    r = positive("radius", radius)
     cx, cy, cz = map(float, centre)
-    with _gmsh_session("sphere") as gmsh:
+    with gmsh_session("sphere") as gmsh:
         vol = gmsh.model.occ.addSphere(cx, cy, cz, r)
         gmsh.model.occ.synchronize()
         faces = list(_surfaces_by_box(gmsh))
-        _group(gmsh, 2, faces, "outer", 1)
-        _group(gmsh, 2, faces, "boundary", 2)
-        _group(gmsh, 3, [vol], "domain", 3)
+        physical_group(gmsh, 2, faces, "outer", 1)
+        physical_group(gmsh, 2, faces, "boundary", 2)
+        physical_group(gmsh, 3, [vol], "domain", 3)
         return _finish3d(gmsh, h)
 
 
@@ -171,10 +171,10 @@ def cylinder(h: float, radius: float = 0.5, height: float = 1.0) -> Mesh:
     ``domain``.
     """
     h = _check_h(h)
-    r, H = _positive("radius", radius), _positive("height", height)
+    r, H = positive("radius", radius), positive("height", height)
     if not math.isfinite(r * H):
         raise InputError(f"cylinder: radius and height must be finite, got {radius}, {height}")
-    with _gmsh_session("cylinder") as gmsh:
+    with gmsh_session("cylinder") as gmsh:
         vol = gmsh.model.occ.addCylinder(0.0, 0.0, 0.0, 0.0, 0.0, H, r)
         gmsh.model.occ.synchronize()
         boxes = _surfaces_by_box(gmsh)
@@ -182,9 +182,9 @@ def cylinder(h: float, radius: float = 0.5, height: float = 1.0) -> Mesh:
         bottom = [s for s, b in boxes.items() if abs(b[5]) < tol]
         top = [s for s, b in boxes.items() if abs(b[2] - H) < tol]
         side = [s for s in boxes if s not in bottom + top]
-        _group(gmsh, 2, bottom, "bottom", 1)
-        _group(gmsh, 2, top, "top", 2)
-        _group(gmsh, 2, side, "side", 3)
-        _group(gmsh, 2, list(boxes), "boundary", 4)
-        _group(gmsh, 3, [vol], "domain", 5)
+        physical_group(gmsh, 2, bottom, "bottom", 1)
+        physical_group(gmsh, 2, top, "top", 2)
+        physical_group(gmsh, 2, side, "side", 3)
+        physical_group(gmsh, 2, list(boxes), "boundary", 4)
+        physical_group(gmsh, 3, [vol], "domain", 5)
         return _finish3d(gmsh, h)
