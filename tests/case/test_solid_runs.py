@@ -156,15 +156,15 @@ def test_warnings_are_one_femkit_line_each(tmp_path, capsys):
 def test_cli_prints_a_foreign_warning_on_one_line(capsys):
     import warnings
 
-    from femkit.cli import _one_line_warning
+    from femkit.cli.messages import one_line_warning
 
-    _one_line_warning(RuntimeWarning("overflow encountered\n in multiply"), RuntimeWarning,
-                      "/x/y.py", 3)
-    _one_line_warning(UserWarning("plain"), UserWarning, "/x/y.py", 3)
+    one_line_warning(RuntimeWarning("overflow encountered\n in multiply"), RuntimeWarning,
+                     "/x/y.py", 3)
+    one_line_warning(UserWarning("plain"), UserWarning, "/x/y.py", 3)
     assert capsys.readouterr().err.splitlines() == [
         "femkit: warning: overflow encountered in multiply (RuntimeWarning)",
         "femkit: warning: plain"]
-    assert warnings.showwarning is not _one_line_warning   # main() restores Python's own
+    assert warnings.showwarning is not one_line_warning   # main() restores Python's own
 
 
 @pytest.mark.parametrize("path", sorted([*(REPO / "cases").glob("*.yaml"),

@@ -28,7 +28,7 @@ LIST_GROUPS = tuple(GROUPS)
 def test_list_groups_of_the_parser_are_the_catalog_groups(capsys):
     """The groups ``femkit list --help`` names are the catalog's, in its order (no second list),
     and each one's singular resolves to it."""
-    from femkit.cli import _list_group
+    from femkit.cli.parser import _list_group
 
     with pytest.raises(SystemExit):
         build_parser().parse_args(["list", "--help"])

@@ -24,8 +24,9 @@ LAZY = ("scipy.spatial", "femkit.study.timing", "femkit.study.load", "femkit.stu
 
 IMPORTS = """
 import sys, types
-from femkit.cli import DEFERRED_IMPORTS, _defer_unused_imports, main
-_defer_unused_imports()                     # as the femkit command does (femkit.cli.entry)
+from femkit.cli import main
+from femkit.cli.startup import DEFERRED_IMPORTS, defer_unused_imports
+defer_unused_imports()                      # as the femkit command does (femkit.cli.entry)
 code = main(["solve", sys.argv[1], "--quiet"])
 print(code)
 print(",".join(m for m in {lazy!r} if m in sys.modules))
@@ -57,7 +58,7 @@ def test_a_solve_imports_neither_spatial_nor_study_nor_xml_and_defers_unused_num
 def test_warmup_bytecode_is_written_and_read_under_dont_write_bytecode(tmp_path, monkeypatch):
     """``byte_compile`` (``femkit warmup``) writes a valid .pyc per module, which a process with
     ``PYTHONDONTWRITEBYTECODE=1`` then reads instead of compiling the source."""
-    from femkit.cli import byte_compile
+    from femkit.cli.bytecode import byte_compile
 
     pkg = tmp_path / "femkit"
     shutil.copytree(Path(__file__).resolve().parents[2] / "femkit" / "mesh", pkg / "mesh",
@@ -121,9 +122,9 @@ def test_python_dash_m_femkit_exits_with_the_code(tmp_path):
 def test_deferred_modules_are_not_deferred_when_already_imported():
     code = textwrap.dedent("""
         import sys, numpy.testing
-        from femkit.cli import _Deferred, _defer_unused_imports
-        _defer_unused_imports()
-        print(any(isinstance(f, _Deferred) for f in sys.meta_path))
+        from femkit.cli.startup import DeferredFinder, defer_unused_imports
+        defer_unused_imports()
+        print(any(isinstance(f, DeferredFinder) for f in sys.meta_path))
     """)
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr

@@ -1,0 +1,80 @@
+"""What each ``femkit`` subcommand does once its arguments are parsed: ``handler(args) -> exit
+code`` (the parsers in :mod:`femkit.cli.parser` name them). Each imports what it needs when it
+runs, so that ``femkit --help`` imports none of it.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from .messages import EXIT_FAILED, EXIT_OK, mpi_rank
+
+
+def max_memory(args) -> float | None:
+    """``--max-memory`` in bytes (``None`` when not given)."""
+    if getattr(args, "max_memory", None) is None:
+        return None
+    from ..cost import parse_bytes
+
+    return parse_bytes(args.max_memory, "--max-memory")
+
+
+def run_solve(args) -> int:
+    """``femkit solve``: load the case, plan it (``--dry-run``) or check its budget, run it."""
+    from ..case import load_case
+    from ..case.budget import check_case, plan_case
+    from ..interrupt import exit_code, stop_on_signals
+
+    overrides = dict(args.overrides)
+    if args.backend:
+        overrides["solver__backend"] = args.backend
+    case = load_case(args.case, **overrides)
+    if args.dry_run:
+        print(plan_case(case).render())
+        return EXIT_OK
+    check_case(case, max_memory=max_memory(args), force=args.force)
+    with stop_on_signals() as stop:
+        case.run_options["stop"] = stop
+        result = case.run(output_dir=args.output, quiet=args.quiet)
+    if getattr(result, "interrupted", None):
+        print(f"femkit: interrupted by {result.interrupted}; what was computed is written to "
+              f"{getattr(result, 'output_dir', None)} (marked interrupted: true)", file=sys.stderr)
+        return exit_code(stop)
+    converged = bool(getattr(result, "converged", True))
+    if not converged:
+        where = getattr(result, "output_dir", None)
+        # a run that failed for a reason of its own (e.g. an unstable integration) has already
+        # printed that reason; only a plain non-convergence is named here
+        what = "run failed" if getattr(result, "failure", None) else "solver did not converge"
+        if mpi_rank() == 0:
+            print(f"femkit: {what}; results written to {where} (marked converged: false)",
+                  file=sys.stderr)
+        return EXIT_FAILED
+    return EXIT_OK
+
+
+def run_check(args) -> int:
+    """``femkit check``: cross-check a Poisson case against scikit-fem and pyamg."""
+    from ..case import load_case
+    from ..case.poisson.cross_check import cross_check, format_table
+
+    case = load_case(args.case, **args.overrides)
+    rows = cross_check(case)
+    ok = all(r.passed for r in rows)
+    if not args.quiet or not ok:
+        print(format_table(rows))
+    return EXIT_OK if ok else EXIT_FAILED
+
+
+def run_warmup(args) -> int:
+    """``femkit warmup``: compile the kernels and write femkit's bytecode."""
+    from ..case.poisson.warmup import warm_up
+    from ..solids.warmup import warm_up as warm_up_solids
+
+    from .bytecode import byte_compile
+
+    print(f"kernels ready in {warm_up(print) + warm_up_solids():.1f} s")
+    written, failed = byte_compile()
+    print(f"bytecode of femkit's {written} modules written"
+          + (f" ({failed} could not be written: a read-only install)" if failed else ""))
+    return EXIT_OK
