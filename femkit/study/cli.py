@@ -80,11 +80,13 @@ def cli_main(args) -> int:
     from .load import load_study
     from .run import run_study
 
-    from ..interrupt import Interrupted, stop_on_signals
+    from ..interrupt import Interrupted, raising, stop_on_signals
 
+    study = None
     with stop_on_signals():  # until the end: a signal after the sweep must not kill the summary
         try:
-            study = load_study(args.study, quick=args.quick, **getattr(args, "overrides", {}))
+            with raising("loading the study file"):  # a signal stops the parse and checks at once
+                study = load_study(args.study, quick=args.quick, **getattr(args, "overrides", {}))
             if _check_cost(study, args):
                 return 0
             result = run_study(study, args.output, progress=False if args.no_progress else None)
@@ -92,6 +94,9 @@ def cli_main(args) -> int:
             print(f"femkit study: error: {exc}", file=sys.stderr)
             return 2
         except Interrupted as exc:
+            if study is None:
+                print(f"femkit study: {exc}; nothing written", file=sys.stderr)
+                return 128 + int(exc.flag.signum or 2)
             out = args.output if args.output is not None else study.default_output()
             print(f"femkit study: {exc}; nothing written, the earlier report in {out} (if any) is "
                   "kept as it was", file=sys.stderr)
