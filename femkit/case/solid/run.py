@@ -509,6 +509,17 @@ def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
     return out
 
 
+def _say_compiling(case, echo: Callable[[str], Any]) -> None:
+    """Say so when the run's materials must be generated and compiled first (a minute or so)."""
+    from ..poisson.warmup import COMPILE_MESSAGE
+
+    pending = [m for m in dict(case.spec.materials).values() if not m.kernels_cached()]
+    if pending:
+        names = sorted({f"energy {m.energy.describe()[:60]}" if getattr(m, "energy", None)
+                        else "the built-in materials" for m in pending})
+        echo(f"{COMPILE_MESSAGE}: {'; '.join(names)}...")
+
+
 def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = False,
               write: bool = True, echo: Callable[[str], Any] | None = None) -> SolidResult:
     """Run a prepared solid case: build, solve (static or dynamic), write, print the summary.
@@ -527,6 +538,8 @@ def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = F
     check_solid_fits(case)
     timer = StageTimer()
     t0 = time.perf_counter()
+    if not quiet:
+        _say_compiling(case, echo or print)
     with timer("build"):
         problem = build_problem(case)
     stop = case.run_options.get("stop")

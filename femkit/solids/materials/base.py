@@ -129,6 +129,10 @@ class Material:
         raise MaterialError(f"{self.name}: neither a registered material nor designed by its "
                             "energy, so it has no compiled kernels")
 
+    def kernels_cached(self) -> bool:
+        """Whether :meth:`kernels` loads compiled code from the cache (no SymPy, no compiling)."""
+        return True
+
 
 @dataclass(frozen=True)
 class StretchMaterial(Material):
