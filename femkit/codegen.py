@@ -64,20 +64,63 @@ def load_named(name: str, kind: str, make_text: Callable[[], str], *,
     if mod is not None:
         return mod
     path = cache_dir(kind) / f"{name}.py"
-    path.parent.mkdir(parents=True, exist_ok=True)
     if not path.exists() or rewrite:
         text = make_text()
         if not path.exists() or path.read_text() != text:
-            fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-            with os.fdopen(fd, "w") as fh:
-                fh.write(text)
-            os.replace(tmp, path)      # atomic: parallel test workers may write the same file
+            try:
+                _write_atomic(path, text)
+            except OSError as exc:  # a read-only cache (or HOME): a private temporary one
+                path = _fallback_dir(kind, path.parent, exc) / path.name
+                _write_atomic(path, text)
     spec = importlib.util.spec_from_file_location(name, path)
     mod = importlib.util.module_from_spec(spec)
     sys.modules[name] = mod
     spec.loader.exec_module(mod)
     _LOADED[name] = mod
     return mod
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+    with os.fdopen(fd, "w") as fh:
+        fh.write(text)
+    os.replace(tmp, path)      # atomic: parallel test workers may write the same file
+
+
+_WARNED: set[str] = set()
+
+
+def _private_temp() -> Path:
+    """``<tmp>/femkit-cache-<uid>``, made private (0700) and checked to be this user's own real
+    directory (modules imported from it run as code); else a fresh ``mkdtemp`` one."""
+    import stat
+
+    uid = getattr(os, "getuid", lambda: None)()
+    root = Path(tempfile.gettempdir()) / f"femkit-cache-{uid}"
+    try:
+        root.mkdir(mode=0o700, exist_ok=True)
+        st = os.lstat(root)
+        if stat.S_ISDIR(st.st_mode) and (uid is None or st.st_uid == uid) \
+                and not st.st_mode & 0o077:
+            return root
+    except OSError:
+        pass
+    return Path(tempfile.mkdtemp(prefix="femkit-cache-"))
+
+
+def _fallback_dir(kind: str, wanted: Path, exc: OSError) -> Path:
+    """A directory of this user's under the system's temporary one, for generated modules of
+    ``kind`` when ``wanted`` cannot be written; says so once per process (one line on stderr:
+    the modules, and their compiled code, are then made again after the temporary files go)."""
+    folder = _private_temp() / kind
+    if str(wanted) not in _WARNED:
+        _WARNED.add(str(wanted))
+        reason = exc.strerror or type(exc).__name__
+        print(f"femkit: warning: cannot write the kernel cache {wanted} ({reason}); using "
+              f"{folder} instead (set FEMKIT_CACHE_DIR to a writable directory to keep them)",
+              file=sys.stderr)
+    return folder
 
 
 def copied_kernels(module: ModuleType, roots: Iterable[str]) -> list[str]:

@@ -81,8 +81,36 @@ def _case_inf(d: Path) -> list[str]:
     return ["solve", str(d / "case.yaml")]
 
 
+def _solid(d: Path, material: dict, **extra) -> list[str]:
+    """A unit cube pulled by 0.1 at x = 1, held at x = 0: the smallest solid case."""
+    data = {"problem": "solid", "mesh": {"geometry": "unit_cube", "h": 0.5}, "material": material,
+            "boundaries": [{"tag": "xmin", "type": "fixed"},
+                           {"tag": "xmax", "type": "fixed", "displacement": [0.1, 0.0, 0.0]}],
+            "static": {"load_steps": 1}, "output": {"dir": "out"}, **extra}
+    (d / "case.yaml").write_text(yaml.safe_dump(data))
+    return ["solve", str(d / "case.yaml")]
+
+
+def _energy(f: str):
+    """A solid whose material is designed by the energy ``f(s)`` (plus a volume term)."""
+    def build(d: Path) -> list[str]:
+        return _solid(d, {"energy": {"f": f, "h": "lam/2*(J-1)**2"},
+                          "constants": {"mu": 1.0, "lam": 2.0}})
+    return build
+
+
 #: id -> (builder, words the one line holds)
 CASES = {
+    # energies: each once hung, ran ~55 s into a numba TypingError, or hit Python's recursion limit
+    "energy-power-tower": (_energy("mu*(s-1)**2 + 0*9**9**9"), ["material", "exponent", "64"]),
+    "energy-googol-exponent": (_energy("mu*(s-1)**(10**100)"), ["material", "exponent", "64"]),
+    "energy-huge-float-exponent": (_energy("mu*s**1e300"), ["material", "1e+300", "outside"]),
+    "energy-huge-integer": (_energy("mu*(s-1)**2*" + "9" * 40), ["material", "outside"]),
+    "energy-tiny-number": (_energy("mu*(s-1)**2*1e-300"), ["material", "1e-300", "outside"]),
+    "energy-nested-minus": (_energy("mu*(s-1)**2" + "+" + "-" * 1991 + "mu*(s-1)**2"),
+                            ["material", "nested deeper than 100 levels"]),
+    "energy-where-without-comparison": (_energy("where(s, mu*(s-1)**2, mu*(s-1)**4)"),
+                                        ["material", "where()'s condition", "comparison", "'s'"]),
     "yaml-alias-bomb": (_alias_bomb, ["case.yaml", "aliases", "200,000 values"]),
     "yaml-alias-cycle": (_alias_cycle, ["case.yaml", "alias", "inside the node it names"]),
     "yaml-file-too-large": (_huge_file, ["case.yaml", "bytes", "larger than the 2,000,000"]),
@@ -109,3 +137,66 @@ def test_hostile_input_is_refused_in_one_line(name, tmp_path, capsys):
         assert word in err, (word, err)
     assert sorted(p.name for p in tmp_path.iterdir()) == before
     assert took < 5.0, took
+
+
+def test_an_energy_sympy_cannot_finish_is_stopped_in_one_line(tmp_path, capsys, monkeypatch):
+    """A product of many distinct factors (under every syntactic bound) once kept SymPy busy for
+    minutes: its time is bounded (lowered here from 30 s to 1 s)."""
+    import femkit.solids.energy.parse as parse
+
+    monkeypatch.setattr(parse, "SYMPY_SECONDS", 1.0)
+    W = "*".join(f"(s1 + {i}*s2 + s3)" for i in range(1, 60))
+    argv = _solid(tmp_path, {"energy": {"W": W}, "constants": {}})
+    start = time.perf_counter()
+    assert main(argv) == 2
+    took = time.perf_counter() - start
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "did not finish" in err and "within 1 s" in err, err
+    assert took < 5.0, took
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.yaml"]
+
+
+def test_a_run_that_must_compile_an_energy_says_so_first(tmp_path, capsys, monkeypatch):
+    """The first use of an energy compiles for about a minute: the run says so before it."""
+    from femkit.solids.materials import MATERIALS
+
+    cls = MATERIALS.get("stable_neo_hookean")
+    argv = _solid(tmp_path, {"model": "stable_neo_hookean", "E": 10.0, "nu": 0.3},
+                  output={"dir": "out", "png": False, "gif": False, "vtu": False})
+    assert main(argv) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert not first.startswith("compiling"), first   # cached: nothing said
+    monkeypatch.setattr(cls, "kernels_cached", lambda self: False)
+    assert main(argv + ["-o", str(tmp_path / "again")]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first == "compiling kernels (first run, cached afterwards): the built-in materials...", first
+
+
+def test_designed_energy_kernels_are_cached_only_once_compiled(tmp_path, monkeypatch):
+    from femkit.solids.materials import EnergyMaterial
+
+    monkeypatch.setenv("FEMKIT_CACHE_DIR", str(tmp_path))
+    m = EnergyMaterial.from_energy({"f": "mu*(s-1)**2 + mu*(s-1)**3", "h": "lam/2*(J-1)**2"},
+                                   {"mu": 1.0, "lam": 2.0})
+    assert not m.kernels_cached()
+
+
+def test_an_unwritable_kernel_cache_falls_back_to_a_private_temporary_one(tmp_path, capsys,
+                                                                          monkeypatch):
+    """A read-only HOME once ended every new energy in a PermissionError traceback."""
+    import uuid
+
+    from femkit import codegen
+
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    monkeypatch.setenv("FEMKIT_CACHE_DIR", str(blocker / "cache"))  # cannot become a directory
+    name = f"femkit_test_{uuid.uuid4().hex}"
+    mod = codegen.load_named(name, "energies", lambda: "ANSWER = 42\n")
+    assert mod.ANSWER == 42
+    assert Path(mod.__file__).parent.parent.name.startswith("femkit-cache-")
+    assert oct(Path(mod.__file__).parent.parent.stat().st_mode & 0o777) == oct(0o700)
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot write the kernel cache" in err, err
+    assert "FEMKIT_CACHE_DIR" in err
+    Path(mod.__file__).unlink()
