@@ -99,8 +99,22 @@ def _energy(f: str):
     return build
 
 
+def _nan_displacement(d: Path) -> list[str]:
+    argv = _solid(d, {"model": "stvk", "E": 10.0, "nu": 0.3})
+    text = (d / "case.yaml").read_text().replace("- 0.1", "- .nan")
+    assert ".nan" in text
+    (d / "case.yaml").write_text(text)
+    return argv
+
+
 #: id -> (builder, words the one line holds)
 CASES = {
+    "material-E-1e300": (lambda d: _solid(d, {"model": "stvk", "E": 1.0e300, "nu": 0.3}),
+                         ["material", "E = 1e+300", "larger than 1e+100", "overflow"]),
+    "material-mu-1e200": (lambda d: _solid(d, {"model": "stvk", "mu": 1.0e200, "lam": 1.0}),
+                          ["material", "mu = 1e+200", "overflow"]),
+    "displacement-nan": (_nan_displacement,
+                         ["boundaries[1].displacement[0]", "finite number", ".nan"]),
     # energies: each once hung, ran ~55 s into a numba TypingError, or hit Python's recursion limit
     "energy-power-tower": (_energy("mu*(s-1)**2 + 0*9**9**9"), ["material", "exponent", "64"]),
     "energy-googol-exponent": (_energy("mu*(s-1)**(10**100)"), ["material", "exponent", "64"]),
@@ -200,3 +214,85 @@ def test_an_unwritable_kernel_cache_falls_back_to_a_private_temporary_one(tmp_pa
     assert err.count("\n") == 1 and "cannot write the kernel cache" in err, err
     assert "FEMKIT_CACHE_DIR" in err
     Path(mod.__file__).unlink()
+
+
+def test_the_library_says_which_displacement_is_wrong_and_how():
+    """Once: 'got shape (20, 3)' for a NaN in a 3-vector."""
+    import numpy as np
+
+    from femkit.errors import InputError
+    from femkit.solids.boundary import Dirichlet
+
+    with pytest.raises(InputError, match=r"must be finite, got nan in \[nan, 0.0, 0.0\]"):
+        Dirichlet(30, 3).fix(np.arange(20), None, [float("nan"), 0.0, 0.0])
+    with pytest.raises(InputError, match=r"one row per node \(20 x 3\); got shape \(2,\)"):
+        Dirichlet(30, 3).fix(np.arange(20), None, [1.0, 2.0])
+    assert Dirichlet(30, 3).fix(np.arange(20), None, [0.1, 0.0, 0.0]).values[:3].tolist() == \
+        [0.1, 0.0, 0.0]
+
+
+def _cube_msh(path: Path, flip_every: int) -> int:
+    """A 2x2x2 Kuhn mesh of the unit cube written with every ``flip_every``-th tetrahedron's
+    last two vertices swapped (listed in the opposite order); how many were swapped."""
+    import numpy as np
+
+    from femkit.mesh import Mesh, structured_box, write_mesh
+
+    m = structured_box(2, 2, 2, (1.0, 1.0, 1.0))
+    cells = m.cells.copy()
+    flip = np.arange(len(cells)) % flip_every == 0 if flip_every else np.zeros(len(cells), bool)
+    cells[flip, 2], cells[flip, 3] = m.cells[flip, 3], m.cells[flip, 2]
+    write_mesh(path, Mesh(points=m.points, cells=cells, cell_tags=np.full(len(cells), 8),
+                          boundary_facets=m.boundary_facets, boundary_tags=m.boundary_tags,
+                          tag_names={**m.tag_names, "domain": 8}))
+    return int(flip.sum())
+
+
+def test_tetrahedra_listed_in_the_opposite_order_are_reoriented_and_said(tmp_path, capsys):
+    """docs/solids.md: a file's vertex order is bookkeeping: such cells are turned round, one
+    line says how many, and the equilibrium is the one of the consistently ordered file."""
+    import json
+
+    results = {}
+    for flip_every in (0, 2):
+        d = tmp_path / f"flip{flip_every}"
+        d.mkdir()
+        flipped = _cube_msh(d / "cube.msh", flip_every)
+        argv = _solid(d, {"model": "stable_neo_hookean", "E": 10.0, "nu": 0.3},
+                      output={"dir": "out", "png": False, "gif": False, "vtu": False})
+        text = (d / "case.yaml").read_text().replace("geometry: unit_cube", "file: cube.msh")
+        (d / "case.yaml").write_text(text.replace("  h: 0.5\n", ""))
+        assert main(argv + ["--quiet"]) == 0
+        err = capsys.readouterr().err
+        if flipped:
+            assert err.count("\n") == 1 and "femkit: note: mesh.file" in err, err
+            assert f"{flipped} of 48 tetrahedron(s) listed with the opposite vertex order; " \
+                "re-oriented" in err, err
+        else:
+            assert err == ""
+        results[flip_every] = json.loads((d / "out" / "result.json").read_text())
+    assert results[2]["verdict"] == results[0]["verdict"] == "converged"
+    assert results[2]["max_displacement"] == pytest.approx(results[0]["max_displacement"],
+                                                           rel=1e-12)
+
+
+def test_a_dynamic_body_needs_no_boundaries(tmp_path):
+    """docs/solids.md: 'a dynamic body needs no support (a body in free flight)'; the schema
+    once required a non-empty list. Without gravity or loads it moves rigidly at its velocity."""
+    import numpy as np
+
+    from femkit.case import case_from_dict
+    from femkit.errors import CaseFileError
+
+    data = {"problem": "solid", "mesh": {"geometry": "unit_cube", "h": 0.5},
+            "material": {"model": "stable_neo_hookean", "E": 10.0, "nu": 0.3},
+            "integrator": "newton", "dt": 0.01, "t_end": 0.05, "velocity": [2.0, 0.0, -1.0]}
+    case = case_from_dict(data, tmp_path)
+    result = case.run(write=False)
+    assert result.verdict == "converged"
+    moved = result.x[-1] - result.x[0]
+    assert np.allclose(moved, [0.1, 0.0, -0.05], atol=1e-9)
+    with pytest.raises(CaseFileError, match="no fixed or roller condition"):
+        case_from_dict({k: v for k, v in data.items()
+                        if k not in ("integrator", "dt", "t_end", "velocity")} | {"static": True},
+                       tmp_path)

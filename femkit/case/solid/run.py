@@ -199,17 +199,30 @@ def folded_cells(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
     return np.flatnonzero(count == count.max())
 
 
+def _reoriented(mesh) -> tuple:
+    """``mesh`` with its cells listed in the other vertex order turned round, and how many: the
+    file's vertex order is bookkeeping, not geometry. Cells that are geometrically inverted
+    (folded over a neighbour) are still refused after this."""
+    from ...mesh.validate import orient_ccw
+
+    return orient_ccw(mesh), int((mesh.signed_volumes() < 0).sum())
+
+
 def build_mesh(spec: SolidSpec):
-    """The validated rest mesh, generated or read; refused with
+    """The validated rest mesh, generated or read (a file's cells listed in the opposite vertex
+    order re-oriented, saying how many); refused with
     :class:`~femkit.errors.DegenerateMeshError` naming the elements when some are inverted
-    (cells of opposite orientation, or cells folded over a neighbour: :func:`folded_cells`)."""
+    (cells folded over a neighbour: :func:`folded_cells`)."""
     from ...mesh import generate, read_mesh, validate
 
     m = spec.mesh
     where = f"mesh.file {m['file']}" if "file" in m else f"mesh.geometry {m['geometry']}"
     try:
-        mesh = read_mesh(m["file"]) if "file" in m else generate(m["geometry"], m["h"],
-                                                                   **dict(m.get("params") or {}))
+        flipped = 0
+        if "file" in m:
+            mesh, flipped = _reoriented(read_mesh(m["file"], orient=False))
+        else:
+            mesh = generate(m["geometry"], m["h"], **dict(m.get("params") or {}))
         neg = mesh.signed_volumes() < 0
         bad = np.flatnonzero(neg if neg.sum() <= (~neg).sum() else ~neg) if neg.any() else \
             folded_cells(mesh.points, mesh.cells)
@@ -218,7 +231,11 @@ def build_mesh(spec: SolidSpec):
                 f"{len(bad)} inverted {mesh.cell_name}(s) in the input mesh (overlapping their "
                 f"neighbours): element ids {', '.join(map(str, bad[:10]))}"
                 f"{' ...' if len(bad) > 10 else ''}", element_ids=bad)
-        return validate(mesh)
+        mesh = validate(mesh)
+        if flipped:  # said once the mesh is accepted: a refusal stays one line
+            print(f"femkit: note: {where}: {flipped:,} of {mesh.n_cells:,} {mesh.cell_name}(s) "
+                  "listed with the opposite vertex order; re-oriented", file=sys.stderr)
+        return mesh
     except InputError as exc:
         raise with_prefix(exc, where) from None
 
