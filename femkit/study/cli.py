@@ -51,20 +51,23 @@ def _check_cost(study, args) -> bool:
     from ..cost import Limits, check_budget, machine_speed, parse_bytes, with_default_time
     from .cost import plan_study
 
-    if getattr(args, "dry_run", False):
-        print(plan_study(study, speed=machine_speed()).render())
-        return True
     max_memory = getattr(args, "max_memory", None)
     # the default time budget (one hour, femkit.cost.DEFAULT_TIME_BUDGET): --force runs past it;
     # the machine's speed is probed only for a sweep the model puts near it
     limits = with_default_time(Limits(
         memory=None if max_memory is None else parse_bytes(max_memory, "--max-memory")))
-    plan = plan_study(study)
-    if plan.seconds > MEASURE_FRACTION * limits.time:
+    dry = getattr(args, "dry_run", False)
+    if dry:  # the plan, then what the run would say of it (a refusal exits 2 as it would)
+        plan = plan_study(study, speed=machine_speed())
+        print(plan.render())
+        sys.stdout.flush()
+    else:
+        plan = plan_study(study)
+    if not dry and plan.seconds > MEASURE_FRACTION * limits.time:
         plan = plan_study(study, speed=machine_speed())
     for w in check_budget(plan, limits, force=getattr(args, "force", False), override="--force"):
         print(f"femkit study: warning: {w} (--force given)", file=sys.stderr)
-    return False
+    return dry
 
 
 def cli_main(args) -> int:
