@@ -296,3 +296,91 @@ def test_a_dynamic_body_needs_no_boundaries(tmp_path):
         case_from_dict({k: v for k, v in data.items()
                         if k not in ("integrator", "dt", "t_end", "velocity")} | {"static": True},
                        tmp_path)
+
+
+def _beam(d: Path, **changes) -> list[str]:
+    data = yaml.safe_load((ROOT / "cases" / "solid_cantilever.yaml").read_text())
+    data.update({"mesh": {"geometry": "beam", "h": 0.5, "params": {"length": 4.0}},
+                 "output": {"dir": "out"}, **changes})
+    (d / "case.yaml").write_text(yaml.safe_dump(data))
+    return ["solve", str(d / "case.yaml")]
+
+
+def _vibration(d: Path, **changes) -> list[str]:
+    data = yaml.safe_load((ROOT / "cases" / "solid_beam_vibration.yaml").read_text())
+    data.update({"output": {"dir": "out"}, **changes})
+    (d / "case.yaml").write_text(yaml.safe_dump(data))
+    return ["solve", str(d / "case.yaml")]
+
+
+@pytest.mark.parametrize("build, dry, words", [
+    (lambda d: _beam(d, static={"load_steps": 1_000_000_000}), True,
+     ["predicted", "exceeds", "1e+09 steps"]),
+    (lambda d: _beam(d, static={"load_steps": 1_000_000_000}), False,
+     ["predicted", "exceeds", "1e+09 steps"]),
+    (lambda d: _vibration(d, integrator={"method": "projective",
+                                         "options": {"iterations": 1_000_000_000}}), False,
+     ["predicted time", "exceeds the default time budget", "integrator.options.iterations <="]),
+    (lambda d: _vibration(d, integrator={"method": "projective",
+                                         "options": {"iterations": 1_000_000_000}}), True,
+     ["predicted time", "integrator.options.iterations <="]),
+], ids=["load-steps-1e9-dry-run", "load-steps-1e9", "projective-1e9-iterations",
+        "projective-1e9-iterations-dry-run"])
+def test_a_run_the_budget_refuses_is_refused_by_its_dry_run_too(build, dry, words, tmp_path,
+                                                                capsys):
+    """Once: the dry run exited 0 saying nothing of the refusal, and a billion projective
+    iterations per step were not priced at all (accepted, then deaf to signals for minutes)."""
+    argv = build(tmp_path) + (["--dry-run"] if dry else [])
+    start = time.perf_counter()
+    assert main(argv) == 2
+    assert time.perf_counter() - start < 5.0
+    out, err = capsys.readouterr()
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    for word in words:
+        assert word in err, (word, err)
+    assert ("stage" in out) == dry
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.yaml"]
+
+
+def test_the_solid_plan_counts_the_tetrahedra_the_run_meshes(tmp_path):
+    """Once: 176 tetrahedra priced for a beam meshed into 420 (gmsh caps its element size)."""
+    from femkit.case import load_case
+    from femkit.case.budget import plan_case
+    from femkit.mesh import generate
+
+    _beam(tmp_path)
+    plan = plan_case(load_case(tmp_path / "case.yaml"))
+    meshed = generate("beam", 0.5, length=4.0)
+    assert plan.sizes["tetrahedra"] == meshed.n_cells
+    assert plan.sizes["points"] == len(meshed.points)
+
+
+def test_a_tetrahedral_poisson_plan_speaks_of_tetrahedra(capsys):
+    """Once: 'read 128,000,000,000 triangles' in the plan of a generated tetrahedral mesh."""
+    assert main(["solve", str(ROOT / "cases" / "cube.yaml"), "--dry-run",
+                 "--set", "mesh.h=0.05"]) in (0, 2)
+    out = capsys.readouterr().out
+    stages = {line.split()[0]: line for line in out.splitlines()[3:]}
+    assert "gmsh, ~" in stages["mesh"] and stages["mesh"].endswith("tetrahedra")
+    assert "triangles" not in out.split("assumes")[0], out
+    assert "tetrahedra" in stages["refine"]
+
+
+def test_projective_sweeps_stop_at_a_stop_request(tmp_path):
+    """A billion local/global sweeps in one step (run past the budget here, as with --force)
+    end at a stop request instead of running on for minutes."""
+    import threading
+
+    from femkit.case import load_case
+    from femkit.interrupt import stop_on_signals
+
+    _vibration(tmp_path, integrator={"method": "projective",
+                                     "options": {"iterations": 1_000_000_000}},
+               output={"dir": "out", "vtu": False, "png": False, "gif": False})
+    case = load_case(tmp_path / "case.yaml")
+    start = time.perf_counter()
+    with stop_on_signals() as flag:
+        case.run_options["stop"] = flag
+        threading.Timer(1.0, flag.request).start()
+        case.run(write=False)
+    assert time.perf_counter() - start < 10.0
