@@ -23,7 +23,8 @@ from pathlib import Path
 from types import ModuleType
 from typing import Callable, Iterable
 
-__all__ = ["cache_dir", "load_generated", "load_named", "copied_kernels", "function_sources", "generated_path"]
+__all__ = ["cache_dir", "load_generated", "load_named", "copied_kernels", "function_sources", "generated_path",
+           "find_generated"]
 
 _LOADED: dict[str, ModuleType] = {}
 
@@ -63,7 +64,7 @@ def load_named(name: str, kind: str, make_text: Callable[[], str], *,
     mod = _LOADED.get(name)
     if mod is not None:
         return mod
-    path = cache_dir(kind) / f"{name}.py"
+    path = find_generated(name, kind) or cache_dir(kind) / f"{name}.py"
     if not path.exists() or rewrite:
         text = make_text()
         if not path.exists() or path.read_text() != text:
@@ -78,6 +79,22 @@ def load_named(name: str, kind: str, make_text: Callable[[], str], *,
     spec.loader.exec_module(mod)
     _LOADED[name] = mod
     return mod
+
+
+def find_generated(name: str, kind: str) -> Path | None:
+    """The file of the generated module ``name`` of ``kind``: in :func:`cache_dir`, else in the
+    private temporary directory a run without a writable cache put it in; None when neither
+    holds it (it was never generated here)."""
+    path = cache_dir(kind) / f"{name}.py"
+    if path.is_file():
+        return path
+    folder = path.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if folder.is_dir() and os.access(folder, os.W_OK):
+        return None  # a writable (or makeable) cache: nothing went to the temporary one
+    fallback = _private_temp() / kind / f"{name}.py"
+    return fallback if fallback.is_file() else None
 
 
 def _write_atomic(path: Path, text: str) -> None:

@@ -213,6 +213,15 @@ def test_an_unwritable_kernel_cache_falls_back_to_a_private_temporary_one(tmp_pa
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "cannot write the kernel cache" in err, err
     assert "FEMKIT_CACHE_DIR" in err
+    # a later process finds it there: nothing generated, nothing said
+    del codegen._LOADED[name]
+
+    def never() -> str:
+        raise AssertionError("generated again")
+
+    again = codegen.load_named(name, "energies", never)
+    assert again.ANSWER == 42 and again.__file__ == mod.__file__
+    assert capsys.readouterr().err == ""
     Path(mod.__file__).unlink()
 
 

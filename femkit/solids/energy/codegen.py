@@ -153,10 +153,12 @@ def module_key(recipe: str) -> str:
 def module_cached(recipe: str) -> bool:
     """Whether the module of ``recipe`` is generated and its element pass in numba's cache
     beside it: a run then loads both and compiles nothing (else it says it compiles first)."""
+    from ...codegen import find_generated
+
     name = module_key(recipe)
-    folder = cache_dir()
-    return (folder / f"{name}.py").is_file() and \
-        any((folder / "__pycache__").glob(f"{name}.element_pass-*.nbi"))
+    path = find_generated(name, "energies")
+    return path is not None and \
+        any((path.parent / "__pycache__").glob(f"{name}.element_pass-*.nbi"))
 
 
 def energy_module(recipe: str, build: Callable[[], Sequence]) -> ModuleType:
