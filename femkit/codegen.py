@@ -23,7 +23,8 @@ from pathlib import Path
 from types import ModuleType
 from typing import Callable, Iterable
 
-__all__ = ["cache_dir", "load_generated", "load_named", "copied_kernels", "function_sources", "generated_path"]
+__all__ = ["cache_dir", "load_generated", "load_named", "copied_kernels", "function_sources", "generated_path",
+           "find_generated"]
 
 _LOADED: dict[str, ModuleType] = {}
 
@@ -63,21 +64,80 @@ def load_named(name: str, kind: str, make_text: Callable[[], str], *,
     mod = _LOADED.get(name)
     if mod is not None:
         return mod
-    path = cache_dir(kind) / f"{name}.py"
-    path.parent.mkdir(parents=True, exist_ok=True)
+    path = find_generated(name, kind) or cache_dir(kind) / f"{name}.py"
     if not path.exists() or rewrite:
         text = make_text()
         if not path.exists() or path.read_text() != text:
-            fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-            with os.fdopen(fd, "w") as fh:
-                fh.write(text)
-            os.replace(tmp, path)      # atomic: parallel test workers may write the same file
+            try:
+                _write_atomic(path, text)
+            except OSError as exc:  # a read-only cache (or HOME): a private temporary one
+                path = _fallback_dir(kind, path.parent, exc) / path.name
+                _write_atomic(path, text)
     spec = importlib.util.spec_from_file_location(name, path)
     mod = importlib.util.module_from_spec(spec)
     sys.modules[name] = mod
     spec.loader.exec_module(mod)
     _LOADED[name] = mod
     return mod
+
+
+def find_generated(name: str, kind: str) -> Path | None:
+    """The file of the generated module ``name`` of ``kind``: in :func:`cache_dir`, else in the
+    private temporary directory a run without a writable cache put it in; None when neither
+    holds it (it was never generated here)."""
+    path = cache_dir(kind) / f"{name}.py"
+    if path.is_file():
+        return path
+    folder = path.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if folder.is_dir() and os.access(folder, os.W_OK):
+        return None  # a writable (or makeable) cache: nothing went to the temporary one
+    fallback = _private_temp() / kind / f"{name}.py"
+    return fallback if fallback.is_file() else None
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+    with os.fdopen(fd, "w") as fh:
+        fh.write(text)
+    os.replace(tmp, path)      # atomic: parallel test workers may write the same file
+
+
+_WARNED: set[str] = set()
+
+
+def _private_temp() -> Path:
+    """``<tmp>/femkit-cache-<uid>``, made private (0700) and checked to be this user's own real
+    directory (modules imported from it run as code); else a fresh ``mkdtemp`` one."""
+    import stat
+
+    uid = getattr(os, "getuid", lambda: None)()
+    root = Path(tempfile.gettempdir()) / f"femkit-cache-{uid}"
+    try:
+        root.mkdir(mode=0o700, exist_ok=True)
+        st = os.lstat(root)
+        if stat.S_ISDIR(st.st_mode) and (uid is None or st.st_uid == uid) \
+                and not st.st_mode & 0o077:
+            return root
+    except OSError:
+        pass
+    return Path(tempfile.mkdtemp(prefix="femkit-cache-"))
+
+
+def _fallback_dir(kind: str, wanted: Path, exc: OSError) -> Path:
+    """A directory of this user's under the system's temporary one, for generated modules of
+    ``kind`` when ``wanted`` cannot be written; says so once per process (one line on stderr:
+    the modules, and their compiled code, are then made again after the temporary files go)."""
+    folder = _private_temp() / kind
+    if str(wanted) not in _WARNED:
+        _WARNED.add(str(wanted))
+        reason = exc.strerror or type(exc).__name__
+        print(f"femkit: warning: cannot write the kernel cache {wanted} ({reason}); using "
+              f"{folder} instead (set FEMKIT_CACHE_DIR to a writable directory to keep them)",
+              file=sys.stderr)
+    return folder
 
 
 def copied_kernels(module: ModuleType, roots: Iterable[str]) -> list[str]:

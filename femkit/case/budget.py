@@ -21,7 +21,7 @@ import sys
 from ..cost import Limits, Plan, check_budget, with_default_time
 from .cost import OVERRIDE
 
-__all__ = ["plan_case", "check_case"]
+__all__ = ["plan_case", "check_case", "check_dry_run"]
 
 #: Without a stated time limit, a run is measured (and checked against the default budget,
 #: :data:`femkit.cost.budget.DEFAULT_TIME_BUDGET`) only when the model predicts more than this
@@ -46,6 +46,17 @@ def plan_case(case, *, measure: bool = True) -> Plan:
     return kind.plan(case, measure=measure)
 
 
+def _limits(case, max_memory: float | None) -> tuple[Limits, Limits, Limits]:
+    """The case's limits (the file's, ``max_memory``, the default time budget), and them split
+    into the untimed part (memory, steps, output) and the time limit."""
+    limits = with_default_time(case.run_options.get("limits"))
+    if max_memory is not None:
+        limits = limits.merged(Limits(memory=max_memory))
+    untimed = dataclasses.replace(limits, time=None, time_is_default=False)
+    timed = Limits(time=limits.time, check_available=False, time_is_default=limits.time_is_default)
+    return limits, untimed, timed
+
+
 def check_case(case, *, max_memory: float | None = None, force: bool = False,
                echo=None) -> Plan:
     """Plan ``case`` and refuse it when it exceeds a budget (before anything runs).
@@ -63,15 +74,11 @@ def check_case(case, *, max_memory: float | None = None, force: bool = False,
     BudgetExceededError
         A limit is exceeded and ``force`` is false.
     """
-    limits = with_default_time(case.run_options.get("limits"))
-    if max_memory is not None:
-        limits = limits.merged(Limits(memory=max_memory))
+    limits, untimed, timed = _limits(case, max_memory)
     case.run_options["force"] = bool(force)
     say = echo or (lambda line: print(line, file=sys.stderr))
-    untimed = dataclasses.replace(limits, time=None, time_is_default=False)
     plan = plan_case(case, measure=False)
     warnings = check_budget(plan, untimed, force=force, override=OVERRIDE)
-    timed = Limits(time=limits.time, check_available=False, time_is_default=limits.time_is_default)
     # a stated time limit is checked on a measured plan; the default budget only when the model
     # puts the run near it (a tenth of it), so short runs pay no measurement
     if not limits.time_is_default or plan.seconds > MEASURE_FRACTION * limits.time:
@@ -83,3 +90,22 @@ def check_case(case, *, max_memory: float | None = None, force: bool = False,
         say(f"femkit: warning: {w} ({OVERRIDE} given)")
     case.run_options["plan"] = plan  # long Poisson runs report each stage against it
     return plan
+
+
+def check_dry_run(case, plan: Plan, *, max_memory: float | None = None,
+                  force: bool = False) -> list[str]:
+    """What ``femkit solve --dry-run`` adds to the printed ``plan``: the refusal the run would
+    meet (the same limits as :func:`check_case`: the file's, ``max_memory``, the available memory,
+    the default time budget), raised as it would be; with ``force`` the warnings the run would
+    print instead.
+
+    Raises
+    ------
+    BudgetExceededError
+        The run would be refused (its one line), unless ``force``.
+    """
+    limits, untimed, timed = _limits(case, max_memory)
+    warnings = check_budget(plan, untimed, force=force, override=OVERRIDE)
+    warnings += check_budget(plan, timed, force=force,
+                             override=RAISE_TIME if limits.time_is_default else OVERRIDE)
+    return warnings

@@ -178,7 +178,7 @@ def plan_poisson_case(case, *, measure: bool = True) -> Plan:
         cells, how = msh_triangle_count(mesh.file)
         if msh_has_volume(mesh.file):
             plan = _tetrahedral_plan(cells, f"{cells:,} elements in {mesh.file} (from {how})",
-                                     f"mesh file ({cells:,} elements)", common)
+                                     f"mesh file ({cells:,} elements)", common, generated=False)
         else:
             plan = plan_poisson(triangles=cells, **common)
             plan.assumptions.insert(0, f"{cells:,} triangles in {mesh.file} (from {how})")
@@ -189,7 +189,8 @@ def plan_poisson_case(case, *, measure: bool = True) -> Plan:
             density = tets_per_h3(mesh.geometry)
             tets = density * size / float(mesh.h) ** 3
             plan = _tetrahedral_plan(tets, f"{tets:,.0f} tetrahedra: {density:g} per h^3 of "
-                                     f"volume {size:g}", f"{mesh.geometry} h={mesh.h:g}", common)
+                                     f"volume {size:g}", f"{mesh.geometry} h={mesh.h:g}", common,
+                                     generated=True)
         else:
             plan = plan_poisson(area=size, line_length=length, h=mesh.h, name=mesh.geometry,
                                 params=params, **common)
@@ -200,16 +201,24 @@ def plan_poisson_case(case, *, measure: bool = True) -> Plan:
     return plan
 
 
-def _tetrahedral_plan(tets: float, source: str, title: str, common: dict) -> Plan:
-    """The plan of a tetrahedral Poisson run of ``tets`` cells before refinement: memory by
-    the 3D laws (:mod:`femkit.cost.tetrahedra`, as :func:`check_mesh_fits` with ``dim=3``),
-    time and the stages without a 3D law as :data:`TET_AS_TRIANGLES` triangles of the 2D model
-    per tetrahedron; 8 children per refinement (Bey 1995); sizes in tetrahedra."""
+def _tetrahedral_plan(tets: float, source: str, title: str, common: dict, *,
+                     generated: bool) -> Plan:
+    """The plan of a tetrahedral Poisson run of ``tets`` cells before refinement (``generated``
+    by gmsh, else read from a file): memory by the 3D laws (:mod:`femkit.cost.tetrahedra`, as
+    :func:`check_mesh_fits` with ``dim=3``), time and the stages without a 3D law as
+    :data:`TET_AS_TRIANGLES` triangles of the 2D model per tetrahedron; 8 children per
+    refinement (Bey 1995); sizes and the stages' words in tetrahedra."""
+    import re
+
     k = common["refine"]
     plan = _in_3d(plan_poisson(triangles=TET_AS_TRIANGLES * tets * 2.0 ** k, **common), tets, k,
                   common["method"])
     rest = {key: v for key, v in plan.sizes.items() if key != "triangles"}
     plan.sizes = {"tetrahedra": tets * 8.0 ** k, **rest}
+    for st in plan.stages:  # the triangle equivalents are the model's, not the run's words
+        if st.name == "mesh":
+            st.detail = f"gmsh, ~{tets:,.0f} tetrahedra" if generated else f"read {tets:,.0f} tetrahedra"
+        st.detail = re.sub(r"-> [\d,]+ triangles", f"-> {tets * 8.0 ** k:,.0f} tetrahedra", st.detail)
     plan.title = title
     plan.assumptions[0] = (f"{source}, x8 per refinement; memory per tetrahedron calibrated on "
                            "tetrahedral runs (femkit/cost/tetrahedra.py), time and the stages "

@@ -27,7 +27,17 @@ from .frozen import freeze
 from ..kinds import KINDS
 from .schema import fill_defaults, validate_against
 
-__all__ = ["Case", "load_case", "case_from_dict", "read_yaml", "apply_overrides"]
+__all__ = ["Case", "load_case", "case_from_dict", "read_yaml", "apply_overrides",
+           "MAX_YAML_BYTES", "MAX_YAML_NODES"]
+
+#: Largest case, scene or study file read (bytes): the bundled ones are a few kilobytes; a larger
+#: file would only be slow to parse and validate, silently.
+MAX_YAML_BYTES = 2_000_000
+
+#: Most YAML nodes a file may hold once its aliases are expanded (``*a`` counts the whole node
+#: it names, again): an "alias bomb" of ten levels of ten aliases is ten billion nodes in a file
+#: of a few hundred bytes, which every later pass (validation, copies) would walk.
+MAX_YAML_NODES = 200_000
 
 
 @dataclass
@@ -111,6 +121,18 @@ def _loader():
                     seen[key] = key_node.start_mark.line
             return super().construct_mapping(node, deep=deep)
 
+        def construct_document(self, node):
+            expanded = _expanded_size(node, MAX_YAML_NODES)
+            if expanded is None:
+                raise yaml.constructor.ConstructorError(
+                    None, None, "an alias (*name) inside the node it names: endless once "
+                    "expanded", None)
+            if expanded > MAX_YAML_NODES:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"more than {MAX_YAML_NODES:,} values once its aliases (*name) are "
+                    "expanded (aliases repeated inside aliases multiply)", None)
+            return super().construct_document(node)
+
     Loader.add_implicit_resolver(
         "tag:yaml.org,2002:float",
         re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
@@ -122,14 +144,58 @@ def _loader():
     return Loader
 
 
+def _expanded_size(root, limit: int) -> int | None:
+    """How many nodes the YAML graph ``root`` holds with every alias expanded (a shared node
+    counted once per reference; None: a node inside itself), counting stops soon after
+    ``limit``. A node's size is kept by identity, so the count is linear in the distinct nodes,
+    never in the expansion."""
+    import yaml
+
+    sizes: dict[int, int] = {}
+    open_nodes: set[int] = set()  # entered, children not yet counted: met again = a cycle
+    stack = [(root, False)]
+    while stack:
+        node, children_done = stack.pop()
+        if id(node) in sizes:
+            continue
+        if not children_done and id(node) in open_nodes:
+            return None  # a node inside itself (&a [*a]): endless once expanded
+        if isinstance(node, yaml.ScalarNode):
+            sizes[id(node)] = 1
+            continue
+        items = node.value if isinstance(node, yaml.SequenceNode) else \
+            [n for pair in node.value for n in pair]
+        if children_done:
+            sizes[id(node)] = min(limit + 1, 1 + sum(sizes.get(id(n), 0) for n in items))
+        else:
+            open_nodes.add(id(node))
+            stack.append((node, True))
+            stack.extend((n, False) for n in items if id(n) not in sizes)
+    return sizes[id(root)]
+
+
 def read_yaml(path: str | os.PathLike) -> Any:
-    """Parse a YAML file; CaseFileError with the file and line number on any problem."""
+    """Parse a YAML file; CaseFileError with the file and line number on any problem.
+
+    A file larger than :data:`MAX_YAML_BYTES`, or holding more than :data:`MAX_YAML_NODES`
+    values once its aliases are expanded, is refused before it is parsed or built."""
     import yaml
 
     p = Path(path)
-    if not p.is_file():
-        what = "is a directory" if p.is_dir() else "not found"
-        raise CaseFileError(f"case file {what}: {p.resolve()}")
+    try:
+        is_file, is_dir = p.is_file(), p.is_dir()
+        size = p.stat().st_size if is_file else 0
+    except (OSError, RuntimeError) as exc:  # a symlink loop, a name too long ...
+        raise CaseFileError(f"cannot read case file {p}: {_os_reason(exc)}") from None
+    if not is_file:
+        what = "is a directory" if is_dir else "not found"
+        if not is_dir and p.is_symlink():
+            what = "is a symbolic link that leads to no file (a loop, or a missing target)"
+        raise CaseFileError(f"case file {what}: {_shown(p)}")
+    if size > MAX_YAML_BYTES:
+        raise CaseFileError(f"{p}: {size:,} bytes, larger than the {MAX_YAML_BYTES:,} a case, "
+                            "scene or study file may have (they are a few kilobytes: put data in "
+                            "a mesh file, not in the YAML)")
     try:
         text = p.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
@@ -138,9 +204,26 @@ def read_yaml(path: str | os.PathLike) -> Any:
         return yaml.load(text, Loader=_loader())  # a SafeLoader subclass
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
-        where = f" line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        where = f": line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise CaseFileError(f"{p}:{where}: invalid YAML: {problem}") from None
+        raise CaseFileError(f"{p}{where}: invalid YAML: {problem}") from None
+
+
+def _os_reason(exc: BaseException) -> str:
+    """The reason of an OS-level failure to reach a path, in words (a symlink loop, ...)."""
+    import errno
+
+    if isinstance(exc, RuntimeError) or getattr(exc, "errno", None) == errno.ELOOP:
+        return "a symbolic link loop (the link points back to itself)"
+    return getattr(exc, "strerror", None) or str(exc)
+
+
+def _shown(p: Path) -> Path:
+    """``p`` made absolute for a message (resolved when that is possible)."""
+    try:
+        return p.resolve()
+    except (OSError, RuntimeError):
+        return p.absolute()
 
 
 def apply_overrides(data: dict, overrides: Mapping[str, Any]) -> dict:

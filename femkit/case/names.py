@@ -59,7 +59,12 @@ def check_geometry_spec(spec: dict, where: str) -> None:
 
 def resolve_file(spec: dict, where: str, base: Path) -> None:
     """Make ``spec["file"]`` absolute (against ``base``); CaseFileError when it does not exist."""
-    path = (Path(base) / spec["file"]).resolve()
+    path = Path(base) / spec["file"]
+    try:
+        path = path.resolve()
+    except (OSError, RuntimeError):  # Python 3.11 raises RuntimeError on a symlink loop
+        raise CaseFileError(f"{where}.file: mesh file is a symbolic link loop: "
+                            f"{path.absolute()}") from None
     if not path.is_file():
         raise CaseFileError(f"{where}.file: mesh file not found: {path}")
     spec["file"] = str(path)

@@ -121,8 +121,10 @@ def validate_against(instance: Any, schema: dict, prefix: str = "") -> None:
     """Validate ``instance`` against ``schema``; raise CaseFileError with the first problem.
 
     The reported error is the first one in document order (shallowest path first among
-    equals), so the message is stable from run to run.
+    equals), so the message is stable from run to run. A number that is not finite (``.nan``,
+    ``.inf``) is refused wherever it stands, free-form options included: no setting means it.
     """
+    _refuse_non_finite(instance, prefix)
     known = _validity_record(instance, schema)
     if known is not None and known.exists():
         return
@@ -141,6 +143,28 @@ def validate_against(instance: Any, schema: dict, prefix: str = "") -> None:
     raise CaseFileError(format_error(err, prefix))
 
 
+def _refuse_non_finite(instance: Any, prefix: str) -> None:
+    """CaseFileError naming the first number of ``instance`` that is NaN or infinite.
+
+    >>> _refuse_non_finite({"dt": 0.1, "scene": {"t_end": float("nan")}}, "")
+    Traceback (most recent call last):
+    ...
+    femkit.errors.CaseFileError: scene.t_end: must be a finite number, got .nan
+    """
+    import math
+
+    stack: list = [((), instance)]
+    while stack:
+        path, value = stack.pop()
+        if isinstance(value, float) and not math.isfinite(value):
+            shown = ".nan" if value != value else (".inf" if value > 0 else "-.inf")
+            raise CaseFileError(f"{key_path(prefix, path)}: must be a finite number, got {shown}")
+        if isinstance(value, dict):
+            stack.extend(((*path, k), v) for k, v in reversed(list(value.items())))
+        elif isinstance(value, (list, tuple)):
+            stack.extend(((*path, i), v) for i, v in reversed(list(enumerate(value))))
+
+
 def _validity_record(instance: Any, schema: dict):
     """The file recording that ``instance`` is valid under ``schema`` (whether or not it exists):
     named by a hash of both as JSON and of jsonschema's version, in femkit's cache directory
@@ -156,7 +180,7 @@ def _validity_record(instance: Any, schema: dict):
     import json
 
     try:
-        text = json.dumps([instance, schema], sort_keys=True, allow_nan=True)
+        text = json.dumps([instance, schema], sort_keys=True, allow_nan=False)
         from importlib.metadata import version
 
         text += "\n" + version("jsonschema")

@@ -29,8 +29,14 @@ def run_solve(args) -> int:
     if args.backend:
         overrides["solver__backend"] = args.backend
     case = load_case(args.case, **overrides)
-    if args.dry_run:
-        print(plan_case(case).render())
+    if args.dry_run:  # the plan, then what the run would say of it: a refusal exits 2 as it would
+        from ..case.budget import check_dry_run
+
+        plan = plan_case(case)
+        print(plan.render())
+        sys.stdout.flush()
+        for w in check_dry_run(case, plan, max_memory=max_memory(args), force=args.force):
+            print(f"femkit: warning: {w}", file=sys.stderr)
         return EXIT_OK
     check_case(case, max_memory=max_memory(args), force=args.force)
     with stop_on_signals() as stop:

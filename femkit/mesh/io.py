@@ -39,7 +39,7 @@ def _block_tags(mesh_io, i: int, n: int) -> np.ndarray:
     return np.asarray(data[i]).reshape(-1).astype(np.int32)
 
 
-def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
+def read_mesh(path: str | os.PathLike, *, compact: bool = True, orient: bool = True) -> Mesh:
     """Read a triangle or tetrahedral mesh; physical tags and names become
     ``cell_tags``/``boundary_tags``/``tag_names``.
 
@@ -51,11 +51,13 @@ def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
         ``.xdmf`` and anything else meshio reads)
     compact : drop nodes used by no cell (e.g. geometry points such as circle centres that
         gmsh writes) and renumber, keeping the order of the rest
+    orient : make every cell positively oriented (:func:`femkit.mesh.validate.orient_ccw`);
+        False keeps the file's vertex order (a caller that reports how many it re-orients)
 
     A ``.vtu`` whose raw appended arrays meshio misreads (femkit's own solution files before
     :func:`femkit.mesh.vtk.reappended`'s layout) is read re-appended.
 
-    Triangles are made counter-clockwise; a 3D point array whose z is zero is reduced to 2D.
+    Triangles are made counter-clockwise (``orient``); a 3D point array whose z is zero is reduced to 2D.
 
     Raises
     ------
@@ -141,7 +143,7 @@ def read_mesh(path: str | os.PathLike, *, compact: bool = True) -> Mesh:
                 boundary_facets=be, boundary_tags=bt, tag_names=names)
     if compact:
         mesh = remove_unreferenced(mesh)
-    return orient_ccw(mesh)
+    return orient_ccw(mesh) if orient else mesh
 
 
 def _check_volume_file(p: str, tets, tet_tags, tri, names, groups) -> None:

@@ -61,11 +61,19 @@ class Dirichlet:
             u = np.asarray(displacement(np.asarray(rest_positions)[nodes]), dtype=float)
         else:
             u = np.asarray(displacement, dtype=float)
-        u = np.broadcast_to(u if u.ndim != 1 or u.shape == (self.dim,) else u[:, None],
-                            (len(nodes), self.dim)) if u.ndim <= 1 else u
-        if u.shape != (len(nodes), self.dim) or not np.all(np.isfinite(u)):
-            raise InputError(f"Dirichlet displacement must be finite, a number, a {self.dim}-vector or "
-                             f"one row per node; got shape {np.shape(u)}")
+        given = u.shape
+        if not np.all(np.isfinite(u)):
+            bad = float(u.ravel()[~np.isfinite(u.ravel())][0])
+            raise InputError(f"Dirichlet displacement must be finite, got {bad!r} in "
+                             f"{u.tolist() if u.size <= 6 else f'an array of shape {given}'}")
+        try:
+            u = np.broadcast_to(u if u.ndim != 1 or u.shape == (self.dim,) else u[:, None],
+                                (len(nodes), self.dim)) if u.ndim <= 1 else u
+        except ValueError:  # a vector of the wrong length
+            pass
+        if u.shape != (len(nodes), self.dim):
+            raise InputError(f"Dirichlet displacement must be a number, a {self.dim}-vector or "
+                             f"one row per node ({len(nodes)} x {self.dim}); got shape {given}")
         dofs = (nodes[:, None] * self.dim + comps[None, :]).ravel()
         self._dofs.append(dofs)
         self._vals.append(u[:, comps].ravel())

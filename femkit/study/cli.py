@@ -51,20 +51,23 @@ def _check_cost(study, args) -> bool:
     from ..cost import Limits, check_budget, machine_speed, parse_bytes, with_default_time
     from .cost import plan_study
 
-    if getattr(args, "dry_run", False):
-        print(plan_study(study, speed=machine_speed()).render())
-        return True
     max_memory = getattr(args, "max_memory", None)
     # the default time budget (one hour, femkit.cost.DEFAULT_TIME_BUDGET): --force runs past it;
     # the machine's speed is probed only for a sweep the model puts near it
     limits = with_default_time(Limits(
         memory=None if max_memory is None else parse_bytes(max_memory, "--max-memory")))
-    plan = plan_study(study)
-    if plan.seconds > MEASURE_FRACTION * limits.time:
+    dry = getattr(args, "dry_run", False)
+    if dry:  # the plan, then what the run would say of it (a refusal exits 2 as it would)
+        plan = plan_study(study, speed=machine_speed())
+        print(plan.render())
+        sys.stdout.flush()
+    else:
+        plan = plan_study(study)
+    if not dry and plan.seconds > MEASURE_FRACTION * limits.time:
         plan = plan_study(study, speed=machine_speed())
     for w in check_budget(plan, limits, force=getattr(args, "force", False), override="--force"):
         print(f"femkit study: warning: {w} (--force given)", file=sys.stderr)
-    return False
+    return dry
 
 
 def cli_main(args) -> int:
@@ -80,11 +83,13 @@ def cli_main(args) -> int:
     from .load import load_study
     from .run import run_study
 
-    from ..interrupt import Interrupted, stop_on_signals
+    from ..interrupt import Interrupted, raising, stop_on_signals
 
+    study = None
     with stop_on_signals():  # until the end: a signal after the sweep must not kill the summary
         try:
-            study = load_study(args.study, quick=args.quick, **getattr(args, "overrides", {}))
+            with raising("loading the study file"):  # a signal stops the parse and checks at once
+                study = load_study(args.study, quick=args.quick, **getattr(args, "overrides", {}))
             if _check_cost(study, args):
                 return 0
             result = run_study(study, args.output, progress=False if args.no_progress else None)
@@ -92,6 +97,9 @@ def cli_main(args) -> int:
             print(f"femkit study: error: {exc}", file=sys.stderr)
             return 2
         except Interrupted as exc:
+            if study is None:
+                print(f"femkit study: {exc}; nothing written", file=sys.stderr)
+                return 128 + int(exc.flag.signum or 2)
             out = args.output if args.output is not None else study.default_output()
             print(f"femkit study: {exc}; nothing written, the earlier report in {out} (if any) is "
                   "kept as it was", file=sys.stderr)

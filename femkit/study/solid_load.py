@@ -113,6 +113,7 @@ def material_cases(study, path=None, base=None):
         path, base = _base(study)
     d = study.spec
     mat = base.data["material"]
+    designed = "energy" in mat   # a designed energy: each material gets its moduli at rest
     static = base.data["static"] if isinstance(base.data["static"], dict) else {}
     for name in d.materials:
         over = {**d.case_overrides, "material": {**mat, "model": name},
@@ -122,7 +123,27 @@ def material_cases(study, path=None, base=None):
                                for b in base.data["boundaries"]]}
         if "gravity" in base.data:
             over["gravity"] = list(np.asarray(base.data["gravity"]) * d.scale)
-        yield name, load_case(path, **over)
+        if designed:
+            yield name, _with_material(path, base, name, over)
+        else:
+            yield name, load_case(path, **over)
+
+
+def _with_material(path, base, name: str, over: dict):
+    """The base case (a material designed by its energy) with the built-in material ``name`` of
+    the same moduli at rest (``mu``, ``lam``) and density in its place, and ``over`` merged."""
+    from ..case.load import case_from_dict, read_yaml
+
+    rest = _base_material(base)
+    data = dict(read_yaml(path))
+    data["material"] = {"model": name, "mu": rest.mu, "lam": rest.lam, "density": rest.density}
+    over = {k: v for k, v in over.items() if k != "material"}
+    return case_from_dict(data, path.parent, name=path.stem, path=path, **over)
+
+
+def _base_material(base):
+    """The base case's material (the one of the whole body)."""
+    return dict(base.spec.materials)[None]
 
 
 def run_solid_load(study, progress_enabled=None) -> dict:
@@ -136,8 +157,7 @@ def run_solid_load(study, progress_enabled=None) -> dict:
     p = dict(base.spec.mesh.get("params") or {})
     L, W, H = (float(p.get(k, v)) for k, v in (("length", 5.0), ("width", 1.0), ("height", 1.0)))
     mat = base.data["material"]
-    E = float(mat["E"]) if "E" in mat else \
-        float(mat["mu"]) * (3 * mat["lam"] + 2 * mat["mu"]) / (mat["lam"] + mat["mu"])
+    E = float(mat["E"]) if "E" in mat else _base_material(base).young
     I = W * H ** 3 / 12.0
     t = np.asarray(trac.traction, float) * d.scale
     direction = t / np.linalg.norm(t)

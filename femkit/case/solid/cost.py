@@ -2,9 +2,13 @@
 
 Element counts come from the geometry's measure (:data:`femkit.mesh.GEOMETRIES`: volume and
 surface area in 3D, area and line length in 2D) and ``h``; a mesh file is counted from its header
-(:func:`femkit.cost.msh_triangle_count` counts the highest-dimensional cells). The constants
-are stated in the plan's assumptions: gmsh's tetrahedra number about ``5.5 V / h^3`` (measured on
-the ``beam`` and ``unit_cube`` geometries: 5.0-5.7), its triangles ``2.3 A / h^2``; P1 rows hold
+(:func:`femkit.cost.msh_triangle_count` counts the highest-dimensional cells). A mesh the formula
+puts below :data:`COUNT_BELOW` cells is generated and counted instead (well under a second; gmsh
+also caps its element size at about a tenth of the domain's diagonal, which no measure shows, so
+a coarse ``h`` gives more cells than any formula of it). The constants are stated in the plan's
+assumptions: gmsh's tetrahedra number about ``4.13 V / h^3 + 1.44 A / h^2`` (fitted on the
+``beam`` and ``unit_cube`` geometries at h 0.08-0.25: within 10 %), its triangles
+``2.3 A / h^2``; P1 rows hold
 about 15 nodes in 3D and 7 in 2D; a sparse direct factor of a 3D stiffness matrix fills in
 about ``n^(1/3)`` times its nonzeros (nested dissection), 2D ``log n``; the compiled element pass
 runs at least 5e4 elements/s (gradient + projected Hessian, docs/benchmarks.md).
@@ -15,6 +19,7 @@ runs at least 5e4 elements/s (gradient + projected Hessian, docs/benchmarks.md).
 
 from __future__ import annotations
 
+import functools
 import math
 
 from ...cost import Plan, Stage, check_budget, load_constants
@@ -23,15 +28,20 @@ from ..cost import OVERRIDE, geometry_domain
 
 __all__ = ["plan_solid_case", "solid_sizes", "check_solid_fits", "check_explicit_step"]
 
-#: cells per h^dim of measure, boundary nodes per h^(dim-1) of boundary measure
-CELLS_PER_MEASURE = {2: 2.3, 3: 5.5}
+#: cells per h^dim of measure, and per h^(dim-1) of boundary measure (3D: gmsh's surface layer)
+CELLS_PER_MEASURE = {2: 2.3, 3: 4.13}
+CELLS_PER_BOUNDARY = {2: 0.0, 3: 1.44}
+
+#: a generated mesh predicted smaller than this is generated and counted by the plan
+COUNT_BELOW = 5000
 ROW_NODES = {2: 7.0, 3: 15.0}
 ELEMENTS_PER_SECOND = 5e4
 REST_BYTES_PER_CELL = 400.0     # rest data, element fields and the pass's work arrays
 
 
 def solid_sizes(mesh: dict) -> tuple[int, float, float]:
-    """``(dim, cells, points)`` predicted for a solid's ``mesh:`` mapping."""
+    """``(dim, cells, points)`` predicted for a solid's ``mesh:`` mapping (counted exactly for
+    a generated mesh the formula puts below :data:`COUNT_BELOW` cells)."""
     if "file" in mesh:
         from ...cost import msh_triangle_count
 
@@ -40,9 +50,22 @@ def solid_sizes(mesh: dict) -> tuple[int, float, float]:
         return dim, float(cells), float(cells) / 4.5
     dim, size, boundary = geometry_domain(mesh["geometry"], mesh.get("params"))
     h = float(mesh["h"])
-    cells = CELLS_PER_MEASURE[dim] * size / h ** dim
+    cells = CELLS_PER_MEASURE[dim] * size / h ** dim \
+        + CELLS_PER_BOUNDARY[dim] * boundary / h ** (dim - 1)
+    if cells < COUNT_BELOW:
+        params = tuple(sorted(dict(mesh.get("params") or {}).items()))
+        return (dim, *_counted(mesh["geometry"], h, params))
     points = cells / (4.5 if dim == 3 else 2.0) + 0.5 * boundary / h ** (dim - 1)
     return dim, cells, points
+
+
+@functools.lru_cache(maxsize=32)
+def _counted(geometry: str, h: float, params: tuple) -> tuple[float, float]:
+    """``(cells, points)`` of the generated mesh (a small one: the plan's exact count)."""
+    from ...mesh import generate
+
+    mesh = generate(geometry, h, **dict(params))
+    return float(mesh.n_cells), float(len(mesh.points))
 
 
 def plan_solid_case(case, *, measure: bool = True) -> Plan:
@@ -56,23 +79,26 @@ def plan_solid_case(case, *, measure: bool = True) -> Plan:
     fill = max(1.0, dofs ** (1.0 / 3.0)) if dim == 3 else max(1.0, math.log(max(dofs, 2.0)))
     factor_bytes = 12.0 * nnz * fill
     steps = spec.steps
-    iterations = steps * (4 if spec.static is not None else 3)
+    per_step, what_iterates = _iterations_per_step(spec)
+    iterations = steps * per_step
     frames = steps // spec.output.every + 1
     pass_s = cells / ELEMENTS_PER_SECOND
-    factor_s = nnz * fill * 2e-8
+    # Newton factors the tangent each iteration; projective dynamics solves with a kept factor
+    factor_s = nnz * fill * (2e-8 if what_iterates == "Newton" else 4e-9)
     frame_bytes = 8.0 * (6 * points + (dim + 1) * cells + (dim + 3) * cells)
     out = spec.output
     out_bytes = (frames * frame_bytes if out.vtu else 0.0) + (2e5 if out.png else 0.0) \
         + (frames * 1e5 if out.gif else 0.0)
     what = "triangles" if dim == 2 else "tetrahedra"
+    counted = "file" not in spec.mesh and cells < COUNT_BELOW
     stages = [
         Stage("mesh", cells * 2e-5, cells * (8.0 * (dim + 1) + 64.0), 0.0,
-              f"{what} ~{cells:,.0f}"),
+              f"{what} {'' if counted else '~'}{cells:,.0f}"),
         Stage("solve", iterations * (pass_s + factor_s),
               cells * REST_BYTES_PER_CELL + 3 * 12.0 * nnz + factor_bytes
               + frames * 16.0 * dofs, 0.0,
-              f"{iterations} Newton iterations (~{4 if spec.static else 3} per "
-              f"{'load' if spec.static else 'time'} step)"),
+              f"{iterations:,} {what_iterates} iterations ({'up to ' if what_iterates != 'Newton' else '~'}"
+              f"{per_step:,} per {'load' if spec.static else 'time'} step)"),
         Stage("output", frames * frame_bytes / 2e7, frame_bytes * 4, out_bytes,
               f"{frames} frames"),
     ]
@@ -86,16 +112,33 @@ def plan_solid_case(case, *, measure: bool = True) -> Plan:
         if spec.static is not None or kind not in ("time", "steps"):
             return ""
         k = limit / max(plan.seconds if kind == "time" else steps, 1e-300)
-        return f"dt >= {round_up(spec.dt / k)} or t_end <= {round_down(spec.t_end * k)}"
+        fewer = f"integrator.options.iterations <= {max(1, int(per_step * k)):,} or " \
+            if kind == "time" and what_iterates != "Newton" else ""
+        return f"{fewer}dt >= {round_up(spec.dt / k)} or t_end <= {round_down(spec.t_end * k)}"
 
     plan = Plan("solid", title, sizes, stages, load_constants()["bytes"]["baseline"],
                 assumptions=[
-                    f"{CELLS_PER_MEASURE[dim]} x measure / h^{dim} {what} (gmsh)",
+                    f"{cells:,.0f} {what}: the mesh generated and counted" if counted else
+                    f"{CELLS_PER_MEASURE[dim]} x measure / h^{dim} + {CELLS_PER_BOUNDARY[dim]} x "
+                    f"boundary / h^{dim - 1} {what} (gmsh)" if "file" not in spec.mesh else
+                    f"{cells:,.0f} {what} in {spec.mesh['file']} (its header)",
                     f"direct factor fill {fill:.0f}x the matrix nonzeros",
                     f"element pass >= {ELEMENTS_PER_SECOND:.0e} elements/s; seconds are an "
                     "order of magnitude (not calibrated on this machine)"])
     plan.suggest = suggest
     return plan
+
+
+def _iterations_per_step(spec) -> tuple[int, str]:
+    """``(iterations, what)`` per load or time step: Newton's (~4 static, ~3 dynamic) or the
+    integrator's own bound (``iterations`` of projective dynamics: every one is a local pass and
+    a solve, so a billion of them is priced as such)."""
+    if spec.static is not None:
+        return 4, "Newton"
+    bound = getattr(spec.integrator.build(), "iterations", None)
+    if isinstance(bound, int) and spec.integrator.method != "newton":
+        return max(1, bound), f"{spec.integrator.method} local/global"
+    return 3, "Newton"
 
 
 def check_solid_fits(case) -> None:

@@ -206,17 +206,30 @@ def folded_cells(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
     return np.flatnonzero(count == count.max())
 
 
+def _reoriented(mesh) -> tuple:
+    """``mesh`` with its cells listed in the other vertex order turned round, and how many: the
+    file's vertex order is bookkeeping, not geometry. Cells that are geometrically inverted
+    (folded over a neighbour) are still refused after this."""
+    from ...mesh.validate import orient_ccw
+
+    return orient_ccw(mesh), int((mesh.signed_volumes() < 0).sum())
+
+
 def build_mesh(spec: SolidSpec):
-    """The validated rest mesh, generated or read; refused with
+    """The validated rest mesh, generated or read (a file's cells listed in the opposite vertex
+    order re-oriented, saying how many); refused with
     :class:`~femkit.errors.DegenerateMeshError` naming the elements when some are inverted
-    (cells of opposite orientation, or cells folded over a neighbour: :func:`folded_cells`)."""
+    (cells folded over a neighbour: :func:`folded_cells`)."""
     from ...mesh import generate, read_mesh, validate
 
     m = spec.mesh
     where = f"mesh.file {m['file']}" if "file" in m else f"mesh.geometry {m['geometry']}"
     try:
-        mesh = read_mesh(m["file"]) if "file" in m else generate(m["geometry"], m["h"],
-                                                                   **dict(m.get("params") or {}))
+        flipped = 0
+        if "file" in m:
+            mesh, flipped = _reoriented(read_mesh(m["file"], orient=False))
+        else:
+            mesh = generate(m["geometry"], m["h"], **dict(m.get("params") or {}))
         neg = mesh.signed_volumes() < 0
         bad = np.flatnonzero(neg if neg.sum() <= (~neg).sum() else ~neg) if neg.any() else \
             folded_cells(mesh.points, mesh.cells)
@@ -225,7 +238,11 @@ def build_mesh(spec: SolidSpec):
                 f"{len(bad)} inverted {mesh.cell_name}(s) in the input mesh (overlapping their "
                 f"neighbours): element ids {', '.join(map(str, bad[:10]))}"
                 f"{' ...' if len(bad) > 10 else ''}", element_ids=bad)
-        return validate(mesh)
+        mesh = validate(mesh)
+        if flipped:  # said once the mesh is accepted: a refusal stays one line
+            print(f"femkit: note: {where}: {flipped:,} of {mesh.n_cells:,} {mesh.cell_name}(s) "
+                  "listed with the opposite vertex order; re-oriented", file=sys.stderr)
+        return mesh
     except InputError as exc:
         raise with_prefix(exc, where) from None
 
@@ -541,6 +558,17 @@ def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
     return out
 
 
+def _say_compiling(case, echo: Callable[[str], Any]) -> None:
+    """Say so when the run's materials must be generated and compiled first (a minute or so)."""
+    from ..poisson.warmup import COMPILE_MESSAGE
+
+    pending = [m for m in dict(case.spec.materials).values() if not m.kernels_cached()]
+    if pending:
+        names = sorted({f"energy {m.energy.describe()[:60]}" if getattr(m, "energy", None)
+                        else "the built-in materials" for m in pending})
+        echo(f"{COMPILE_MESSAGE}: {'; '.join(names)}...")
+
+
 def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = False,
               write: bool = True, echo: Callable[[str], Any] | None = None) -> SolidResult:
     """Run a prepared solid case: build, solve (static or dynamic), write, print the summary.
@@ -570,6 +598,8 @@ def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = F
     check_solid_fits(case)
     timer = StageTimer()
     t0 = time.perf_counter()
+    if not quiet:
+        _say_compiling(case, echo or print)
     with raising("meshing"), timer("build"):
         problem = build_problem(case)
     stop = case.run_options.get("stop")

@@ -92,7 +92,7 @@ def solid_schema() -> dict:
         "title": "femkit elastic solid",
         "type": "object",
         "additionalProperties": False,
-        "required": ["problem", "mesh", "material", "boundaries"],
+        "required": ["problem", "mesh", "material"],
         "properties": {
             "problem": {"const": "solid"},
             "name": {"type": "string", "minLength": 1},
@@ -101,7 +101,8 @@ def solid_schema() -> dict:
             "mesh": _mesh(),
             "material": material,
             "regions": {"type": "object", "additionalProperties": material, "default": {}},
-            "boundaries": {"type": "array", "minItems": 1, "items": _boundary()},
+            # none for a body in free flight (dynamics); a static run needs a support (prepare)
+            "boundaries": {"type": "array", "items": _boundary(), "default": []},
             "gravity": _VEC,
             "static": {"anyOf": [{"type": "boolean"},
                                  closed({"load_steps": {"type": "integer", "minimum": 1},

@@ -150,8 +150,10 @@ class Projective(Integrator):
         return ops
 
     def step(self, system, state: StepperState, dt: float, ctx: StepContext) -> StepperState:
+        from ...interrupt import active_flag
         from .projective_local import local_step
 
+        stop = active_flag()  # a stop request ends the sweeps: the run then stops after this step
         h = dt
         ops = self._operators(system, h, ctx)
         free, pinned = ops.free, ops.pinned
@@ -189,7 +191,7 @@ class Projective(Integrator):
             if roller is not None:      # a held component has no equation
                 res, rn = res[roller], rn[roller]
             rel = float(np.linalg.norm(res) / max(np.linalg.norm(rn), 1e-300))
-            if k >= int(self.iterations) or (self.tol is not None and rel <= self.tol):
+            if k >= int(self.iterations) or (self.tol is not None and rel <= self.tol) or stop:
                 break
             x[free] = ops.factor.solve(np.asfortranarray(b), held)
             k += 1

@@ -30,7 +30,7 @@ from typing import Callable, Sequence
 
 from ...codegen import cache_dir as _cache_dir, copied_kernels as _copied_kernels, load_named
 
-__all__ = ["energy_module", "energy_source", "module_key", "cache_dir"]
+__all__ = ["energy_module", "energy_source", "module_key", "cache_dir", "module_cached"]
 
 
 def cache_dir() -> Path:
@@ -150,6 +150,17 @@ def module_key(recipe: str) -> str:
     return "femkit_energy_" + hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
+def module_cached(recipe: str) -> bool:
+    """Whether the module of ``recipe`` is generated and its element pass in numba's cache
+    beside it: a run then loads both and compiles nothing (else it says it compiles first)."""
+    from ...codegen import find_generated
+
+    name = module_key(recipe)
+    path = find_generated(name, "energies")
+    return path is not None and \
+        any((path.parent / "__pycache__").glob(f"{name}.element_pass-*.nbi"))
+
+
 def energy_module(recipe: str, build: Callable[[], Sequence]) -> ModuleType:
     """The compiled kernels of the energies ``build()`` returns (``(W, stretches, constants)``
     each, :func:`energy_source`): a module with ``stretch_energy``, ``point`` and
@@ -157,5 +168,19 @@ def energy_module(recipe: str, build: Callable[[], Sequence]) -> ModuleType:
 
     ``recipe`` names the energies in text (their expressions and the constants' order); the
     module is found by :func:`module_key` of it, so a later process loads it (and numba its
-    machine code) without running SymPy or ``build`` at all. Written once, atomically."""
-    return load_named(module_key(recipe), "energies", lambda: energy_source(build()))
+    machine code) without running SymPy or ``build`` at all. Written once, atomically.
+
+    Generating it (SymPy's derivatives) is bounded in time (:func:`.parse.sympy_time_limit`)
+    and stops at once on a signal inside :func:`femkit.interrupt.stop_on_signals`."""
+    from ...interrupt import raising
+    from .parse import sympy_time_limit
+
+    def make_text() -> str:
+        with raising("the energy's derivatives"), sympy_time_limit(_short(recipe)):
+            return energy_source(build())
+
+    return load_named(module_key(recipe), "energies", make_text)
+
+
+def _short(text: str) -> str:
+    return text if len(text) <= 100 else text[:97] + "..."

@@ -11,6 +11,12 @@ the caller, ``pi`` and ``E``; ``+ - * / **`` and unary minus; the functions of :
 ``where(condition, a, b)`` with one comparison ``< <= > >=`` as the condition (a piecewise
 energy, e.g. stiffer in tension than in compression).
 
+Before SymPy sees anything the tree is bounded (:func:`check_bounds`), so that no expression
+under the length limit can keep SymPy (or the compiler after it) busy: at most
+:data:`MAX_DEPTH` levels of nesting, every number and every constant part (``9**9``) between
+:data:`MIN_NUMBER` and :data:`MAX_NUMBER` in size (or zero), and a constant exponent at most
+:data:`MAX_EXPONENT` in size (``0*9**9**9`` would otherwise be computed exactly first).
+
 >>> import sympy
 >>> s = sympy.Symbol("s")
 >>> parse_energy("mu*(s-1)**2 + 0.5", {"s": s, "mu": sympy.Symbol("mu")})
@@ -24,14 +30,60 @@ femkit.errors.MaterialError: energy 's.__class__': attribute access is not allow
 from __future__ import annotations
 
 import ast
-from typing import Mapping
+import contextlib
+import signal
+import threading
+from typing import Iterator, Mapping
 
 from ...errors import MaterialError
 
-__all__ = ["parse_energy", "FUNCTIONS", "MAX_LENGTH"]
+__all__ = ["parse_energy", "check_bounds", "sympy_time_limit", "SYMPY_SECONDS", "FUNCTIONS", "MAX_LENGTH", "MAX_DEPTH", "MAX_NUMBER",
+           "MIN_NUMBER", "MAX_EXPONENT"]
 
 #: Longest accepted expression (characters).
 MAX_LENGTH = 4000
+
+#: Deepest nesting of operations and calls (``-(-(-s))`` is three levels).
+MAX_DEPTH = 100
+
+#: Largest size of a number, or of a constant part, of an energy: the kernels print numbers as
+#: exact fractions, whose integers must fit the compiled code's 64-bit integers.
+MAX_NUMBER = 1e15
+
+#: Smallest size of a non-zero number or constant part (its fraction's denominator, as above).
+MIN_NUMBER = 1e-15
+
+#: Largest size of a constant exponent (``s**64``; a symbolic one, ``s**alpha``, is not bounded).
+MAX_EXPONENT = 64
+
+#: Longest SymPy may work on one energy (its checks at rest, or its derivatives for the
+#: kernels), seconds: the bundled energies take well under one; a product of dozens of distinct
+#: factors would otherwise take minutes.
+SYMPY_SECONDS = 30.0
+
+
+@contextlib.contextmanager
+def sympy_time_limit(what: str, seconds: float | None = None) -> Iterator[None]:
+    """Within the block, SymPy's work on the energy ``what`` is stopped after ``seconds``
+    (default :data:`SYMPY_SECONDS`) with a one-line :class:`MaterialError`. A real-time timer
+    (``SIGALRM``) on the main thread; elsewhere, or without ``setitimer``, no limit."""
+    seconds = SYMPY_SECONDS if seconds is None else seconds
+    if threading.current_thread() is not threading.main_thread() or \
+            not hasattr(signal, "setitimer"):
+        yield
+        return
+
+    def expired(signum, frame):
+        raise MaterialError(f"{what}: SymPy did not finish the energy's derivatives within "
+                            f"{seconds:g} s; write it with fewer distinct factors or terms")
+
+    previous = signal.signal(signal.SIGALRM, expired)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
 
 #: Functions an energy may call: name -> number of arguments (SymPy function looked up lazily).
 FUNCTIONS: dict[str, int] = {"sqrt": 1, "exp": 1, "log": 1, "sin": 1, "cos": 1, "tanh": 1,
@@ -44,10 +96,90 @@ _SYMPY_NAMES = {"sqrt": "sqrt", "exp": "exp", "log": "log", "sin": "sin", "cos":
 
 
 def _fail(text: str, what: str, names: Mapping) -> MaterialError:
+    shown = text if len(text) <= 80 else f"{text[:60]}...{text[-15:]}"
     return MaterialError(
-        f"energy {text!r}: {what}; allowed: numbers, the names {', '.join(sorted(names))}, pi, E, "
+        f"energy {shown!r}: {what}; allowed: numbers, the names {', '.join(sorted(names))}, pi, E, "
         f"+ - * / ** and the functions {', '.join(sorted(FUNCTIONS))} "
         "(where(a < b, x, y) for a piecewise energy)")
+
+
+def _short(part: str) -> str:
+    return part if len(part) <= 40 else part[:37] + "..."
+
+
+def check_bounds(text: str, tree: ast.AST, names: Mapping) -> None:
+    """Refuse ``tree`` (parsed from ``text``) when it nests deeper than :data:`MAX_DEPTH`, holds a
+    number or a constant part outside :data:`MIN_NUMBER` .. :data:`MAX_NUMBER`, or a constant
+    exponent above :data:`MAX_EXPONENT`; ``where()`` whose condition is not a comparison.
+
+    Iterative (no recursion, whatever the depth) and in floating point: the constant parts are
+    sized, never computed exactly, so this takes microseconds for any text under the length limit.
+
+    Raises
+    ------
+    MaterialError
+        Naming the bound and the part of ``text`` that breaks it.
+    """
+    value: dict[int, float | None] = {}  # id(node) -> its value if constant, else None
+    stack: list = [(tree, 1, False)]
+    while stack:
+        node, depth, done = stack.pop()
+        if depth > MAX_DEPTH:
+            raise _fail(text, f"nested deeper than {MAX_DEPTH} levels", names)
+        kids = [k for k in ast.iter_child_nodes(node) if isinstance(k, ast.expr)]
+        if not done:
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
+                    and node.func.id == "where" and node.args \
+                    and not isinstance(node.args[0], ast.Compare):
+                raise _fail(text, "where()'s condition must be one comparison < <= > >=, got "
+                            f"{ast.unparse(node.args[0])!r}", names)
+            stack.append((node, depth, True))
+            stack.extend((k, depth + 1, False) for k in kids)
+            continue
+        value[id(node)] = v = _constant_value(text, node, value, names)
+        if v is not None and v != 0 and not MIN_NUMBER <= abs(v) <= MAX_NUMBER:
+            raise _fail(text, f"the number {_short(ast.unparse(node))!r} (about {v:.3g}) is outside "
+                        f"{MIN_NUMBER:g} .. {MAX_NUMBER:g} in size", names)
+
+
+def _constant_value(text: str, node: ast.AST, value: Mapping[int, float | None],
+                    names: Mapping) -> float | None:
+    """The value of ``node`` when it is a constant (its children's values in ``value``), in
+    floating point; None for anything that depends on a name or a call. A constant exponent is
+    checked against :data:`MAX_EXPONENT` before the power is taken."""
+    import math
+
+    if isinstance(node, ast.Constant):
+        v = node.value
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool)
+        if isinstance(v, int) and ok and v.bit_length() > 1000:
+            return math.inf
+        return float(v) if ok and math.isfinite(v) else (math.inf if ok else None)
+    if isinstance(node, ast.UnaryOp):
+        v = value.get(id(node.operand))
+        return None if v is None else (-v if isinstance(node.op, ast.USub) else v)
+    if not isinstance(node, ast.BinOp):
+        return None
+    a, b = value.get(id(node.left)), value.get(id(node.right))
+    if isinstance(node.op, ast.Pow) and b is not None and abs(b) > MAX_EXPONENT:
+        raise _fail(text, f"the exponent {_short(ast.unparse(node.right))!r} (about {b:.3g}) is larger "
+                    f"than {MAX_EXPONENT} in size", names)
+    if a is None or b is None:
+        return None
+    try:
+        if isinstance(node.op, ast.Add):
+            return a + b
+        if isinstance(node.op, ast.Sub):
+            return a - b
+        if isinstance(node.op, ast.Mult):
+            return a * b
+        if isinstance(node.op, ast.Div):
+            return a / b if b != 0 else None  # SymPy's zoo: the finiteness check refuses it
+        if isinstance(node.op, ast.Pow):
+            return abs(a) ** b if a != 0 or b > 0 else None
+    except (OverflowError, ZeroDivisionError):
+        return math.inf
+    return None
 
 
 def parse_energy(text, names: Mapping[str, object]):
@@ -71,6 +203,9 @@ def parse_energy(text, names: Mapping[str, object]):
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as exc:
         raise MaterialError(f"energy {text!r}: syntax error: {exc.msg}") from None
+    except (RecursionError, MemoryError):  # CPython's own parser nests too
+        raise _fail(text, f"nested deeper than {MAX_DEPTH} levels", names) from None
+    check_bounds(text, tree, names)
     binops = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
               ast.Mult: lambda a, b: a * b, ast.Div: lambda a, b: a / b,
               ast.Pow: lambda a, b: a ** b}

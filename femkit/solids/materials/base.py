@@ -30,7 +30,20 @@ import numpy as np
 
 from ...errors import MaterialError
 
-__all__ = ["Material", "StretchMaterial", "lame_from_young"]
+__all__ = ["Material", "StretchMaterial", "lame_from_young", "MAX_MODULUS"]
+
+#: Largest size of a modulus (``E``, ``mu``, ``lam``) and of a density: the energy, its
+#: derivatives and the checks multiply up to three of them (``mu * lam``, ``E * I``, ...), which
+#: must stay finite in double precision (about 1.8e308). Physical moduli are below 1e13 Pa.
+MAX_MODULUS = 1e100
+
+
+def _bounded(value: float, name: str) -> float:
+    if abs(value) > MAX_MODULUS:
+        raise MaterialError(f"{name} = {value:g} is larger than {MAX_MODULUS:g}: products of "
+                            "the moduli (mu * lam, the energy's derivatives) would overflow; "
+                            "choose units that make it smaller")
+    return value
 
 
 def _finite(value, name: str) -> float:
@@ -49,7 +62,8 @@ def lame_from_young(E: float, nu: float) -> tuple[float, float]:
     >>> [round(v, 12) for v in lame_from_young(2.6, 0.3)]
     [1.0, 1.5]
     """
-    E, nu = _finite(E, "Young's modulus E"), _finite(nu, "Poisson ratio nu")
+    E = _bounded(_finite(E, "Young's modulus E"), "Young's modulus E")
+    nu = _finite(nu, "Poisson ratio nu")
     if E <= 0.0:
         raise MaterialError(f"Young's modulus E must be > 0, got {E:g}")
     if not -1.0 < nu < 0.5:
@@ -82,8 +96,9 @@ class Material:
     name: ClassVar[str] = "material"
 
     def __post_init__(self):
-        mu, lam = _finite(self.mu, "mu"), _finite(self.lam, "lambda")
-        rho = _finite(self.density, "density")
+        mu = _bounded(_finite(self.mu, "mu"), f"{self.name}: shear modulus mu")
+        lam = _bounded(_finite(self.lam, "lambda"), f"{self.name}: lambda")
+        rho = _bounded(_finite(self.density, "density"), f"{self.name}: density")
         if mu <= 0.0:
             raise MaterialError(f"{self.name}: shear modulus mu must be > 0, got {mu:g}")
         if lam <= -2.0 * mu / 3.0:
@@ -128,6 +143,10 @@ class Material:
         its energy (:class:`.designed.EnergyMaterial`)."""
         raise MaterialError(f"{self.name}: neither a registered material nor designed by its "
                             "energy, so it has no compiled kernels")
+
+    def kernels_cached(self) -> bool:
+        """Whether :meth:`kernels` loads compiled code from the cache (no SymPy, no compiling)."""
+        return True
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,7 @@ from typing import ClassVar, Mapping
 import numpy as np
 
 from ...errors import MaterialError
+from ..energy.parse import sympy_time_limit
 from .base import Material, StretchMaterial
 
 __all__ = ["EnergyMaterial", "designed", "ENERGY_KEYS"]
@@ -97,12 +98,23 @@ class EnergyMaterial(StretchMaterial):
         energy = _as_energy(energy)
         consts = tuple((str(k), _finite(v, f"constant {k}")) for k, v in (constants or {}).items())
         names = tuple(k for k, _ in consts)
-        W = _symbolic(energy, names)
-        moduli = energy.check(W, dict(consts), name=f"{label} ({energy.describe()})")
+        what = f"{label} ({energy.describe()})"
+        with sympy_time_limit(what if len(what) <= 100 else what[:97] + "..."):
+            W = _symbolic(energy, names)
+            moduli = energy.check(W, dict(consts), name=what)
         return cls(moduli.mu, moduli.lam, density, energy, consts, label)
 
     def params(self) -> np.ndarray:
         return np.array([v for _, v in self.constants], dtype=float)
+
+    def _recipe(self) -> str:
+        return f"{self.energy!r} ({', '.join(k for k, _ in self.constants)})"
+
+    def kernels_cached(self) -> bool:
+        from ..energy.codegen import module_cached
+
+        return (self.energy, tuple(k for k, _ in self.constants)) in _KERNELS or \
+            module_cached(self._recipe())
 
     def kernels(self):
         names = tuple(k for k, _ in self.constants)
@@ -117,7 +129,7 @@ class EnergyMaterial(StretchMaterial):
                 return [(_symbolic(self.energy, names), sympy.symbols("s1:4"),
                          [sympy.Symbol(k) for k in names])]
 
-            mod = energy_module(f"{self.energy!r} ({', '.join(names)})", build)
+            mod = energy_module(self._recipe(), build)
             _KERNELS[key] = mod
         return mod
 

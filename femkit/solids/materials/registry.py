@@ -15,13 +15,25 @@ __all__ = ["MATERIALS", "LinearElastic", "Corotational", "StVenantKirchhoff",
 MATERIALS: Registry = Registry("material")
 
 
+def _builtin_classes() -> list:
+    classes = [MATERIALS.get(n) for n in MATERIALS.names()]
+    return [c for c in classes if getattr(c, "energy_expression", None) is not None]
+
+
+def _builtin_cached(self) -> bool:
+    """Whether the built-ins' generated module and its machine code are in the cache."""
+    from ..energy.codegen import module_cached
+    from .builtin import builtin_recipe
+
+    return module_cached(builtin_recipe(_builtin_classes()))
+
+
 def _builtin_kernels(self):
     """The built-in materials' generated module (:func:`.builtin.builtin_kernels` of the
     registered classes written as energies, in the order of their ``code``)."""
     from .builtin import builtin_kernels
 
-    classes = [MATERIALS.get(n) for n in MATERIALS.names()]
-    return builtin_kernels([c for c in classes if getattr(c, "energy_expression", None) is not None])
+    return builtin_kernels(_builtin_classes())
 
 
 def register_material(name: str):
@@ -31,6 +43,7 @@ def register_material(name: str):
     def decorator(cls):
         cls.name = name
         cls.kernels = _builtin_kernels
+        cls.kernels_cached = _builtin_cached
         return MATERIALS.register(name, cls)
 
     return decorator
