@@ -138,10 +138,11 @@ def prepare_solid(case) -> None:
             if dim is not None and v and len(v) != dim:
                 raise CaseFileError(f"boundaries[{i}].{what}: needs {dim} components, got {len(v)}")
     if not dynamic and all(b.kind == "traction" for b in boundaries):
-        raise CaseFileError("boundaries: no fixed or roller condition (a free body has "
-                            "rigid-body motions and no unique equilibrium)")
-    case.solver = solver = solver_spec(d["linear_solver"], "linear_solver", 
-                                         default_method=KINDS.get(case.problem, "problem").default_solver)
+        raise CaseFileError("boundaries: no fixed or roller condition: a static body with no "
+                            "support is singular (rigid-body motions, no unique equilibrium); "
+                            "hold a tag, or integrate in time (a body in free flight)")
+    case.solver = solver = solver_spec(d["linear_solver"], "linear_solver",
+                                       default_method=KINDS.get(case.problem, "problem").default_solver)
     case.run_options["limits"] = limits_spec(d.get("limits"))
     out = d["output"]
     if dynamic:

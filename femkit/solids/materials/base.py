@@ -35,6 +35,8 @@ __all__ = ["Material", "StretchMaterial", "lame_from_young", "MAX_MODULUS"]
 #: Largest size of a modulus (``E``, ``mu``, ``lam``) and of a density: the energy, its
 #: derivatives and the checks multiply up to three of them (``mu * lam``, ``E * I``, ...), which
 #: must stay finite in double precision (about 1.8e308). Physical moduli are below 1e13 Pa.
+#: Its reciprocal is the smallest positive modulus and density (below it the same products
+#: underflow to zero). An energy's constants are bounded alike.
 MAX_MODULUS = 1e100
 
 
@@ -47,13 +49,29 @@ def _bounded(value: float, name: str) -> float:
 
 
 def _finite(value, name: str) -> float:
+    """``value`` as a float, refused unless finite and at most :data:`MAX_MODULUS` in size.
+
+    >>> _finite(1e300, "constant k")
+    Traceback (most recent call last):
+    ...
+    femkit.errors.MaterialError: constant k = 1e+300 is larger than 1e+100: products of the moduli (mu * lam, the energy's derivatives) would overflow; choose units that make it smaller
+    """
     try:
         v = float(value)
     except (TypeError, ValueError):
         raise MaterialError(f"{name} must be a number, got {value!r}") from None
     if not math.isfinite(v):
         raise MaterialError(f"{name} must be finite, got {value!r}")
-    return v
+    return _bounded(v, name)
+
+
+def _positive(v: float, name: str) -> None:
+    """Refuse ``v`` unless ``>= 1 / MAX_MODULUS`` (``<= 0``: "must be > 0")."""
+    if v <= 0.0:
+        raise MaterialError(f"{name} must be > 0, got {v:g}")
+    if v < 1.0 / MAX_MODULUS:
+        raise MaterialError(f"{name} = {v:g} is smaller than {1 / MAX_MODULUS:g}: products of "
+                            "the moduli would underflow to 0; choose units that make it larger")
 
 
 def lame_from_young(E: float, nu: float) -> tuple[float, float]:
@@ -62,13 +80,15 @@ def lame_from_young(E: float, nu: float) -> tuple[float, float]:
     >>> [round(v, 12) for v in lame_from_young(2.6, 0.3)]
     [1.0, 1.5]
     """
-    E = _bounded(_finite(E, "Young's modulus E"), "Young's modulus E")
-    nu = _finite(nu, "Poisson ratio nu")
-    if E <= 0.0:
-        raise MaterialError(f"Young's modulus E must be > 0, got {E:g}")
+    E, nu = _finite(E, "Young's modulus E"), _finite(nu, "Poisson ratio nu")
+    _positive(E, "Young's modulus E")
     if not -1.0 < nu < 0.5:
         raise MaterialError(f"Poisson ratio nu must lie in (-1, 0.5), got {nu:g}")
-    return E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    if abs(lam) > MAX_MODULUS:
+        raise MaterialError(f"Poisson ratio nu = {nu!r} with E = {E:g} gives lam = {lam:g}, "
+                            f"larger than {MAX_MODULUS:g}: take nu further from 0.5")
+    return E / (2.0 * (1.0 + nu)), lam
 
 
 @dataclass(frozen=True)
@@ -96,16 +116,14 @@ class Material:
     name: ClassVar[str] = "material"
 
     def __post_init__(self):
-        mu = _bounded(_finite(self.mu, "mu"), f"{self.name}: shear modulus mu")
-        lam = _bounded(_finite(self.lam, "lambda"), f"{self.name}: lambda")
-        rho = _bounded(_finite(self.density, "density"), f"{self.name}: density")
-        if mu <= 0.0:
-            raise MaterialError(f"{self.name}: shear modulus mu must be > 0, got {mu:g}")
+        mu = _finite(self.mu, f"{self.name}: shear modulus mu")
+        lam = _finite(self.lam, f"{self.name}: lambda")
+        rho = _finite(self.density, f"{self.name}: density")
+        _positive(mu, f"{self.name}: shear modulus mu")
         if lam <= -2.0 * mu / 3.0:
             raise MaterialError(f"{self.name}: lambda = {lam:g} <= -2 mu / 3 = {-2 * mu / 3:g} "
                                 "(negative bulk modulus: Poisson ratio <= -1)")
-        if rho <= 0.0:
-            raise MaterialError(f"{self.name}: density must be > 0, got {rho:g}")
+        _positive(rho, f"{self.name}: density")
         object.__setattr__(self, "mu", mu)
         object.__setattr__(self, "lam", lam)
         object.__setattr__(self, "density", rho)
