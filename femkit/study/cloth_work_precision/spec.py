@@ -58,7 +58,7 @@ def _methods(methods: list, default: str) -> list:
 
 @dataclass(frozen=True)
 class ClothReference:
-    """``reference:`` of the cloth study (defaults: :func:`femkit.study.cloth.cloth_schema`)."""
+    """``reference:`` of the cloth study (defaults: :func:`.schema.schema`)."""
 
     tol: float
     solve: str
