@@ -8,8 +8,6 @@ __all__ = ["schema"]
 
 
 _POS = {"type": "number", "exclusiveMinimum": 0}
-
-
 _ITS = {"type": "array", "minItems": 1, "items": {"type": "integer", "minimum": 1}}
 
 
