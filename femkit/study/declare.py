@@ -36,7 +36,10 @@ from typing import Callable
 
 from ..kinds import Kind, register_kind
 
-__all__ = ["study_kind"]
+__all__ = ["study_kind", "NEEDED"]
+
+#: The modules every study kind's package has (``cost`` is optional).
+NEEDED = ("schema", "spec", "run", "report")
 
 
 def _deferred(package: str, module: str, attr: str) -> Callable:
@@ -80,8 +83,13 @@ def study_kind(name: str, package: str, *, default_solver: str | None = None) ->
     Raises
     ------
     ValueError
-        ``name`` is registered already.
+        ``name`` is registered already, or the package lacks one of the needed modules (a
+        plugin's is then a one-line :class:`~femkit.errors.InputError`, :mod:`femkit.plugins`).
     """
+    missing = [m for m in NEEDED if importlib.util.find_spec(f"{package}.{m}") is None]
+    if missing:
+        raise ValueError(f"study kind {name!r}: package {package} has no {missing[0]}.py (a study "
+                         f"kind's package holds {', '.join(NEEDED)} and optionally cost)")
     has_cost = importlib.util.find_spec(f"{package}.cost") is not None
     return register_kind(Kind(
         name, "kind", schema=_deferred(package, "schema", "schema"),

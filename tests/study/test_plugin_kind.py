@@ -183,6 +183,18 @@ def test_the_plugin_kind_s_schema_validates_and_refuses_its_file(plugin_dir, tmp
         assert not (tmp_path / "never").exists()
 
 
+def test_a_plugin_kind_without_a_needed_module_is_one_line(plugin_dir, tmp_path):
+    (plugin_dir / "geometric_sums" / "report.py").unlink()
+    study = _study_file(tmp_path, terms=[3])
+    run = _femkit(["study", str(study), "--output", str(tmp_path / "never")], plugin_dir, tmp_path)
+    assert run.returncode == 2, run.stderr
+    assert run.stderr.strip().splitlines() == [
+        "femkit study: error: plugin 'geometric_sums.kind' from FEMKIT_PLUGINS failed while "
+        "importing: ValueError: study kind 'geometric_sums': package geometric_sums has no "
+        "report.py (a study kind's package holds schema, spec, run, report and optionally cost)"]
+    assert not (tmp_path / "never").exists()
+
+
 def _kind_packages() -> list[str]:
     return sorted(p.parent.name for p in STUDY.glob("*/kind.py"))
 
