@@ -5,7 +5,7 @@ study file with ``kind: <name>`` (``poisson_convergence``, ``stability``, ...). 
 :class:`Kind`: its JSON schema, its typed run spec, the load-time check, the cost plan, the run
 and, for studies, the report and the summary ``femkit study`` prints. Each built-in kind
 registers itself from its own module (``femkit/case/<folder>/kind.py``: ``poisson/``,
-``scene/``, ``solid/``; ``femkit/study/kinds/<name>.py``); the loaders, ``femkit solve``,
+``scene/``, ``solid/``; ``femkit/study/<name>/kind.py``); the loaders, ``femkit solve``,
 ``femkit study``, the cost check and the report dispatch through :data:`KINDS` alone.
 
 This module imports no case or study module (it sits below both, beside the other shared

@@ -1,5 +1,5 @@
 """The prices study plans sum (:mod:`femkit.study.cost`, the stress-case types of
-:data:`femkit.study.stability.STRESS_CASES`): a Poisson run on a mesh of ``triangles`` and a
+:data:`femkit.study.stability.cases.STRESS_CASES`): a Poisson run on a mesh of ``triangles`` and a
 sequence of time steps on a small particle system, both from the cost model's constants
 (:mod:`femkit.cost`), from numbers alone.
 """

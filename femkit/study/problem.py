@@ -1,5 +1,9 @@
 """The Poisson problem of a study: a Poisson case (inline ``problem:`` or a ``base_case:`` file).
 
+Shared by the study kinds that sweep one Poisson case (``poisson_convergence``, ``adaptive``):
+the schema of the two keys (:data:`SOURCE_SCHEMA`), the spec fields (:class:`PoissonSource`)
+and the case itself (:func:`study_problem`).
+
 Both are one :class:`~femkit.case.Case` in the case-file language (docs/case-files.md), and
 every mesh level is assembled, reduced and solved through the one Poisson pipeline
 (:func:`femkit.case.poisson.run.poisson_problem`, a :class:`femkit.fem.PoissonProblem`).
@@ -8,10 +12,12 @@ every mesh level is assembled, reduced and solved through the one Poisson pipeli
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Mapping
 
 from ..errors import CaseFileError, InputError, with_prefix
+from .spec import plain
 
-__all__ = ["StudyProblem", "study_problem"]
+__all__ = ["StudyProblem", "study_problem", "PoissonSource", "PROBLEM", "SOURCE_SCHEMA"]
 
 
 @dataclass
@@ -82,3 +88,26 @@ def study_problem(study, *, need_exact: bool = True) -> StudyProblem:
     if need_exact and "exact.u" not in case.functions:
         raise CaseFileError(f"{where} gives no exact solution; a convergence study needs 'exact'")
     return StudyProblem(case)
+
+
+@dataclass(frozen=True)
+class PoissonSource:
+    """Where a Poisson study's problem comes from: an inline case mapping (``problem``) or a
+    case file (``base_case``, as written; resolved against the study file)."""
+
+    problem: Mapping | None
+    base_case: str | None
+
+    @staticmethod
+    def source(d: Mapping) -> dict:
+        return dict(problem=plain(d["problem"]) if "problem" in d else None,
+                    base_case=d.get("base_case"))
+
+
+#: An inline Poisson problem: a case mapping in the case-file language (docs/case-files.md),
+#: validated by the Poisson case schema; ``mesh.h`` may be left out (the levels give it).
+PROBLEM = {"type": "object", "x-message": "expected a Poisson case mapping (mesh, source, boundary, exact)"}
+
+#: The two keys naming the problem of a Poisson study (exactly one given:
+#: :func:`femkit.study.checks.check_problem_source`).
+SOURCE_SCHEMA = {"problem": PROBLEM, "base_case": {"type": "string"}}

@@ -55,7 +55,7 @@ def test_scene_frame_text_is_at_least_8_points_and_gif_frames_are_readable():
 
 
 def test_dense_adaptive_mesh_is_drawn_as_local_size(tmp_path):
-    import femkit.study.adaptive as adaptive
+    import femkit.study.adaptive.report as adaptive
     from femkit.mesh import generate
 
     figures = []

@@ -140,6 +140,6 @@ def test_signal_inside_a_poisson_studys_solve(tmp_path, sig, code):
         "solvers": [{"method": "cg", "rtol": 1e-15, "maxiter": 1000000}], "repeats": 1}))
     out = tmp_path / "report"
     files = _earlier_report(out)
-    rc, elapsed, err = signal_inside("femkit.study.poisson:_assemble", ["study", str(study), "--output",
+    rc, elapsed, err = signal_inside("femkit.study.poisson_convergence.run:_assemble", ["study", str(study), "--output",
                                      str(out), "--quiet"], sig, cwd=tmp_path)
     _check_study_stopped(rc, elapsed, err, sig, code, out, files)

@@ -269,7 +269,7 @@ def test_default_stagnation_window_lets_high_contrast_cg_converge():
     # iterations). A fixed 1000-iteration window called this "stagnation"; the default window
     # max(1000, n) must not.
     from femkit.mesh import structured_mesh
-    from femkit.study.stability import _checker_kappa, _poisson_system
+    from femkit.study.stability.cases import _checker_kappa, _poisson_system
 
     mesh = structured_mesh(128, 128)
     _, _, system = _poisson_system(mesh, _checker_kappa(mesh, 1e4), 1.0)

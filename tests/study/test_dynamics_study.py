@@ -84,7 +84,7 @@ def test_bundled_dynamics_study_quick(tmp_path):
 
 
 def test_every_integrator_has_its_own_style_and_family_line():
-    from femkit.study.report_dynamics import FAMILY_LINES, integrator_styles
+    from femkit.study.dynamics_work_precision.report import FAMILY_LINES, integrator_styles
 
     names = list(ORDERS)
     st = integrator_styles(study_from_dict({**OSC, "integrators": names}))

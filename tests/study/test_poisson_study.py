@@ -11,7 +11,7 @@ import pytest
 
 from femkit.errors import CaseFileError, ExpressionError
 from femkit.study import load_study, run_study, study_from_dict
-from femkit.study.poisson import interpolate_nested
+from femkit.study.poisson_convergence.run import interpolate_nested
 
 ROOT = Path(__file__).resolve().parents[2]
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -99,7 +99,7 @@ def test_gauss_radau_bound_is_an_upper_bound():
     import scipy.sparse as sp
 
     from femkit.solvers import SolverSpec
-    from femkit.study.poisson import cg_history, gauss_radau_bounds, smallest_ritz_value
+    from femkit.study.poisson_convergence.run import cg_history, gauss_radau_bounds, smallest_ritz_value
 
     T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(15, 15))
     A = (sp.kron(T, sp.eye(15)) + sp.kron(sp.eye(15), T)).tocsr()  # 2D Laplacian: IC(0) is not exact
@@ -171,7 +171,7 @@ def test_bundled_poisson_study_quick(tmp_path):
 
 
 def test_rate_table_groups_solvers_with_equal_fits(smooth):
-    from femkit.study.report_poisson import grouped_rate_rows
+    from femkit.study.poisson_convergence.report import grouped_rate_rows
 
     rows = grouped_rate_rows(smooth.fits)
     femkit_rows = [r for r in rows if r[0] != "scikit-fem+pyamg"]

@@ -29,7 +29,7 @@ def test_skfem_reference_converged_flag_is_honest(monkeypatch):
     """The scikit-fem rows claimed converged=True whatever SciPy's CG returned."""
     import scipy.sparse.linalg as spla
 
-    from femkit.study import poisson
+    from femkit.study.poisson_convergence import run as poisson
 
     real_cg = spla.cg
 
@@ -40,7 +40,7 @@ def test_skfem_reference_converged_flag_is_honest(monkeypatch):
     monkeypatch.setattr(spla, "cg", one_step_cg)
     data = {"kind": "poisson_convergence", "warmup": 0, "problem": SMOOTH,
             "levels": {"h0": 0.25, "count": 2}, "solvers": [{"method": "direct"}], "reference": "scikit-fem"}
-    res = poisson.run_poisson_study(study_from_dict(data))
+    res = poisson.run(study_from_dict(data))
     sk = [r for r in res["records"] if r["source"] == "scikit-fem"]
     assert sk and not any(r["converged"] for r in sk)
     assert all(r["relative_residual"] > 1e-10 for r in sk)
@@ -61,7 +61,7 @@ def test_skfem_reference_solves_the_same_system(tmp_path):
 
 def test_skfem_reference_is_warmed_up_before_timing(monkeypatch):
     """The first scikit-fem level was timed cold (skfem/pyamg first calls ~2x slower)."""
-    from femkit.study import poisson
+    from femkit.study.poisson_convergence import run as poisson
 
     calls = []
     real = poisson._skfem_run
@@ -69,6 +69,6 @@ def test_skfem_reference_is_warmed_up_before_timing(monkeypatch):
                         or real(spec, mesh, rtol, repeats))
     data = {"kind": "poisson_convergence", "warmup": 1, "problem": SMOOTH,
             "levels": {"h0": 0.25, "count": 2}, "solvers": [{"method": "direct"}], "reference": "scikit-fem"}
-    res = poisson.run_poisson_study(study_from_dict(data))
+    res = poisson.run(study_from_dict(data))
     n0, n1 = (r["nodes"] for r in res["records"] if r["source"] == "scikit-fem")
     assert calls == [n0, n0, n1]  # one untimed call first, then one per level

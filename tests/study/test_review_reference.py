@@ -38,11 +38,11 @@ def test_unconverged_reference_is_said_and_limits_the_fit(tmp_path):
                          ids=["rk4-even", "rk4-odd", "verlet", "symplectic-euler"])
 def test_reference_error_estimate_matches_analytic_error(name, every):
     """The Richardson estimate of the reference's own error against the oscillator's exact solution."""
-    from femkit.study.dynamics import _reference_run, build_scene
+    from femkit.study.dynamics_work_precision.run import _reference_run, build_scene
 
     scene = {"type": "harmonic_oscillator", "k": 10.0, "mass": 1.0, "amplitude": 0.1, "rest": 1.0, "n": 8,
              "gravity": 0.0, "t_end": 4.0}
-    from femkit.study.spec import DynamicsScene
+    from femkit.study.dynamics_work_precision.spec import DynamicsScene
 
     system, x0, v0, exact = build_scene(DynamicsScene(**scene))
     traj, est = _reference_run(system, name, 0.0625, every, 4.0, x0, v0)

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from femkit.study.load import load_study
-from femkit.study.solid_load import elastica_deflection
+from femkit.study.solid_load.run import elastica_deflection
 
 STUDY = Path(__file__).parents[2] / "studies" / "solid_load.yaml"
 

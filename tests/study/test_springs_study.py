@@ -12,7 +12,7 @@ import pytest
 
 from femkit.errors import CaseFileError, UnknownNameError
 from femkit.study.load import load_study, study_from_dict
-from femkit.study.spring_layouts import SPRING_LAYOUTS, plane_strain_modulus
+from femkit.study.springs_vs_elements.layouts import SPRING_LAYOUTS, plane_strain_modulus
 
 STUDY = Path(__file__).parents[2] / "studies" / "springs_vs_elements.yaml"
 FIGURES = {"work_precision_hanging_beam.png", "work_precision_falling_disk.png",
@@ -125,7 +125,7 @@ def _data(**over):
 
 def test_bad_input_is_one_line_naming_the_key(tmp_path):
     with pytest.raises(UnknownNameError, match="valid spring layouts: edges, edges_cross"):
-        from femkit.study.spring_layouts import SPRING_LAYOUTS as reg
+        from femkit.study.springs_vs_elements.layouts import SPRING_LAYOUTS as reg
         reg.get("lattice")
     with pytest.raises(CaseFileError, match="layout"):
         study_from_dict(_data(methods=[{"model": "springs", "layout": "grid"}]), tmp_path)

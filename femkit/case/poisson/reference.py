@@ -1,7 +1,7 @@
 """The scikit-fem reference of the P1 Poisson problem: the one place femkit calls scikit-fem.
 
 ``femkit check`` (:mod:`femkit.case.poisson.cross_check`) and the convergence study's reference
-rows (:mod:`femkit.study.poisson`) assemble, condense and solve the same problem with
+rows (:mod:`femkit.study.poisson_convergence.run`) assemble, condense and solve the same problem with
 scikit-fem (Gustafsson & McBain, "scikit-fem: A Python package for finite element assembly",
 JOSS 2020) through these functions, on femkit's own mesh (points and cells in femkit's order;
 triangles or tetrahedra):

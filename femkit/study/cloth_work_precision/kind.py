@@ -1,0 +1,5 @@
+"""Registers ``kind: cloth_work_precision`` (its modules by convention: :mod:`femkit.study.declare`)."""
+
+from ..declare import study_kind
+
+KIND = study_kind("cloth_work_precision", __package__, default_solver="direct")
