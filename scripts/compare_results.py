@@ -30,13 +30,14 @@ from pathlib import Path
 #: Keys whose values measure time (or follow from a measured time): never compared.
 TIMING_KEYS = ("time", "times", "seconds", "wall", "elapsed", "timings", "stages", "cpu",
                "per_step", "rate", "throughput", "date", "started", "finished", "peak_rss",
-               "memory", "version", "python", "platform", "host", "machine", "cache")
+               "memory", "version", "python", "platform", "host", "machine", "cache",
+               "pareto")  # studies: stage times t_*, and the Pareto flags ranked by them
 
 
 def is_timing(key: str) -> bool:
     """Whether ``key`` names a measured (run-dependent) quantity."""
     low = key.lower()
-    return any(part in low for part in TIMING_KEYS)
+    return low.startswith("t_") or any(part in low for part in TIMING_KEYS)
 
 
 def compare(a, b, path: str = "") -> tuple[list[str], list[str]]:
