@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
-import math
 import os
 import sys
 import time
@@ -61,6 +60,7 @@ from ..frozen import freeze
 from ..load import Case
 from ..names import check_geometry_spec, resolve_file
 from ..specs import IntegratorSpec, limits_spec, solver_spec
+from ..timeline import time_value
 from .forces import FORCES
 from .output import FrameStream, write_scene_outputs
 from .spec import OutputSpec, SceneSpec, StabilitySpec, record_every
@@ -71,21 +71,6 @@ __all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "bu
 
 
 # ----------------------------------------------------------------------------- prepare
-
-def _time_value(case: Case, key: str) -> float:
-    """``dt``/``t_end`` of the file: a number, or a constant expression such as ``"1/60"``."""
-    value = case.data[key]
-    if isinstance(value, str):
-        try:
-            f = compile_expression(value, ("x",), case.data.get("constants") or {})
-            value = float(f(np.zeros(1))[0])
-        except ExpressionError as exc:
-            raise ExpressionError(f"{key}: {exc}") from None
-    value = float(value)
-    if not (math.isfinite(value) and value > 0.0):
-        raise CaseFileError(f"{key}: must be a positive finite number, got {value!r}")
-    return value
-
 
 def _normalise_forces(spec) -> list[dict]:
     """Forces as a list of ``{type: ..., params...}`` (mapping form and gravity shorthand too)."""
@@ -140,8 +125,8 @@ def prepare_scene(case: Case) -> None:
             raise CaseFileError(f"linear_solver: {exc}") from None
 
     # times
-    dt = _time_value(case, "dt")
-    t_end = _time_value(case, "t_end")
+    dt = time_value(case, "dt")
+    t_end = time_value(case, "t_end")
     steps = int(round(t_end / dt))
     if steps < 1:
         raise CaseFileError(f"t_end: {t_end:g} is shorter than one step dt = {dt:g}")

@@ -47,6 +47,7 @@ from ...timing import StageTimer
 from ..frozen import freeze
 from ..names import check_geometry_spec, resolve_file
 from ..specs import IntegratorSpec, limits_spec, solver_spec
+from ..timeline import time_value
 from .schema import COMPONENTS
 from .spec import Boundary, SolidOutput, SolidSpec, StaticSpec
 
@@ -150,9 +151,7 @@ def prepare_solid(case) -> None:
             if key not in d:
                 raise CaseFileError(f"{key}: a time integration needs 'dt' and 't_end'")
         integ = IntegratorSpec.from_mapping(d["integrator"], "integrator")
-        from ..scene.run import _time_value  # dt / t_end: numbers or constant expressions
-
-        dt, t_end = _time_value(case, "dt"), _time_value(case, "t_end")
+        dt, t_end = time_value(case, "dt"), time_value(case, "t_end")
         steps = int(round(t_end / dt))
         if steps < 1:
             raise CaseFileError(f"t_end: {t_end:g} is shorter than one step dt = {dt:g}")
