@@ -284,7 +284,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
 def _compile_stage(case: Case, mesh, stage, echo) -> None:
     """The first run after an install compiles the kernels it needs ahead, in its own
     ``compile`` stage (not inside assembly and solve), saying so on the terminal (``echo``)."""
-    from ..cost import case_dimension
+    from .cost import case_dimension
     from .warmup import dimensions, must_compile, needs_kernels, start_numba, warm_up
 
     multigrid = case.solver.needs_hierarchy

@@ -54,7 +54,7 @@ from ...io.atomic import EARLIER_RUN, atomic_directory, check_output_dir
 from ...kinds import KINDS
 from ...progress import Progress
 from ...timing import StageTimer
-from ..cost import check_scene_fits
+from .cost import check_scene_fits
 from ..expressions import compile_expression
 from ..frozen import freeze
 from ..load import Case
