@@ -37,7 +37,6 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..._version import __version__
 from ...dynamics.integrators import StepContext
 from ...dynamics.integrators.base import check_matrix_free
 from ...dynamics.simulate import StabilityWarning, simulate
@@ -59,6 +58,7 @@ from ..expressions import compile_expression
 from ..frozen import freeze
 from ..load import Case
 from ..names import check_geometry_spec, resolve_file
+from ..result import RunResult
 from ..specs import IntegratorSpec, limits_spec, solver_spec
 from ..timeline import time_value
 from .forces import FORCES
@@ -277,8 +277,9 @@ def _declared(case: Case, system) -> list[str]:
 
 
 @dataclass
-class SceneResult:
-    """What a scene run produced: the trajectory in memory and the facts of ``result.json``."""
+class SceneResult(RunResult):
+    """What a scene run produced: the trajectory in memory and the facts of ``result.json``
+    (the scene kind's :class:`~femkit.case.result.RunResult`)."""
 
     case: Case
     system: Any
@@ -313,6 +314,11 @@ class SceneResult:
         return getattr(stop, "name", None) or "a stop request"
 
     @property
+    def verdict(self) -> str:
+        """``unstable`` when the run stopped on an instability, else the base verdict."""
+        return "unstable" if self.instability is not None else super().verdict
+
+    @property
     def failure(self) -> str | None:
         """One-line reason of the failure (None when stable)."""
         return None if self.instability is None else " ".join(str(self.instability).split())
@@ -337,8 +343,8 @@ class SceneResult:
                        dt_crit=e.dt_crit, message=self.failure)
         return out
 
-    def to_dict(self) -> dict:
-        """The content of ``result.json`` (keys documented in docs/scenes.md)."""
+    def facts(self) -> dict:
+        """The scene keys of ``result.json`` (documented in docs/scenes.md)."""
         tr = self.trajectory
         s = self.system
         x_final = tr.x[-1]
@@ -346,10 +352,6 @@ class SceneResult:
         stats = tr.summary()["stats"]
         desc = self.integrator.describe()
         return {
-            "case": self.case.name,
-            "problem": self.case.problem,
-            "case_file": str(self.case.path) if self.case.path else None,
-            "femkit_version": __version__,
             "system": {"type": self.case.spec.system["type"], "particles": int(s.n),
                        "springs": int(s.n_springs), "dim": int(s.dim), "dofs": int(s.ndof),
                        "pinned": int(np.count_nonzero(s.pinned)),
@@ -424,7 +426,7 @@ class SceneResult:
             verdict += " (but dt exceeds the critical step: growth may not have shown yet)"
         lines.append(f"verdict   {verdict}" + (f" ({stab})" if stab else ""))
         if self.output_dir is not None:
-            lines.append(f"output    {self.output_dir} ({len(self.files)} files)")
+            lines.append(self.output_line())
         return lines
 
 

@@ -20,7 +20,6 @@ import numpy as np
 
 from ...interrupt import Interrupted, active_flag, raising
 from ...io.atomic import EARLIER_RUN, atomic_directory
-from ...io.writers import write_json
 from ...mesh.vtk import pad3, write_cells, write_collection
 
 __all__ = ["write_solid_outputs", "write_solid_frames"]
@@ -77,9 +76,7 @@ def write_solid_outputs(result, directory: str | os.PathLike) -> Path:
         files += _pictures(tmp, result, opts, flag)
         if flag and flag.name != result.stopped:
             result.output_stop = flag.name
-        files.append("result.json")
-        result.files = files
-        write_json(tmp / "result.json", result.to_dict())
+        result.write_result_json(tmp, [*files, "result.json"])
     return final
 
 

@@ -46,6 +46,7 @@ from ...kinds import KINDS
 from ...timing import StageTimer
 from ..frozen import freeze
 from ..names import check_geometry_spec, resolve_file
+from ..result import RunResult
 from ..specs import IntegratorSpec, limits_spec, solver_spec
 from ..timeline import time_value
 from .schema import COMPONENTS
@@ -344,9 +345,11 @@ def frame_energies(problem: SolidProblem, x: np.ndarray, v: np.ndarray | None = 
 # ----------------------------------------------------------------------------- result
 
 @dataclass
-class SolidResult:
+class SolidResult(RunResult):
     """What a solid run produced: frames (times or load factors, positions, velocities), their
-    energies and fields, and the facts of ``result.json``."""
+    energies and fields, and the facts of ``result.json`` (the solid kind's
+    :class:`~femkit.case.result.RunResult`; ``verdict`` names its failure: ``newton_failed``,
+    ``solver_failed``, ``unstable``)."""
 
     case: Any
     problem: SolidProblem
@@ -392,17 +395,13 @@ class SolidResult:
         u = self.x[k] - self.problem.body.rest_positions
         return u[int(np.argmax(np.linalg.norm(u, axis=1)))]
 
-    def to_dict(self) -> dict:
-        from ..._version import __version__
-
+    def facts(self) -> dict:
+        """The solid keys of ``result.json`` (documented in docs/solids.md)."""
         spec, body = self.case.spec, self.problem.body
         u = self.x[-1] - body.rest_positions
         fields = self.fields(len(self.x) - 1)
         inverted = body.inverted(self.x[-1])
         return {
-            "case": self.case.name, "problem": "solid",
-            "case_file": str(self.case.path) if self.case.path else None,
-            "femkit_version": __version__,
             "mesh": {"dim": body.dim, "points": int(body.n), "cells": int(body.rest.n_cells),
                      "cell_type": "tetra" if body.dim == 3 else "triangle",
                      "fixed_dofs": int(len(self.problem.dirichlet().dofs))},
@@ -468,9 +467,9 @@ class SolidResult:
                  f"{'load' if d['mode'] == 'static' else 'time'} steps{stopped}, "
                  f"{d['frames']} frames",
                  f"verdict   {self.verdict}" + (f": {self.failure}" if self.failure else ""),
-                 "time      " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timings.items())]
+                 self.timings_line()]
         if self.output_dir is not None:
-            lines.append(f"output    {self.output_dir} ({len(self.files)} files)")
+            lines.append(self.output_line())
         return lines
 
 
