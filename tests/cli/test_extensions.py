@@ -89,6 +89,8 @@ FORCES.register("push", ForceType(
 
 PROBLEM = '''
 """problem: rod -- -u'' = f on (0, 1), u(0) = u(1) = 0, P1 elements, femkit's solver spec."""
+from typing import NamedTuple
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -106,13 +108,19 @@ class Result:
         self.error, self.res, self.converged = error, res, bool(res.converged)
 
 
+class Spec(NamedTuple):  # the run spec holds the solver spec (case.solver reads it)
+    n: int
+    f: float
+    solver: object
+
+
 def prepare(case):
-    case.solver = solver_spec(case.data["solver"], "solver")
-    case.spec = (int(case.data["n"]), float(case.data["f"]))
+    case.spec = Spec(int(case.data["n"]), float(case.data["f"]),
+                     solver_spec(case.data["solver"], "solver"))
 
 
 def run(case, output_dir=None, quiet=False, write=True, echo=None):
-    n, f = case.spec
+    n, f, _ = case.spec
     h = 1.0 / n
     A = sp.diags([-np.ones(n - 2), 2 * np.ones(n - 1), -np.ones(n - 2)], [-1, 0, 1]).tocsr() / h
     res = case.solver.solve(A, np.full(n - 1, f * h))

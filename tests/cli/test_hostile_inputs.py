@@ -391,7 +391,6 @@ def test_projective_sweeps_stop_at_a_stop_request(tmp_path):
     case = load_case(tmp_path / "case.yaml")
     start = time.perf_counter()
     with stop_on_signals() as flag:
-        case.run_options["stop"] = flag
         threading.Timer(1.0, flag.request).start()
-        case.run(write=False)
+        case.with_options(stop=flag).run(write=False)
     assert time.perf_counter() - start < 10.0

@@ -84,12 +84,12 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
 
     spec = case.spec.mesh
     where = f"mesh.file {spec.file}" if spec.file is not None else f"mesh.geometry {spec.geometry}"
-    force = case.run_options.get("force", False)  # --force also passes the memory guard
+    force = case.options.force  # --force also passes the memory guard
     try:
         if spec.file is not None:
             # a file's unused nodes (gmsh's circle centres ...) are dropped with a printed note
             mesh, note = drop_unreferenced(read_mesh(spec.file, compact=False))
-            notes = case.run_options.setdefault("notes", [])
+            notes = case.notes
             if note and f"mesh.file: {note}" not in notes:
                 notes.append(f"mesh.file: {note}")
         else:

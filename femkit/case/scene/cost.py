@@ -21,7 +21,7 @@ def plan_scene_case(case, size, *, build=None, measure: bool = True) -> Plan:
 
     With ``measure`` (and ``build() -> (system, integrator, ctx)``) the memory is checked first
     (a scene that cannot fit is refused before it is built:
-    :class:`~femkit.errors.BudgetExceededError`, unless ``case.run_options["force"]``), then the
+    :class:`~femkit.errors.BudgetExceededError`, unless ``case.options.force``), then the
     system is built and its seconds per step timed on a first batch of steps (at most 20 steps
     or 1 s, :func:`measure_step_seconds`). ``size`` None (a system type that cannot count
     itself) needs ``build``: the plan is then made from the built system.
@@ -44,7 +44,7 @@ def plan_scene_case(case, size, *, build=None, measure: bool = True) -> Plan:
     if not measure or build is None:
         return plan
     if system is None:
-        check_budget(plan, force=bool(case.run_options.get("force")), override=OVERRIDE)
+        check_budget(plan, force=case.options.force, override=OVERRIDE)
         system, integrator, ctx = build()
     per_step = measure_step_seconds(system, integrator, spec.dt, ctx=ctx)
     return _with_mesh(plan_scene(**common, step_seconds=per_step), mesh)
@@ -53,7 +53,7 @@ def plan_scene_case(case, size, *, build=None, measure: bool = True) -> Plan:
 def check_scene_fits(case, size) -> None:
     """The memory guard of a scene before its system is built (``force`` skips it): the model's
     peak from the file's numbers against the available memory."""
-    if size is None or case.run_options.get("force"):
+    if size is None or case.options.force:
         return
     check_budget(plan_scene_case(case, size, measure=False), override=OVERRIDE)
 

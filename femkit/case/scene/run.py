@@ -26,6 +26,7 @@ Each stage is a public function (:func:`build_system`, :func:`build_integrator`,
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import hashlib
 import os
 import sys
@@ -116,8 +117,8 @@ def prepare_scene(case: Case) -> None:
 
     # linear solver
     default = KINDS.get(case.problem, "problem").default_solver
-    case.solver = ls_spec = solver_spec(d["linear_solver"], "linear_solver", default_method=default)
-    case.run_options["limits"] = limits_spec(d.get("limits"))
+    ls_spec = solver_spec(d["linear_solver"], "linear_solver", default_method=default)
+    case.options = dataclasses.replace(case.options, limits=limits_spec(d.get("limits")))
     if integ.options.get("matrix_free"):  # caught at load time, before anything runs
         try:
             check_matrix_free(integ.method, StepContext(ls_spec))
@@ -217,7 +218,7 @@ def build_system(case: Case):
         raise
     except InputError as exc:
         raise with_prefix(exc, "system") from None
-    known = case.run_options.setdefault("notes", [])
+    known = case.notes
     known.extend(n for n in (notes[0] if notes else ()) if n not in known)
     vel = [case.functions[f"system.velocity[{i}]"]
            for i in range(len(case.spec.system.get("velocity") or []))]
@@ -310,7 +311,7 @@ class SceneResult(RunResult):
             return self.output_stop
         if not getattr(self.trajectory, "interrupted", False):
             return None
-        stop = self.case.run_options.get("stop")
+        stop = self.case.options.stop
         return getattr(stop, "name", None) or "a stop request"
 
     @property
@@ -442,7 +443,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     output_dir : overrides ``output.dir``.
     quiet : print nothing (no summary, no progress) when true. Progress: a tqdm bar when stderr
         is a terminal, else one line per 10 % of the steps or per minute (elapsed, remaining).
-        A stop request (``case.run_options["stop"]``, set by SIGINT/SIGTERM under ``femkit solve``)
+        A stop request (``case.options.stop``, set by SIGINT/SIGTERM under ``femkit solve``)
         ends the run after the current step; the frames so far are written as usual, with
         ``interrupted: true`` in result.json.
     write : write the outputs (atomically) when true.
@@ -467,7 +468,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
         ctx = build_context(case)
         every = output_every(case)
     st = case.spec.stability
-    stop = case.run_options.get("stop")
+    stop = case.options.stop
     # a tqdm bar on a terminal, else one line per 10 % or per minute on stderr (logs, batch jobs)
     progress = Progress(n_steps(case), f"scene {case.name}", unit="step", quiet=quiet)
 
@@ -518,7 +519,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     if not quiet:
         for line in result.summary_lines():
             out(line)
-        for note in case.run_options.get("notes", ()):  # e.g. a mesh file's unused nodes
+        for note in case.notes:  # e.g. a mesh file's unused nodes
             out(f"note      {note}")
         hint = fast_path_hint(case, system, integrator)
         if hint:

@@ -63,7 +63,7 @@ def write_solid_outputs(result, directory: str | os.PathLike) -> Path:
     final = Path(directory).resolve()
     result.output_dir = final
     files: list[str] = []
-    flag = result.case.run_options.get("stop")   # the run's flag (femkit solve: the active one)
+    flag = result.case.options.stop   # the run's flag (femkit solve: the active one)
     flag = active_flag() if flag is None else flag
     stop = None if flag else flag   # a stop already answered by the solve: write every frame
     with atomic_directory(final, EARLIER_RUN) as tmp:

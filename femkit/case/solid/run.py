@@ -24,11 +24,12 @@ prescribed increment spread into the body by a linear solve, the step cut when t
 inverts elements); each equilibrium is kept as a frame (its ``on_step``), and a stop request is
 seen between Newton iterations (its ``stop``).
 
-SIGINT / SIGTERM (``case.run_options["stop"]``): see :func:`run_solid`.
+SIGINT / SIGTERM (``case.options.stop``): see :func:`run_solid`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import sys
@@ -143,9 +144,9 @@ def prepare_solid(case) -> None:
         raise CaseFileError("boundaries: no fixed or roller condition: a static body with no "
                             "support is singular (rigid-body motions, no unique equilibrium); "
                             "hold a tag, or integrate in time (a body in free flight)")
-    case.solver = solver = solver_spec(d["linear_solver"], "linear_solver",
+    solver = solver_spec(d["linear_solver"], "linear_solver",
                                        default_method=KINDS.get(case.problem, "problem").default_solver)
-    case.run_options["limits"] = limits_spec(d.get("limits"))
+    case.options = dataclasses.replace(case.options, limits=limits_spec(d.get("limits")))
     out = d["output"]
     if dynamic:
         for key in ("dt", "t_end"):
@@ -572,7 +573,7 @@ def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = F
               write: bool = True, echo: Callable[[str], Any] | None = None) -> SolidResult:
     """Run a prepared solid case: build, solve (static or dynamic), write, print the summary.
 
-    A stop request (``case.run_options["stop"]``, set by SIGINT/SIGTERM under ``femkit solve``)
+    A stop request (``case.options.stop``, set by SIGINT/SIGTERM under ``femkit solve``)
     during the meshing stops at once (nothing written); during the solve it ends the run after
     the current time step or Newton iteration, and the frames so far are written with
     ``interrupted: true`` (no pictures); during the output the frames written so far are kept,
@@ -601,7 +602,7 @@ def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = F
         _say_compiling(case, echo or print)
     with raising("meshing"), timer("build"):
         problem = build_problem(case)
-    stop = case.run_options.get("stop")
+    stop = case.options.stop
     with timer("solve"), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         if case.spec.static is not None:
