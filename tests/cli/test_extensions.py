@@ -18,7 +18,8 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared helper
+from _plugins import ROOT, run_with_plugins, write_yaml  # noqa: E402
 
 GEOMETRY = '''
 """A strip [0, length] x [0, 1] meshed without gmsh (structured), tags: sides and 'boundary'."""
@@ -174,16 +175,10 @@ register_kind(Kind("midpoint_rate", "kind", SCHEMA, check, run, report=report, s
 
 def _femkit(tmp_path: Path, plugin: str, source: str, *args: str):
     (tmp_path / f"{plugin}.py").write_text(textwrap.dedent(source))
-    env = {**os.environ, "FEMKIT_PLUGINS": plugin, "OPENBLAS_NUM_THREADS": "1",
-           "MPLBACKEND": "Agg",
-           "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT), os.environ.get("PYTHONPATH", "")])}
-    return subprocess.run([sys.executable, "-m", "femkit.cli", *args], cwd=tmp_path, env=env,
-                          capture_output=True, text=True, timeout=300)
+    return run_with_plugins(tmp_path, tmp_path, plugin, *args)
 
 
-def _yaml(tmp_path: Path, name: str, text: str) -> str:
-    (tmp_path / name).write_text(textwrap.dedent(text))
-    return name
+_yaml = write_yaml
 
 
 def test_a_plugin_geometry_runs_through_femkit_solve(tmp_path):

@@ -15,13 +15,13 @@ seconds (``1e-5 n``) make ``n: 1e9`` exceed the default one-hour budget.
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared helper
+from _plugins import run_with_plugins, write_yaml  # noqa: E402
 
 PACKAGE = {
     "__init__.py": '''
@@ -163,19 +163,13 @@ PACKAGE = {
 def _femkit(tmp_path: Path, *args: str) -> subprocess.CompletedProcess:
     plugins = tmp_path / "plugins"
     if not plugins.exists():
+        (plugins / "heatbar").mkdir(parents=True)
         for name, text in PACKAGE.items():
-            (plugins / "heatbar").mkdir(parents=True, exist_ok=True)
             (plugins / "heatbar" / name).write_text(textwrap.dedent(text).lstrip())
-    env = {**os.environ, "FEMKIT_PLUGINS": "heatbar", "OPENBLAS_NUM_THREADS": "1",
-           "MPLBACKEND": "Agg",
-           "PYTHONPATH": os.pathsep.join([str(plugins), str(ROOT), os.environ.get("PYTHONPATH", "")])}
-    return subprocess.run([sys.executable, "-m", "femkit", *args], cwd=tmp_path, env=env,
-                          capture_output=True, text=True, timeout=300)
+    return run_with_plugins(tmp_path, plugins, "heatbar", *args)
 
 
-def _case(tmp_path: Path, name: str, text: str) -> str:
-    (tmp_path / name).write_text(textwrap.dedent(text))
-    return name
+_case = write_yaml
 
 
 def test_a_problem_kind_package_runs_through_femkit_solve(tmp_path):
