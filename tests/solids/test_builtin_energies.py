@@ -58,7 +58,7 @@ def test_builtins_share_one_generated_module():
     assert len(mods) == 1
     mod = mods.pop()
     assert mod.__name__.startswith("femkit_energy_")
-    from femkit.solids import compiled
+    from femkit.elements import compiled
 
     for name in ("corotational_energy", "stvk_energy", "stable_neo_hookean_energy", "stretch_energy"):
         assert not hasattr(compiled, name)          # no hand-written energy left in the library
