@@ -133,13 +133,13 @@ def describe(obj) -> str:
     if isinstance(obj, Geometry):
         params = ", ".join(obj.parameters) or "none"
         return f"{obj.dim}D; parameters: {params}; tags: {', '.join(obj.boundary_tags + obj.cell_tags)}"
+    run = getattr(obj, "run", None)
+    if callable(run) and hasattr(obj, "key"):  # a file kind (whatever its schema): its module
+        return _first_line(sys.modules[run.__module__].__doc__)
     schema = getattr(obj, "schema", None)
     if isinstance(schema, dict) and "properties" in schema:  # forces, system types
         keys = [k for k in schema["properties"] if k != "type"]
         return "keys: " + ", ".join(keys) if keys else "no keys"
-    run = getattr(obj, "run", None)
-    if callable(run) and hasattr(obj, "key"):  # a file kind: its module says what it is
-        return _first_line(sys.modules[run.__module__].__doc__)
     text = _first_line(getattr(obj, "__doc__", None))
     if inspect.isclass(obj) and text.startswith(obj.__name__ + "("):  # generated signature
         text = _first_line(sys.modules[obj.__module__].__doc__)

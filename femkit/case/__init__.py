@@ -2,9 +2,13 @@
 
 ``load_case(path, **overrides) -> Case``; ``Case.run(output_dir=None, quiet=True, write=True)``.
 Kinds of file (``problem: poisson``, ``problem: mass_spring``, ``problem: solid``) are
-dispatched through the one registry :data:`femkit.kinds.KINDS` (a leaf below this package); a
-new kind is one module calling :func:`femkit.kinds.register_kind`. This package hands the
-registry the finder of its built-in kinds: the ``kind.py`` of each of its folders.
+dispatched through the one registry :data:`femkit.kinds.KINDS` (a leaf below this package). Each
+kind is one package owning everything about it (``kind.py`` registering it with
+:func:`femkit.kinds.register_kind`, its schema, spec, plan, run and a result extending
+:class:`femkit.case.result.RunResult`); this package's own modules hold what kinds share
+(loading, expressions, specs and schema fragments, ``cost.py``, ``result.py``, ``timeline.py``,
+``pictures.py``). It hands the registry the finder of its built-in kinds: the ``kind.py`` of
+each of its folders.
 """
 
 import importlib

@@ -5,10 +5,11 @@ kind (``KINDS[...].plan``); :func:`check_case` checks it against the case's
 ``limits:``, the command line's ``--max-memory`` and the available memory, refusing with
 :class:`~femkit.errors.BudgetExceededError` (exit code 2, one line) unless forced.
 
-Run options travel in ``case.run_options``: ``limits`` (:class:`femkit.cost.Limits`, from the
-file), ``force`` (skip every budget, also the memory guard before meshing:
+Run options travel in ``case.options`` (:class:`femkit.case.load.RunOptions`, typed and
+frozen; a new case carries changed ones: ``case.with_options(...)``): ``limits``
+(:class:`femkit.cost.Limits`, from the file), ``force`` (skip every budget, also the memory guard before meshing:
 :func:`femkit.case.cost.check_mesh_fits`), ``stop`` (a :class:`femkit.interrupt.StopFlag` the
-runners check between steps and iterations) and ``plan`` (set by :func:`check_case`: a Poisson
+runners check between steps and iterations) and ``plan`` (in the case :func:`check_case` returns: a Poisson
 run predicted to last 30 s or more prints a line on stderr after each stage with the elapsed
 and the predicted remaining time).
 """
@@ -49,7 +50,7 @@ def plan_case(case, *, measure: bool = True) -> Plan:
 def _limits(case, max_memory: float | None) -> tuple[Limits, Limits, Limits]:
     """The case's limits (the file's, ``max_memory``, the default time budget), and them split
     into the untimed part (memory, steps, output) and the time limit."""
-    limits = with_default_time(case.run_options.get("limits"))
+    limits = with_default_time(case.options.limits)
     if max_memory is not None:
         limits = limits.merged(Limits(memory=max_memory))
     untimed = dataclasses.replace(limits, time=None, time_is_default=False)
@@ -58,7 +59,7 @@ def _limits(case, max_memory: float | None) -> tuple[Limits, Limits, Limits]:
 
 
 def check_case(case, *, max_memory: float | None = None, force: bool = False,
-               echo=None) -> Plan:
+               echo=None):
     """Plan ``case`` and refuse it when it exceeds a budget (before anything runs).
 
     Limits: the file's ``limits:``, ``max_memory`` (bytes, ``--max-memory``), the available
@@ -67,7 +68,13 @@ def check_case(case, *, max_memory: float | None = None, force: bool = False,
     the model alone (immediately, however large the run); a time limit first measures: the
     machine's speed (Poisson) or a batch of steps (scenes), for the default budget only when the
     model predicts more than :data:`MEASURE_FRACTION` of it. With ``force`` the violations are printed as warnings on stderr and the run goes on (also past the
-    memory guard before meshing: ``case.run_options["force"]``).
+    memory guard before meshing: ``options.force``).
+
+    Returns
+    -------
+    Case
+        ``case`` with ``options.force`` and ``options.plan`` (the plan checked) set: the case
+        to run.
 
     Raises
     ------
@@ -75,7 +82,7 @@ def check_case(case, *, max_memory: float | None = None, force: bool = False,
         A limit is exceeded and ``force`` is false.
     """
     limits, untimed, timed = _limits(case, max_memory)
-    case.run_options["force"] = bool(force)
+    case = case.with_options(force=bool(force))
     say = echo or (lambda line: print(line, file=sys.stderr))
     plan = plan_case(case, measure=False)
     warnings = check_budget(plan, untimed, force=force, override=OVERRIDE)
@@ -88,8 +95,7 @@ def check_case(case, *, max_memory: float | None = None, force: bool = False,
     for w in warnings:
         w = w.replace(f" (or {OVERRIDE} to run anyway)", "").replace(f" (or {RAISE_TIME} to run anyway)", "")
         say(f"femkit: warning: {w} ({OVERRIDE} given)")
-    case.run_options["plan"] = plan  # long Poisson runs report each stage against it
-    return plan
+    return case.with_options(plan=plan)  # long Poisson runs report each stage against it
 
 
 def check_dry_run(case, plan: Plan, *, max_memory: float | None = None,

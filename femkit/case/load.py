@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import copy
+import dataclasses
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,7 +28,7 @@ from .frozen import freeze
 from ..kinds import KINDS
 from .schema import fill_defaults, validate_against
 
-__all__ = ["Case", "load_case", "case_from_dict", "read_yaml", "apply_overrides",
+__all__ = ["Case", "RunOptions", "load_case", "case_from_dict", "read_yaml", "apply_overrides",
            "MAX_YAML_BYTES", "MAX_YAML_NODES"]
 
 #: Largest case, scene or study file read (bytes): the bundled ones are a few kilobytes; a larger
@@ -40,9 +41,36 @@ MAX_YAML_BYTES = 2_000_000
 MAX_YAML_NODES = 200_000
 
 
+@dataclass(frozen=True)
+class RunOptions:
+    """How to run a case, beside what the file says: passed explicitly, never keyed by strings.
+
+    Attributes
+    ----------
+    limits : femkit.cost.Limits or None
+        The file's ``limits:`` (set by the kind's ``prepare``).
+    force : bool
+        Skip every budget and memory guard (``--force``; set by
+        :func:`femkit.case.budget.check_case`).
+    stop : femkit.interrupt.StopFlag or None
+        Checked by the runners between steps and iterations (``femkit solve`` sets it).
+    plan : femkit.cost.Plan or None
+        The plan the budget check made (long Poisson runs report each stage against it).
+    """
+
+    limits: Any = None
+    force: bool = False
+    stop: Any = None
+    plan: Any = None
+
+
 @dataclass
 class Case:
     """A validated case: the data (defaults filled, paths absolute) and its compiled pieces.
+
+    Immutable once loaded: the kind's ``prepare`` fills it, then every attribute is fixed
+    (setting one raises ``dataclasses.FrozenInstanceError``); :meth:`replace` and
+    :meth:`with_options` make a new case instead.
 
     Attributes
     ----------
@@ -59,16 +87,17 @@ class Case:
         The case file (None for a case built from a dict).
     functions : dict
         Compiled callables keyed by their key path (``"source"``, ``"exact.u"`` ...),
-        each with ``.source`` holding its text. Replace an entry to swap a piece.
-    solver : SolverSpec or None
-        The validated ``solver`` (``linear_solver`` in scenes): built once at load time.
+        each with ``.source`` holding its text; read-only once loaded (swap one with
+        ``case.replace(functions={**case.functions, key: f})``).
     spec : object or None
         The kind's typed, frozen run spec built at load time (scenes:
-        :class:`femkit.case.scene.spec.SceneSpec`); the runners read it, not ``data``.
-    run_options : dict
-        How to run it (:mod:`femkit.case.budget`): ``limits`` (:class:`femkit.cost.Limits` from
-        the ``limits:`` key, set at load time), ``force`` (skip every budget) and ``stop`` (a
-        :class:`femkit.interrupt.StopFlag` the runners check between steps and iterations).
+        :class:`femkit.case.scene.spec.SceneSpec`); the runners read it, not ``data``. It is
+        the one holder of the solver spec (``spec.solver``; :attr:`solver` reads it).
+    options : RunOptions
+        How to run it (:mod:`femkit.case.budget`): ``limits``, ``force``, ``stop``, ``plan``.
+    notes : list of str
+        What a run learnt while reading its inputs (e.g. a mesh file's unused nodes), printed
+        after its summary: the one thing a run adds to its case.
     """
 
     data: dict
@@ -77,13 +106,42 @@ class Case:
     base_dir: Path
     path: Path | None = None
     functions: dict = field(default_factory=dict)
-    solver: Any = None
-    run_options: dict = field(default_factory=dict)
     spec: Any = None
+    options: RunOptions = field(default_factory=RunOptions)
+    notes: list = field(default_factory=list)
+
+    def __setattr__(self, key: str, value: Any) -> None:
+        if self.__dict__.get("_sealed"):
+            raise dataclasses.FrozenInstanceError(
+                f"a loaded Case is immutable: cannot set {key!r} (make a new one with "
+                f"case.replace({key}=...) or case.with_options(...))")
+        object.__setattr__(self, key, value)
+
+    def seal(self) -> "Case":
+        """Fix every attribute (the data and the functions read-only); returns the case."""
+        object.__setattr__(self, "data", freeze(self.data))
+        object.__setattr__(self, "functions", freeze(dict(self.functions)))
+        object.__setattr__(self, "_sealed", True)
+        return self
+
+    @property
+    def solver(self):
+        """The solver spec (:class:`femkit.solvers.SolverSpec`) of the kind's run spec
+        (``spec.solver``), None for a kind without one."""
+        return getattr(self.spec, "solver", None)
+
+    def replace(self, **changes) -> "Case":
+        """A new, sealed case with ``changes`` (field names: ``spec``, ``functions``, ...)."""
+        changes.setdefault("notes", list(self.notes))
+        return dataclasses.replace(self, **changes).seal()
+
+    def with_options(self, **changes) -> "Case":
+        """A new case whose :class:`RunOptions` have ``changes`` (``stop=flag``, ``force=True``)."""
+        return self.replace(options=dataclasses.replace(self.options, **changes))
 
     def run(self, output_dir: str | os.PathLike | None = None, quiet: bool = True,
             write: bool = True, echo=None):
-        """Run the case; returns the problem's result object (CaseResult for Poisson).
+        """Run the case; returns the problem's result (a :class:`femkit.case.result.RunResult`).
 
         Parameters
         ----------
@@ -277,8 +335,7 @@ def case_from_dict(data: Mapping, base_dir: str | os.PathLike = ".", *, name: st
     case = Case(data=full, problem=str(full["problem"]), name=case_name, base_dir=base,
                 path=Path(path).resolve() if path is not None else None)
     kind.prepare(case)
-    case.data = freeze(case.data)  # from here on the data is read, never edited
-    return case
+    return case.seal()  # from here on the case is read, never edited
 
 
 def _not_a_case(data: Mapping, path) -> str | None:

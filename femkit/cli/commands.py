@@ -38,10 +38,9 @@ def run_solve(args) -> int:
         for w in check_dry_run(case, plan, max_memory=max_memory(args), force=args.force):
             print(f"femkit: warning: {w}", file=sys.stderr)
         return EXIT_OK
-    check_case(case, max_memory=max_memory(args), force=args.force)
+    case = check_case(case, max_memory=max_memory(args), force=args.force)
     with stop_on_signals() as stop:
-        case.run_options["stop"] = stop
-        result = case.run(output_dir=args.output, quiet=args.quiet)
+        result = case.with_options(stop=stop).run(output_dir=args.output, quiet=args.quiet)
     if getattr(result, "interrupted", None):
         print(f"femkit: interrupted by {result.interrupted}; what was computed is written to "
               f"{getattr(result, 'output_dir', None)} (marked interrupted: true)", file=sys.stderr)

@@ -25,7 +25,7 @@ class StopAfterChecks(StopFlag):
 def test_interrupted_cg_writes_the_last_iterate(tmp_path):
     case = load_case("cases/poisson_unit_square.yaml", solver={"method": "cg", "preconditioner": None, "rtol": 1e-12},
                      output={"dir": str(tmp_path / "out")})
-    case.run_options["stop"] = StopAfterChecks(3 + 4)  # set during iteration 5
+    case = case.with_options(stop=StopAfterChecks(3 + 4))  # set during iteration 5
     result = case.run(quiet=True)
     assert result.interrupted == "SIGTERM"
     assert result.solve.reason == "interrupted" and result.solve.iterations == 5
@@ -41,7 +41,7 @@ def test_stop_between_stages_writes_nothing(tmp_path):
     from femkit.interrupt import Interrupted
 
     case = load_case("cases/poisson_unit_square.yaml", output={"dir": str(tmp_path / "out")})
-    case.run_options["stop"] = StopAfterChecks(1)  # set when the assembly stage ends (second look)
+    case = case.with_options(stop=StopAfterChecks(1))  # set when the assembly stage ends (second look)
     with pytest.raises(Interrupted, match="interrupted by SIGTERM after the assembly stage"):
         case.run(quiet=True)
     assert not (tmp_path / "out").exists()

@@ -119,3 +119,34 @@ def test_each_kind_declares_its_default_solver_and_a_file_without_one_gets_it():
     case = case_from_dict({"problem": "poisson", "mesh": {"geometry": "unit_square", "h": 0.5},
                            "source": "1", "boundary": {"dirichlet": [{"tags": ["boundary"], "value": 0}]}})
     assert case.solver.method == declared["poisson"] == "pcg"
+
+
+def test_a_loaded_case_is_immutable_and_holds_its_solver_spec_once(tmp_path):
+    """After prepare nothing of a Case is rebound (overrides and run options make a new case),
+    and its solver spec is the run spec's (no second copy to drift)."""
+    import dataclasses
+
+    from femkit.case.load import RunOptions
+
+    case = case_from_dict({"problem": "poisson", "mesh": {"geometry": "unit_square", "h": 0.5},
+                           "source": "1", "boundary": {"dirichlet": [{"tags": ["boundary"]}]},
+                           "solver": {"method": "cg", "rtol": 1e-9}}, tmp_path)
+    assert case.solver is case.spec.solver and case.solver.method == "cg"
+    for name, value in (("spec", None), ("name", "other"), ("options", RunOptions(force=True))):
+        with pytest.raises(dataclasses.FrozenInstanceError, match="immutable"):
+            setattr(case, name, value)
+    with pytest.raises(TypeError, match="read-only"):
+        case.functions["source"] = case.functions["source"]
+    with pytest.raises(AttributeError):
+        case.solver = None
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        case.options.force = True  # the options are frozen too
+    forced = case.with_options(force=True)
+    assert forced is not case and forced.options.force and not case.options.force
+    assert forced.spec is case.spec and forced.solver is case.solver
+    direct = case.replace(spec=dataclasses.replace(case.spec, solver=dataclasses.replace(
+        case.spec.solver, method="direct")))
+    assert (direct.solver.method, case.solver.method) == ("direct", "cg")
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        direct.spec = case.spec
+

@@ -107,7 +107,7 @@ def test_msh_without_any_physical_group_is_read_alike_in_2d_and_3d(tmp_path, dim
 
 def _plan(case_path: Path):
     from femkit.case import load_case
-    from femkit.case.cost import plan_poisson_case
+    from femkit.case.poisson.cost import plan_poisson_case
 
     return plan_poisson_case(load_case(case_path), measure=False)
 

@@ -103,8 +103,8 @@ def cube_levels(tmp_path_factory):
         errs = compute_errors(case, problem, u)
         effs = {}
         for est in ("residual", "zz"):
-            case.spec = dataclasses.replace(case.spec, estimator=est)
-            effs[est] = estimate_facts(case, problem, u, exact_gradient(case))[1]
+            variant = case.replace(spec=dataclasses.replace(case.spec, estimator=est))
+            effs[est] = estimate_facts(variant, problem, u, exact_gradient(variant))[1]
         rows.append({"h": 0.5 / 2 ** k, **errs, **effs})
     return rows
 

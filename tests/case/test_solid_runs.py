@@ -236,8 +236,7 @@ def test_a_stop_between_load_steps_keeps_them_marked_without_pictures(tmp_path, 
 
     monkeypatch.setattr(solid_run, "frame_energies", energies_then_stop)
     data = {**LOG_J, "static": {"load_steps": 3}, "output": {"png": True, "gif": True}}
-    case = femkit.load_case(_write(tmp_path, data))
-    case.run_options["stop"] = flag
+    case = femkit.load_case(_write(tmp_path, data)).with_options(stop=flag)
     result = case.run(output_dir=tmp_path / "out", quiet=True)
     assert result.interrupted == "SIGINT" and not result.converged
     d = json.loads((tmp_path / "out" / "result.json").read_text())

@@ -18,7 +18,8 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared helper
+from _plugins import ROOT, run_with_plugins, write_yaml  # noqa: E402
 
 GEOMETRY = '''
 """A strip [0, length] x [0, 1] meshed without gmsh (structured), tags: sides and 'boundary'."""
@@ -89,6 +90,8 @@ FORCES.register("push", ForceType(
 
 PROBLEM = '''
 """problem: rod -- -u'' = f on (0, 1), u(0) = u(1) = 0, P1 elements, femkit's solver spec."""
+from typing import NamedTuple
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -106,13 +109,19 @@ class Result:
         self.error, self.res, self.converged = error, res, bool(res.converged)
 
 
+class Spec(NamedTuple):  # the run spec holds the solver spec (case.solver reads it)
+    n: int
+    f: float
+    solver: object
+
+
 def prepare(case):
-    case.solver = solver_spec(case.data["solver"], "solver")
-    case.spec = (int(case.data["n"]), float(case.data["f"]))
+    case.spec = Spec(int(case.data["n"]), float(case.data["f"]),
+                     solver_spec(case.data["solver"], "solver"))
 
 
 def run(case, output_dir=None, quiet=False, write=True, echo=None):
-    n, f = case.spec
+    n, f, _ = case.spec
     h = 1.0 / n
     A = sp.diags([-np.ones(n - 2), 2 * np.ones(n - 1), -np.ones(n - 2)], [-1, 0, 1]).tocsr() / h
     res = case.solver.solve(A, np.full(n - 1, f * h))
@@ -166,16 +175,10 @@ register_kind(Kind("midpoint_rate", "kind", SCHEMA, check, run, report=report, s
 
 def _femkit(tmp_path: Path, plugin: str, source: str, *args: str):
     (tmp_path / f"{plugin}.py").write_text(textwrap.dedent(source))
-    env = {**os.environ, "FEMKIT_PLUGINS": plugin, "OPENBLAS_NUM_THREADS": "1",
-           "MPLBACKEND": "Agg",
-           "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT), os.environ.get("PYTHONPATH", "")])}
-    return subprocess.run([sys.executable, "-m", "femkit.cli", *args], cwd=tmp_path, env=env,
-                          capture_output=True, text=True, timeout=300)
+    return run_with_plugins(tmp_path, tmp_path, plugin, *args)
 
 
-def _yaml(tmp_path: Path, name: str, text: str) -> str:
-    (tmp_path / name).write_text(textwrap.dedent(text))
-    return name
+_yaml = write_yaml
 
 
 def test_a_plugin_geometry_runs_through_femkit_solve(tmp_path):

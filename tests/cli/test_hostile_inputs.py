@@ -397,8 +397,7 @@ def test_projective_sweeps_stop_at_a_stop_request(tmp_path):
     case = load_case(tmp_path / "case.yaml")
     asked = []
     with stop_on_signals() as flag:
-        case.run_options["stop"] = flag
         timer = threading.Timer(1.0, lambda: (asked.append(time.perf_counter()), flag.request()))
         timer.start()
-        case.run(write=False)
+        case.with_options(stop=flag).run(write=False)
     assert asked and time.perf_counter() - asked[0] < 10.0  # stopped soon after the request

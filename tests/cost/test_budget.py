@@ -127,7 +127,7 @@ def test_case_layer_guard_refuses_before_gmsh_starts():
 
 def test_case_run_refuses_a_ruinous_mesh_before_meshing(monkeypatch):
     """load_case(...).run() goes through the guard (no femkit solve budget check needed); with
-    run_options force the guard steps aside (gmsh would then be called: stopped here)."""
+    options.force the guard steps aside (gmsh would then be called: stopped here)."""
     import femkit
     import femkit.mesh.geometries.planar as geometries  # the module unit_square calls rectangle in
 

@@ -45,9 +45,9 @@ def test_raised_budget_or_force_lets_it_through(tmp_path):
     assert err.value.what == "time" and err.value.predicted > 3600.0
     # raised far above the estimate (a first batch of steps on a busy machine varies 10x and more)
     raised = load_case(_rope(tmp_path, limits={"time": "100000d"}))
-    assert check_case(raised).seconds > 3600.0  # priced as before, now within the raised budget
+    assert check_case(raised).options.plan.seconds > 3600.0  # priced as before, now within the raised budget
     said = []
-    plan = check_case(load_case(_rope(tmp_path)), force=True, echo=said.append)
+    plan = check_case(load_case(_rope(tmp_path)), force=True, echo=said.append).options.plan
     assert plan.seconds > 3600.0 and len(said) == 1 and "default time budget" in said[0]
     assert said[0].endswith("(--force given)")
 
@@ -59,7 +59,7 @@ def test_the_budget_has_one_home(tmp_path, monkeypatch):
     from femkit.case.budget import check_case
 
     short = _rope(tmp_path, dt=1e-3, t_end=2.0)
-    assert check_case(load_case(short)).seconds < 3600.0
+    assert check_case(load_case(short)).options.plan.seconds < 3600.0
     monkeypatch.setattr(budget, "DEFAULT_TIME_BUDGET", 1e-6)
     with pytest.raises(BudgetExceededError, match="default time budget"):
         check_case(load_case(short))

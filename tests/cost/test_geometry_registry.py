@@ -140,7 +140,8 @@ def test_a_3d_geometry_is_priced_by_tetrahedra_not_as_triangles():
     and refuses a mesh beyond the machine; a case's plan prices the same tetrahedra (9 per
     h^3 of volume), not the volume's measure as triangles."""
     import femkit
-    from femkit.case.cost import check_mesh_fits, plan_poisson_case
+    from femkit.case.cost import check_mesh_fits
+    from femkit.case.poisson.cost import plan_poisson_case
     from femkit.errors import BudgetExceededError
 
     register_geometry("test_cube", measure=lambda side=1.0: (side ** 3, 6 * side ** 2), dim=3,

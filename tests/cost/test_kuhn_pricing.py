@@ -28,7 +28,7 @@ def _case(tmp_path, geometry: str, h: float, refine: int):
     ("kuhn_fichera", 0.5, 1)],
     ids=["cube h=1/4", "cube h=1/3 refined once", "fichera h=1/2", "fichera h=1/2 refined once"])
 def test_plan_prices_the_tetrahedra_the_kuhn_mesh_has(tmp_path, geometry, h, refine):
-    from femkit.case.cost import plan_poisson_case
+    from femkit.case.poisson.cost import plan_poisson_case
     from femkit.mesh import generate, refine as red
 
     plan = plan_poisson_case(_case(tmp_path, geometry, h, refine), measure=False)

@@ -29,7 +29,7 @@ def _cube(h, refine):
 
 @pytest.mark.parametrize("size", sorted(MEASURED))
 def test_model_covers_the_measured_peak_within_fifteen_percent(size):
-    from femkit.case.cost import plan_poisson_case
+    from femkit.case.poisson.cost import plan_poisson_case
 
     h, refine, measured = MEASURED[size]
     predicted = plan_poisson_case(_cube(h, refine), measure=False).peak_bytes
@@ -72,7 +72,7 @@ def test_guard_admits_the_1M_cube_on_a_23_GB_machine(path):
 
 
 def test_whole_plan_admits_the_1M_cube_and_refuses_a_level_beyond_the_machine():
-    from femkit.case.cost import plan_poisson_case
+    from femkit.case.poisson.cost import plan_poisson_case
     from femkit.cost import check_budget
 
     assert check_budget(plan_poisson_case(_cube(1 / 3, 5), measure=False), available=MACHINE) == []

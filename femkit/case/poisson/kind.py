@@ -2,7 +2,7 @@
 
 Schema :data:`femkit.case.poisson.schema.POISSON_SCHEMA`; load-time checks
 :func:`femkit.case.poisson.run.prepare_poisson`; the run :func:`femkit.case.poisson.run.run_poisson`;
-the cost plan :func:`femkit.case.cost.plan_poisson_case`. The pipeline modules are imported on
+the cost plan :func:`femkit.case.poisson.cost.plan_poisson_case`. The pipeline modules are imported on
 first use, so discovering this kind imports nothing heavy.
 """
 
@@ -30,7 +30,7 @@ def _run(case, **kwargs):
 
 
 def _plan(case, **kwargs):
-    from ..cost import plan_poisson_case
+    from .cost import plan_poisson_case
 
     return plan_poisson_case(case, **kwargs)
 

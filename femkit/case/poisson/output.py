@@ -198,7 +198,6 @@ def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None,
     already being written (:class:`SolutionFile`), moved in here.
     """
     from ...io.atomic import EARLIER_RUN, atomic_directory
-    from ...io.writers import write_json
 
     opts = result.case.spec.output
     final = output_location(directory)
@@ -225,8 +224,7 @@ def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None,
             est = result.error_estimate or {}
             write_plot(tmp / "solution.png", result.mesh, result.u, title,
                        indicators=result.indicators, estimator=est.get("estimator", ""))
-        result.files = sorted({p.name for p in tmp.iterdir()} | {"result.json"})
         result.timings["output"] = time.perf_counter() - t0  # up to result.json itself
-        write_json(tmp / "result.json", result.to_dict())
+        result.write_result_json(tmp, sorted({p.name for p in tmp.iterdir()} | {"result.json"}))
     result.timings["output"] = time.perf_counter() - t0
     return final

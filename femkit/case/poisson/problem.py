@@ -16,6 +16,7 @@ import numpy as np
 from ...errors import CaseFileError, ExpressionError, InputError
 from ..load import Case
 from ..names import with_prefix
+from ..result import RunResult
 
 __all__ = ["VARIABLES", "check_dimension", "build_mesh", "build_mesh_levels", "multigrid_inputs",
            "multigrid_overrides", "on_free_nodes", "level_system",
@@ -83,12 +84,12 @@ def build_mesh_levels(case: Case, *, h: float | None = None):
 
     spec = case.spec.mesh
     where = f"mesh.file {spec.file}" if spec.file is not None else f"mesh.geometry {spec.geometry}"
-    force = case.run_options.get("force", False)  # --force also passes the memory guard
+    force = case.options.force  # --force also passes the memory guard
     try:
         if spec.file is not None:
             # a file's unused nodes (gmsh's circle centres ...) are dropped with a printed note
             mesh, note = drop_unreferenced(read_mesh(spec.file, compact=False))
-            notes = case.run_options.setdefault("notes", [])
+            notes = case.notes
             if note and f"mesh.file: {note}" not in notes:
                 notes.append(f"mesh.file: {note}")
         else:
@@ -335,8 +336,9 @@ _QUALITY_KEYS = {2: ("n_points", "n_triangles", "h_max", "h_min", "h_mean", "min
                      "max_dihedral", "min_radius_ratio", "volume")}
 
 @dataclass
-class CaseResult:
-    """Everything a Poisson run produced (arrays in memory, facts in :meth:`to_dict`)."""
+class CaseResult(RunResult):
+    """Everything a Poisson run produced (arrays in memory, facts in :meth:`to_dict`): the
+    Poisson kind's :class:`~femkit.case.result.RunResult`."""
 
     case: Case
     mesh: Any
@@ -364,10 +366,8 @@ class CaseResult:
     def converged(self) -> bool:
         return bool(self.solve.converged)
 
-    def to_dict(self) -> dict:
-        """The content of ``result.json`` (keys documented in docs/case-files.md)."""
-        from ..._version import __version__
-
+    def facts(self) -> dict:
+        """The Poisson keys of ``result.json`` (documented in docs/case-files.md)."""
         spec = self.case.spec.mesh
         from ...mesh.mesh import CELLS_NAME
 
@@ -378,10 +378,6 @@ class CaseResult:
         mesh_info["source"] = spec.source()
         mesh_info["refine"] = spec.refine
         return {
-            "case": self.case.name,
-            "problem": self.case.problem,
-            "case_file": str(self.case.path) if self.case.path else None,
-            "femkit_version": __version__,
             "mesh": mesh_info,
             "dofs": self.dofs,
             "n_dirichlet": self.n_dirichlet,
@@ -459,9 +455,9 @@ class CaseResult:
             lines.append(f"adaptive  {len(a['levels'])} levels, theta {a['theta']:g}, "
                          f"{a['levels'][0]['dofs']} -> {a['levels'][-1]['dofs']} dofs; {met}; "
                          f"smallest {kind} on any level {worst:.1f} deg")
-        lines.append("time      " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timings.items()))
+        lines.append(self.timings_line())
         if self.output_dir is not None:
-            lines.append(f"output    {self.output_dir} ({', '.join(self.files)})")
+            lines.append(self.output_line(names=True))
         return lines
 
 

@@ -20,6 +20,7 @@ atomically (see :func:`femkit.io.atomic.atomic_directory`).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 from typing import Any, Callable
 
@@ -76,16 +77,16 @@ def prepare_poisson(case: Case) -> None:
     from ...kinds import KINDS
     from ..specs import solver_spec
 
-    case.solver = solver_spec(d["solver"], "solver",
-                              default_method=KINDS.get(case.problem, "problem").default_solver)
-    d["solver"] = case.solver.to_dict()
+    solver = solver_spec(d["solver"], "solver",
+                         default_method=KINDS.get(case.problem, "problem").default_solver)
+    d["solver"] = solver.to_dict()
     from ..specs import limits_spec
 
-    case.run_options["limits"] = limits_spec(d.get("limits"))
-    if case.solver.needs_hierarchy and (not mesh.get("refine") or d.get("adaptive")):
+    case.options = dataclasses.replace(case.options, limits=limits_spec(d.get("limits")))
+    if solver.needs_hierarchy and (not mesh.get("refine") or d.get("adaptive")):
         from ...errors import HierarchyError
 
-        what = "method 'fmg'" if case.solver.method == "fmg" else "preconditioner 'gmg'"
+        what = "method 'fmg'" if solver.method == "fmg" else "preconditioner 'gmg'"
         if d.get("adaptive"):
             raise HierarchyError(f"solver: {what} needs uniformly refined nested meshes, which "
                                  f"adaptive refinement does not make; use method pcg with "
@@ -139,7 +140,7 @@ def prepare_poisson(case: Case) -> None:
                               tuple(freeze(list(bnd.get("neumann") or ()))), bnd.get("nullspace"),
                               bnd.get("compatibility_rtol")),
         load_rule=d["quadrature"]["load"], estimator=d["estimator"],
-        adaptive=freeze(d["adaptive"]) if d.get("adaptive") else None, solver=case.solver,
+        adaptive=freeze(d["adaptive"]) if d.get("adaptive") else None, solver=solver,
         output=PoissonOutputSpec(out["dir"], bool(out["vtu"]), bool(out["xdmf"]),
                                  bool(out["plot"]), out.get("gather_limit"),
                                  out.get("compression", "none")))
@@ -192,8 +193,8 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         from .output import output_location
 
         target = output_location(output_dir or case.spec.output.dir)
-    stop = case.run_options.get("stop")
-    plan = case.run_options.get("plan")
+    stop = case.options.stop
+    plan = case.options.plan
     report = Progress.planned([(st.name, st.seconds) for st in plan.stages] if plan else [],
                               case.name, quiet=quiet)
 
@@ -275,7 +276,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
         out = echo or print
         for line in result.summary_lines():
             out(line)
-        for note in case.run_options.get("notes", ()):  # e.g. a mesh file's unused nodes
+        for note in case.notes:  # e.g. a mesh file's unused nodes
             out(f"note      {note}")
         out(clock.summary(result.timings))
     return result
@@ -284,7 +285,7 @@ def run_poisson(case: Case, output_dir: str | os.PathLike | None = None, quiet: 
 def _compile_stage(case: Case, mesh, stage, echo) -> None:
     """The first run after an install compiles the kernels it needs ahead, in its own
     ``compile`` stage (not inside assembly and solve), saying so on the terminal (``echo``)."""
-    from ..cost import case_dimension
+    from .cost import case_dimension
     from .warmup import dimensions, must_compile, needs_kernels, start_numba, warm_up
 
     multigrid = case.solver.needs_hierarchy

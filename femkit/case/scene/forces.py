@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from ...registry import Registry
-from .fragments import NONNEG, POS, VEC, closed
+from ..fragments import NONNEG, POS, VEC, closed
 
 __all__ = ["ForceType", "FORCES"]
 

@@ -3,7 +3,7 @@
 Schema :func:`femkit.case.scene.schema.scene_schema` (its force and system enums come from
 :data:`~femkit.case.scene.forces.FORCES` and :data:`~femkit.case.scene.systems.SYSTEMS`);
 load-time checks :func:`femkit.case.scene.run.prepare_scene`; the run
-:func:`femkit.case.scene.run.run_scene`; the cost plan :func:`femkit.case.cost.plan_scene_case` (priced from the system's counts,
+:func:`femkit.case.scene.run.run_scene`; the cost plan :func:`femkit.case.scene.cost.plan_scene_case` (priced from the system's counts,
 :func:`femkit.case.scene.systems.system_size`, before anything is built).
 The dynamics modules are imported on first use only.
 """
@@ -32,7 +32,7 @@ def _run(case, **kwargs):
 
 
 def _plan(case, measure: bool = True):
-    from ..cost import plan_scene_case
+    from .cost import plan_scene_case
     from .systems import system_size
 
     def build():

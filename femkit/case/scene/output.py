@@ -26,7 +26,7 @@ import numpy as np
 from ...interrupt import active_flag
 from ...io.atomic import EARLIER_RUN, atomic_directory
 from ...io.background import BackgroundWriter
-from ...io.writers import write_csv, write_json
+from ...io.writers import write_csv
 from ...dynamics.system import COMPILED_SPRINGS
 from ...mesh.vtk import VtuFrames, pad3, write_collection
 from .plot import write_final_png, write_gif
@@ -273,6 +273,4 @@ def _write_outputs(result, tmp: Path, stream: FrameStream | None) -> None:
     if opts.gif and not stop and not stopped:
         write_gif(tmp / "animation.gif", system, traj, result.case.name, triangles=tri)
         files.append("animation.gif")
-    files.append("result.json")
-    result.files = files
-    write_json(tmp / "result.json", result.to_dict())
+    result.write_result_json(tmp, [*files, "result.json"])

@@ -32,13 +32,11 @@ from typing import Sequence
 import numpy as np
 
 from ...io.figures import new_figure
+from ..pictures import gif_frame_times, gif_frames, rgb_image, save_gif
 
 __all__ = ["spring_strain", "tracked_nodes", "SceneView", "scene_view", "plot_frame",
            "write_final_png", "write_gif", "gif_frames", "gif_frame_times"]
 
-#: Playback length of a GIF: simulated time is shown in real time when it lies in this range,
-#: otherwise scaled into it.
-GIF_PLAYBACK = (2.0, 8.0)
 _SURFACE = np.array([0.62, 0.78, 0.93])          # light blue cloth/mesh
 _PIN = "#c0392b"
 
@@ -410,7 +408,7 @@ def write_final_png(path: str | os.PathLike, system, traj, name: str, *, triangl
         final = np.abs(spring_strain(system, traj.x[-1]))
         view.strain_max = max(float(np.max(final[np.isfinite(final)], initial=0.0)), 1e-6)
     fig = plot_frame(system, traj, -1, triangles=triangles, name=name, view=view, dpi=dpi)
-    image = _quantize([_rgb_image(fig)], 256)[0]
+    image = _quantize([rgb_image(fig)], 256)[0]
     with atomic_path(path) as tmp:
         image.save(tmp, format="PNG", optimize=True)        # 8-bit palette: ~1/3 the bytes
     return Path(path)
@@ -444,54 +442,6 @@ def _quantize(images, colours: int):
     return [q.crop((0, i * h, w, (i + 1) * h)) for i in range(len(images))]
 
 
-def _rgb_image(fig):
-    """The rendered figure as a Pillow RGB image."""
-    from PIL import Image
-
-    fig.canvas.draw()
-    return Image.fromarray(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy())
-
-
-def gif_frames(n: int, max_frames: int = 60) -> np.ndarray:
-    """Recorded frames a GIF shows: every ``ceil(n / max_frames)``-th one (even spacing in
-    time), always the last one.
-
-    >>> gif_frames(101, 60).size, gif_frames(6, 60).tolist()
-    (51, [0, 1, 2, 3, 4, 5])
-    """
-    if n < 1 or max_frames < 1:
-        from ...errors import InputError
-
-        raise InputError(f"a GIF needs at least one frame (n = {n}, max_frames = {max_frames})")
-    stride = -(-n // max_frames)
-    picks = np.arange(0, n, stride)
-    if picks[-1] != n - 1:
-        picks = np.append(picks[: max_frames - 1], n - 1)
-    return picks
-
-
-def gif_frame_times(times: Sequence[float], picks: Sequence[int],
-                    playback: tuple[float, float] = GIF_PLAYBACK) -> np.ndarray:
-    """Display time (s) of each picked frame: simulated time, scaled into ``playback``.
-
-    A run of 2-8 s plays in real time; a shorter one is slowed down to 2 s, a longer one sped
-    up to 8 s. Every frame shows at least 20 ms (the GIF minimum browsers honour); the last one
-    is held for 1 s, so a looping GIF pauses on the final state.
-
-    >>> gif_frame_times([0.0, 0.5, 1.0, 3.0], [0, 1, 2]).tolist()   # 1 s of simulation -> 2 s
-    [1.0, 1.0, 1.0]
-    """
-    t = np.asarray(times, dtype=float)[np.asarray(picks, dtype=int)]
-    span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
-    total = float(np.clip(span, *playback)) if span > 0 else playback[0]
-    if len(t) > 1:
-        steps = np.diff(t) * (total / span) if span > 0 else np.full(len(t) - 1, total / (len(t) - 1))
-        out = np.maximum(np.round(steps, 2), 0.02)
-    else:
-        out = np.zeros(0)
-    return np.append(out, 1.0)
-
-
 def write_gif(path: str | os.PathLike, system, traj, name: str, *, triangles=None,
               max_frames: int = 60, dpi: float = 100) -> Path:
     """An animated GIF of at most ``max_frames`` evenly spaced recorded frames.
@@ -499,7 +449,6 @@ def write_gif(path: str | os.PathLike, system, traj, name: str, *, triangles=Non
     Same two panels as the PNG, with fixed axes over the whole animation and the current time
     marked on the energy panel; one shared palette; frame times from :func:`gif_frame_times`.
     """
-    from ...io.atomic import atomic_path
 
     picks = gif_frames(len(traj.times), max_frames)
     view = scene_view(system, traj, picks)
@@ -507,10 +456,7 @@ def write_gif(path: str | os.PathLike, system, traj, name: str, *, triangles=Non
     for k in picks:
         fig = plot_frame(system, traj, int(k), triangles=triangles, name=name, view=view,
                          dpi=dpi, marker=True)
-        images.append(_rgb_image(fig))
+        images.append(rgb_image(fig))
     frames = _quantize(images, 128)
     ms = [int(round(1000 * d)) for d in gif_frame_times(traj.times, picks)]
-    with atomic_path(path) as tmp:
-        frames[0].save(tmp, format="GIF", save_all=True, append_images=frames[1:], duration=ms,
-                       loop=0, optimize=False, disposal=1)
-    return Path(path)
+    return save_gif(path, frames, ms)

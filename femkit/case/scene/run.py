@@ -26,8 +26,8 @@ Each stage is a public function (:func:`build_system`, :func:`build_integrator`,
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import hashlib
-import math
 import os
 import sys
 import time
@@ -38,7 +38,6 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..._version import __version__
 from ...dynamics.integrators import StepContext
 from ...dynamics.integrators.base import check_matrix_free
 from ...dynamics.simulate import StabilityWarning, simulate
@@ -55,12 +54,14 @@ from ...io.atomic import EARLIER_RUN, atomic_directory, check_output_dir
 from ...kinds import KINDS
 from ...progress import Progress
 from ...timing import StageTimer
-from ..cost import check_scene_fits
+from .cost import check_scene_fits
 from ..expressions import compile_expression
 from ..frozen import freeze
 from ..load import Case
 from ..names import check_geometry_spec, resolve_file
+from ..result import RunResult
 from ..specs import IntegratorSpec, limits_spec, solver_spec
+from ..timeline import time_value
 from .forces import FORCES
 from .output import FrameStream, write_scene_outputs
 from .spec import OutputSpec, SceneSpec, StabilitySpec, record_every
@@ -71,21 +72,6 @@ __all__ = ["prepare_scene", "run_scene", "build_system", "build_integrator", "bu
 
 
 # ----------------------------------------------------------------------------- prepare
-
-def _time_value(case: Case, key: str) -> float:
-    """``dt``/``t_end`` of the file: a number, or a constant expression such as ``"1/60"``."""
-    value = case.data[key]
-    if isinstance(value, str):
-        try:
-            f = compile_expression(value, ("x",), case.data.get("constants") or {})
-            value = float(f(np.zeros(1))[0])
-        except ExpressionError as exc:
-            raise ExpressionError(f"{key}: {exc}") from None
-    value = float(value)
-    if not (math.isfinite(value) and value > 0.0):
-        raise CaseFileError(f"{key}: must be a positive finite number, got {value!r}")
-    return value
-
 
 def _normalise_forces(spec) -> list[dict]:
     """Forces as a list of ``{type: ..., params...}`` (mapping form and gravity shorthand too)."""
@@ -131,8 +117,8 @@ def prepare_scene(case: Case) -> None:
 
     # linear solver
     default = KINDS.get(case.problem, "problem").default_solver
-    case.solver = ls_spec = solver_spec(d["linear_solver"], "linear_solver", default_method=default)
-    case.run_options["limits"] = limits_spec(d.get("limits"))
+    ls_spec = solver_spec(d["linear_solver"], "linear_solver", default_method=default)
+    case.options = dataclasses.replace(case.options, limits=limits_spec(d.get("limits")))
     if integ.options.get("matrix_free"):  # caught at load time, before anything runs
         try:
             check_matrix_free(integ.method, StepContext(ls_spec))
@@ -140,8 +126,8 @@ def prepare_scene(case: Case) -> None:
             raise CaseFileError(f"linear_solver: {exc}") from None
 
     # times
-    dt = _time_value(case, "dt")
-    t_end = _time_value(case, "t_end")
+    dt = time_value(case, "dt")
+    t_end = time_value(case, "t_end")
     steps = int(round(t_end / dt))
     if steps < 1:
         raise CaseFileError(f"t_end: {t_end:g} is shorter than one step dt = {dt:g}")
@@ -232,7 +218,7 @@ def build_system(case: Case):
         raise
     except InputError as exc:
         raise with_prefix(exc, "system") from None
-    known = case.run_options.setdefault("notes", [])
+    known = case.notes
     known.extend(n for n in (notes[0] if notes else ()) if n not in known)
     vel = [case.functions[f"system.velocity[{i}]"]
            for i in range(len(case.spec.system.get("velocity") or []))]
@@ -292,8 +278,9 @@ def _declared(case: Case, system) -> list[str]:
 
 
 @dataclass
-class SceneResult:
-    """What a scene run produced: the trajectory in memory and the facts of ``result.json``."""
+class SceneResult(RunResult):
+    """What a scene run produced: the trajectory in memory and the facts of ``result.json``
+    (the scene kind's :class:`~femkit.case.result.RunResult`)."""
 
     case: Case
     system: Any
@@ -324,8 +311,13 @@ class SceneResult:
             return self.output_stop
         if not getattr(self.trajectory, "interrupted", False):
             return None
-        stop = self.case.run_options.get("stop")
+        stop = self.case.options.stop
         return getattr(stop, "name", None) or "a stop request"
+
+    @property
+    def verdict(self) -> str:
+        """``unstable`` when the run stopped on an instability, else the base verdict."""
+        return "unstable" if self.instability is not None else super().verdict
 
     @property
     def failure(self) -> str | None:
@@ -352,8 +344,8 @@ class SceneResult:
                        dt_crit=e.dt_crit, message=self.failure)
         return out
 
-    def to_dict(self) -> dict:
-        """The content of ``result.json`` (keys documented in docs/scenes.md)."""
+    def facts(self) -> dict:
+        """The scene keys of ``result.json`` (documented in docs/scenes.md)."""
         tr = self.trajectory
         s = self.system
         x_final = tr.x[-1]
@@ -361,10 +353,6 @@ class SceneResult:
         stats = tr.summary()["stats"]
         desc = self.integrator.describe()
         return {
-            "case": self.case.name,
-            "problem": self.case.problem,
-            "case_file": str(self.case.path) if self.case.path else None,
-            "femkit_version": __version__,
             "system": {"type": self.case.spec.system["type"], "particles": int(s.n),
                        "springs": int(s.n_springs), "dim": int(s.dim), "dofs": int(s.ndof),
                        "pinned": int(np.count_nonzero(s.pinned)),
@@ -439,7 +427,7 @@ class SceneResult:
             verdict += " (but dt exceeds the critical step: growth may not have shown yet)"
         lines.append(f"verdict   {verdict}" + (f" ({stab})" if stab else ""))
         if self.output_dir is not None:
-            lines.append(f"output    {self.output_dir} ({len(self.files)} files)")
+            lines.append(self.output_line())
         return lines
 
 
@@ -455,7 +443,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     output_dir : overrides ``output.dir``.
     quiet : print nothing (no summary, no progress) when true. Progress: a tqdm bar when stderr
         is a terminal, else one line per 10 % of the steps or per minute (elapsed, remaining).
-        A stop request (``case.run_options["stop"]``, set by SIGINT/SIGTERM under ``femkit solve``)
+        A stop request (``case.options.stop``, set by SIGINT/SIGTERM under ``femkit solve``)
         ends the run after the current step; the frames so far are written as usual, with
         ``interrupted: true`` in result.json.
     write : write the outputs (atomically) when true.
@@ -480,7 +468,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
         ctx = build_context(case)
         every = output_every(case)
     st = case.spec.stability
-    stop = case.run_options.get("stop")
+    stop = case.options.stop
     # a tqdm bar on a terminal, else one line per 10 % or per minute on stderr (logs, batch jobs)
     progress = Progress(n_steps(case), f"scene {case.name}", unit="step", quiet=quiet)
 
@@ -531,7 +519,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     if not quiet:
         for line in result.summary_lines():
             out(line)
-        for note in case.run_options.get("notes", ()):  # e.g. a mesh file's unused nodes
+        for note in case.notes:  # e.g. a mesh file's unused nodes
             out(f"note      {note}")
         hint = fast_path_hint(case, system, integrator)
         if hint:

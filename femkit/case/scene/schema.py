@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from ..specs import INTEGRATOR_SCHEMA, LIMITS_SCHEMA, SOLVER_SCHEMA
 from .forces import FORCES
-from .fragments import POS
+from ..fragments import POS
 from .systems import SYSTEMS
 
 __all__ = ["scene_schema", "force_types", "system_types"]

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from ...registry import Registry
-from .fragments import COUNT2, DIM, NODES, NONNEG, POS, VEC, closed, pinned
+from ..fragments import COUNT2, DIM, NODES, NONNEG, POS, VEC, closed, pinned
 
 __all__ = ["SystemType", "SystemSize", "SYSTEMS", "COMMON", "system_size"]
 

@@ -144,9 +144,9 @@ def _iterations_per_step(spec) -> tuple[int, str]:
 def check_solid_fits(case) -> None:
     """Refuse, before meshing, a solid run whose predicted memory exceeds the available memory
     (:class:`~femkit.errors.BudgetExceededError`, one line); ``--force`` skips it."""
-    if case.run_options.get("force"):
+    if case.options.force:
         return
-    check_budget(plan_solid_case(case, measure=False), case.run_options.get("limits"),
+    check_budget(plan_solid_case(case, measure=False), case.options.limits,
                  override=OVERRIDE)
 
 
@@ -162,7 +162,7 @@ def check_explicit_step(case, system) -> None:
 
     spec = case.spec
     integrator = spec.integrator.build()
-    if case.run_options.get("force") or integrator.implicit:
+    if case.options.force or integrator.implicit:
         return
     omega = float(estimate_omega_max(system, system.x0))
     dt_crit = float(critical_dt(omega, integrator.stability_bound))

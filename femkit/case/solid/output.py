@@ -20,7 +20,6 @@ import numpy as np
 
 from ...interrupt import Interrupted, active_flag, raising
 from ...io.atomic import EARLIER_RUN, atomic_directory
-from ...io.writers import write_json
 from ...mesh.vtk import pad3, write_cells, write_collection
 
 __all__ = ["write_solid_outputs", "write_solid_frames"]
@@ -64,7 +63,7 @@ def write_solid_outputs(result, directory: str | os.PathLike) -> Path:
     final = Path(directory).resolve()
     result.output_dir = final
     files: list[str] = []
-    flag = result.case.run_options.get("stop")   # the run's flag (femkit solve: the active one)
+    flag = result.case.options.stop   # the run's flag (femkit solve: the active one)
     flag = active_flag() if flag is None else flag
     stop = None if flag else flag   # a stop already answered by the solve: write every frame
     with atomic_directory(final, EARLIER_RUN) as tmp:
@@ -77,9 +76,7 @@ def write_solid_outputs(result, directory: str | os.PathLike) -> Path:
         files += _pictures(tmp, result, opts, flag)
         if flag and flag.name != result.stopped:
             result.output_stop = flag.name
-        files.append("result.json")
-        result.files = files
-        write_json(tmp / "result.json", result.to_dict())
+        result.write_result_json(tmp, [*files, "result.json"])
     return final
 
 

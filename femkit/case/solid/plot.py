@@ -178,18 +178,14 @@ def write_solid_gif(path: str | os.PathLike, result, *, max_frames: int = 40,
                     dpi: float = 80) -> Path:
     """Animated GIF of at most ``max_frames`` evenly spaced frames, fixed axes, colour scale and
     displacement factor (:func:`display_scale` of the largest displacement of those frames)."""
-    from ...io.atomic import atomic_path
-    from ..scene.plot import _rgb_image, gif_frame_times, gif_frames
+    from ..pictures import gif_frame_times, gif_frames, rgb_image, save_gif
 
     picks = gif_frames(len(result.x), max_frames)
     scale = _scale(result, picks)
     norm, lim = _norm(result, picks), _limits(result, picks, scale)
-    images = [_rgb_image(plot_solid_frame(result, int(k), norm=norm, limits=lim, scale=scale,
+    images = [rgb_image(plot_solid_frame(result, int(k), norm=norm, limits=lim, scale=scale,
                                           dpi=dpi))
               for k in picks]
     frames = [im.quantize(colors=128) for im in images]
     ms = [int(round(1000 * d)) for d in gif_frame_times(result.times, picks)]
-    with atomic_path(path) as tmp:
-        frames[0].save(tmp, format="GIF", save_all=True, append_images=frames[1:], duration=ms,
-                       loop=0, optimize=False, disposal=1)
-    return Path(path)
+    return save_gif(path, frames, ms)

@@ -24,11 +24,12 @@ prescribed increment spread into the body by a linear solve, the step cut when t
 inverts elements); each equilibrium is kept as a frame (its ``on_step``), and a stop request is
 seen between Newton iterations (its ``stop``).
 
-SIGINT / SIGTERM (``case.run_options["stop"]``): see :func:`run_solid`.
+SIGINT / SIGTERM (``case.options.stop``): see :func:`run_solid`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import sys
@@ -46,7 +47,9 @@ from ...kinds import KINDS
 from ...timing import StageTimer
 from ..frozen import freeze
 from ..names import check_geometry_spec, resolve_file
+from ..result import RunResult
 from ..specs import IntegratorSpec, limits_spec, solver_spec
+from ..timeline import time_value
 from .schema import COMPONENTS
 from .spec import Boundary, SolidOutput, SolidSpec, StaticSpec
 
@@ -141,18 +144,16 @@ def prepare_solid(case) -> None:
         raise CaseFileError("boundaries: no fixed or roller condition: a static body with no "
                             "support is singular (rigid-body motions, no unique equilibrium); "
                             "hold a tag, or integrate in time (a body in free flight)")
-    case.solver = solver = solver_spec(d["linear_solver"], "linear_solver",
+    solver = solver_spec(d["linear_solver"], "linear_solver",
                                        default_method=KINDS.get(case.problem, "problem").default_solver)
-    case.run_options["limits"] = limits_spec(d.get("limits"))
+    case.options = dataclasses.replace(case.options, limits=limits_spec(d.get("limits")))
     out = d["output"]
     if dynamic:
         for key in ("dt", "t_end"):
             if key not in d:
                 raise CaseFileError(f"{key}: a time integration needs 'dt' and 't_end'")
         integ = IntegratorSpec.from_mapping(d["integrator"], "integrator")
-        from ..scene.run import _time_value  # dt / t_end: numbers or constant expressions
-
-        dt, t_end = _time_value(case, "dt"), _time_value(case, "t_end")
+        dt, t_end = time_value(case, "dt"), time_value(case, "t_end")
         steps = int(round(t_end / dt))
         if steps < 1:
             raise CaseFileError(f"t_end: {t_end:g} is shorter than one step dt = {dt:g}")
@@ -345,9 +346,11 @@ def frame_energies(problem: SolidProblem, x: np.ndarray, v: np.ndarray | None = 
 # ----------------------------------------------------------------------------- result
 
 @dataclass
-class SolidResult:
+class SolidResult(RunResult):
     """What a solid run produced: frames (times or load factors, positions, velocities), their
-    energies and fields, and the facts of ``result.json``."""
+    energies and fields, and the facts of ``result.json`` (the solid kind's
+    :class:`~femkit.case.result.RunResult`; ``verdict`` names its failure: ``newton_failed``,
+    ``solver_failed``, ``unstable``)."""
 
     case: Any
     problem: SolidProblem
@@ -393,17 +396,13 @@ class SolidResult:
         u = self.x[k] - self.problem.body.rest_positions
         return u[int(np.argmax(np.linalg.norm(u, axis=1)))]
 
-    def to_dict(self) -> dict:
-        from ..._version import __version__
-
+    def facts(self) -> dict:
+        """The solid keys of ``result.json`` (documented in docs/solids.md)."""
         spec, body = self.case.spec, self.problem.body
         u = self.x[-1] - body.rest_positions
         fields = self.fields(len(self.x) - 1)
         inverted = body.inverted(self.x[-1])
         return {
-            "case": self.case.name, "problem": "solid",
-            "case_file": str(self.case.path) if self.case.path else None,
-            "femkit_version": __version__,
             "mesh": {"dim": body.dim, "points": int(body.n), "cells": int(body.rest.n_cells),
                      "cell_type": "tetra" if body.dim == 3 else "triangle",
                      "fixed_dofs": int(len(self.problem.dirichlet().dofs))},
@@ -469,9 +468,9 @@ class SolidResult:
                  f"{'load' if d['mode'] == 'static' else 'time'} steps{stopped}, "
                  f"{d['frames']} frames",
                  f"verdict   {self.verdict}" + (f": {self.failure}" if self.failure else ""),
-                 "time      " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timings.items())]
+                 self.timings_line()]
         if self.output_dir is not None:
-            lines.append(f"output    {self.output_dir} ({len(self.files)} files)")
+            lines.append(self.output_line())
         return lines
 
 
@@ -574,7 +573,7 @@ def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = F
               write: bool = True, echo: Callable[[str], Any] | None = None) -> SolidResult:
     """Run a prepared solid case: build, solve (static or dynamic), write, print the summary.
 
-    A stop request (``case.run_options["stop"]``, set by SIGINT/SIGTERM under ``femkit solve``)
+    A stop request (``case.options.stop``, set by SIGINT/SIGTERM under ``femkit solve``)
     during the meshing stops at once (nothing written); during the solve it ends the run after
     the current time step or Newton iteration, and the frames so far are written with
     ``interrupted: true`` (no pictures); during the output the frames written so far are kept,
@@ -603,7 +602,7 @@ def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = F
         _say_compiling(case, echo or print)
     with raising("meshing"), timer("build"):
         problem = build_problem(case)
-    stop = case.run_options.get("stop")
+    stop = case.options.stop
     with timer("solve"), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         if case.spec.static is not None:

@@ -12,7 +12,7 @@ messages name the constant. Every property is described in docs/solids.md.
 
 from __future__ import annotations
 
-from ..scene.fragments import POS, closed
+from ..fragments import POS, closed
 from ..specs import LIMITS_SCHEMA, SOLVER_SCHEMA
 
 __all__ = ["solid_schema", "BOUNDARY_TYPES", "COMPONENTS"]

@@ -1,4 +1,5 @@
-"""JSON-schema fragments shared by the scene schema, its forces and its system types."""
+"""JSON-schema fragments shared by the file kinds' schemas (scenes, their forces and system types,
+solids): positive numbers, vectors, node lists, closed objects."""
 
 from __future__ import annotations
 
