@@ -48,9 +48,7 @@ def _registry():
     a run has imported them already, so this costs it nothing)."""
     for package in PIPELINE:
         importlib.import_module(package)
-    from ... import warmup_registry
-
-    return warmup_registry
+    return importlib.import_module("femkit.warmup_registry")
 
 
 def _thresholds() -> tuple[tuple[str, str], ...]:

@@ -13,8 +13,7 @@ key                    default
                        ``direct`` for scenes, solids and the cloth study
 ``engine``             ``cholmod``: the factorisation library of ``cholesky``
 ``comparison rtol``    ``1e-8``: the solvers a study compares by cost (adaptive,
-                       stability) stop here unless the study file names its own; the cost
-                       model's plans assume it when given no ``rtol``
+                       stability) stop here unless the study file names its own
 ``newton rtol``        ``1e-10``: Newton's residual tolerance of a static solid
                        (:func:`femkit.solids.solve_static`, a solid file's ``static.rtol``)
 =====================  ===========================================================
