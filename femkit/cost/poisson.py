@@ -106,16 +106,24 @@ def solver_key(method: str, preconditioner: str | None = None) -> str:
     if method != "pcg":
         return method
     pc = "amg_sa" if preconditioner in (None, "amg") else str(preconditioner)
-    return f"pcg+{pc}"
+    return f"{method}+{pc}"
 
 
-def predict_iterations(key: str, unknowns: float, rtol: float = 1e-8, *,
+#: The relative tolerance the iteration constants were measured at (``cost/constants.json``):
+#: a plan for another ``rtol`` scales them by ``log(1/rtol) / log(1 / CALIBRATION_RTOL)``; a plan
+#: given no ``rtol`` is priced at it.
+CALIBRATION_RTOL = 1e-8
+
+
+def predict_iterations(key: str, unknowns: float, rtol: float | None = None, *,
                        constants: dict | None = None) -> float:
-    """Iterations of an iterative solver: ``a n^p log(1/rtol) / log(1e8)`` (1 for ``direct``)."""
+    """Iterations of an iterative solver: ``a n^p log(1/rtol) / log(1e8)`` (1 for ``direct``);
+    ``rtol`` None: :data:`CALIBRATION_RTOL`."""
     if key == "direct":
         return 1.0
+    rtol = CALIBRATION_RTOL if rtol is None else rtol
     it = (constants or load_constants())["iterations"][key]
-    scale = max(math.log(1.0 / max(float(rtol), 1e-300)), 1.0) / math.log(1e8)
+    scale = max(math.log(1.0 / max(float(rtol), 1e-300)), 1.0) / math.log(1.0 / CALIBRATION_RTOL)
     return max(1.0, it["coefficient"] * max(unknowns, 1.0) ** it["exponent"] * scale)
 
 
@@ -191,7 +199,7 @@ def plan_mesh(*, area: float | None = None, line_length: float | None = None,
 def plan_poisson(*, area: float | None = None, line_length: float | None = None,
                  h: float | None = None, refine: int = 0, name: str = "domain",
                  params: dict | None = None, triangles: float | None = None,
-                 method: str = "pcg", preconditioner: str | None = "amg_sa", rtol: float = 1e-8,
+                 method: str = "pcg", preconditioner: str | None = "amg_sa", rtol: float | None = None,
                  outputs=("vtu",), errors: bool = True, estimate: bool = True,
                  constants: dict | None = None,
                  speed: float = 1.0, _stages: tuple | None = None) -> Plan:
@@ -204,7 +212,8 @@ def plan_poisson(*, area: float | None = None, line_length: float | None = None,
     triangles : the triangle count of a mesh file (read, not generated).
     name, params : the geometry's name and parameters, for the title only.
     refine : uniform red refinements after generation or reading.
-    method, preconditioner, rtol : the solver (as in :func:`femkit.solvers.solve`).
+    method, preconditioner, rtol : the solver (as in :func:`femkit.solvers.solve`); ``rtol``
+        None: :data:`CALIBRATION_RTOL`, the constants' own.
     outputs : files written, any of ``"vtu"``, ``"xdmf"``, ``"png"``.
     errors : error norms against an exact solution are computed.
     estimate : the a posteriori error estimate is computed (every ``femkit solve`` does).
@@ -224,6 +233,7 @@ def plan_poisson(*, area: float | None = None, line_length: float | None = None,
         Neither area, line_length and h nor triangles given; bad sizes; unknown output kind.
     """
     c = constants or load_constants()
+    rtol = CALIBRATION_RTOL if rtol is None else rtol
     refine = _check_refine(refine)
     m0, lines_h, source, title = _mesh_source(area, line_length, h, triangles, name, params, c)
     if refine:

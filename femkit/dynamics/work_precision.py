@@ -29,17 +29,28 @@ import numpy as np
 
 from ..errors import InputError
 from ..solvers.spec import SolverSpec
-from .integrators import StepContext, get_integrator
+from .integrators import INTEGRATORS, StepContext, get_integrator
 
-__all__ = ["MethodRun", "FAMILIES", "expand_methods", "cloth_work_precision"]
+__all__ = ["MethodRun", "FAMILIES", "method_families", "expand_methods", "cloth_work_precision"]
 
-#: Method families: label prefix, integrator name, and the option the sweep varies.
-FAMILIES = {
-    "fast_mass_spring": ("fast mass-spring", "fast_mass_spring", "iterations"),
-    "chebyshev": ("Chebyshev fast mass-spring", "fast_mass_spring", "iterations"),
-    "baraff_witkin": ("Baraff-Witkin", "implicit_euler", None),
-    "newton": ("Newton", "newton", "max_iterations"),
-}
+
+def method_families() -> dict[str, tuple[str, str, str | None, dict]]:
+    """The method families, as the integrators declare them (``Integrator.work_precision``):
+    family -> ``(label prefix, integrator name, the option the sweep varies or None, options
+    every run of the family takes)``, integrator by integrator in name order.
+
+    >>> list(method_families())
+    ['fast_mass_spring', 'chebyshev', 'baraff_witkin', 'newton']
+    """
+    return {family: (label, name, knob, dict(fixed)) for name in INTEGRATORS.names()
+            for family, (label, knob, fixed) in INTEGRATORS.get(name).work_precision.items()}
+
+
+def __getattr__(name: str):
+    """``FAMILIES``: :func:`method_families` now (a plugin's integrator included)."""
+    if name == "FAMILIES":
+        return method_families()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @dataclass
@@ -80,31 +91,32 @@ def expand_methods(spec: list[dict]) -> list[MethodRun]:
     runs = []
     for item in spec:
         fam = item.get("family")
-        if fam not in FAMILIES:
+        families = method_families()
+        if fam not in families:
             from ..errors import UnknownNameError
 
-            raise UnknownNameError("work-precision method family", str(fam), FAMILIES)
-        prefix, integ, knob = FAMILIES[fam]
+            raise UnknownNameError("work-precision method family", str(fam), families)
+        prefix, integ, knob, fixed = families[fam]
         extra = dict(item.get("options") or {})
         own = item.get("linear_solver")
         if own is not None and not isinstance(own, SolverSpec):
             raise InputError(f"method family {fam!r}: linear_solver must be a SolverSpec, got "
                              f"{type(own).__name__}")
-        if fam == "chebyshev":
-            extra["chebyshev"] = True
-        if fam == "baraff_witkin":
-            extra.setdefault("fix", "clamp")
-            runs.append(MethodRun(fam, prefix, integ, extra, solver=own))
+        if knob is None:
+            runs.append(MethodRun(fam, prefix, integ, _with_fixed(extra, fixed), solver=own))
             continue
         its = item.get("iterations")
         if not its or any(int(k) < 1 for k in its):
             raise InputError(f"method family {fam!r} needs iterations: a list of integers >= 1")
         for k in its:
-            opts = {**extra, knob: int(k)}
-            if fam == "newton":
-                opts.setdefault("tol", 1e-14)     # stopped by the iteration count, not the tolerance
+            opts = _with_fixed({**extra, knob: int(k)}, fixed)
             runs.append(MethodRun(fam, f"{prefix} {k} it", integ, opts, setting=int(k), solver=own))
     return runs
+
+
+def _with_fixed(options: dict, fixed: dict) -> dict:
+    """``options`` and, after them, the family's ``fixed`` options the file did not set."""
+    return {**options, **{k: v for k, v in fixed.items() if k not in options}}
 
 
 def _trajectory(system, name, opts, dt, frames, solver, substeps=1):

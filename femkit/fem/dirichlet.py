@@ -24,6 +24,7 @@ import scipy.sparse as sp
 
 from ..errors import InputError
 from .coefficients import evaluate_callable
+from ..warmup_registry import register_kernels, register_threshold
 
 Values = Union[float, np.ndarray, Callable]
 
@@ -86,6 +87,8 @@ def dirichlet_values(mesh, nodes, g: Values) -> np.ndarray:
 #: Systems with at least this many rows are reduced by one compiled pass over ``K``
 #: (:func:`femkit.fem._kernels.eliminate_kernel`: the same ``A`` and ``b`` as SciPy's indexing).
 NUMBA_THRESHOLD = 100_000
+register_threshold(__name__, "NUMBA_THRESHOLD")
+register_kernels("P1 assembly", "femkit.fem._kernels", "_eliminate", rank=1)
 
 
 def apply_dirichlet(K, F, nodes, values, *, overwrite: bool = False) -> DirichletSystem:

@@ -22,6 +22,10 @@ from ._elements import check_areas, select_elements
 from .coefficients import evaluate_callable
 from .quadrature import get_rule
 from .sparsity import NUMBA_THRESHOLD
+from ..warmup_registry import register_kernels, register_threshold
+
+register_threshold(__name__, "NUMBA_THRESHOLD")
+register_kernels("P1 assembly", "femkit.fem._kernels", "_load_barycentric", "_load_tet", rank=1)
 
 Source = Union[float, Callable]
 

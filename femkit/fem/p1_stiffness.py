@@ -23,6 +23,13 @@ from ._elements import check_areas, select_elements, tetrahedron_geometry
 from .coefficients import Coefficient, element_coefficient
 from ..errors import InputError
 from .sparsity import NUMBA_THRESHOLD, SparsityPattern
+from ..warmup_registry import register_kernels, register_threshold
+
+register_threshold(__name__, "NUMBA_THRESHOLD")
+register_kernels("P1 assembly", "femkit.fem._kernels", "_stiffness", "_stiffness_tet", rank=1)
+register_kernels("P1 assembly", "femkit.fem._one_off", "_cell_rows", "_triangle_values", "_edge_pattern",
+                 "_edge_values", "_edge_fill", rank=1)
+register_kernels("P1 assembly", "femkit.fem._one_off", "_tet_values", rank=1, tetrahedra_only=True)
 
 
 def local_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None) -> np.ndarray:

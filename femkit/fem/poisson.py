@@ -84,7 +84,7 @@ def node_weights(mesh, *, elements=None) -> np.ndarray:
 
 
 def check_compatibility(F_source: np.ndarray, F_flux=None, *, weights: np.ndarray | None = None,
-                        rtol: float = COMPATIBILITY_RTOL) -> tuple[np.ndarray, dict]:
+                        rtol: float | None = None) -> tuple[np.ndarray, dict]:
     """Check ``int f dx + int h ds = 0`` on the discrete load of a pure-Neumann problem.
 
     Parameters
@@ -94,8 +94,9 @@ def check_compatibility(F_source: np.ndarray, F_flux=None, *, weights: np.ndarra
     weights : ndarray, shape (n,), optional
         ``int N_i dx`` (:func:`node_weights`); the remainder is removed as a constant source,
         ``F - (sum F) w / sum w``. Without it, a uniform shift of ``F``.
-    rtol : float
-        Largest ``|sum F| / sum |F|`` accepted (the quadrature error of ``int f``).
+    rtol : float, optional
+        Largest ``|sum F| / sum |F|`` accepted (the quadrature error of ``int f``; default
+        :data:`COMPATIBILITY_RTOL`, read at the call).
 
     Returns
     -------
@@ -131,9 +132,11 @@ def check_compatibility(F_source: np.ndarray, F_flux=None, *, weights: np.ndarra
 
 
 def compatibility_facts(source_integral: float, flux_integral: float, scale: float,
-                        rtol: float = COMPATIBILITY_RTOL) -> dict:
+                        rtol: float | None = None) -> dict:
     """The compatibility check of :func:`check_compatibility` on the sums alone (a distributed
-    run reduces them over ranks): ``scale = sum |F_source| + sum |F_flux|``."""
+    run reduces them over ranks): ``scale = sum |F_source| + sum |F_flux|``; ``rtol`` None:
+    :data:`COMPATIBILITY_RTOL`."""
+    rtol = COMPATIBILITY_RTOL if rtol is None else rtol
     total = source_integral + flux_integral
     rel = abs(total) / scale if scale > 0 else 0.0
     info = {"source_integral": source_integral, "flux_integral": flux_integral,

@@ -26,10 +26,13 @@ import scipy.sparse as sp
 
 from ..errors import InputError
 from ._elements import select_elements
+from ..warmup_registry import register_kernels, register_threshold
 
 #: Meshes with at least this many triangles use the compiled (numba) pattern builder
 #: under ``backend="auto"``; below it numpy's sort is fast enough and no compile is paid.
 NUMBA_THRESHOLD = 200_000
+register_threshold(__name__, "NUMBA_THRESHOLD")
+register_kernels("P1 assembly", "femkit.fem._kernels", "_incidences", "_pattern", "_pattern_cells", rank=1)
 
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 

@@ -16,12 +16,15 @@ import numpy as np
 
 from ..errors import MeshError
 from .mesh import LOCAL_EDGES, Mesh
+from ..warmup_registry import register_kernels, register_threshold
 
 __all__ = ["edges", "boundary_edges_topological", "boundary_nodes", "edge_ids", "boundary_edge_ids"]
 
 #: Meshes with at least this many cells find their edges with the compiled counting-sort kernel
 #: (:mod:`femkit.mesh._edges_kernel`); smaller ones with ``np.unique``.
 NUMBA_THRESHOLD = 200_000
+register_threshold(__name__, "NUMBA_THRESHOLD")
+register_kernels("mesh passes", "femkit.mesh._edges_kernel", "cell_edges", "sort_buckets", rank=0)
 
 #: ``edges(mesh)`` per mesh, computed once while the mesh lives: refinement, the prolongations,
 #: the quality numbers and the estimators all ask for the same edges. The arrays are read-only.

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from .mesh import Mesh
+from ..warmup_registry import register_kernels, register_threshold
 
 __all__ = ["LOCAL_FACES", "local_faces", "faces", "boundary_faces_topological", "unique_rows",
            "face_ids"]
@@ -25,6 +26,8 @@ LOCAL_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 #: Meshes with at least this many tetrahedra find their faces with a compiled counting sort
 #: (:mod:`femkit.mesh._faces_kernel`, the same numbering); smaller ones with a lexicographic sort.
 NUMBA_THRESHOLD = 100_000
+register_threshold(__name__, "NUMBA_THRESHOLD")
+register_kernels("mesh passes", "femkit.mesh._faces_kernel", "tet_faces", rank=0, tetrahedra_only=True)
 
 
 def local_faces(tets: np.ndarray) -> np.ndarray:

@@ -14,6 +14,7 @@ import weakref
 import numpy as np
 
 from .mesh import Mesh
+from ..warmup_registry import register_kernels, register_threshold
 
 #: Triangle meshes made by red refinement from a root mesh of at most this many triangles
 #: (:func:`note_red_refinement`) get their numbers from the root's, without a pass of their own.
@@ -262,6 +263,10 @@ NUMBA_THRESHOLD = 200_000
 #: Tetrahedral meshes with at least this many cells get theirs from one compiled pass
 #: (:func:`~._quality_kernel.tetrahedron_quality`: the same floats as the NumPy formulas).
 NUMBA_THRESHOLD_3D = 50_000
+register_threshold(__name__, "NUMBA_THRESHOLD", "NUMBA_THRESHOLD_3D")
+register_kernels("mesh passes", "femkit.mesh._quality_kernel", "triangle_quality", "mean_edge_length", rank=0)
+register_kernels("mesh passes", "femkit.mesh._quality_kernel", "edge_lengths", "tetrahedron_quality", rank=0,
+                 tetrahedra_only=True)
 
 
 def _quality_compiled(mesh: Mesh) -> dict:

@@ -23,6 +23,7 @@ from .bey_tables import CORNERS, DIAGONAL_PAIRS, DIAGONALS, FACE_PAIRS, INNER
 from .edges import boundary_edge_ids, edge_ids, edges, remember_edges
 from .quality import note_red_refinement
 from .mesh import LOCAL_EDGES, Mesh
+from ..warmup_registry import register_kernels, register_threshold
 
 #: Triangle meshes with at least this many cells are refined by compiled passes
 #: (:mod:`femkit.mesh._refine_kernel`; the same arrays as the NumPy path).
@@ -31,6 +32,11 @@ NUMBA_THRESHOLD = 50_000
 #: Tetrahedral meshes with at least this many cells are refined by compiled passes
 #: (:func:`~._refine_kernel.red_tetrahedra`: the same children as the NumPy path).
 NUMBA_THRESHOLD_3D = 20_000
+register_threshold(__name__, "NUMBA_THRESHOLD", "NUMBA_THRESHOLD_3D")
+register_kernels("mesh passes", "femkit.mesh._refine_kernel", "red_children", "child_edges", "with_midpoints",
+                 "interleaved_red", "interleaved_rows", rank=0)
+register_kernels("mesh passes", "femkit.mesh._refine_kernel", "red_tetrahedra", "interleaved_bey", rank=0,
+                 tetrahedra_only=True)
 
 
 def refine_once(mesh: Mesh, *, derive_edges: bool = True) -> tuple[Mesh, np.ndarray]:

@@ -37,6 +37,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..errors import EquilibriumError, InputError, SolverError
+from ..solvers.core import defaults
 from ..solvers.spec import SolverSpec
 from .body import ElasticBody
 from .boundary import Dirichlet
@@ -88,7 +89,7 @@ MAX_CUTS = 10
 
 
 def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=None, *,
-                 load_steps: int = 1, project: bool | str = True, rtol: float = 1e-12,
+                 load_steps: int = 1, project: bool | str = True, rtol: float | None = None,
                  xtol: float = 1e-13, max_iterations: int = 50, armijo: float = 1e-4,
                  shrink: float = 0.5, max_backtracks: int = 40,
                  linear_solver: SolverSpec | str = "direct", x0=None,
@@ -113,6 +114,9 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
         compressed side of a bent beam); ``"auto"``: the exact Hessian, and the projected one
         only for an iteration whose exact direction is not a descent direction (quadratic
         convergence near a stable equilibrium).
+    rtol : float, optional
+        Newton's relative residual tolerance (default
+        :data:`~femkit.solvers.core.defaults.NEWTON_RTOL`, read at the call).
     linear_solver : SolverSpec or method name
         How each Newton system is solved (default a sparse direct solve).
     x0 : (n, d), optional
@@ -142,6 +146,7 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
     f_ext = np.zeros(body.ndof) if forces is None else np.asarray(forces, dtype=float).reshape(-1)
     if f_ext.shape != (body.ndof,) or not np.all(np.isfinite(f_ext)):
         raise InputError(f"forces must be finite with shape ({body.n}, {body.dim})")
+    rtol = defaults.NEWTON_RTOL if rtol is None else rtol
     newton = _Newton(body, dirichlet, f_ext, project, rtol, xtol, max_iterations, armijo, shrink,
                      max_backtracks, SolverSpec(linear_solver) if isinstance(linear_solver, str)
                      else linear_solver, stop)

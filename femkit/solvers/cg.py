@@ -7,13 +7,12 @@ values, stagnation, and the true residual at exit.
 
 from __future__ import annotations
 
-from .core.defaults import DEFAULT_RTOL
 
 from .pcg import pcg
 from .core.result import SolveResult
 
 
-def cg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
+def cg(A, b, x0=None, *, rtol: float | None = None, atol: float | None = None, maxiter: int | None = None,
        M=None, callback=None, check_symmetry: bool = True,
        stagnation_window: int | None = None,
        raise_on_breakdown: bool = False) -> SolveResult:

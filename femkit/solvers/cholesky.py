@@ -51,7 +51,7 @@ from scipy.sparse.linalg import LinearOperator
 from ..errors import InputError, NotSPDError
 from .core.checks import (SYMMETRY_TOL, as_operator, asymmetry, dependency_boundary, finish, prepare,
                      zero_rhs_result)
-from .core.defaults import DEFAULT_ATOL, DEFAULT_ENGINE, DEFAULT_RTOL
+from .core import defaults
 from .factor import NOT_SPD_ADVICE, Factor
 from .core.result import SolveResult
 
@@ -261,7 +261,7 @@ class CholeskyFactor(Factor):
 
 
 def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, mode: str = "supernodal",
-                  engine: str = DEFAULT_ENGINE, check_symmetry: bool = True):
+                  engine: str | None = None, check_symmetry: bool = True):
     """Cholesky factorisation of a sparse SPD matrix, reusing the cached symbolic analysis of
     its pattern (module docstring).
 
@@ -289,6 +289,7 @@ def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, mode: str = "supernoda
     NotSPDError
         ``A`` is not symmetric, or not positive definite.
     """
+    engine = defaults.DEFAULT_ENGINE if engine is None else engine
     if engine not in ENGINES:
         from ..errors import UnknownNameError
 
@@ -325,9 +326,9 @@ def factorize_spd(A, *, ordering: str = DEFAULT_ORDERING, mode: str = "supernoda
     return CholeskyFactor(f, Ac.shape, sym, reused, dt)
 
 
-def cholesky(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+def cholesky(A, b, x0=None, *, rtol: float | None = None, atol: float | None = None,
              maxiter=None, M=None, callback=None, factorization: CholeskyFactor | None = None,
-             ordering: str = DEFAULT_ORDERING, engine: str = DEFAULT_ENGINE,
+             ordering: str = DEFAULT_ORDERING, engine: str | None = None,
              check_symmetry: bool = True) -> SolveResult:
     """Solve ``A x = b`` for SPD ``A`` by sparse Cholesky (see :func:`factorize_spd`).
 

@@ -19,7 +19,6 @@ Time-stepping code factors once and reuses the factor::
 
 from __future__ import annotations
 
-from .core.defaults import DEFAULT_ATOL, DEFAULT_RTOL
 
 import time
 
@@ -143,7 +142,7 @@ def superlu_factor(A, *, symmetric: bool | None = None, permc_spec: str | None =
     return SuperLUFactor(lu, Ac.shape, bool(spd), dt, info)
 
 
-def direct(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+def direct(A, b, x0=None, *, rtol: float | None = None, atol: float | None = None,
            maxiter=None, M=None, callback=None, factorization: Factor | None = None,
            spd: bool | None = None) -> SolveResult:
     """Solve ``A x = b`` with a sparse LU factorisation (see :func:`factorize`).

@@ -56,7 +56,6 @@ import numpy as np
 
 from ..errors import InputError
 from .core.checks import dependency_boundary, finish, prepare, zero_rhs_result
-from .core.defaults import DEFAULT_ATOL, DEFAULT_RTOL
 from .core.norms import ldexp_saturating, norm2, scaled, unscale, unscale_all
 from .core.result import SolveResult
 
@@ -141,7 +140,7 @@ def _coarse_dirichlet(mg, values) -> list[np.ndarray]:
     return out[::-1]
 
 
-def fmg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+def fmg(A, b, x0=None, *, rtol: float | None = None, atol: float | None = None,
         maxiter: int | None = None, M=None, callback=None, hierarchy=None, free=None,
         levels=None, dirichlet=None, sweeps: int | None = None,
         omega: float | None = None, fraction: float = DEFAULT_FRACTION,

@@ -37,6 +37,10 @@ import scipy.sparse as sp
 from ..errors import HierarchyError, InputError
 from .core.checks import check_positive_diagonal, check_symmetric, dependency_boundary, explicit_csr
 from .preconditioners.base import Preconditioner
+from ..warmup_registry import register_kernels
+
+register_kernels("geometric multigrid", "femkit.solvers._gmg_kernels", "_galerkin_rows", "transpose", "add_matvec",
+                 "gs_forward_zero", "gs_sweeps", "residual", rank=3)
 
 #: Over-relaxation of the smoothing sweeps. Measured V(2,2) energy-norm factors (asymptotic, 7
 #: levels from gmsh meshes of h = 0.5): unit square 0.114 / 0.100 / 0.102, L-shape 0.170 / 0.133 /

@@ -11,7 +11,6 @@ minimum for ``max(1000, n)`` iterations stops with ``reason="stagnation"`` at th
 
 from __future__ import annotations
 
-from .core.defaults import DEFAULT_RTOL
 
 import math
 import numbers
@@ -32,7 +31,7 @@ from .core.result import SolveResult
 DIVERGENCE_FACTOR = 1e100
 
 
-def jacobi(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
+def jacobi(A, b, x0=None, *, rtol: float | None = None, atol: float | None = None, maxiter: int | None = None,
            M=None, callback=None, omega: float = 1.0, diagonal=None) -> SolveResult:
     """Weighted Jacobi: ``x += omega D^-1 (b - A x)`` until ``||b - A x|| <= max(rtol ||b||, atol)``.
 

@@ -15,7 +15,6 @@ updates, with no temporaries for the vector updates.
 
 from __future__ import annotations
 
-from .core.defaults import DEFAULT_RTOL
 
 import math
 from typing import Callable
@@ -135,7 +134,7 @@ def _rz_failure(rz: float, r: np.ndarray, z: np.ndarray, k: int) -> tuple[str, s
                          f"{k}: the preconditioner is not positive definite")
 
 
-def pcg(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
+def pcg(A, b, x0=None, *, rtol: float | None = None, atol: float | None = None, maxiter: int | None = None,
         M=None, callback=None, check_symmetry: bool = True,
         stagnation_window: int | None = None,
         raise_on_breakdown: bool = False) -> SolveResult:

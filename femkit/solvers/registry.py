@@ -212,8 +212,7 @@ def solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = No
     >>> r.converged, r.method, r.preconditioner
     (True, 'pcg', 'jacobi')
     """
-    rtol = defaults.DEFAULT_RTOL if rtol is None else rtol
-    atol = defaults.DEFAULT_ATOL if atol is None else atol
+    rtol, atol = defaults.tolerances(rtol, atol)
     if backend != "femkit":
         factory = BACKENDS.get(backend)
         if preconditioner_options:

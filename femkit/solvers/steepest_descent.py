@@ -9,7 +9,6 @@ stagnation is declared only when the true residual stops decreasing across a rep
 
 from __future__ import annotations
 
-from .core.defaults import DEFAULT_RTOL
 
 import math
 
@@ -21,7 +20,7 @@ from .core.norms import curvature_check
 from .core.result import SolveResult
 
 
-def steepest_descent(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0,
+def steepest_descent(A, b, x0=None, *, rtol: float | None = None, atol: float | None = None,
                      maxiter: int | None = None, M=None, callback=None,
                      check_symmetry: bool = True) -> SolveResult:
     """Steepest descent for SPD ``A`` until ``||b - A x|| <= max(rtol ||b||, atol)``.

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from ..cost import plan_poisson
 
-__all__ = ["poisson_run_seconds", "steps_seconds", "implicit_run_seconds", "SOLVES_PER_STEP"]
+__all__ = ["poisson_run_seconds", "steps_seconds", "implicit_run_seconds", "solves_per_step"]
 
 
 def poisson_run_seconds(triangles: float, solver=None, *, assemble: bool = True,
@@ -44,11 +44,13 @@ def steps_seconds(steps: float, *, nodes: int, springs: int, dim: int = 2,
                       every=max(int(steps), 1), outputs=(), implicit=implicit).seconds
 
 
-#: Linear solves per time step an implicit integrator typically makes on the study scenes
-#: (Newton's implicit Euler: ~4 iterations measured on the springs_vs_elements scenes;
-#: projective dynamics and fast mass-spring: one kept factorisation, ~2 step-equivalents for
-#: their 10 cheap local/global sweeps).
-SOLVES_PER_STEP = {"newton": 4.0, "projective": 2.0, "fast_mass_spring": 2.0}
+def solves_per_step(integrator: str) -> float:
+    """Linear solves per time step the integrator named ``integrator`` typically makes on the
+    study scenes, as it declares (:attr:`femkit.dynamics.integrators.Integrator.solves_per_step`;
+    the base class's for a name not registered)."""
+    from ..dynamics.integrators import INTEGRATORS, Integrator
+
+    return (INTEGRATORS.get(integrator) if integrator in INTEGRATORS else Integrator).solves_per_step
 
 
 def implicit_run_seconds(steps: float, *, nodes: float, parts: float, integrator: str,
@@ -56,8 +58,8 @@ def implicit_run_seconds(steps: float, *, nodes: float, parts: float, integrator
     """Seconds of ``steps`` implicit steps on a 2D body of ``nodes`` nodes and ``parts``
     springs (or triangles: an element costs about what 3 springs cost, ``elements=True``): the
     scene model's implicit step times the solves per step of ``integrator``
-    (:data:`SOLVES_PER_STEP`, 4 for an integrator not listed)."""
-    solves = SOLVES_PER_STEP.get(integrator, 4.0)
+    (:func:`solves_per_step`)."""
+    solves = solves_per_step(integrator)
     springs = 3.0 * parts if elements else parts
     return steps_seconds(steps * solves, nodes=int(nodes), springs=int(springs), dim=2,
                          implicit=True)

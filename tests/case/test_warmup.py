@@ -153,7 +153,7 @@ import importlib, sys
 import numba
 from femkit.case import case_from_dict
 from femkit.case.poisson import warmup
-for module, name in warmup._THRESHOLDS:   # the compiled paths a large tetrahedral mesh takes
+for module, name in warmup._thresholds():   # the compiled paths a large tetrahedral mesh takes
     setattr(importlib.import_module(module), name, 0)
 case = case_from_dict({case!r})
 print("compile now:", warmup.must_compile(None, True))
@@ -182,3 +182,44 @@ def test_warmup_compiles_the_tetrahedral_kernels(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert "compile now: False" in proc.stdout
     assert "compiled: []" in proc.stdout, proc.stdout
+
+
+EXACTLY = """
+import re, sys
+import numba
+from femkit.case.poisson import warmup
+warmup.warm_up(None, multigrid={multigrid}, dims={dims})
+compiled = sorted(f"{{mod}}.{{name}}" for mod, m in list(sys.modules.items())
+                  if mod.startswith(("femkit.mesh", "femkit.fem", "femkit.solvers"))
+                  for name, fn in vars(m).items()
+                  if isinstance(fn, numba.core.registry.CPUDispatcher) and fn.__module__ == mod and fn.signatures)
+print("compiled:", compiled)
+registry = warmup._registry()
+print("registered:", sorted(f"{{k.module}}.{{k.name}}" for k in registry.kernels(warmup.families({multigrid}))
+                           if 3 in {dims} or not k.tetrahedra_only))
+print("constants:", sorted(f"{{mod}}.{{name}}" for mod, m in list(sys.modules.items())
+                           if mod.startswith(("femkit.mesh", "femkit.fem", "femkit.solvers"))
+                           for name in vars(m) if re.fullmatch(r"\\w*NUMBA_(THRESHOLD\\w*|NNZ)", name)))
+print("thresholds:", sorted(f"{{mod}}.{{name}}" for mod, name in warmup._thresholds()))
+"""
+
+
+@pytest.mark.parametrize("multigrid, dims", [(True, (2, 3)), (False, (2,))])
+def test_the_warm_up_compiles_exactly_the_declared_kernels(multigrid, dims):
+    """The kernels a warm-up compiles (or loads) are the ones the library modules declare
+    (:mod:`femkit.warmup_registry`), no more and no fewer: a kernel added to a compiled path
+    without its declaration would be compiled inside a first run's stages and never checked by
+    :func:`~femkit.case.poisson.warmup.kernels_cached`. Every size constant of the pipeline's
+    modules that chooses a compiled path is a declared threshold (the warm-up lowers it)."""
+    proc = subprocess.run([sys.executable, "-c", EXACTLY.format(multigrid=multigrid, dims=dims)],
+                          capture_output=True, text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr
+    lines = dict(line.split(": ", 1) for line in proc.stdout.splitlines() if ": " in line)
+    compiled, registered = _printed_list(lines["compiled"]), _printed_list(lines["registered"])
+    assert len(compiled) > 20 and compiled == registered
+    assert _printed_list(lines["constants"]) == _printed_list(lines["thresholds"])
+
+
+def _printed_list(text: str) -> list[str]:
+    """A printed list of strings (``['a.b', 'c.d']``) read back without eval."""
+    return json.loads(text.replace("'", '"'))

@@ -85,3 +85,65 @@ def test_a_study_file_without_rtol_and_the_study_default_take_the_patched_defaul
     assert [s.rtol for s in default.solvers] == [patched]
     named = load_study(_write(tmp_path / "named.yaml", {**study, "solvers": [{"method": "cg"}]}))
     assert [s.rtol for s in named.solvers] == [patched]
+
+
+def _bound_defaults() -> list[str]:
+    """Every signature in femkit that binds a default at import: a name of
+    :mod:`femkit.solvers.core.defaults` as a default value, or an ``rtol`` / ``atol`` parameter
+    (or dataclass field) whose default is anything but None (a literal copy of a default)."""
+    import ast
+    from pathlib import Path
+
+    names = {n for n in vars(defaults) if n.isupper()}
+    found = []
+    for path in sorted(Path(femkit.__file__).parent.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            where = f"{path.name}:{getattr(node, 'lineno', 0)}"
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
+                a = node.args
+                positional = a.posonlyargs + a.args
+                pairs = list(zip(positional[len(positional) - len(a.defaults):], a.defaults))
+                pairs += [(k, d) for k, d in zip(a.kwonlyargs, a.kw_defaults) if d is not None]
+                for arg, d in pairs:
+                    named = getattr(d, "id", getattr(d, "attr", None)) in names
+                    literal = arg.arg in ("rtol", "atol") and not (
+                        isinstance(d, ast.Constant) and d.value is None)
+                    if named or literal:
+                        found.append(f"{where} {arg.arg}={ast.unparse(d)}")
+            elif (isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name)
+                  and node.target.id in ("rtol", "atol") and isinstance(node.value, ast.Constant)):
+                found.append(f"{where} field {node.target.id} = {ast.unparse(node.value)}")
+    return found
+
+
+def test_no_signature_binds_a_default_at_import():
+    """A default bound into a signature (``rtol=DEFAULT_RTOL``, ``rtol=1e-10``) would keep the
+    old value when :mod:`femkit.solvers.core.defaults` changes: every one reads it at the call
+    (``rtol=None``)."""
+    assert _bound_defaults() == []
+
+
+@pytest.mark.parametrize("method", ["cg", "pcg", "jacobi", "steepest_descent", "direct"])
+def test_each_method_called_directly_stops_at_the_patched_default(patched, method):
+    """Not only :func:`solve`: each method's own function reads the default at the call."""
+    import femkit.solvers as solvers
+
+    n = 31
+    A = _laplacian(n)
+    b = np.linspace(1.0, 2.0, n)
+    fn = getattr(solvers, method)
+    res = fn(A, b, maxiter=100000)
+    assert res.tolerance == pytest.approx(patched * np.linalg.norm(b), rel=1e-12)
+
+
+def test_the_newton_default_is_read_when_used(monkeypatch):
+    """The Newton tolerance of a static solid has one home too: a solid file's ``static`` block
+    without ``rtol`` and :func:`femkit.solids.solve_static` read it when used."""
+    import inspect
+
+    from femkit.case.solid.spec import StaticSpec
+    from femkit.solids import solve_static
+
+    monkeypatch.setattr(defaults, "NEWTON_RTOL", 2.5e-9)
+    assert StaticSpec().rtol == 2.5e-9
+    assert inspect.signature(solve_static).parameters["rtol"].default is None

@@ -1,5 +1,8 @@
 """Compile the Poisson pipeline's kernels ahead: ``femkit warmup``, or the first large run.
 
+The kernels and the size thresholds are those the library modules of the pipeline declare
+(:mod:`femkit.warmup_registry`, where each chooses its compiled path); nothing here lists them.
+
 femkit's compiled kernels (numba, ``cache=True``: mesh passes, P1 assembly,
 solver checks, geometric multigrid, error estimate)
 are compiled on their first call after an install and loaded from the on-disk cache afterwards.
@@ -11,7 +14,7 @@ run prints ``compiling kernels (first run, cached afterwards): mesh passes, P1 a
 geometric multigrid...`` naming what it compiles, books the time as its own ``compile`` stage
 and prints how long it took).
 
-Only the families a run needs are compiled (:data:`FAMILIES`): a run without multigrid compiles
+Only the families a run needs are compiled (:func:`families`): a run without multigrid compiles
 no multigrid kernel. One tiny fmg run compiles every multigrid kernel that pcg + gmg calls too
 (the same V-cycle, the same argument types), so the warm-up runs one case, not one per solver.
 
@@ -27,37 +30,32 @@ import importlib
 import time
 from typing import Callable
 
-__all__ = ["warm_up", "kernels_cached", "dimensions", "TETRAHEDRA_ONLY", "needs_kernels", "must_compile", "families", "FAMILIES",
-           "COMPILE_MESSAGE", "start_numba", "NUMBA_STAGE"]
+__all__ = ["warm_up", "kernels_cached", "dimensions", "needs_kernels", "must_compile", "families", "PIPELINE",
+           "MULTIGRID", "COMPILE_MESSAGE", "start_numba", "NUMBA_STAGE"]
 
 COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)"
 
-#: Each compiled family of the Poisson pipeline: (module, name) of its kernels that a warm-up
-#: leaves in numba's on-disk cache (when all are there, the family was compiled before).
-FAMILIES = {
-    "mesh passes": (("femkit.mesh._edges_kernel", "cell_edges"),
-                    ("femkit.mesh._quality_kernel", "triangle_quality"),
-                    ("femkit.mesh._refine_kernel", "red_children"),
-                    ("femkit.mesh._refine_kernel", "child_edges"),
-                    ("femkit.mesh._refine_kernel", "interleaved_red"),
-                    ("femkit.mesh._faces_kernel", "tet_faces")),
-    "P1 assembly": (("femkit.fem._kernels", "_pattern"), ("femkit.fem._kernels", "_stiffness"),
-                    ("femkit.fem._one_off", "_cell_rows"), ("femkit.fem._one_off", "_triangle_values"),
-                    ("femkit.fem._one_off", "_edge_pattern"), ("femkit.fem._one_off", "_edge_values"),
-                    ("femkit.fem._one_off", "_edge_fill"),
-                    ("femkit.fem._kernels", "_eliminate"), ("femkit.fem._one_off", "_tet_values")),
-    "solver checks": (("femkit.solvers.core._check_kernels", "asymmetry_sums"),),
-    "geometric multigrid": (("femkit.solvers._gmg_kernels", "_galerkin_rows"),
-                            ("femkit.solvers._gmg_kernels", "gs_sweeps")),
-}
+#: The kernel family only geometric multigrid calls (a run without it neither needs nor compiles it).
+MULTIGRID = "geometric multigrid"
 
-#: The module constants that choose the compiled paths by size (lowered during a warm-up).
-_THRESHOLDS = (("femkit.fem.sparsity", "NUMBA_THRESHOLD"), ("femkit.fem.p1_stiffness", "NUMBA_THRESHOLD"),
-               ("femkit.fem.load", "NUMBA_THRESHOLD"), ("femkit.mesh.edges", "NUMBA_THRESHOLD"),
-               ("femkit.mesh.quality", "NUMBA_THRESHOLD"), ("femkit.mesh.refine", "NUMBA_THRESHOLD"),
-               ("femkit.mesh.quality", "NUMBA_THRESHOLD_3D"), ("femkit.mesh.refine", "NUMBA_THRESHOLD_3D"),
-               ("femkit.fem.dirichlet", "NUMBA_THRESHOLD"),
-               ("femkit.solvers.core.checks", "SYMMETRY_NUMBA_NNZ"))
+#: The library packages the Poisson pipeline runs on: their modules declare the pipeline's
+#: compiled kernels and size thresholds (:mod:`femkit.warmup_registry`) when imported.
+PIPELINE = ("femkit.mesh", "femkit.fem", "femkit.fem.fused", "femkit.fem.estimators", "femkit.solvers")
+
+
+def _registry():
+    """:mod:`femkit.warmup_registry` with the pipeline's declarations in it (its packages imported:
+    a run has imported them already, so this costs it nothing)."""
+    for package in PIPELINE:
+        importlib.import_module(package)
+    return importlib.import_module("femkit.warmup_registry")
+
+
+def _thresholds() -> tuple[tuple[str, str], ...]:
+    """The declared module constants that choose the compiled paths by size (lowered during a
+    warm-up)."""
+    return _registry().thresholds()
+
 
 #: The tetrahedral tiny case (run after :data:`_TINY`): the 3D kernels of the same families
 #: (the tetrahedron assembly, the face numbering, the estimator's face jumps); a constant source
@@ -83,21 +81,9 @@ _TINY = {
 def families(multigrid: bool) -> tuple[str, ...]:
     """The compiled families a run uses: all of them with geometric multigrid, else edges,
     assembly and the error estimate."""
-    if multigrid:
-        return tuple(FAMILIES)
-    return tuple(f for f in FAMILIES if f != "geometric multigrid")
+    every = _registry().families()
+    return every if multigrid else tuple(f for f in every if f != MULTIGRID)
 
-
-#: The errors and estimate stages' compiled passes: the residual estimator's (a family of the
-#: warm-up), and the size thresholds of those and of a case's compiled expressions.
-FAMILIES["error estimate"] = tuple(("femkit.fem.estimators._kernels", name) for name in
-                                   ("residual_pass", "slot_fluxes", "triangle_areas", "squares_by_tag")
-                                   ) + (("femkit.fem.estimators._kernels3d", "residual_faces"),)
-_THRESHOLDS += (("femkit.fem.fused.kernels", "NUMBA_THRESHOLD"),
-                ("femkit.fem.estimators.geometry", "NUMBA_THRESHOLD"),
-                ("femkit.fem.estimators.residual", "NUMBA_THRESHOLD"),
-                ("femkit.fem.estimators.residual_faces", "NUMBA_THRESHOLD"),
-                ("femkit.mesh.faces", "NUMBA_THRESHOLD"))
 
 __all__ += ["compile_expressions", "expressions_cached", "EXPRESSIONS_MESSAGE"]
 
@@ -118,32 +104,24 @@ def needs_kernels(mesh, multigrid: bool) -> bool:
     return mesh.n_cells >= min(NUMBA_THRESHOLD, EDGES)
 
 
-#: The kernels only tetrahedra call: a run on triangles neither needs nor compiles them (a run on
-#: tetrahedra compiles every dimension's: its boundary and coarse passes share the 2D kernels).
-TETRAHEDRA_ONLY = frozenset({("femkit.mesh._faces_kernel", "tet_faces"),
-                             ("femkit.fem._one_off", "_tet_values"),
-                             ("femkit.fem.estimators._kernels3d", "residual_faces")})
-
-
 def dimensions(dim: int | None) -> tuple[int, ...]:
     """The dimensions whose kernels a run on a ``dim``-D mesh compiles (None: unknown, all)."""
     return (2,) if dim == 2 else (2, 3)
 
 
 def kernels_cached(names: tuple[str, ...] | None = None, dims: tuple[int, ...] = (2, 3)) -> bool:
-    """True when every kernel of the families ``names`` (default: all of :data:`FAMILIES`) that a
-    run in the dimensions ``dims`` calls is in numba's on-disk cache (``NUMBA_CACHE_DIR`` or the
-    package's ``__pycache__``)."""
+    """True when every declared kernel (:mod:`femkit.warmup_registry`) of the families ``names``
+    (default: all) that a run in the dimensions ``dims`` calls is in numba's on-disk cache
+    (``NUMBA_CACHE_DIR`` or the package's ``__pycache__``)."""
     import os
 
-    for family in (tuple(FAMILIES) if names is None else names):
-        for module, name in FAMILIES[family]:
-            if 3 not in dims and (module, name) in TETRAHEDRA_ONLY:
-                continue
-            cache = getattr(importlib.import_module(module), name)._cache
-            path = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
-            if path is None or not os.path.exists(path):
-                return False
+    for kernel in _registry().kernels(names):
+        if 3 not in dims and kernel.tetrahedra_only:
+            continue
+        cache = getattr(importlib.import_module(kernel.module), kernel.name)._cache
+        path = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
+        if path is None or not os.path.exists(path):
+            return False
     return True
 
 
@@ -164,7 +142,7 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True,
     if echo is not None:
         echo(f"{COMPILE_MESSAGE}: {', '.join(families(multigrid))}...")
     t0 = time.perf_counter()
-    saved = [(importlib.import_module(m), name) for m, name in _THRESHOLDS]
+    saved = [(importlib.import_module(m), name) for m, name in _thresholds()]
     values = [getattr(mod, name) for mod, name in saved]
     _ACTIVE = True
     try:

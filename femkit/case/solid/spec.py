@@ -3,8 +3,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Mapping
+from ...solvers.core import defaults
 
 __all__ = ["SolidSpec", "Boundary", "StaticSpec", "SolidOutput"]
 
@@ -28,7 +29,7 @@ class StaticSpec:
     load_steps: int = 1
     project: Any = True
     max_iterations: int = 50
-    rtol: float = 1e-10
+    rtol: float = field(default_factory=lambda: defaults.NEWTON_RTOL)
 
 
 @dataclass(frozen=True)

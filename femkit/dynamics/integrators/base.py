@@ -107,6 +107,13 @@ class Integrator:
     positions), ``implicit``, ``symplectic`` and ``stability_bound`` (the largest ``h * omega``
     for which the undamped oscillator stays bounded, ``inf`` for unconditionally stable methods;
     the critical step is ``stability_bound / omega_max``).
+
+    What the application layer derives from an integrator it reads here, not from a table of
+    names: ``solves_per_step`` (an implicit step's cost in linear solves, the study prices'
+    :func:`femkit.study.prices.implicit_run_seconds`) and ``work_precision`` (the method
+    families of the work-precision study that run it: family -> ``(label, the option its sweep
+    varies or None, options every run of the family takes)``,
+    :func:`femkit.dynamics.work_precision.method_families`).
     """
 
     name = "integrator"
@@ -114,6 +121,12 @@ class Integrator:
     implicit = False
     symplectic = False
     stability_bound = math.inf
+    #: Linear solves an implicit step typically makes on the study scenes (Newton's implicit
+    #: Euler: ~4 iterations measured on the springs_vs_elements scenes; the default for an
+    #: integrator that declares none).
+    solves_per_step = 4.0
+    #: The work-precision method families that run this integrator (none by default).
+    work_precision = {}
 
     def start(self, system, x, v, t: float, dt: float, ctx: StepContext) -> StepperState:
         """Initial state: copies of ``x``, ``v`` with pinned velocities zeroed."""

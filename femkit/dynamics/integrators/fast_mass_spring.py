@@ -164,6 +164,10 @@ class FastMassSpring(Integrator):
     order = 1
     implicit = True
     symplectic = False
+    #: one kept factorisation: ~2 step-equivalents for its 10 cheap local/global sweeps
+    solves_per_step = 2.0
+    work_precision = {"fast_mass_spring": ("fast mass-spring", "iterations", {}),
+                      "chebyshev": ("Chebyshev fast mass-spring", "iterations", {"chebyshev": True})}
 
     def __post_init__(self):
         check_iteration_options(self.name, self.iterations, self.tol, option="iterations")

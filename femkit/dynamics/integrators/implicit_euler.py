@@ -60,6 +60,7 @@ class ImplicitEuler(Integrator):
     order = 1
     implicit = True
     symplectic = False
+    work_precision = {"baraff_witkin": ("Baraff-Witkin", None, {"fix": "clamp"})}
 
     def __post_init__(self):
         check_matrix_free_options(self.name, self.matrix_free, self.reuse_factorization)

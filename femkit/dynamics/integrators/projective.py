@@ -110,6 +110,8 @@ class Projective(Integrator):
     order = 1
     implicit = True
     symplectic = False
+    #: one kept factorisation: ~2 step-equivalents for its cheap local/global sweeps
+    solves_per_step = 2.0
     #: needs an elastic solid (no springs) and integrates its own ARAP energy, not the body's
     #: material: generic every-integrator tests leave it out
     solids_only = True

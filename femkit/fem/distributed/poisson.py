@@ -20,7 +20,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...solvers.core.defaults import DEFAULT_RTOL
 from ...solvers.petsc.backend import ksp_solve
 from ...solvers.petsc.env import require_petsc
 from ...solvers.petsc.failure import collective, from_root
@@ -77,7 +76,7 @@ class DistributedSolution:
 
 
 def solve_poisson(problem, *, method: str = "pcg", preconditioner: str | None = None,
-                  rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
+                  rtol: float | None = None, atol: float | None = None, maxiter: int | None = None,
                   petsc_options: dict | None = None, omega: float = 1.0, exact=None,
                   grad_exact=None, error_order: int = 5, gather: bool = True,
                   partitioner: str = DEFAULT_PARTITIONER, comm=None) -> DistributedSolution:

@@ -7,6 +7,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...registry import Registry
+from ...warmup_registry import register_kernels
+
+register_kernels("error estimate", "femkit.fem.estimators._kernels", "squares_by_tag", rank=4)
 
 #: name -> estimator ``est(mesh, u, *, kappa, f, neumann, dirichlet_nodes) -> ErrorEstimate``
 ESTIMATORS: Registry = Registry("error estimator")

@@ -11,6 +11,10 @@ import numpy as np
 from .._elements import p1_gradients, simplex_gradients, triangle_geometry
 from ..coefficients import element_coefficient
 from ..sparsity import NUMBA_THRESHOLD
+from ...warmup_registry import register_kernels, register_threshold
+
+register_threshold(__name__, "NUMBA_THRESHOLD")
+register_kernels("error estimate", "femkit.fem.estimators._kernels", "triangle_areas", rank=4)
 
 
 @dataclass(frozen=True)

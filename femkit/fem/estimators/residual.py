@@ -44,6 +44,14 @@ from ..sparsity import NUMBA_THRESHOLD
 from .base import ESTIMATORS, ErrorEstimate
 from .._elements import triangle_geometry
 from .geometry import checked_solution, element_fields, element_kappa
+from ...warmup_registry import register_kernels, register_threshold
+
+register_threshold(__name__, "NUMBA_THRESHOLD")
+register_kernels("error estimate", "femkit.fem.estimators._kernels", "residual_pass", "slot_fluxes", rank=4)
+# the faces of a tetrahedral mesh (:mod:`.residual_faces`, imported only for one)
+register_threshold("femkit.fem.estimators.residual_faces", "NUMBA_THRESHOLD")
+register_kernels("error estimate", "femkit.fem.estimators._kernels3d", "residual_faces", rank=4,
+                 tetrahedra_only=True)
 
 #: Gauss-Legendre points on [0, 1] (3 points, exact to degree 5) for edge integrals of the Neumann data
 _GL_S = 0.5 + 0.5 * np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 from types import ModuleType
 from typing import Callable
+from ...warmup_registry import register_threshold
 
 #: Cells from which the compiled passes are used (below: the NumPy path, no compile).
 NUMBA_THRESHOLD = 100_000
+register_threshold(__name__, "NUMBA_THRESHOLD")
 
 
 class FusedKernels:

@@ -38,10 +38,15 @@ def _builtin_kernels(self):
 
 def register_material(name: str):
     """Class decorator: register a material class as ``name`` and set its ``name`` attribute
-    (the name is written once, here)."""
+    (the name is written once, here) and, for one written as an energy (``energy_expression``),
+    its ``code``: the next number of the generated module's ``stretch_energy`` (1, 2, ... in the
+    order of registration; nobody numbers them by hand). A material with no energy keeps the
+    ``code`` it declares (the linear material's 0: its own compiled point function)."""
 
     def decorator(cls):
         cls.name = name
+        if getattr(cls, "energy_expression", None) is not None:
+            cls.code = len(_builtin_classes()) + 1
         cls.kernels = _builtin_kernels
         cls.kernels_cached = _builtin_cached
         return MATERIALS.register(name, cls)
@@ -54,6 +59,7 @@ def register_material(name: str):
 class LinearElastic(Material):
     """Small-strain linear elasticity (not rotation invariant)."""
 
+    #: not an energy of the stretches: the compiled point function of the linear frame
     code: ClassVar[int] = 0
 
 
@@ -62,7 +68,6 @@ class LinearElastic(Material):
 class Corotational(StretchMaterial):
     """Co-rotational linear elasticity ``mu |F - R|^2 + lam/2 tr(R^T F - I)^2``."""
 
-    code: ClassVar[int] = 1
     energy_expression: ClassVar[Energy] = Energy(
         W="mu*((s1 - 1)**2 + (s2 - 1)**2 + (s3 - 1)**2) + lam/2*(s1 + s2 + s3 - 3)**2")
 
@@ -72,7 +77,6 @@ class Corotational(StretchMaterial):
 class StVenantKirchhoff(StretchMaterial):
     """St. Venant-Kirchhoff ``mu |E|^2 + lam/2 tr(E)^2`` (softens and collapses in compression)."""
 
-    code: ClassVar[int] = 2
     energy_expression: ClassVar[Energy] = Energy(
         W="mu/4*((s1**2 - 1)**2 + (s2**2 - 1)**2 + (s3**2 - 1)**2)"
           " + lam/8*(s1**2 + s2**2 + s3**2 - 3)**2")
@@ -93,7 +97,6 @@ class StableNeoHookean(StretchMaterial):
     simulation", ACM Trans. Graph. 37(2), 2018.)
     """
 
-    code: ClassVar[int] = 3
     energy_expression: ClassVar[Energy] = Energy(
         W="mu/2*(s1**2 + s2**2 + s3**2 - 3) - mu*(J - 1) + (lam + mu)/2*(J - 1)**2")
 

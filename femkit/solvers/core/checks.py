@@ -18,8 +18,6 @@ silently running to ``maxiter``.
 
 from __future__ import annotations
 
-from .defaults import DEFAULT_RTOL
-
 import sys
 import time
 from dataclasses import dataclass
@@ -30,8 +28,10 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
 from ...errors import InputError, NotSPDError
+from .defaults import tolerances
 from .norms import binary_exponent, is_zero, norm2
 from .result import SolveResult
+from ...warmup_registry import register_kernels, register_threshold
 
 #: Relative asymmetry ``||A - A^T||_inf / ||A||_inf`` above which CG-type methods refuse ``A``.
 SYMMETRY_TOL = 1e-10
@@ -187,6 +187,8 @@ def check_tolerances(rtol: float, atol: float) -> None:
 #: already (a compiled assembly or multigrid ran), else from 10x this size: importing numba for
 #: the check alone would add ~100 MB to a mid-size run that needs no other kernel.
 SYMMETRY_NUMBA_NNZ = 200_000
+register_threshold(__name__, "SYMMETRY_NUMBA_NNZ")
+register_kernels("solver checks", "femkit.solvers.core._check_kernels", "asymmetry_sums", rank=2)
 
 
 #: Up to this many rows a sparse matrix is checked as a dense array (a time step's system of a
@@ -258,11 +260,13 @@ def check_positive_diagonal(d: np.ndarray, *, what: str) -> None:
         )
 
 
-def prepare(A, b, x0=None, *, rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter=None,
+def prepare(A, b, x0=None, *, rtol: float | None = None, atol: float | None = None, maxiter=None,
             method: str, symmetric: bool = False, check_symmetry: bool = True,
             default_maxiter_factor: int = 10) -> Problem:
-    """Validate a system and return a :class:`Problem` (``x`` is a fresh float64 copy)."""
+    """Validate a system and return a :class:`Problem` (``x`` is a fresh float64 copy); ``rtol``
+    and ``atol`` None are the defaults of :mod:`femkit.solvers.core.defaults` at this call."""
     t_start = time.perf_counter()
+    rtol, atol = tolerances(rtol, atol)
     check_tolerances(rtol, atol)
     A = as_operator(A)
     n = A.shape[0]

@@ -14,6 +14,8 @@ key                    default
 ``engine``             ``cholmod``: the factorisation library of ``cholesky``
 ``comparison rtol``    ``1e-8``: the solvers a study compares by cost (adaptive,
                        stability) stop here unless the study file names its own
+``newton rtol``        ``1e-10``: Newton's residual tolerance of a static solid
+                       (:func:`femkit.solids.solve_static`, a solid file's ``static.rtol``)
 =====================  ===========================================================
 
 docs/case-files.md documents the same table for users.
@@ -31,6 +33,18 @@ DEFAULT_PRECONDITIONER: str = "amg"
 DEFAULT_ENGINE: str = "cholmod"
 #: Relative tolerance of the default solver lists of the studies that compare solvers' cost.
 COMPARISON_RTOL: float = 1e-8
+#: Newton's relative residual tolerance of :func:`femkit.solids.solve_static` when none is given.
+NEWTON_RTOL: float = 1e-10
+
+
+def tolerances(rtol: float | None, atol: float | None) -> tuple[float, float]:
+    """``(rtol, atol)`` with None read as this module's default *now* (every solver's signature
+    says ``rtol=None, atol=None``, so that a default changed here is the default everywhere).
+
+    >>> tolerances(None, None) == (DEFAULT_RTOL, DEFAULT_ATOL), tolerances(1e-6, 1e-3)
+    (True, (1e-06, 0.001))
+    """
+    return (DEFAULT_RTOL if rtol is None else rtol, DEFAULT_ATOL if atol is None else atol)
 
 
 def default_preconditioner(method: str) -> str:

@@ -21,7 +21,6 @@ import numpy as np
 
 from ...errors import InputError
 from ..core import defaults
-from ..core.defaults import DEFAULT_RTOL
 from ..core.checks import check_symmetric, check_tolerances, explicit_csr, real_array, unknown_options
 from ..core.result import SolveResult
 from . import names, options as popts
@@ -71,7 +70,7 @@ def configure(ksp, method: str, preconditioner: str | None, *, omega: float = 1.
 
 
 def ksp_solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = None,
-              rtol: float = DEFAULT_RTOL, atol: float = 0.0, maxiter: int | None = None,
+              rtol: float | None = None, atol: float | None = None, maxiter: int | None = None,
               callback: Callable | None = None, omega: float = 1.0,
               petsc_options: dict | None = None):
     """Solve ``A x = b`` for a PETSc ``Mat``/``Vec`` pair (any communicator).
@@ -108,6 +107,7 @@ def ksp_solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None 
         A method or preconditioner the PETSc backend does not offer.
     """
     PETSc = require_petsc()
+    rtol, atol = defaults.tolerances(rtol, atol)
     check_tolerances(rtol, atol)
     t_start = time.perf_counter()
     comm = A.getComm()
@@ -226,8 +226,7 @@ class PetscBackend:
               callback: Callable | None = None, **options) -> SolveResult:
         """Same contract as :func:`femkit.solvers.solve`; extra options ``omega`` (jacobi),
         ``petsc_options`` (dict) and ``check_symmetry`` (bool, scipy input)."""
-        rtol = defaults.DEFAULT_RTOL if rtol is None else rtol
-        atol = defaults.DEFAULT_ATOL if atol is None else atol
+        rtol, atol = defaults.tolerances(rtol, atol)
         unknown_options(sorted(set(options) - set(EXTRA_OPTIONS)), list(EXTRA_OPTIONS),
                         what="the petsc backend")
         check_symmetry = options.pop("check_symmetry", True)
