@@ -1,7 +1,7 @@
 """The mass-spring system: particles, springs, declared forces, Jacobians and energies.
 
 State arrays are node-major ``(n, d)`` float64 (``d`` = 2 or 3); the flat dof index is
-``i*d + c`` (``x.reshape(-1)``). See ``docs/architecture.md`` and the dynamics contract.
+``i*d + c`` (``x.reshape(-1)``). See the dynamics contract in ``docs/modules.md``.
 
 Pinned nodes and components
 ---------------------------

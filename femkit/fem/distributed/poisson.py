@@ -5,7 +5,7 @@ gmsh's output is not guaranteed to be identical across processes (threads, versi
 node numbering that differed between ranks would silently corrupt the assembly; reading a
 file on every rank would also multiply the I/O. Every rank then holds the whole mesh
 (``points``, ``triangles``, tags: ~56 bytes per node for a triangle mesh), which is the
-memory limit of this design (see "Scale-out" in docs/architecture.md); the matrix, the
+memory limit of this design (see "Scale-out" in docs/modules.md); the matrix, the
 vectors, the partition's work and the solver's memory are distributed.
 
 Steps (all ranks): partition the nodes (:mod:`.partition`), renumber them contiguously,
