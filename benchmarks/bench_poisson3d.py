@@ -69,11 +69,11 @@ def assembly(mesh, repeat: int) -> None:
     import skfem
     from skfem.helpers import dot, grad
 
-    from femkit.fem import _kernels, _one_off, assemble_load, assemble_stiffness
+    from femkit.fem import _kernels, _one_off_stiffness, assemble_load, assemble_stiffness
     from femkit.mesh import Mesh
 
     _kernels.warm_up()
-    _one_off.warm_up()
+    _one_off_stiffness.warm_up()
     laplace = skfem.BilinearForm(lambda u, v, w: dot(grad(u), grad(v)))
     unit = skfem.LinearForm(lambda v, w: 1.0 * v)
 

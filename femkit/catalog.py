@@ -63,7 +63,7 @@ def _systems():
 
 
 def _materials():
-    from .solids.materials.registry import MATERIALS
+    from .solids.materials.builtin_materials import MATERIALS
 
     return MATERIALS
 

@@ -26,7 +26,7 @@ from typing import Any, Mapping
 
 from ..errors import CaseFileError, InputError, UnknownNameError
 from ..solvers.spec import SolverSpec
-from .names import lookup, with_prefix
+from .name_checks import lookup, with_prefix
 
 __all__ = ["SolverSpec", "IntegratorSpec", "SOLVER_SCHEMA", "INTEGRATOR_SCHEMA", "solver_schema",
            "solver_spec", "LIMITS_SCHEMA", "limits_spec"]

@@ -25,7 +25,7 @@ The invertible SVD of one small matrix, compiled (Irving, Teran & Fedkiw 2004).
 Energies
 --------
 No energy is written here. Every stretch material -- the built-ins (co-rotational, StVK,
-stable neo-Hookean: :mod:`femkit.solids.materials.registry`) and the ones a user designs -- is
+stable neo-Hookean: :mod:`femkit.solids.materials.builtin_materials`) and the ones a user designs -- is
 an expression of the principal stretches whose derivatives are generated and printed as numba
 functions by :mod:`femkit.solids.energy.codegen`. The functions below that call
 ``stretch_energy`` (:func:`_stretch_frame`, :func:`point`, :func:`element_pass`) are templates:

@@ -27,9 +27,9 @@ from ..warmup_registry import register_kernels, register_threshold
 
 register_threshold(__name__, "NUMBA_THRESHOLD")
 register_kernels("P1 assembly", "femkit.fem._kernels", "_stiffness", "_stiffness_tet", rank=1)
-register_kernels("P1 assembly", "femkit.fem._one_off", "_cell_rows", "_triangle_values", "_edge_pattern",
+register_kernels("P1 assembly", "femkit.fem._one_off_stiffness", "_cell_rows", "_triangle_values", "_edge_pattern",
                  "_edge_values", "_edge_fill", rank=1)
-register_kernels("P1 assembly", "femkit.fem._one_off", "_tet_values", rank=1, tetrahedra_only=True)
+register_kernels("P1 assembly", "femkit.fem._one_off_stiffness", "_tet_values", rank=1, tetrahedra_only=True)
 
 
 def local_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None) -> np.ndarray:
@@ -105,7 +105,7 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
     keep_pattern : bool
         ``False``: a whole-mesh numba assembly without a cached pattern builds the matrix's
         rows from a node -> element incidence list, then adds each element's geometry once
-        (:func:`femkit.fem._one_off.stiffness_rows_kernel`: the same matrix bit for bit)
+        (:func:`femkit.fem._one_off_stiffness.stiffness_rows_kernel`: the same matrix bit for bit)
         and caches nothing, so no (m, 9) or (m, 16) int slot map is ever allocated (the one-off
         assembly of a large run: a third of the memory of the fused pass).
 
@@ -123,7 +123,7 @@ def assemble_stiffness(mesh, kappa: Coefficient = 1.0, *, elements=None,
     if pattern is None:
         pattern = SparsityPattern.cached(mesh)
         if pattern is None and backend == "numba" and idx is None and not keep_pattern:
-            from ._one_off import stiffness_rows_kernel
+            from ._one_off_stiffness import stiffness_rows_kernel
 
             arrays = stiffness_rows_kernel(mesh, _kernel_coefficient(mesh, kappa, None))
             if arrays is not None:

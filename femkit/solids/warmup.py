@@ -1,7 +1,7 @@
 """Compile the elastic solids' kernels ahead: part of ``femkit warmup``.
 
 The built-in materials' kernels are generated from their energy expressions
-(:mod:`femkit.solids.materials.builtin`) into femkit's cache directory and compiled by numba on
+(:mod:`femkit.solids.materials.builtin_kernels`) into femkit's cache directory and compiled by numba on
 first use (about a minute on a loaded machine). :func:`warm_up` does both now, on a tiny
 triangle and tetrahedron body: the element pass (every level, projected or not: one
 compilation, the arguments' types are those of any body), the point function and the stretch

@@ -12,7 +12,7 @@ Importing this package imports numpy and scipy only (pyamg and numba load on fir
 Layout (no import cycle between these folders): :mod:`femkit.solvers.core` (defaults, results,
 checks, norms, pairing) below everything; :mod:`femkit.solvers.preconditioners` and
 :mod:`femkit.solvers.petsc` on it; the solver modules of this folder (and :mod:`.gmg`, geometric
-multigrid, which factorises its coarsest level through :mod:`.kept`) on top, with the registry.
+multigrid, which factorises its coarsest level through :mod:`.kept_factor`) on top, with the registry.
 ``femkit.solvers.defaults`` is :mod:`femkit.solvers.core.defaults` (the one table of defaults).
 """
 

@@ -18,7 +18,7 @@ pass returns canonical CSR and the diagonal the smoother needs; it equals SciPy'
 One application is a V(nu, nu)-cycle from a zero initial guess: ``nu`` forward SOR sweeps
 (Gauss-Seidel over-relaxed by ``omega``, default 1.25) before the coarse correction, ``nu`` backward
 sweeps after it (compiled numba kernels), a cached direct factorisation
-(:func:`femkit.solvers.kept.factorize_kept`, the kept-factor path the linear-solve
+(:func:`femkit.solvers.kept_factor.factorize_kept`, the kept-factor path the linear-solve
 session uses too) on the coarsest level. Backward SOR is the ``A``-adjoint of
 forward SOR, so the cycle is a symmetric positive definite operator ``M ~ A^-1`` and PCG applies (Briggs, Henson and McCormick, *A Multigrid Tutorial*,
 2000; Saad, *Iterative Methods for Sparse Linear Systems*, 2nd ed., sec. 13.4).
@@ -256,7 +256,7 @@ class Multigrid:
 
     def __init__(self, A, hierarchy, *, free=None, sweeps: int = 2, coarse_operators=None,
                  omega: float = DEFAULT_OMEGA, check_symmetry: bool = True):
-        from .kept import factorize_kept
+        from .kept_factor import factorize_kept
 
         if hierarchy is None:
             raise _hierarchy_error("geometric multigrid")

@@ -250,7 +250,7 @@ class LinearSession:
         ``(n,)`` or ``(n, k)``). With ``cholesky`` the factor is the engine's (nested
         dissection; CHOLMOD's simplicial mode, the faster solves on these patterns;
         :class:`~femkit.errors.NotSPDError` if ``A`` is not SPD), otherwise SuperLU's."""
-        from .kept import factorize_kept
+        from .kept_factor import factorize_kept
 
         if self.spec.backend != "femkit":
             raise InputError(f"a factorisation kept for the whole run uses femkit's SuperLU; "

@@ -47,7 +47,7 @@ from typing import ClassVar
 
 from femkit.solids.energy import Energy
 from femkit.solids.materials.base import StretchMaterial
-from femkit.solids.materials.registry import register_material
+from femkit.solids.materials.builtin_materials import register_material
 
 
 @register_material("plugin_corotational")

@@ -9,7 +9,7 @@ import pytest
 
 from femkit.errors import DegenerateMeshError
 from femkit.fem import assemble_stiffness
-from femkit.fem._one_off import stiffness_rows_kernel
+from femkit.fem._one_off_stiffness import stiffness_rows_kernel
 from femkit.mesh import Mesh, refine
 from femkit.mesh.edges import edges, forget_edges, known_edges
 

@@ -133,7 +133,7 @@ def test_one_off_assembly_names_a_degenerate_triangle():
 def test_one_off_long_rows_take_the_element_order_pass(spokes):
     """A node in more triangles than a byte can index takes the element-order pass: the same
     matrix either way."""
-    from femkit.fem._one_off import MAX_ROW, stiffness_rows_kernel
+    from femkit.fem._one_off_stiffness import MAX_ROW, stiffness_rows_kernel
 
     t = np.linspace(0.0, 2.0 * np.pi, spokes, endpoint=False)
     pts = np.vstack([[0.0, 0.0], np.stack([np.cos(t), np.sin(t)], axis=1)])

@@ -28,7 +28,7 @@ def test_rows_equal_the_fused_pass_bit_for_bit(kappa):
     assert np.array_equal(K.data, K_ref.data)
     assert K.indices.dtype == np.int32 and K.has_sorted_indices
 
-    from femkit.fem._one_off import stiffness_rows_kernel
+    from femkit.fem._one_off_stiffness import stiffness_rows_kernel
 
     # the column buffer reserved at its bound was shrunk, not sliced: no hidden tail kept alive
     indptr, indices, data = stiffness_rows_kernel(mesh, kap)
@@ -76,7 +76,7 @@ def _fan(spokes: int) -> Mesh:
 
 @pytest.mark.parametrize("spokes", [252, 253, 400], ids=["row-of-255", "row-of-256", "row-of-403"])
 def test_long_rows_take_the_element_order_pass(spokes):
-    from femkit.fem._one_off import MAX_ROW, stiffness_rows_kernel
+    from femkit.fem._one_off_stiffness import MAX_ROW, stiffness_rows_kernel
 
     mesh = _fan(spokes)
     rows = stiffness_rows_kernel(mesh, 1.0)

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from femkit.catalog import entries
-from femkit.solids.materials.registry import MATERIALS
+from femkit.solids.materials.builtin_materials import MATERIALS
 
 sympy = pytest.importorskip("sympy")
 from sympy.parsing.sympy_parser import (  # noqa: E402

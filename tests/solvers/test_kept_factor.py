@@ -1,5 +1,5 @@
 """One kept-factor path (issue 16): the linear-solve session's kept factors and multigrid's
-coarsest level (gmg-PCG and fmg) are made by :func:`femkit.solvers.kept.factorize_kept`, and the
+coarsest level (gmg-PCG and fmg) are made by :func:`femkit.solvers.kept_factor.factorize_kept`, and the
 coarse solve it gives is exact (against SciPy's sparse LU)."""
 
 import numpy as np
@@ -7,7 +7,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-import femkit.solvers.kept as kept
+import femkit.solvers.kept_factor as kept
 from femkit.fem import apply_dirichlet, assemble_load, assemble_stiffness
 from femkit.mesh import MeshHierarchy, boundary_nodes, structured_mesh
 from femkit.solvers import SolverSpec, solve

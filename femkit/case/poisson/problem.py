@@ -15,7 +15,7 @@ import numpy as np
 
 from ...errors import CaseFileError, ExpressionError, InputError
 from ..load import Case
-from ..names import with_prefix
+from ..name_checks import with_prefix
 from ..result import RunResult
 
 __all__ = ["VARIABLES", "check_dimension", "build_mesh", "build_mesh_levels", "multigrid_inputs",

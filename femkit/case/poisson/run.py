@@ -32,7 +32,7 @@ from ...progress import Progress
 from ..expressions import compile_expression
 from ..frozen import freeze
 from ..load import Case
-from ..names import check_geometry_spec, lookup, resolve_file, with_prefix
+from ..name_checks import check_geometry_spec, lookup, resolve_file, with_prefix
 from .spec import BoundarySpec, MeshSpec, PoissonOutputSpec, PoissonSpec
 from .problem import (VARIABLES, CaseResult, build_mesh, build_mesh_levels, check_dimension,
                       compute_errors, element_kappa, exact_gradient, is_pure_neumann,

@@ -154,7 +154,7 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True,
             case.run(write=False, quiet=True)
             _compile_all_passes(case, dim)
         from ...fem._kernels import warm_up as assembly_kernels
-        from ...fem._one_off import warm_up as one_off_kernels
+        from ...fem._one_off_stiffness import warm_up as one_off_kernels
 
         one_off_kernels(dims)  # the incidence rows of a mesh read (the tiny case's are refined)
 

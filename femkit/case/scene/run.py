@@ -58,7 +58,7 @@ from .cost import check_scene_fits
 from ..expressions import compile_expression
 from ..frozen import freeze
 from ..load import Case
-from ..names import check_geometry_spec, resolve_file
+from ..name_checks import check_geometry_spec, resolve_file
 from ..result import RunResult
 from ..specs import IntegratorSpec, limits_spec, solver_spec
 from ..timeline import time_value

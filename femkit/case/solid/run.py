@@ -46,7 +46,7 @@ from ...io.atomic import EARLIER_RUN, check_output_dir
 from ...kinds import KINDS
 from ...timing import StageTimer
 from ..frozen import freeze
-from ..names import check_geometry_spec, resolve_file
+from ..name_checks import check_geometry_spec, resolve_file
 from ..result import RunResult
 from ..specs import IntegratorSpec, limits_spec, solver_spec
 from ..timeline import time_value

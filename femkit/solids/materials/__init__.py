@@ -2,7 +2,7 @@
 
 from .base import Material, StretchMaterial, lame_from_young
 from .designed import EnergyMaterial, designed
-from .registry import (MATERIALS, Corotational, LinearElastic, StableNeoHookean, StVenantKirchhoff,
+from .builtin_materials import (MATERIALS, Corotational, LinearElastic, StableNeoHookean, StVenantKirchhoff,
                        material)
 from .spec import material_from_spec
 

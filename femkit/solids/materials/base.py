@@ -6,10 +6,10 @@ follow from the SVD derivative (:mod:`femkit.elements.compiled`) with only ``dW/
 ``d^2W/ds^2``. So a material here *is* that function and its constants:
 
 * :class:`StretchMaterial` subclasses carry that function as an expression: the built-ins
-  (:mod:`.registry`) as ``energy_expression``, a material designed by a user (:mod:`.designed`)
+  (:mod:`.builtin_materials`) as ``energy_expression``, a material designed by a user (:mod:`.designed`)
   as its ``energy``. Derivatives are generated symbolically and compiled into numba kernels by
   one path (:mod:`femkit.solids.energy.codegen`; the built-ins share one module,
-  :mod:`.builtin`); the material names its energy there by number, ``code``, and the element
+  :mod:`.builtin_kernels`); the material names its energy there by number, ``code``, and the element
   kernels (SVD, SVD derivative, projection, assembly: :mod:`femkit.elements.compiled`) are shared.
 * The linear (small-strain) material is not a function of the stretches (not rotation
   invariant); its point function of ``F`` is :func:`femkit.elements.compiled._linear_frame`

@@ -5,7 +5,7 @@
 stable, symmetric; :meth:`~femkit.solids.energy.Energy.check}`), its Lame-equivalent moduli at
 rest become the record's ``mu``, ``lam``, and its kernels are generated and compiled
 (:mod:`femkit.solids.energy.codegen`) on first evaluation. The built-in stretch materials are
-written the same way (``energy_expression``, compiled together: :mod:`.builtin`);
+written the same way (``energy_expression``, compiled together: :mod:`.builtin_kernels`);
 :func:`designed` gives one's expression as a user's energy, with a module of its own.
 
 >>> m = EnergyMaterial.from_energy({"f": "mu*(s-1)**2", "h": "lam/2*(J-1)**2"},

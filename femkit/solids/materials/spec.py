@@ -21,7 +21,7 @@ from typing import Any, Mapping
 
 from ...errors import MaterialError
 from .base import Material
-from .registry import MATERIALS, material
+from .builtin_materials import MATERIALS, material
 
 __all__ = ["material_from_spec", "SPEC_KEYS"]
 

@@ -16,7 +16,7 @@ __all__ = ["AdaptiveStudySpec", "prepare"]
 def prepare(study) -> None:
     """Check what the schema cannot (one problem source, ``max_dofs``, the estimators and the
     loop's settings, the case, no multigrid on graded meshes) and set ``study.spec``."""
-    from ...case.names import lookup
+    from ...case.name_checks import lookup
     from ...fem.adaptive import check_settings
     from ...fem.estimators import ESTIMATORS
 

@@ -23,7 +23,7 @@ def _builtin_classes() -> list:
 def _builtin_cached(self) -> bool:
     """Whether the built-ins' generated module and its machine code are in the cache."""
     from ..energy.codegen import module_cached
-    from .builtin import builtin_recipe
+    from .builtin_kernels import builtin_recipe
 
     return module_cached(builtin_recipe(_builtin_classes()))
 
@@ -31,7 +31,7 @@ def _builtin_cached(self) -> bool:
 def _builtin_kernels(self):
     """The built-in materials' generated module (:func:`.builtin.builtin_kernels` of the
     registered classes written as energies, in the order of their ``code``)."""
-    from .builtin import builtin_kernels
+    from .builtin_kernels import builtin_kernels
 
     return builtin_kernels(_builtin_classes())
 
