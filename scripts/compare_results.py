@@ -34,9 +34,15 @@ TIMING_KEYS = ("time", "times", "seconds", "wall", "elapsed", "timings", "stages
                "pareto")  # studies: stage times t_*, and the Pareto flags ranked by them
 
 
+#: Keys that name simulated time or a time limit, compared like any number.
+SIMULATED = ("t_end", "t_reached", "t_start", "dt", "max_time", "time_budget")
+
+
 def is_timing(key: str) -> bool:
     """Whether ``key`` names a measured (run-dependent) quantity."""
     low = key.lower()
+    if low in SIMULATED:
+        return False
     return low.startswith("t_") or any(part in low for part in TIMING_KEYS)
 
 
