@@ -23,7 +23,11 @@ from __future__ import annotations
 
 from collections import namedtuple
 
-__all__ = ["Kernel", "register_kernels", "register_threshold", "kernels", "thresholds", "families"]
+__all__ = ["Kernel", "register_kernels", "register_threshold", "kernels", "thresholds", "families",
+           "COMPILE_MESSAGE"]
+
+#: What every run says before it compiles kernels (the Poisson pipeline's, a solid's energies).
+COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)"
 
 
 Kernel = namedtuple("Kernel", "family module name tetrahedra_only", defaults=(False,))

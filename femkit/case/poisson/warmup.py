@@ -30,10 +30,10 @@ import importlib
 import time
 from typing import Callable
 
+from ...warmup_registry import COMPILE_MESSAGE  # the one wording, shared with solids' energies
+
 __all__ = ["warm_up", "kernels_cached", "dimensions", "needs_kernels", "must_compile", "families", "PIPELINE",
            "MULTIGRID", "COMPILE_MESSAGE", "start_numba", "NUMBA_STAGE"]
-
-COMPILE_MESSAGE = "compiling kernels (first run, cached afterwards)"
 
 #: The kernel family only geometric multigrid calls (a run without it neither needs nor compiles it).
 MULTIGRID = "geometric multigrid"

@@ -560,7 +560,7 @@ def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
 
 def _say_compiling(case, echo: Callable[[str], Any]) -> None:
     """Say so when the run's materials must be generated and compiled first (a minute or so)."""
-    from ..poisson.warmup import COMPILE_MESSAGE
+    from ...warmup_registry import COMPILE_MESSAGE
 
     pending = [m for m in dict(case.spec.materials).values() if not m.kernels_cached()]
     if pending:
