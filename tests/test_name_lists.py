@@ -28,13 +28,7 @@ import femkit
 PACKAGE = Path(femkit.__file__).resolve().parent
 
 #: file (relative to the package) -> why its name table is still there. Empty it, never grow it.
-KNOWN = {
-    # femkit name -> PETSc KSP/PC type: deriving it from traits declared in solvers/registry.py
-    # needs the PETSc backend to read that registry (an import solvers.petsc -> solvers, the
-    # package cycle issue 31 removes) or the tables handed to ksp_solve by its callers.
-    "solvers/petsc/names.py": "the PETSc translation table",
-    "solvers/petsc/backend.py": "the PETSc backend's symmetric methods",
-}
+KNOWN: dict[str, str] = {}
 
 
 def _registries() -> dict[str, set[str]]:

@@ -101,12 +101,14 @@ def mesh_sizes(triangles: float, line_length_over_h: float, constants: dict | No
 
 
 def solver_key(method: str, preconditioner: str | None = None) -> str:
-    """``"pcg+amg_sa"``-style key of the constants (``amg`` is smoothed aggregation)."""
-    method = str(method)
-    if method != "pcg":
-        return method
-    pc = "amg_sa" if preconditioner in (None, "amg") else str(preconditioner)
-    return f"{method}+{pc}"
+    """``"pcg+amg_sa"``-style key of the constants, for names as the solver registry prices
+    them (``femkit.solvers.registry.priced_names``: defaults and aliases already resolved;
+    this pure-numbers layer knows no solver names).
+
+    >>> solver_key("pcg", "amg_sa"), solver_key("direct")
+    ('pcg+amg_sa', 'direct')
+    """
+    return str(method) if preconditioner is None else f"{method}+{preconditioner}"
 
 
 #: The relative tolerance the iteration constants were measured at (``cost/constants.json``):

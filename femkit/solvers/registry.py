@@ -36,6 +36,7 @@ from . import gmg as _gmg
 from .preconditioners import ic0 as _ic0
 from .preconditioners import jacobi as _pjacobi
 from .core.result import SolveResult
+from .petsc.names import MethodSpelling, PetscNames
 from .steepest_descent import steepest_descent
 
 SOLVERS: Registry = Registry("solver")
@@ -58,11 +59,24 @@ class Traits:
     needs_hierarchy : bool
         Geometric multigrid: the caller passes a :class:`~femkit.mesh.MeshHierarchy`
         (``hierarchy=``, ``free=``) at solve time.
+    symmetric : bool
+        The method needs a symmetric (positive definite) matrix; the PETSc backend checks a
+        scipy matrix for it before solving.
+    petsc : object, optional
+        How PETSc spells the entry (``None``: the PETSc backend does not offer it): a
+        :class:`~femkit.solvers.petsc.names.MethodSpelling` for a method, ``(PC type,
+        options)`` for a preconditioner. :func:`petsc_names` gathers them.
+    same_as : str, optional
+        An alias: the entry builds what the named entry builds (``amg`` is ``amg_sa`` in
+        femkit's own solvers), so it is priced as that one (:func:`priced_names`).
     """
 
     matrix_free: bool = False
     own_setup_time: bool = False
     needs_hierarchy: bool = False
+    symmetric: bool = False
+    petsc: object = None
+    same_as: str | None = None
 
 
 def declare(entry: Callable, **traits) -> Callable:
@@ -77,13 +91,16 @@ def traits(registry: Registry, name: str) -> Traits:
     return getattr(registry.get(name), "traits", Traits())
 
 
-SOLVERS.register("jacobi", jacobi)
+SOLVERS.register("jacobi", declare(jacobi, petsc=MethodSpelling(  # weighted Jacobi = Richardson
+    "richardson", pc_name="jacobi", pc_type="jacobi")))
 SOLVERS.register("sd", steepest_descent)
-SOLVERS.register("cg", declare(cg, matrix_free=True))
-SOLVERS.register("pcg", declare(pcg, matrix_free=True))
-SOLVERS.register("direct", declare(direct, own_setup_time=True))
+SOLVERS.register("cg", declare(cg, matrix_free=True, symmetric=True, petsc=MethodSpelling("cg")))
+SOLVERS.register("pcg", declare(pcg, matrix_free=True, symmetric=True, petsc=MethodSpelling("cg")))
+SOLVERS.register("direct", declare(direct, own_setup_time=True, symmetric=True, petsc=MethodSpelling(
+    "preonly", pc_name="mumps_cholesky", pc_type="cholesky",  # on PETSc: MUMPS Cholesky
+    options={"pc_factor_mat_solver_type": "mumps"})))
 SOLVERS.register("fmg", declare(fmg, own_setup_time=True, needs_hierarchy=True))
-SOLVERS.register("cholesky", declare(cholesky, own_setup_time=True))
+SOLVERS.register("cholesky", declare(cholesky, own_setup_time=True, symmetric=True))
 
 
 def _no_preconditioner(A, **opts):
@@ -93,12 +110,16 @@ def _no_preconditioner(A, **opts):
     return None
 
 
-PRECONDITIONERS.register("none", declare(_no_preconditioner, matrix_free=True))
-PRECONDITIONERS.register("jacobi", declare(_pjacobi.build, matrix_free=True))  # diag(A) only
-PRECONDITIONERS.register("ic0", _ic0.build)
-PRECONDITIONERS.register("amg_sa", _amg.build_sa)
-PRECONDITIONERS.register("amg_rs", _amg.build_rs)
-PRECONDITIONERS.register("amg", _amg.build)
+_BOOMERAMG = ("hypre", {"pc_hypre_type": "boomeramg"})  # classical Ruge-Stueben AMG
+PRECONDITIONERS.register("none", declare(_no_preconditioner, matrix_free=True,
+                                         petsc=("none", {})))
+PRECONDITIONERS.register("jacobi", declare(_pjacobi.build, matrix_free=True,  # diag(A) only
+                                           petsc=("jacobi", {})))
+PRECONDITIONERS.register("ic0", declare(_ic0.build, petsc=(  # IC(0) of each rank's block
+    "bjacobi", {"sub_pc_type": "icc", "sub_pc_factor_levels": 0, "sub_ksp_type": "preonly"})))
+PRECONDITIONERS.register("amg_sa", declare(_amg.build_sa, petsc=("gamg", {"pc_gamg_type": "agg"})))
+PRECONDITIONERS.register("amg_rs", declare(_amg.build_rs, petsc=_BOOMERAMG))
+PRECONDITIONERS.register("amg", declare(_amg.build, same_as="amg_sa", petsc=_BOOMERAMG))
 PRECONDITIONERS.register("gmg", declare(_gmg.build, needs_hierarchy=True))
 
 
@@ -117,10 +138,37 @@ class FemkitBackend:
         return solve(A, b, x0, **kwargs)
 
 
+def petsc_names() -> PetscNames:
+    """The PETSc translation table, derived from the entries' ``petsc`` and ``symmetric``
+    traits (what the PETSc backend and :mod:`femkit.fem.distributed` are handed)."""
+    return PetscNames(
+        methods={n: traits(SOLVERS, n).petsc for n in SOLVERS.names() if traits(SOLVERS, n).petsc},
+        preconditioners={n: traits(PRECONDITIONERS, n).petsc for n in PRECONDITIONERS.names()
+                         if traits(PRECONDITIONERS, n).petsc},
+        symmetric=frozenset(n for n in SOLVERS.names() if traits(SOLVERS, n).symmetric))
+
+
+def priced_names(method: str, preconditioner: str | None) -> tuple[str, str | None]:
+    """``(method, preconditioner)`` as the cost model's constants name them: the method's
+    default preconditioner when none is given, an alias replaced by what it is (``same_as``),
+    and no preconditioner for a method that takes none.
+
+    >>> priced_names("pcg", None), priced_names("pcg", "amg"), priced_names("direct", None)
+    (('pcg', 'amg_sa'), ('pcg', 'amg_sa'), ('direct', None))
+    """
+    if preconditioner is None:
+        preconditioner = default_preconditioner(method)
+    if method != PRECONDITIONED_METHOD:
+        return method, None
+    if preconditioner in PRECONDITIONERS:
+        preconditioner = traits(PRECONDITIONERS, preconditioner).same_as or preconditioner
+    return method, preconditioner
+
+
 def _petsc_backend():
     from .petsc.backend import PetscBackend  # lazy: petsc4py only when asked for
 
-    return PetscBackend()
+    return PetscBackend(petsc_names())
 
 
 #: backend name -> factory returning a :class:`~femkit.solvers.backend.LinearSolverBackend`

@@ -165,9 +165,10 @@ def _check_petsc(method: str, pc: str, options: dict, pc_options: dict, petsc_op
     ``petsc_options`` keys and values PETSc's options database can hold."""
     from .petsc import names
     from .petsc.options import normalise
+    from .registry import petsc_names
 
     try:
-        names.resolve(method, pc)
+        names.resolve(method, pc, petsc_names())
     except UnknownNameError as exc:
         raise with_prefix(exc, f"{where}.{'method' if exc.kind.endswith('solver') else 'preconditioner'}") from None
     except InputError as exc:

@@ -17,9 +17,10 @@ def poisson_run_seconds(triangles: float, solver=None, *, assemble: bool = True,
     (when ``assemble``) plus the setup and solve of ``solver`` (a :class:`SolverSpec`; None: a
     direct solve; ``solve=False``: none), without library imports (a study's warm-up pays them)."""
     from ..cost import load_constants
+    from ..solvers.registry import priced_names
 
-    method = "direct" if solver is None else solver.method
-    pc = "none" if solver is None else solver.preconditioner
+    method, pc = priced_names("direct", None) if solver is None else priced_names(
+        solver.method, solver.preconditioner)
     rtol = None if solver is None else solver.rtol
     p = plan_poisson(triangles=max(float(triangles), 2.0), method=method, preconditioner=pc,
                      rtol=rtol, outputs=(), errors=False)

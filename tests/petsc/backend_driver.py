@@ -11,13 +11,13 @@ import scipy.sparse as sp
 
 
 def main(out):
-    from femkit.solvers.petsc import PetscBackend
+    from femkit.solvers.registry import BACKENDS
 
     m = 30
     T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(m, m))
     A = (sp.kron(T, sp.identity(m)) + sp.kron(sp.identity(m), T)).tocsr()
     b = np.sin(np.arange(m * m))
-    backend = PetscBackend()
+    backend = BACKENDS.get("petsc")()
     specs = [("cg", None), ("pcg", "jacobi"), ("pcg", "ic0"), ("pcg", "amg"), ("pcg", "amg_sa"),
              ("direct", None), ("jacobi", None)]
     arrays, facts = {}, []

@@ -7,6 +7,7 @@ import pytest
 from femkit.errors import InputError, UnknownNameError
 from femkit.solvers.petsc import names
 from femkit.solvers.petsc.reasons import femkit_reason
+from femkit.solvers.registry import petsc_names
 
 
 @pytest.mark.parametrize("method,pc,expected", [
@@ -21,7 +22,7 @@ from femkit.solvers.petsc.reasons import femkit_reason
     ("jacobi", None, ("richardson", "jacobi", "jacobi")),
 ], ids=lambda v: str(v))
 def test_names_map_onto_ksp_and_pc(method, pc, expected):
-    ksp, pc_name, pc_type, extra = names.resolve(method, pc)
+    ksp, pc_name, pc_type, extra = names.resolve(method, pc, petsc_names())
     assert (ksp, pc_name, pc_type) == expected
     if pc_type == "hypre":
         assert extra == {"pc_hypre_type": "boomeramg"}
@@ -39,7 +40,17 @@ def test_names_map_onto_ksp_and_pc(method, pc, expected):
 ], ids=["sd-not-offered", "unknown-pc", "pc-with-cg", "pc-with-direct"])
 def test_bad_names(method, pc, error, words):
     with pytest.raises(error, match=words):
-        names.resolve(method, pc)
+        names.resolve(method, pc, petsc_names())
+
+
+def test_the_table_is_what_the_registry_entries_declare():
+    """Every registered method with a ``petsc`` trait is offered, the others are not."""
+    from femkit.solvers.registry import SOLVERS, traits
+
+    table = petsc_names()
+    assert sorted(table.methods) == ["cg", "direct", "jacobi", "pcg"]
+    assert table.symmetric == {"cg", "pcg", "direct", "cholesky"}
+    assert all(traits(SOLVERS, m).petsc is table.methods[m] for m in table.methods)
 
 
 @pytest.mark.parametrize("petsc,femkit", [

@@ -9,6 +9,7 @@ import pytest
 from femkit.errors import InputError
 from femkit.solvers import SolverSpec, solve
 from femkit.solvers.petsc import names
+from femkit.solvers.registry import petsc_names
 
 from .conftest import poisson_2d
 
@@ -29,7 +30,7 @@ def _petsc_spec():
 
 
 def _petsc_names():
-    names.resolve("cg", "ic0")
+    names.resolve("cg", "ic0", petsc_names())
 
 
 @pytest.mark.parametrize("route, prefix", [(_api, ""), (_spec, "linear_solver.preconditioner: "),

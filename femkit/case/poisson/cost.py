@@ -35,13 +35,15 @@ def plan_poisson_case(case, *, measure: bool = True) -> Plan:
     """The plan of a Poisson case (from ``case.spec``); with ``measure`` its seconds are scaled
     by this machine's speed now (:func:`femkit.cost.machine_speed`, ~0.25 s of probing)."""
     from ...cost import machine_speed, msh_has_volume, msh_triangle_count
+    from ...solvers.registry import priced_names
 
     spec = case.spec
     mesh, out = spec.mesh, spec.output
     outputs = tuple(k for k, on in (("vtu", out.vtu), ("xdmf", out.xdmf), ("png", out.plot)) if on)
-    common = dict(refine=mesh.refine, method=case.solver.method,
+    method, preconditioner = priced_names(case.solver.method, case.solver.preconditioner)
+    common = dict(refine=mesh.refine, method=method,
                   speed=machine_speed() if measure else 1.0,
-                  preconditioner=case.solver.preconditioner, rtol=case.solver.rtol,
+                  preconditioner=preconditioner, rtol=case.solver.rtol,
                   outputs=outputs, errors="exact.u" in case.functions)
     if mesh.file is not None:
         cells, how = msh_triangle_count(mesh.file)

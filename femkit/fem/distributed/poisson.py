@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...solvers.petsc.backend import ksp_solve
+from ...solvers.registry import petsc_names
 from ...solvers.petsc.env import require_petsc
 from ...solvers.petsc.failure import collective, from_root
 from ...solvers.core.result import SolveResult
@@ -118,7 +119,8 @@ def solve_poisson(problem, *, method: str = "pcg", preconditioner: str | None = 
         owner = partition_nodes(mesh, comm, method=partitioner)
         layout = build_layout(mesh, owner, fixed, rank, size)
     system = collective(mpi, assemble_poisson, problem, layout, comm, fixed, values, timer=timer)
-    result, x = ksp_solve(system.A, system.b, method=method, preconditioner=preconditioner,
+    result, x = ksp_solve(system.A, system.b, table=petsc_names(), method=method,
+                          preconditioner=preconditioner,
                           rtol=rtol, atol=atol, maxiter=maxiter, petsc_options=petsc_options,
                           omega=omega)
     times["setup"] = result.setup_time

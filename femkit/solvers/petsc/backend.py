@@ -46,8 +46,8 @@ def petsc_error(exc, what: str) -> InputError:
                       f"{' (' + meaning + ')' if meaning else ''}")
 
 
-def configure(ksp, method: str, preconditioner: str | None, *, omega: float = 1.0,
-              petsc_options: dict | None = None) -> tuple[str, dict, dict]:
+def configure(ksp, method: str, preconditioner: str | None, *, table: names.PetscNames,
+              omega: float = 1.0, petsc_options: dict | None = None) -> tuple[str, dict, dict]:
     """Set KSP/PC types and the norm from femkit names.
 
     Returns ``(pc_name, femkit_options, user_options)``: the PETSc options femkit's names
@@ -56,7 +56,7 @@ def configure(ksp, method: str, preconditioner: str | None, *, omega: float = 1.
     until after ``KSPSetUp`` and checks the user's were used.
     """
     PETSc = require_petsc()
-    ksp_type, pc_name, pc_type, extra = names.resolve(method, preconditioner)
+    ksp_type, pc_name, pc_type, extra = names.resolve(method, preconditioner, table)
     ksp.setType(ksp_type)
     pc = ksp.getPC()
     pc.setType(pc_type)
@@ -69,8 +69,8 @@ def configure(ksp, method: str, preconditioner: str | None, *, omega: float = 1.
     return pc_name, {k: popts.option_text(v) for k, v in extra.items()}, popts.normalise(petsc_options)
 
 
-def ksp_solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = None,
-              rtol: float | None = None, atol: float | None = None, maxiter: int | None = None,
+def ksp_solve(A, b, x0=None, *, table: names.PetscNames, method: str = "pcg",
+              preconditioner: str | None = None, rtol: float | None = None, atol: float | None = None, maxiter: int | None = None,
               callback: Callable | None = None, omega: float = 1.0,
               petsc_options: dict | None = None):
     """Solve ``A x = b`` for a PETSc ``Mat``/``Vec`` pair (any communicator).
@@ -82,6 +82,9 @@ def ksp_solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None 
     b : petsc4py.PETSc.Vec
     x0 : petsc4py.PETSc.Vec, optional
         Initial guess (zero by default).
+    table : PetscNames
+        The translation of femkit names, as the solver registry derives it
+        (``femkit.solvers.registry.petsc_names()``).
     method, preconditioner : str
         femkit names (:mod:`.names`).
     rtol, atol, maxiter, callback
@@ -118,7 +121,7 @@ def ksp_solve(A, b, x0=None, *, method: str = "pcg", preconditioner: str | None 
         raise InputError(f"maxiter must be >= 0, got {maxiter}")
     ksp = PETSc.KSP().create(comm)
     ksp.setOperators(A)
-    pc_name, extra, user = configure(ksp, method, preconditioner, omega=omega,
+    pc_name, extra, user = configure(ksp, method, preconditioner, table=table, omega=omega,
                                      petsc_options=petsc_options)
     prefix = popts.new_prefix()
     ksp.setOptionsPrefix(prefix)
@@ -210,16 +213,24 @@ class PetscBackend:
     ``solve(A, b)`` takes a ``PETSc.Mat``/``PETSc.Vec`` (distributed; ``x`` of the result is
     this rank's part) or a scipy.sparse matrix and numpy vector (solved on one process,
     ``PETSc.COMM_SELF``; ``x`` is the whole solution), e.g.
-    ``PetscBackend().solve(A, b, method="pcg", preconditioner="amg", rtol=1e-10)``.
+    ``BACKENDS.get("petsc")().solve(A, b, method="pcg", preconditioner="amg", rtol=1e-10)``.
+
+    Parameters
+    ----------
+    table : PetscNames
+        The femkit-name translation the solver registry derives from its entries' traits.
     """
 
     name = "petsc"
 
+    def __init__(self, table: names.PetscNames):
+        self.table = table
+
     def methods(self) -> list[str]:
-        return names.methods()
+        return sorted(self.table.methods)
 
     def preconditioners(self) -> list[str]:
-        return names.preconditioners()
+        return sorted(self.table.preconditioners)
 
     def solve(self, A, b, x0=None, *, method: str = "pcg", preconditioner: str | None = None,
               rtol: float | None = None, atol: float | None = None, maxiter: int | None = None,
@@ -232,15 +243,16 @@ class PetscBackend:
         check_symmetry = options.pop("check_symmetry", True)
         PETSc = require_petsc()
         if isinstance(A, PETSc.Mat):
-            return ksp_solve(A, b, x0, method=method, preconditioner=preconditioner, rtol=rtol,
+            return ksp_solve(A, b, x0, table=self.table, method=method,
+                             preconditioner=preconditioner, rtol=rtol,
                              atol=atol, maxiter=maxiter, callback=callback, **options)[0]
-        names.resolve(method, preconditioner)  # names first: a bad name is the clearest error
+        names.resolve(method, preconditioner, self.table)  # names first: a bad name is the clearest error
         A = explicit_csr(A, what="the petsc backend")
         n = A.shape[0]
         b = real_array(b, name="b").ravel()
         if b.shape != (n,):
             raise InputError(f"b has shape {b.shape}, expected ({n},)")
-        if check_symmetry and method in ("cg", "pcg", "direct"):
+        if check_symmetry and method in self.table.symmetric:
             check_symmetric(A, method=method)
         Ap = as_petsc_matrix(A, PETSc.COMM_SELF)
         bp = PETSc.Vec().createWithArray(b.copy(), comm=PETSc.COMM_SELF)
@@ -250,7 +262,8 @@ class PetscBackend:
             if x0.shape != (n,):
                 raise InputError(f"x0 has shape {x0.shape}, expected ({n},)")
             xp = PETSc.Vec().createWithArray(x0.copy(), comm=PETSc.COMM_SELF)
-        res, x = ksp_solve(Ap, bp, xp, method=method, preconditioner=preconditioner, rtol=rtol,
+        res, x = ksp_solve(Ap, bp, xp, table=self.table, method=method,
+                           preconditioner=preconditioner, rtol=rtol,
                            atol=atol, maxiter=maxiter, callback=callback, **options)
         for obj in (Ap, bp, x) + ((xp,) if xp is not None else ()):
             obj.destroy()

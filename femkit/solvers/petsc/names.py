@@ -1,5 +1,10 @@
 """femkit solver and preconditioner names -> PETSc KSP and PC types.
 
+The translation is not kept here: each method and preconditioner declares how PETSc spells
+it (its ``petsc`` trait, in :mod:`femkit.solvers.registry`), and the registry hands the
+table it derives (:class:`PetscNames`, from ``registry.petsc_names()``) to the PETSc backend.
+This module only holds the table's shape and :func:`resolve`. What the registry declares:
+
 ============  =====================================================================
 femkit name   PETSc
 ============  =====================================================================
@@ -18,43 +23,42 @@ BoomerAMG (classical Ruge-Stueben AMG, Henson & Yang 2002); ``amg_sa`` -> ``PCGA
 aggregation (pyamg), while here ``amg`` is BoomerAMG, the better-measured choice in PETSc
 for this operator (6 CG iterations at 1e6 unknowns against 22 for GAMG).
 
-``sd`` (steepest descent) has no KSP counterpart and is not offered.
+Methods without a ``petsc`` trait (``sd``, ``fmg``, ``cholesky``; preconditioner ``gmg``)
+are not offered.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass, field
 
 from ...errors import UnknownNameError
 from ..core.defaults import default_preconditioner
 from ..core.pairing import check_pairing
 
-#: method -> KSP type
-KSP_TYPES = {"cg": "cg", "pcg": "cg", "jacobi": "richardson", "direct": "preonly"}
 
-#: preconditioner -> (PC type, extra options set on the solve's prefix)
-PC_TYPES = {
-    "none": ("none", {}),
-    "jacobi": ("jacobi", {}),
-    "ic0": ("bjacobi", {"sub_pc_type": "icc", "sub_pc_factor_levels": 0, "sub_ksp_type": "preonly"}),
-    "amg": ("hypre", {"pc_hypre_type": "boomeramg"}),
-    "amg_rs": ("hypre", {"pc_hypre_type": "boomeramg"}),
-    "amg_sa": ("gamg", {"pc_gamg_type": "agg"}),
-}
+@dataclass(frozen=True)
+class MethodSpelling:
+    """How PETSc spells a femkit method: a KSP type, and the PC it fixes (``None``: the
+    method takes the solve's preconditioner)."""
 
-#: what ``direct`` uses
-DIRECT = ("cholesky", {"pc_factor_mat_solver_type": "mumps"})
+    ksp: str
+    pc_name: str | None = None
+    pc_type: str | None = None
+    options: dict = field(default_factory=dict)
 
 
-def methods() -> list[str]:
-    """Method names the PETSc backend understands."""
-    return sorted(KSP_TYPES)
+@dataclass(frozen=True)
+class PetscNames:
+    """The translation table the registry derives: method -> :class:`MethodSpelling`,
+    preconditioner -> ``(PC type, options)``, and the methods that need a symmetric matrix."""
+
+    methods: dict
+    preconditioners: dict
+    symmetric: frozenset = frozenset()
 
 
-def preconditioners() -> list[str]:
-    """Preconditioner names the PETSc backend understands."""
-    return sorted(PC_TYPES)
-
-
-def resolve(method: str, preconditioner: str | None) -> tuple[str, str, str, dict]:
+def resolve(method: str, preconditioner: str | None,
+            table: PetscNames) -> tuple[str, str, str, dict]:
     """``(ksp_type, pc_name, pc_type, extra_options)`` for femkit names.
 
     Raises
@@ -62,21 +66,19 @@ def resolve(method: str, preconditioner: str | None) -> tuple[str, str, str, dic
     UnknownNameError
         A name the PETSc backend does not offer (the valid ones are listed).
     InputError
-        A preconditioner with a method other than ``pcg``.
+        A preconditioner with a method that fixes its own (or is not ``pcg``).
     """
-    if method not in KSP_TYPES:
-        raise UnknownNameError("petsc solver", method, KSP_TYPES)
-    if method == "direct":
-        check_pairing(method, preconditioner)
-        return "preonly", "mumps_cholesky", DIRECT[0], dict(DIRECT[1])
-    if method == "jacobi":
-        if preconditioner != "jacobi":  # the jacobi iteration is PCJACOBI under Richardson
+    if method not in table.methods:
+        raise UnknownNameError("petsc solver", method, table.methods)
+    spelling = table.methods[method]
+    if spelling.pc_type is not None:  # direct (MUMPS Cholesky), jacobi (PCJACOBI under Richardson)
+        if preconditioner != spelling.pc_name:
             check_pairing(method, preconditioner)
-        return "richardson", "jacobi", "jacobi", {}
+        return spelling.ksp, spelling.pc_name, spelling.pc_type, dict(spelling.options)
     if preconditioner is None:
         preconditioner = default_preconditioner(method)
-    if preconditioner not in PC_TYPES:
-        raise UnknownNameError("petsc preconditioner", preconditioner, PC_TYPES)
+    if preconditioner not in table.preconditioners:
+        raise UnknownNameError("petsc preconditioner", preconditioner, table.preconditioners)
     check_pairing(method, preconditioner)
-    pc_type, extra = PC_TYPES[preconditioner]
-    return "cg", preconditioner, pc_type, dict(extra)
+    pc_type, extra = table.preconditioners[preconditioner]
+    return spelling.ksp, preconditioner, pc_type, dict(extra)

@@ -142,5 +142,9 @@ def build_rs(A, *, cycle: str = "V", **opts) -> Preconditioner:
     return _wrap("amg_rs", built, cycle, t0)
 
 
-#: Default AMG flavour behind the ``amg`` alias.
-build = build_sa
+def build(A, *, cycle: str = "V", **opts) -> Preconditioner:
+    """``amg``: femkit's default AMG flavour, smoothed aggregation (:func:`build_sa`).
+
+    A function of its own, not the same object as :func:`build_sa`, so that each registered
+    name carries its own traits (on PETSc, ``amg`` is BoomerAMG and ``amg_sa`` is GAMG)."""
+    return build_sa(A, cycle=cycle, **opts)

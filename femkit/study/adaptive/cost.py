@@ -17,6 +17,7 @@ def plan(study) -> Plan:
     estimate and error evaluation, plus the loop's fixed cost per level (marking, bisection)."""
     from ...case.cost import geometry_domain
     from ...cost import load_constants, msh_triangle_count, predict_triangles
+    from ...solvers.registry import priced_names
     from ..problem import study_problem
 
     d = study.spec
@@ -31,8 +32,9 @@ def plan(study) -> Plan:
     fixed = load_constants()["seconds"].get("adaptive_level_fixed", 0.0)
 
     def level_seconds(dofs: float) -> float:
-        p = plan_poisson(triangles=2.0 * dofs, method=solver.method, rtol=solver.rtol,
-                         preconditioner=solver.preconditioner, outputs=(), errors=True)
+        method, preconditioner = priced_names(solver.method, solver.preconditioner)
+        p = plan_poisson(triangles=2.0 * dofs, method=method, rtol=solver.rtol,
+                         preconditioner=preconditioner, outputs=(), errors=True)
         return (poisson_run_seconds(2.0 * dofs, solver) + p.stage("estimate").seconds
                 + p.stage("errors").seconds + p.stage("quality").seconds + fixed)
 

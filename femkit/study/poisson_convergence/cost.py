@@ -19,6 +19,7 @@ def plan(study) -> Plan:
     """
     from ...case.cost import geometry_domain
     from ...cost import load_constants, msh_triangle_count
+    from ...solvers.registry import priced_names
     from ..problem import study_problem
 
     case = study_problem(study).case
@@ -41,6 +42,7 @@ def plan(study) -> Plan:
         where["refine"] = k + mesh.refine
 
         def run(method, preconditioner="none", rtol=None):
+            method, preconditioner = priced_names(method, preconditioner)
             return plan_poisson(method=method, preconditioner=preconditioner, rtol=rtol,
                                 outputs=(), errors=True, **where)
 
