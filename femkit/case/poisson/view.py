@@ -1,0 +1,102 @@
+"""The Poisson kind's picture (:attr:`femkit.kinds.Kind.view` of ``problem: poisson``): the
+solution ``u`` (or the element error indicators ``eta``, the coefficient ``kappa``, the region
+``tag``) on the mesh, 2D from above, 3D clipped through the middle (or sliced, or its surface)
+with the whole boundary as a ghost. Drawn from the result in memory (``result.plot()``: the
+indicators are there) or from ``solution.vtu`` of a run directory. pyvista: ``femkit[view]``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import InputError
+from ...view.core import Frame, Layer, Picture
+from ...view.core.generic import field_names, surface
+from ...view.core.render import pyvista
+from ...view.core.source import Run, check_field
+
+__all__ = ["poisson_view", "SECTIONS"]
+
+#: How a tetrahedral mesh is cut open -> what it shows.
+SECTIONS = {"clip": "the half behind the plane through the centre normal to (1, 1, 1)",
+            "slice": "three orthogonal slices through the centre",
+            "surface": "the boundary surface"}
+
+_TITLES = {"u": "u", "eta": "error indicator eta_T (log scale)", "kappa": "coefficient kappa",
+           "tag": "region tag"}
+
+
+def _grid_from_result(result):
+    """The mesh of a result in memory with ``u``, ``kappa``, ``tag`` and ``eta``."""
+    pv = pyvista()
+    mesh = result.mesh
+    points = np.zeros((mesh.n_points, 3))
+    points[:, :mesh.dim] = mesh.points
+    kind = pv.CellType.TRIANGLE if mesh.dim == 2 else pv.CellType.TETRA
+    grid = pv.UnstructuredGrid({kind: np.asarray(mesh.cells)}, points)
+    grid.point_data["u"] = np.asarray(result.u, dtype=float)
+    grid.cell_data["tag"] = np.asarray(mesh.cell_tags)
+    kappa = np.asarray(result.kappa, dtype=float)
+    grid.cell_data["kappa"] = np.broadcast_to(kappa, (mesh.n_cells,)).copy()
+    if result.indicators is not None:
+        grid.cell_data["eta"] = np.asarray(result.indicators, dtype=float)
+    return grid, mesh.dim
+
+
+def _grid_from_file(run: Run):
+    """``solution.vtu``'s triangles (2D) or tetrahedra (3D), without the boundary facets."""
+    pv = pyvista()
+    grid = pv.read(run.file("solution.vtu"))
+    dim = int(run.facts.get("mesh", {}).get("dim", 3 if pv.CellType.TETRA in grid.celltypes else 2))
+    kind = pv.CellType.TRIANGLE if dim == 2 else pv.CellType.TETRA
+    return grid.extract_cells_by_type(kind), dim
+
+
+def _layers_3d(grid, scalars: str, title: str, log: bool, edges: bool, section: str) -> list:
+    """The cut-open solid (coloured) and the whole boundary as a ghost."""
+    centre = np.asarray(grid.center)
+    ghost = Layer(surface(grid), color="grey", opacity=0.12)
+    if section == "surface":
+        shown = surface(grid)
+        return [Layer(shown, scalars, title, log=log, edges=edges, cmap=_cmap(scalars))]
+    if section == "slice":
+        shown = grid.slice_orthogonal(*centre)
+    else:
+        shown = grid.clip(normal=(1.0, 1.0, 1.0), origin=centre, crinkle=scalars == "eta")
+    return [Layer(shown, scalars, title, log=log, edges=edges, cmap=_cmap(scalars)), ghost]
+
+
+def _cmap(scalars: str) -> str:
+    return {"eta": "magma", "tag": "tab10"}.get(scalars, "viridis")
+
+
+def poisson_view(run: Run, field: str | None = None, edges: bool | None = None,
+                 section: str = "clip") -> Picture:
+    """The picture of a Poisson run.
+
+    Parameters
+    ----------
+    run : Run
+        The result in memory or the run directory (:func:`femkit.view.core.source.open_run`).
+    field : str, optional
+        ``u`` (default), ``eta`` (the estimator's indicators: a result in memory with an
+        ``estimator``), ``kappa`` or ``tag``.
+    edges : bool, optional
+        Draw the mesh edges (default: when the mesh has at most 5000 cells).
+    section : str
+        3D only: one of :data:`SECTIONS`.
+    """
+    if section not in SECTIONS:
+        raise InputError(f"unknown section {section!r}; valid sections: {', '.join(SECTIONS)}")
+    grid, dim = _grid_from_result(run.result) if run.result is not None else _grid_from_file(run)
+    fields = field_names(grid)
+    name = check_field(field, fields, "u")
+    edges = grid.n_cells <= 5000 if edges is None else edges
+    log = name == "eta"
+    cells = "triangles" if dim == 2 else "tetrahedra"
+    title = f"{run.name}: {_TITLES.get(name, name)}, {grid.n_cells} {cells}"
+    if dim == 2:
+        layers = [Layer(grid, name, _TITLES.get(name, name), log=log, edges=edges, cmap=_cmap(name))]
+    else:
+        layers = _layers_3d(grid, name, _TITLES.get(name, name), log, edges, section)
+    return Picture([Frame(layers)], title=title, dim=dim, field=name, fields=tuple(fields))
