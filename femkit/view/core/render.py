@@ -25,7 +25,7 @@ from ...errors import InputError, ViewUnavailableError
 from .picture import Picture
 
 __all__ = ["pyvista", "display_available", "offscreen_available", "plotter", "draw",
-           "image", "png_bytes", "screenshot", "movie", "show", "MOVIE_SUFFIXES",
+           "image", "png_bytes", "screenshot", "movie", "show", "check_movie_path", "MOVIE_SUFFIXES",
            "INSTALL_VIEW", "INSTALL_OFFSCREEN"]
 
 #: What the one line says when pyvista cannot be imported.
@@ -143,10 +143,10 @@ def draw(p: Any, picture: Picture, index: int = -1, *, clim=None, camera: bool =
         p.add_mesh(layer.mesh, scalars=layer.scalars, cmap=layer.cmap, log_scale=layer.log,
                    clim=clim if i == main else None, show_scalar_bar=i == main,
                    scalar_bar_args=bar, **kwargs)
-    p.add_text(picture.title, position="upper_edge", font_size=int(font * 0.9), color=FOREGROUND)
+    p.add_text(picture.title, position="upper_edge", font_size=int(font * 0.75), color=FOREGROUND)
     if frame.time is not None and len(picture.frames) > 1:
-        p.add_text(f"t = {frame.time:.4g}", position="lower_left", font_size=int(font * 0.8),
-                   color=FOREGROUND)
+        p.add_text(f"t = {frame.time:.4g}", position=(int(0.8 * size[0]), int(0.02 * size[1])),
+                   font_size=int(font * 0.7), color=FOREGROUND)
     if camera:
         _camera(p, picture)
 
@@ -207,7 +207,7 @@ def screenshot(picture: Picture, path: str | os.PathLike, frame: int = -1,
     return atomic_write_bytes(path, png_bytes(picture, frame, size))
 
 
-def _check_movie_path(path: Path) -> None:
+def check_movie_path(path: Path) -> None:
     suffix = path.suffix.lower()
     if suffix not in MOVIE_SUFFIXES:
         raise InputError(f"--movie {path}: unknown movie format {suffix or '(none)'!r}; valid: "
@@ -229,7 +229,7 @@ def movie(picture: Picture, path: str | os.PathLike, size: tuple[int, int] = (80
     from ...io.atomic import atomic_path
 
     path = Path(path)
-    _check_movie_path(path)
+    check_movie_path(path)
     clim = colour_range(picture)
     p = plotter(size, off_screen=True)
     images = []
