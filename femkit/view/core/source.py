@@ -1,7 +1,8 @@
-"""What a picture is made from: :class:`Run` (a result object, its run directory, its facts), and
-the dispatch to the kind's view function through :data:`femkit.kinds.KINDS`.
+"""What a picture is made from: :class:`Run` (a result object, its run directory, its facts);
+:func:`check_field`, the one check of a field name.
 
-A kind declares its view in its own package (:attr:`femkit.kinds.Kind.view`, imported on first
+The dispatch to the kind's view function is :func:`femkit.view.core.dispatch.picture_of`. A
+kind declares its view in its own package (:attr:`femkit.kinds.Kind.view`, imported on first
 use, like its ``run``); a kind without one gets the generic picture of its run directory
 (:func:`femkit.view.core.generic.generic_picture`: the ``.pvd`` time series, else
 ``solution.vtu``), so a time-dependent kind that writes a PVD is drawn without any code of its
@@ -17,9 +18,8 @@ from pathlib import Path
 from typing import Any
 
 from ...errors import InputError, UnknownNameError
-from .picture import Picture
 
-__all__ = ["Run", "open_run", "picture_of", "check_field"]
+__all__ = ["Run", "open_run", "check_field"]
 
 
 @dataclass
@@ -89,20 +89,3 @@ def check_field(field: str | None, fields: list[str] | tuple[str, ...], default:
     if name not in fields:
         raise UnknownNameError("field", str(name), fields)
     return name
-
-
-def picture_of(source: Any, field: str | None = None, **options) -> Picture:
-    """The picture of ``source`` (a result object or a run directory) drawn by its kind's view
-    function (``options`` go to it), or the generic picture of its run directory."""
-    from ...kinds import KINDS
-
-    run = open_run(source)
-    try:
-        view = KINDS.get(run.problem, "problem").view
-    except UnknownNameError:
-        view = None  # a kind not loaded here: its files are drawn as they are
-    if view is not None:
-        return view(run, field=field, **options)
-    from .generic import generic_picture
-
-    return generic_picture(run, field=field)

@@ -19,7 +19,7 @@ class View:
     Parameters
     ----------
     picture : Picture
-        What :func:`femkit.view.core.source.picture_of` built.
+        What :func:`femkit.view.core.dispatch.picture_of` built.
     size : tuple of int
         Width and height in pixels of the inline image.
     frame : int
