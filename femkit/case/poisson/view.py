@@ -58,12 +58,15 @@ def _layers_3d(grid, scalars: str, title: str, log: bool, edges: bool, section: 
     ghost = Layer(surface(grid), color="grey", opacity=0.12)
     if section == "surface":
         shown = surface(grid)
-        return [Layer(shown, scalars, title, log=log, edges=edges, cmap=_cmap(scalars))]
+        return [Layer(shown, scalars, title, log=log, edges=edges, cmap=_cmap(scalars),
+                      lighting=False)]
     if section == "slice":
-        shown = grid.slice_orthogonal(*centre)
+        shown = grid.slice_orthogonal(x=centre[0], y=centre[1], z=centre[2]).combine()
     else:
         shown = grid.clip(normal=(1.0, 1.0, 1.0), origin=centre, crinkle=scalars == "eta")
-    return [Layer(shown, scalars, title, log=log, edges=edges, cmap=_cmap(scalars)), ghost]
+    # unlit: the colours are the colour map's, so the field reads off the colour bar
+    return [Layer(shown, scalars, title, log=log, edges=edges, cmap=_cmap(scalars), lighting=False),
+            ghost]
 
 
 def _cmap(scalars: str) -> str:

@@ -43,6 +43,9 @@ class Layer:
         Sizes of points and lines (pixels).
     tubes : bool
         Draw lines as tubes and points as spheres (ropes, pins).
+    lighting : bool, optional
+        Shade by the lights (default: in 3D); False draws the colour map's own colours (a scalar
+        field read by its colours).
     """
 
     mesh: Any
@@ -57,6 +60,7 @@ class Layer:
     point_size: float = 6.0
     line_width: float = 2.0
     tubes: bool = False
+    lighting: bool | None = None
 
 
 @dataclass

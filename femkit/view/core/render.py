@@ -133,7 +133,8 @@ def draw(p: Any, picture: Picture, index: int = -1, *, clim=None, camera: bool =
         kwargs = dict(style=layer.style, opacity=layer.opacity, show_edges=layer.edges,
                       point_size=layer.point_size, line_width=layer.line_width,
                       render_lines_as_tubes=layer.tubes, render_points_as_spheres=layer.tubes,
-                      edge_color="#404040", lighting=picture.dim == 3)
+                      edge_color="#404040",
+                      lighting=picture.dim == 3 if layer.lighting is None else layer.lighting)
         if layer.scalars is None:
             p.add_mesh(layer.mesh, color=layer.color, **kwargs)
             continue
