@@ -74,7 +74,7 @@ def assert_picture(img: np.ndarray, min_cover: float = 0.03) -> None:
 
 CASES = [("poisson2d", {}), ("poisson2d", {"field": "eta"}), ("poisson3d", {}),
          ("poisson3d", {"section": "slice"}), ("disk", {}), ("rope", {}), ("cloth", {}),
-         ("cloth", {"field": "stretch"}), ("solid", {}), ("solid", {"field": "displacement"})]
+         ("cloth", {"field": "stretch"}), ("solid", {})]
 
 
 @pytest.mark.parametrize("name, options", CASES, ids=[f"{n}-{o}" for n, o in CASES])
@@ -104,12 +104,13 @@ def test_the_3d_clip_shows_the_fichera_corner_singularity(runs):
     img = open_view(runs["poisson3d"].output_dir, size=SIZE, edges=False).image().astype(float)
     top = int(0.12 * SIZE[1])
     area = img[top:, :int(0.8 * SIZE[0])]  # below the title, left of the colour bar
-    lut = colormaps["viridis"](np.linspace(0, 1, 256))[:, :3] * 255
+    area = area[::2, ::2]  # every other pixel: enough, and 4x cheaper
+    lut = colormaps["viridis"](np.linspace(0, 1, 64))[:, :3] * 255
     dist = np.linalg.norm(area[:, :, None, :] - lut[None, None], axis=3)
     t, near = dist.argmin(axis=2), dist.min(axis=2) < 40
-    assert near.mean() > 0.05 and np.ptp(t[near]) > 150
+    assert near.mean() > 0.05 and np.ptp(t[near]) > 40
     low = np.argwhere(near & (t <= np.percentile(t[near], 1)))
-    cy, cx = low.mean(axis=0) + (top, 0)
+    cy, cx = 2 * low.mean(axis=0) + (top, 0)
     assert abs(cy - SIZE[1] / 2) < 0.1 * SIZE[1] and abs(cx - SIZE[0] / 2) < 0.1 * SIZE[0], (cy, cx)
 
 
@@ -123,7 +124,7 @@ def test_a_kind_without_a_view_is_drawn_from_its_pvd(runs, tmp_path):
     assert_picture(view.image())
 
 
-@pytest.mark.parametrize("name", ["poisson3d", "disk", "cloth", "solid"])
+@pytest.mark.parametrize("name", ["poisson3d", "cloth"])
 def test_femkit_view_writes_a_png_and_a_gif(runs, name, tmp_path, capsys):
     png, gif = tmp_path / "a.png", tmp_path / "a.gif"
     code = main(["view", str(runs[name].output_dir), "--screenshot", str(png), "--movie", str(gif),
