@@ -97,7 +97,7 @@ def poisson_view(run: Run, field: str | None = None, edges: bool | None = None,
     edges = grid.n_cells <= 5000 if edges is None else edges
     log = name == "eta"
     cells = "triangles" if dim == 2 else "tetrahedra"
-    title = f"{run.name}: {_TITLES.get(name, name)}, {grid.n_cells} {cells}"
+    title = f"{run.name}: {_TITLES.get(name, name).split(' (')[0]}, {grid.n_cells} {cells}"
     if dim == 2:
         layers = [Layer(grid, name, _TITLES.get(name, name), log=log, edges=edges, cmap=_cmap(name))]
     else:

@@ -68,4 +68,6 @@ def solid_view(run: Run, field: str | None = None, scale: float | None = None,
                           ghost], t))
     shown_as = "" if factor == 1 else f", displacement x {factor:g}"
     title = f"{run.name}: {TITLES.get(name, name).split(' (')[0]}{shown_as}"
-    return Picture(out, title=title, dim=dim, field=name, fields=tuple(fields))
+    facts = run.facts or (run.result.to_dict() if run.result is not None else {})
+    label = "load factor" if facts.get("mode") == "static" else "t"
+    return Picture(out, title=title, dim=dim, field=name, fields=tuple(fields), time_label=label)

@@ -91,6 +91,8 @@ class Picture:
         A camera position ``(eye, focus, up)`` replacing the default view.
     clim : tuple of float, optional
         The colour range; None: the range over every frame.
+    time_label : str
+        What a frame's time is called under the picture (``t``; a static solid: ``load factor``).
     """
 
     frames: list[Frame]
@@ -100,6 +102,7 @@ class Picture:
     fields: tuple[str, ...]
     camera: tuple | None = None
     clim: tuple[float, float] | None = None
+    time_label: str = "t"
     notes: list[str] = field(default_factory=list)
 
     @property

@@ -87,7 +87,7 @@ def plotter(size: tuple[int, int], off_screen: bool = True) -> Any:
     pv = pyvista()
     if off_screen and not offscreen_available():
         raise ViewUnavailableError(f"no display and no off-screen OpenGL here: install {INSTALL_OFFSCREEN}")
-    p = pv.Plotter(off_screen=off_screen, window_size=list(size))
+    p = pv.Plotter(off_screen=off_screen, window_size=list(size), lighting="three lights")
     p.set_background(BACKGROUND)
     return p
 
@@ -146,7 +146,7 @@ def draw(p: Any, picture: Picture, index: int = -1, *, clim=None, camera: bool =
                    scalar_bar_args=bar, **kwargs)
     p.add_text(picture.title, position="upper_edge", font_size=int(font * 0.75), color=FOREGROUND)
     if frame.time is not None and len(picture.frames) > 1:
-        p.add_text(f"t = {frame.time:.4g}", position=(int(0.8 * size[0]), int(0.02 * size[1])),
+        p.add_text(f"{picture.time_label} = {frame.time:.4g}", position=(int(0.76 * size[0]), int(0.02 * size[1])),
                    font_size=int(font * 0.7), color=FOREGROUND)
     if camera:
         _camera(p, picture)

@@ -22,14 +22,17 @@ class View:
         What :func:`femkit.view.core.dispatch.picture_of` built.
     size : tuple of int
         Width and height in pixels of the inline image.
-    frame : int
-        The frame shown inline and by :meth:`screenshot` (default: the last).
+    frame : int, optional
+        The frame shown inline (a PNG) and by :meth:`screenshot`; None (the default): a time
+        series shows inline as an animation, and its screenshot is the last frame.
     """
 
-    def __init__(self, picture: Picture, size: tuple[int, int] = (960, 720), frame: int = -1):
+    def __init__(self, picture: Picture, size: tuple[int, int] = (960, 720),
+                 frame: int | None = None):
         self.picture = picture
         self.size = tuple(size)
-        self.frame_index = frame
+        self.animated = frame is None and len(picture.frames) > 1
+        self.frame_index = -1 if frame is None else frame
 
     @property
     def fields(self) -> tuple[str, ...]:
@@ -66,7 +69,7 @@ class View:
         show(self.picture, self.frame_index, self.size)
 
     def _repr_png_(self) -> bytes | None:
-        if len(self.picture.frames) > 1:
+        if self.animated:
             return None  # shown as an animation by _repr_html_
         from .render import png_bytes
 
@@ -74,7 +77,7 @@ class View:
 
     def _repr_html_(self) -> str | None:
         """A time series inline: an animated GIF (every frame, one colour range)."""
-        if len(self.picture.frames) < 2:
+        if not self.animated:
             return None
         import tempfile
 
