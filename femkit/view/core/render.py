@@ -25,7 +25,7 @@ from ...errors import InputError, ViewUnavailableError
 from .picture import Picture
 
 __all__ = ["pyvista", "display_available", "offscreen_available", "plotter", "draw",
-           "image", "png_bytes", "screenshot", "movie", "show", "check_movie_path", "MOVIE_SUFFIXES",
+           "image", "png_bytes", "screenshot", "movie", "show", "check_movie_path", "frame_index", "MOVIE_SUFFIXES",
            "INSTALL_VIEW", "INSTALL_OFFSCREEN"]
 
 #: What the one line says when pyvista cannot be imported.
@@ -168,7 +168,7 @@ def _camera(p: Any, picture: Picture) -> None:
     p.camera.zoom(0.95 if picture.dim == 3 else 0.9)
 
 
-def _frame_index(picture: Picture, frame: int) -> int:
+def frame_index(picture: Picture, frame: int) -> int:
     n = len(picture.frames)
     if not -n <= frame < n:
         raise InputError(f"frame {frame} out of range: the picture has {n} frame(s) (0 to {n - 1}, "
@@ -180,7 +180,7 @@ def image(picture: Picture, frame: int = -1, size: tuple[int, int] = (1280, 960)
     """Frame ``frame`` rendered off screen: an ``(height, width, 3)`` array of RGB bytes."""
     p = plotter(size, off_screen=True)
     try:
-        draw(p, picture, _frame_index(picture, frame))
+        draw(p, picture, frame_index(picture, frame))
         return np.asarray(p.screenshot(None, return_img=True))
     finally:
         p.close()
@@ -259,7 +259,7 @@ def show(picture: Picture, frame: int = -1, size: tuple[int, int] = (1024, 768))
         raise ViewUnavailableError("no display here for an interactive window: give --screenshot "
                                    "FILE or --movie FILE to render off screen")
     p = plotter(size, off_screen=False)
-    draw(p, picture, _frame_index(picture, frame))
+    draw(p, picture, frame_index(picture, frame))
     if len(picture.frames) > 1:
         clim = colour_range(picture)
 

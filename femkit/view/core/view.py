@@ -40,8 +40,11 @@ class View:
         return self.picture.fields
 
     def frame(self, index: int) -> "View":
-        """The same view showing frame ``index`` (a time series' instant)."""
-        return View(self.picture, self.size, index)
+        """The same view showing frame ``index`` (a time series' instant; an InputError names
+        the valid range)."""
+        from .render import frame_index
+
+        return View(self.picture, self.size, frame_index(self.picture, index))
 
     def image(self):
         """The frame as an ``(height, width, 3)`` RGB array."""
