@@ -178,3 +178,24 @@ def test_without_display_or_offscreen_opengl_one_line_names_what_to_install(runs
     _refused(capsys, ["view", str(runs["poisson3d"].output_dir), "--screenshot", str(png)],
              "libegl1", "scripts/install-view.sh")
     assert not png.exists()
+
+
+STUDY_3D = ["study", str(ROOT / "studies" / "poisson_convergence_3d.yaml"), "--quick", "--set",
+            "levels.count=2", "--set", "quadrature=[barycentric]", "--set",
+            "solvers=[{method: direct}]", "--set", "reference=none", "--quiet"]
+
+
+def test_a_3d_study_report_embeds_the_solution_and_works_without_pyvista(tmp_path, monkeypatch,
+                                                                          capsys):
+    assert main(STUDY_3D + ["--output", str(tmp_path / "with")]) == 0, capsys.readouterr().err
+    from PIL import Image
+
+    png = tmp_path / "with" / "figures" / "solution_3d.png"
+    img = np.asarray(Image.open(png).convert("RGB").resize(SIZE))
+    assert judge(img)["std"] > 15 and judge(img)["bar_colours"] >= 15
+    assert "figures/solution_3d.png" in (tmp_path / "with" / "report.html").read_text()
+    monkeypatch.setitem(sys.modules, "pyvista", None)
+    assert main(STUDY_3D + ["--output", str(tmp_path / "without")]) == 0, capsys.readouterr().err
+    html = (tmp_path / "without" / "report.html").read_text()
+    assert "pip install femkit[view]" in html and "solution_3d" not in html
+    assert (tmp_path / "without" / "figures" / "error_vs_h.png").is_file()

@@ -15,7 +15,7 @@ from ...view.core.generic import field_names, surface
 from ...view.core.render import pyvista
 from ...view.core.source import Run, check_field
 
-__all__ = ["poisson_view", "SECTIONS"]
+__all__ = ["poisson_view", "solution_picture", "SECTIONS"]
 
 #: How a tetrahedral mesh is cut open -> what it shows.
 SECTIONS = {"clip": "the half behind the plane through the centre normal to (1, 1, 1)",
@@ -26,20 +26,21 @@ _TITLES = {"u": "u", "eta": "error indicator eta_T (log scale)", "kappa": "coeff
            "tag": "region tag"}
 
 
-def _grid_from_result(result):
-    """The mesh of a result in memory with ``u``, ``kappa``, ``tag`` and ``eta``."""
+def _grid(mesh, u, kappa=None, indicators=None):
+    """A femkit mesh (triangles or tetrahedra) as a pyvista grid with ``u``, ``tag`` and, when
+    given, ``kappa`` and ``eta``."""
     pv = pyvista()
-    mesh = result.mesh
     points = np.zeros((mesh.n_points, 3))
     points[:, :mesh.dim] = mesh.points
     kind = pv.CellType.TRIANGLE if mesh.dim == 2 else pv.CellType.TETRA
     grid = pv.UnstructuredGrid({kind: np.asarray(mesh.cells)}, points)
-    grid.point_data["u"] = np.asarray(result.u, dtype=float)
+    grid.point_data["u"] = np.asarray(u, dtype=float)
     grid.cell_data["tag"] = np.asarray(mesh.cell_tags)
-    kappa = np.asarray(result.kappa, dtype=float)
-    grid.cell_data["kappa"] = np.broadcast_to(kappa, (mesh.n_cells,)).copy()
-    if result.indicators is not None:
-        grid.cell_data["eta"] = np.asarray(result.indicators, dtype=float)
+    if kappa is not None:
+        kappa = np.asarray(kappa, dtype=float)
+        grid.cell_data["kappa"] = np.broadcast_to(kappa, (mesh.n_cells,)).copy()
+    if indicators is not None:
+        grid.cell_data["eta"] = np.asarray(indicators, dtype=float)
     return grid, mesh.dim
 
 
@@ -89,15 +90,33 @@ def poisson_view(run: Run, field: str | None = None, edges: bool | None = None,
     section : str
         3D only: one of :data:`SECTIONS`.
     """
+    if run.result is not None:
+        r = run.result
+        grid, dim = _grid(r.mesh, r.u, r.kappa, r.indicators)
+    else:
+        grid, dim = _grid_from_file(run)
+    return _picture(grid, dim, run.name, field, edges, section)
+
+
+def solution_picture(mesh, u, name: str, edges: bool | None = None,
+                     section: str = "clip") -> Picture:
+    """The picture of a P1 field ``u`` on a femkit ``mesh`` (a study's solution), titled
+    ``name``; as :func:`poisson_view` draws ``u``."""
+    grid, dim = _grid(mesh, u)
+    return _picture(grid, dim, name, "u", edges, section)
+
+
+def _picture(grid, dim: int, case: str, field: str | None, edges: bool | None,
+             section: str) -> Picture:
+    """The picture of ``grid`` coloured by ``field`` (2D from above, 3D cut open)."""
     if section not in SECTIONS:
         raise InputError(f"unknown section {section!r}; valid sections: {', '.join(SECTIONS)}")
-    grid, dim = _grid_from_result(run.result) if run.result is not None else _grid_from_file(run)
     fields = field_names(grid)
     name = check_field(field, fields, "u")
     edges = grid.n_cells <= 5000 if edges is None else edges
     log = name == "eta"
     cells = "triangles" if dim == 2 else "tetrahedra"
-    title = f"{run.name}: {_TITLES.get(name, name).split(' (')[0]}, {grid.n_cells} {cells}"
+    title = f"{case}: {_TITLES.get(name, name).split(' (')[0]}, {grid.n_cells} {cells}"
     if dim == 2:
         layers = [Layer(grid, name, _TITLES.get(name, name), log=log, edges=edges, cmap=_cmap(name))]
     else:
