@@ -86,7 +86,7 @@ def poisson_view(run: Run, field: str | None = None, edges: bool | None = None,
         ``u`` (default), ``eta`` (the estimator's indicators: a result in memory with an
         ``estimator``), ``kappa`` or ``tag``.
     edges : bool, optional
-        Draw the mesh edges (default: when the mesh has at most 5000 cells).
+        Draw the mesh edges (default: when each cell gets 20 x 20 pixels on average).
     section : str
         3D only: one of :data:`SECTIONS`.
     """
@@ -113,7 +113,6 @@ def _picture(grid, dim: int, case: str, field: str | None, edges: bool | None,
         raise InputError(f"unknown section {section!r}; valid sections: {', '.join(SECTIONS)}")
     fields = field_names(grid)
     name = check_field(field, fields, "u")
-    edges = grid.n_cells <= 5000 if edges is None else edges
     log = name == "eta"
     cells = "triangles" if dim == 2 else "tetrahedra"
     title = f"{case}: {_TITLES.get(name, name).split(' (')[0]}, {grid.n_cells} {cells}"

@@ -82,7 +82,7 @@ def _body_layers(mesh, name: str) -> list[Layer]:
     elif rope:
         body = [Layer(springs, "speed", TITLES[name], tubes=True, line_width=5)]
     else:
-        body = [Layer(faces, "speed", TITLES[name], edges=faces.n_cells <= 2000)]
+        body = [Layer(faces, "speed", TITLES[name], edges=None)]
     pins = np.asarray(mesh.point_data["pinned"]) > 0 if "pinned" in mesh.point_data else []
     if np.any(pins):
         body.append(Layer(pv.PolyData(np.asarray(mesh.points)[pins]), color="red", style="points",

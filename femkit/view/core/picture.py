@@ -33,8 +33,9 @@ class Layer:
         1 opaque, 0.15 a ghost.
     style : str
         ``"surface"``, ``"wireframe"`` or ``"points"``.
-    edges : bool
-        Draw the cell edges over the surface.
+    edges : bool, optional
+        Draw the cell edges over the surface; None: when each cell gets at least 20 x 20 pixels
+        of the window on average (decided when drawn, by the window's size).
     log : bool
         Logarithmic colour scale (error indicators).
     cmap : str
@@ -54,7 +55,7 @@ class Layer:
     color: str = "lightgrey"
     opacity: float = 1.0
     style: str = "surface"
-    edges: bool = False
+    edges: bool | None = False
     log: bool = False
     cmap: str = "viridis"
     point_size: float = 6.0

@@ -130,7 +130,9 @@ def draw(p: Any, picture: Picture, index: int = -1, *, clim=None, camera: bool =
     font = max(10, int(size[1] / 40))
     clim = colour_range(picture) if clim is None else clim
     for i, layer in enumerate(frame.layers):
-        kwargs = dict(style=layer.style, opacity=layer.opacity, show_edges=layer.edges,
+        edges = layer.edges if layer.edges is not None else \
+            layer.mesh.n_cells * 400 <= size[0] * size[1]
+        kwargs = dict(style=layer.style, opacity=layer.opacity, show_edges=edges,
                       point_size=layer.point_size, line_width=layer.line_width,
                       render_lines_as_tubes=layer.tubes, render_points_as_spheres=layer.tubes,
                       edge_color="#404040",
@@ -138,18 +140,39 @@ def draw(p: Any, picture: Picture, index: int = -1, *, clim=None, camera: bool =
         if layer.scalars is None:
             p.add_mesh(layer.mesh, color=layer.color, **kwargs)
             continue
-        bar = dict(title=layer.title or layer.scalars, vertical=True, position_x=0.84,
-                   position_y=0.1, width=0.05, height=0.75, color=FOREGROUND, fmt="%.3g",
-                   title_font_size=font, label_font_size=int(font * 0.85), n_labels=5)
+        title = layer.title or layer.scalars
+        bar = dict(title=title, vertical=True, position_x=0.84, position_y=0.1, width=0.05,
+                   height=0.75, color=FOREGROUND, fmt="%.3g",
+                   title_font_size=_fit(font, title, 0.26 * size[0]),
+                   label_font_size=int(font * 0.85), n_labels=5)
         p.add_mesh(layer.mesh, scalars=layer.scalars, cmap=layer.cmap, log_scale=layer.log,
                    clim=clim if i == main else None, show_scalar_bar=i == main,
                    scalar_bar_args=bar, **kwargs)
-    p.add_text(picture.title, position="upper_edge", font_size=int(font * 0.75), color=FOREGROUND)
+    p.add_text(picture.title, position="upper_edge", color=FOREGROUND,
+               font_size=_fit(int(font * 0.75), picture.title, 0.95 * size[0]))
     if frame.time is not None and len(picture.frames) > 1:
         p.add_text(f"{picture.time_label} = {frame.time:.4g}", position=(int(0.76 * size[0]), int(0.02 * size[1])),
                    font_size=int(font * 0.7), color=FOREGROUND)
     if camera:
         _camera(p, picture)
+
+
+def _fit(font: int, text: str, width: float) -> int:
+    """``font`` (points), made smaller when ``text`` would be wider than ``width`` pixels (a
+    character is about 0.75 of the font size wide in VTK's Arial, one point a pixel)."""
+    return max(6, min(font, int(width / (0.75 * max(len(text), 1)))))
+
+
+def plane_bounds(picture: Picture) -> list[float]:
+    """The x and y range of every layer of every frame of a 2D picture, padded so that neither
+    side is under 40 % of the other (a straight rope is not a line), as
+    ``[x0, x1, y0, y1, 0, 0]``."""
+    b = np.array([layer.mesh.bounds for frame in picture.frames for layer in frame.layers])
+    lo, hi = np.array([b[:, 0].min(), b[:, 2].min()]), np.array([b[:, 1].max(), b[:, 3].max()])
+    span = max(float(np.max(hi - lo)), 1e-12)
+    grow = np.maximum(0.0, 0.4 * span - (hi - lo)) / 2
+    lo, hi = lo - grow, hi + grow
+    return [lo[0], hi[0], lo[1], hi[1], 0.0, 0.0]
 
 
 def _camera(p: Any, picture: Picture) -> None:
@@ -160,9 +183,12 @@ def _camera(p: Any, picture: Picture) -> None:
     else:
         p.view_isometric()
     if picture.dim == 2:
-        p.show_bounds(xtitle="x", ytitle="y", ztitle="", color=FOREGROUND, location="outer",
-                      font_size=max(8, int(p.window_size[1] / 55)), n_zlabels=0, grid=False,
-                      show_zaxis=False, show_zlabels=False)
+        bounds = plane_bounds(picture)
+        if picture.camera is None:
+            p.reset_camera(bounds=bounds)
+        p.show_bounds(bounds=bounds, xtitle="x", ytitle="y", ztitle="", color=FOREGROUND,
+                      location="outer", font_size=max(8, int(p.window_size[1] / 55)), n_zlabels=0,
+                      grid=False, show_zaxis=False, show_zlabels=False)
     else:
         p.add_axes(color=FOREGROUND, line_width=2)
     p.camera.zoom(0.95 if picture.dim == 3 else 0.9)
