@@ -1,7 +1,7 @@
 """The notebooks of docs/notebooks/ run (nbclient, a fresh kernel each) and draw their pictures:
 a notebook ends without an error and shows an image (a PNG, or a time series' animated GIF) for
 every code cell but its first, so the gallery cannot rot. The default run executes the cheapest
-one; ``FEMKIT_NOTEBOOKS=all`` executes them all (about a minute on 2 cores)."""
+one; ``FEMKIT_VIEW_ALL=1`` executes them all (about a minute on 2 cores)."""
 
 from __future__ import annotations
 
@@ -15,10 +15,10 @@ pytest.importorskip("pyvista", reason="femkit[view] (pyvista) is part of the tes
 
 ROOT = Path(__file__).resolve().parents[2]
 ALL = sorted((ROOT / "docs" / "notebooks").glob("*.ipynb"))
-#: The default run executes the cheapest notebook (the suite's time budget); FEMKIT_NOTEBOOKS=all
+#: The default run executes the cheapest notebook (the suite's time budget); FEMKIT_VIEW_ALL=1
 #: executes every one (docs/views.md). The others are not collected, not skipped.
 CHEAPEST = "convergence_study"
-NOTEBOOKS = ALL if os.environ.get("FEMKIT_NOTEBOOKS") == "all" else \
+NOTEBOOKS = ALL if os.environ.get("FEMKIT_VIEW_ALL") == "1" else \
     [p for p in ALL if p.stem == CHEAPEST]
 
 
