@@ -159,7 +159,26 @@ def test_a_bad_field_is_one_line_naming_the_valid_ones_nothing_written(runs, tmp
     _refused(capsys, ["view", str(runs["solid"].output_dir), "--movie", str(tmp_path / "x.avi")],
              ".gif")
     _refused(capsys, ["view", str(tmp_path), "--screenshot", str(png)], "result.json")
+    _refused(capsys, ["view", str(runs["solid"].output_dir), "--size", "big"], "WIDTHxHEIGHT")
+    import importlib.util
+
+    if importlib.util.find_spec("imageio_ffmpeg") is None:  # MP4 needs it: said in one line
+        _refused(capsys, ["view", str(runs["solid"].output_dir), "--movie",
+                          str(tmp_path / "x.mp4")], "pip install imageio-ffmpeg")
     assert not list(tmp_path.iterdir())
+
+
+def test_without_a_display_and_without_files_asked_the_picture_is_written_here(runs, tmp_path,
+                                                                              monkeypatch, capsys):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setattr(sys, "platform", "linux")
+    monkeypatch.chdir(tmp_path)
+    assert main(["view", str(runs["solid"].output_dir), "--field", "J", "--size", "400x300"]) == 0
+    assert capsys.readouterr().out.strip() == "wrote solid_cantilever-J.png"
+    from PIL import Image
+
+    assert_picture(np.asarray(Image.open(tmp_path / "solid_cantilever-J.png").convert("RGB")))
 
 
 def test_without_pyvista_one_line_names_the_extra(runs, tmp_path, capsys, monkeypatch):
