@@ -141,6 +141,7 @@ def test_femkit_view_writes_a_png_and_a_gif(runs, name, tmp_path, capsys):
     assert len(frames) == n and frames[0].shape[:2] == (300, 400)
     if n > 1:
         assert np.abs(frames[0].astype(int) - frames[-1].astype(int)).max() > 0
+    assert judge(np.asarray(frames[-1])[..., :3])["bar_colours"] >= 15  # every frame has its bar
     assert not list(tmp_path.glob(".*"))  # no temporary file left
 
 
@@ -248,3 +249,21 @@ def test_a_bundled_file_renders(path, tmp_path):
     img = open_view(tmp_path / "run", size=SIZE).image()
     j = judge(img)
     assert j["std"] > 15 and j["bar_colours"] >= 15 and 0.005 < j["covered"] < 0.95, j
+
+
+def test_the_window_slider_redraws_the_chosen_frame(runs):
+    """:func:`render.show`'s slider callback, on an off-screen plotter: frame 0 (the cloth at
+    rest, every node still) and the last frame (falling) differ; the colour bar stays."""
+    picture = open_view(runs["cloth"].output_dir).picture
+    p = render.plotter(SIZE)
+    try:
+        render.draw(p, picture, -1)
+        go = render.frame_slider(p, picture)
+        images = []
+        for k in (0, len(picture.frames) - 1):
+            go(k)
+            images.append(np.asarray(p.screenshot(None, return_img=True)))
+    finally:
+        p.close()
+    assert np.abs(images[0].astype(int) - images[1].astype(int)).max() > 50
+    assert all(judge(img)["bar_colours"] >= 15 for img in images)

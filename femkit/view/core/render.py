@@ -25,7 +25,7 @@ from ...errors import InputError, ViewUnavailableError
 from .picture import Picture
 
 __all__ = ["pyvista", "display_available", "offscreen_available", "plotter", "draw",
-           "image", "png_bytes", "screenshot", "movie", "show", "check_movie_path", "frame_index", "MOVIE_SUFFIXES",
+           "image", "png_bytes", "screenshot", "movie", "show", "check_movie_path", "frame_index", "frame_slider", "MOVIE_SUFFIXES",
            "INSTALL_VIEW", "INSTALL_OFFSCREEN"]
 
 #: What the one line says when pyvista cannot be imported.
@@ -123,7 +123,8 @@ def colour_range(picture: Picture) -> tuple[float, float] | None:
 def draw(p: Any, picture: Picture, index: int = -1, *, clim=None, camera: bool = True) -> None:
     """Add frame ``index`` of ``picture`` to plotter ``p``: its layers, the colour bar of the
     main layer (vertical, at the right), the title, the time and the axes; ``camera``: set the
-    view (2D: from +z; 3D: isometric, or the picture's own camera)."""
+    view too (2D: from +z; 3D: isometric, or the picture's own camera), else keep ``p``'s (the
+    later frames of a movie, the slider)."""
     frame = picture.frames[index]
     main = _main_layer(picture)
     size = p.window_size
@@ -153,8 +154,7 @@ def draw(p: Any, picture: Picture, index: int = -1, *, clim=None, camera: bool =
     if frame.time is not None and len(picture.frames) > 1:
         p.add_text(f"{picture.time_label} = {frame.time:.4g}", position=(int(0.76 * size[0]), int(0.02 * size[1])),
                    font_size=int(font * 0.7), color=FOREGROUND)
-    if camera:
-        _camera(p, picture)
+    _camera(p, picture, move=camera)
 
 
 def _fit(font: int, text: str, width: float) -> int:
@@ -175,23 +175,25 @@ def plane_bounds(picture: Picture) -> list[float]:
     return [lo[0], hi[0], lo[1], hi[1], 0.0, 0.0]
 
 
-def _camera(p: Any, picture: Picture) -> None:
-    if picture.camera is not None:
-        p.camera_position = picture.camera
-    elif picture.dim == 2:
-        p.view_xy()
-    else:
-        p.view_isometric()
-    if picture.dim == 2:
-        bounds = plane_bounds(picture)
-        if picture.camera is None:
+def _camera(p: Any, picture: Picture, move: bool = True) -> None:
+    """The axes (2D: x and y rulers around the bounds of every frame; 3D: the orientation
+    triad) and, with ``move``, the view: from +z in 2D, isometric in 3D, or the picture's own."""
+    bounds = plane_bounds(picture) if picture.dim == 2 else None
+    if move:
+        if picture.camera is not None:
+            p.camera_position = picture.camera
+        elif picture.dim == 2:
+            p.view_xy()
             p.reset_camera(bounds=bounds)
+        else:
+            p.view_isometric()
+        p.camera.zoom(0.95 if picture.dim == 3 else 0.9)
+    if picture.dim == 2:
         p.show_bounds(bounds=bounds, xtitle="x", ytitle="y", ztitle="", color=FOREGROUND,
                       location="outer", font_size=max(8, int(p.window_size[1] / 55)), n_zlabels=0,
                       grid=False, show_zaxis=False, show_zlabels=False)
-    else:
+    elif move:
         p.add_axes(color=FOREGROUND, line_width=2)
-    p.camera.zoom(0.95 if picture.dim == 3 else 0.9)
 
 
 def frame_index(picture: Picture, frame: int) -> int:
@@ -287,14 +289,21 @@ def show(picture: Picture, frame: int = -1, size: tuple[int, int] = (1024, 768))
     p = plotter(size, off_screen=False)
     draw(p, picture, frame_index(picture, frame))
     if len(picture.frames) > 1:
-        clim = colour_range(picture)
-
-        def go(value):
-            camera = p.camera_position
-            p.clear_actors()
-            draw(p, picture, int(round(value)), clim=clim, camera=False)
-            p.camera_position = camera
-
-        p.add_slider_widget(go, [0, len(picture.frames) - 1], value=len(picture.frames) - 1,
-                            title="frame", fmt="%.0f", pointa=(0.1, 0.06), pointb=(0.6, 0.06))
+        p.add_slider_widget(frame_slider(p, picture), [0, len(picture.frames) - 1],
+                            value=len(picture.frames) - 1, title="frame", fmt="%.0f",
+                            pointa=(0.1, 0.06), pointb=(0.6, 0.06))
     p.show()
+
+
+def frame_slider(p: Any, picture: Picture):
+    """The slider's callback of :func:`show`: ``go(value)`` redraws plotter ``p`` at frame
+    ``round(value)``, keeping the camera and the colour range of the whole series."""
+    clim = colour_range(picture)
+
+    def go(value: float) -> None:
+        camera = p.camera_position
+        p.clear()  # actors, colour bar, texts
+        draw(p, picture, int(round(value)), clim=clim, camera=False)
+        p.camera_position = camera
+
+    return go
