@@ -1,11 +1,11 @@
 """Pictures of femkit's results with pyvista, in a notebook, in a window, or off screen
 (``femkit view RUN_DIR``; the optional extra ``femkit[view]``: ``pip install femkit[view]``).
 
->>> import femkit.view                                     # imports no pyvista
->>> v = femkit.view.open_view("runs/fichera")              # doctest: +SKIP
->>> v                                                      # a notebook shows it inline # doctest: +SKIP
->>> v.screenshot("fichera.png"); v.show()                  # doctest: +SKIP
->>> result.plot(field="eta")                               # any result object # doctest: +SKIP
+>>> import femkit.view  # imports no pyvista: the first picture does
+>>> v = femkit.view.open_view("runs/fichera")  # doctest: +SKIP
+>>> v  # a notebook shows it inline  # doctest: +SKIP
+>>> v.screenshot("fichera.png"); v.show()  # doctest: +SKIP
+>>> result.plot(field="eta")  # any result object  # doctest: +SKIP
 
 Each problem kind draws itself: its view function (:attr:`femkit.kinds.Kind.view`, declared in
 the kind's package: ``femkit/case/poisson/view.py``, ``femkit/case/solid/view.py``,

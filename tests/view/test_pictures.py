@@ -86,6 +86,16 @@ def test_every_kind_renders_a_picture_with_a_body_and_a_colour_bar(runs, name, o
     assert_picture(view.image(), min_cover=0.005 if name == "rope" else 0.03)
 
 
+def test_a_scene_draws_its_obstacles_from_the_run_directory_and_from_the_result(runs):
+    """The soft disk's ground (y = 0) is a layer of every frame, read from the case file for a
+    run directory and from the forces of the result in memory."""
+    for source in (runs["disk"].output_dir, runs["disk"]):
+        picture = open_view(source).picture
+        ground = [layer for layer in picture.frames[-1].layers if layer.color == "dimgrey"]
+        assert len(ground) == 1
+        assert np.allclose(np.asarray(ground[0].mesh.points)[:, 1], 0.0)
+
+
 def test_the_checks_fail_on_a_picture_without_colours_or_without_a_body(runs):
     view = open_view(runs["poisson3d"].output_dir, size=SIZE)
     for layer in view.picture.frames[0].layers:
@@ -224,7 +234,8 @@ def test_a_3d_study_report_embeds_the_solution_and_works_without_pyvista(tmp_pat
 
 #: Every bundled case and scene file with FEMKIT_VIEW_ALL=1 (a few minutes: cube.yaml alone is a
 #: minute); the default run draws two cheap ones this way, beside the runs above.
-BUNDLED = sorted((ROOT / "cases").glob("*.yaml")) + sorted((ROOT / "cases" / "scenes").glob("*.yaml"))
+BUNDLED = sorted((ROOT / "cases").glob("*.yaml")) + \
+    sorted((ROOT / "cases" / "scenes").glob("*.yaml"))
 if os.environ.get("FEMKIT_VIEW_ALL") != "1":
     BUNDLED = [p for p in BUNDLED if p.stem in ("poisson_unit_square", "stiff_spring_implicit")]
 

@@ -117,7 +117,8 @@ def _picture(grid, dim: int, case: str, field: str | None, edges: bool | None,
     cells = "triangles" if dim == 2 else "tetrahedra"
     title = f"{case}: {_TITLES.get(name, name).split(' (')[0]}, {grid.n_cells} {cells}"
     if dim == 2:
-        layers = [Layer(grid, name, _TITLES.get(name, name), log=log, edges=edges, cmap=_cmap(name))]
+        layers = [Layer(grid, name, _TITLES.get(name, name), log=log, edges=edges,
+                        cmap=_cmap(name))]
     else:
         layers = _layers_3d(grid, name, _TITLES.get(name, name), log, edges, section)
     return Picture([Frame(layers)], title=title, dim=dim, field=name, fields=tuple(fields))

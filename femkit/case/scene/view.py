@@ -64,8 +64,8 @@ def obstacle_layers(forces, lo: np.ndarray, hi: np.ndarray, dim: int) -> list[La
         elif isinstance(f, SphereContact):
             c = np.zeros(3)
             c[:dim] = np.asarray(f.centre, dtype=float)[:dim]
-            mesh = (pv.Disc(center=c, inner=0.0, outer=f.radius, c_res=64) if dim == 2
-                    else pv.Sphere(radius=f.radius, center=c, theta_resolution=48, phi_resolution=48))
+            mesh = (pv.Disc(center=c, inner=0.0, outer=f.radius, c_res=64) if dim == 2 else
+                    pv.Sphere(radius=f.radius, center=c, theta_resolution=48, phi_resolution=48))
             layers.append(Layer(mesh, color="lightsteelblue", opacity=0.9))
     return layers
 
@@ -111,7 +111,8 @@ def scene_view(run: Run, field: str | None = None, frames: int = 60) -> Picture:
     out = [Frame(_body_layers(mesh, name) + obstacles, t) for t, mesh in series]
     clim = None
     if name == "stretch":
-        m = max(float(np.abs(np.asarray(f.layers[0].mesh["stretch"])).max(initial=0.0)) for f in out)
+        m = max(float(np.abs(np.asarray(f.layers[0].mesh["stretch"])).max(initial=0.0))
+                for f in out)
         clim = (-max(m, 1e-9), max(m, 1e-9))
     return Picture(out, title=f"{run.name}: {TITLES[name].split(' (')[0]}", dim=dim,
                    field=name, fields=tuple(fields), clim=clim)

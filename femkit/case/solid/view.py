@@ -62,9 +62,9 @@ def solid_view(run: Run, field: str | None = None, scale: float | None = None,
     for t, mesh in series:
         shown = mesh.warp_by_vector("displacement", factor=factor)
         scalars = colour_by(shown, name)
-        out.append(Frame([Layer(surface(shown) if dim == 3 else shown, scalars, TITLES.get(name, name),
-                                edges=edges, cmap="turbo" if name == "von_mises" else "viridis"),
-                          ghost], t))
+        body = surface(shown) if dim == 3 else shown
+        out.append(Frame([Layer(body, scalars, TITLES.get(name, name), edges=edges,
+                                cmap="turbo" if name == "von_mises" else "viridis"), ghost], t))
     shown_as = "" if factor == 1 else f", displacement x {factor:g}"
     title = f"{run.name}: {TITLES.get(name, name).split(' (')[0]}{shown_as}"
     facts = run.facts or (run.result.to_dict() if run.result is not None else {})

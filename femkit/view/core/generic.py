@@ -18,7 +18,8 @@ from .picture import Frame, Layer, Picture
 from .render import pyvista
 from .source import Run, check_field
 
-__all__ = ["read_pvd", "read_series", "field_names", "flat", "colour_by", "surface", "generic_picture"]
+__all__ = ["read_pvd", "read_series", "field_names", "flat", "colour_by", "surface",
+           "generic_picture"]
 
 #: Arrays that are bookkeeping, not fields (gmsh's tags).
 HIDDEN = ("gmsh:physical", "gmsh:geometrical", "vtkOriginalPointIds", "vtkOriginalCellIds")

@@ -9,7 +9,7 @@ pyvista through :func:`femkit.view.core.render.pyvista` (the optional extra ``fe
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 __all__ = ["Layer", "Frame", "Picture"]
@@ -104,7 +104,6 @@ class Picture:
     camera: tuple | None = None
     clim: tuple[float, float] | None = None
     time_label: str = "t"
-    notes: list[str] = field(default_factory=list)
 
     @property
     def times(self) -> list[float | None]:

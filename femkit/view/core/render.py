@@ -24,8 +24,9 @@ import numpy as np
 from ...errors import InputError, ViewUnavailableError
 from .picture import Picture
 
-__all__ = ["pyvista", "display_available", "offscreen_available", "plotter", "draw",
-           "image", "png_bytes", "screenshot", "movie", "show", "check_movie_path", "frame_index", "frame_slider", "MOVIE_SUFFIXES",
+__all__ = ["pyvista", "display_available", "offscreen_available", "plotter", "draw", "image",
+           "png_bytes", "screenshot", "movie", "show", "check_movie_path", "frame_index",
+           "frame_slider", "plane_bounds", "colour_range", "MOVIE_SUFFIXES",
            "INSTALL_VIEW", "INSTALL_OFFSCREEN"]
 
 #: What the one line says when pyvista cannot be imported.
@@ -86,7 +87,8 @@ def plotter(size: tuple[int, int], off_screen: bool = True) -> Any:
     """
     pv = pyvista()
     if off_screen and not offscreen_available():
-        raise ViewUnavailableError(f"no display and no off-screen OpenGL here: install {INSTALL_OFFSCREEN}")
+        raise ViewUnavailableError("no display and no off-screen OpenGL here: install "
+                                   f"{INSTALL_OFFSCREEN}")
     p = pv.Plotter(off_screen=off_screen, window_size=list(size), lighting="three lights")
     p.set_background(BACKGROUND)
     return p
@@ -152,8 +154,8 @@ def draw(p: Any, picture: Picture, index: int = -1, *, clim=None, camera: bool =
     p.add_text(picture.title, position="upper_edge", color=FOREGROUND,
                font_size=_fit(int(font * 0.75), picture.title, 0.95 * size[0]))
     if frame.time is not None and len(picture.frames) > 1:
-        p.add_text(f"{picture.time_label} = {frame.time:.4g}", position=(int(0.76 * size[0]), int(0.02 * size[1])),
-                   font_size=int(font * 0.7), color=FOREGROUND)
+        p.add_text(f"{picture.time_label} = {frame.time:.4g}", font_size=int(font * 0.7),
+                   position=(int(0.76 * size[0]), int(0.02 * size[1])), color=FOREGROUND)
     _camera(p, picture, move=camera)
 
 
