@@ -20,6 +20,8 @@ Hierarchy::
     │   │                          (before the run; ``force`` overrides)
     │   ├── BackendUnavailableError  a solver backend (PETSc: petsc4py, mpi4py) cannot be
     │                              imported; the message names scripts/install-petsc.sh
+    │   │   └── ViewUnavailableError  pictures (``femkit view``, ``result.plot()``) without
+    │   │                          pyvista, or without a display and off-screen OpenGL
     │   └── MaterialError          bad material parameters (E <= 0, nu outside (-1, 1/2), density <= 0)
     ├── SolverError                a linear solver could not do what was asked
     │   ├── NotSPDError            input to CG-type method is not symmetric positive definite
@@ -110,6 +112,12 @@ class MaterialError(InputError):
 class BackendUnavailableError(InputError):
     """A solver backend cannot be used here (e.g. ``backend="petsc"`` without petsc4py):
     the one-line message says what is missing and how to install it."""
+
+
+class ViewUnavailableError(BackendUnavailableError):
+    """A picture (``femkit view``, ``result.plot()``) cannot be drawn here: pyvista is missing
+    (``pip install femkit[view]``), or there is neither a display nor off-screen OpenGL (EGL or
+    OSMesa; ``scripts/install-view.sh``). The one-line message names what to install."""
 
 
 class RankFailureError(FemkitError):

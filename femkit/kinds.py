@@ -83,6 +83,12 @@ class Kind:
         ``linear_solver:`` without ``method``): the one home of that default (``pcg`` for
         Poisson, ``direct`` for scenes, ``cholesky`` for the cloth study). None: the kind takes no
         solver mapping of its own.
+    view : callable, optional
+        Problems: ``view(source, field=None, **options) -> femkit.view.core.Picture``, the
+        picture of a result object or a run directory (``source``) that ``femkit view`` and
+        ``result.plot()`` draw; a kind's package declares it in its ``kind.py`` and imports its
+        view module on first use. None: the generic picture of the run directory (its ``.pvd``
+        time series, else its ``solution.vtu``; :mod:`femkit.view.core.generic`).
     """
 
     name: str
@@ -94,6 +100,7 @@ class Kind:
     report: Callable | None = None
     summary: Callable | None = None
     default_solver: str | None = None
+    view: Callable | None = None
 
     def __post_init__(self):
         if self.key not in FAMILIES:

@@ -4,7 +4,8 @@ Every problem kind's result extends it (Poisson :class:`femkit.case.poisson.prob
 scenes :class:`femkit.case.scene.run.SceneResult`, solids :class:`femkit.case.solid.run.SolidResult`,
 and a kind added by a plugin), so ``femkit solve``, the studies and the tests read every result the
 same way: ``converged``, ``interrupted``, ``verdict``, ``timings``, ``files``, ``output_dir``,
-``summary_lines()``, ``to_dict()`` (``result.json``) and :meth:`RunResult.write_result_json`.
+``summary_lines()``, ``to_dict()`` (``result.json``) and :meth:`RunResult.write_result_json`;
+:meth:`RunResult.plot` draws any of them (pyvista: the extra ``femkit[view]``).
 
 A kind writes only its own facts (:meth:`RunResult.facts`); the keys every ``result.json`` starts
 with (``case``, ``problem``, ``case_file``, ``femkit_version``) are written here.
@@ -101,6 +102,27 @@ class RunResult:
             return None
         listed = ", ".join(self.files) if names else f"{len(self.files)} files"
         return f"output    {self.output_dir} ({listed})"
+
+    def plot(self, field: str | None = None, **options):
+        """The picture of this result, drawn by its kind's view function (``femkit[view]``:
+        pyvista, imported only now); a notebook shows it inline.
+
+        Parameters
+        ----------
+        field : str, optional
+            The field to colour by (the kind's default when None); an unknown one raises
+            :class:`~femkit.errors.UnknownNameError` listing the valid ones.
+        **options
+            ``size=(w, h)`` and the kind's own options (docs/views.md).
+
+        Returns
+        -------
+        femkit.view.core.view.View
+            ``.screenshot(path)``, ``.movie(path)``, ``.show()``, ``.frame(k)``.
+        """
+        from ..view.core import view_of
+
+        return view_of(self, field=field, **options)
 
     def write_result_json(self, directory: str | os.PathLike, files: Iterable[str]) -> Path:
         """Record ``files`` (the names written, ``result.json`` among them) and write

@@ -1,5 +1,5 @@
 """The ``femkit`` command line: ``femkit solve CASE``, ``femkit check CASE``, ``femkit study``,
-``femkit list``, ``femkit warmup``.
+``femkit list``, ``femkit warmup``, ``femkit view RUN_DIR``.
 
 Modules: :mod:`~femkit.cli.parser` (argparse: every subcommand's flags and help, ``--set``),
 :mod:`~femkit.cli.commands` (what each subcommand does), :mod:`~femkit.cli.messages` (exit codes,

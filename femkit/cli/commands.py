@@ -83,3 +83,43 @@ def run_warmup(args) -> int:
     print(f"bytecode of femkit's {written} modules written"
           + (f" ({failed} could not be written: a read-only install)" if failed else ""))
     return EXIT_OK
+
+
+def _size(text: str) -> tuple[int, int]:
+    """``"1280x960"`` -> ``(1280, 960)``; anything else an InputError naming the form."""
+    from ..errors import InputError
+
+    w, x, h = text.lower().partition("x")
+    if not (x and w.isdigit() and h.isdigit() and 16 <= int(w) <= 8192 and 16 <= int(h) <= 8192):
+        raise InputError(f"--size {text!r}: expected WIDTHxHEIGHT in pixels, e.g. 1280x960")
+    return int(w), int(h)
+
+
+def run_view(args) -> int:
+    """``femkit view``: draw a run directory (window, ``--screenshot``, ``--movie``)."""
+    from pathlib import Path
+
+    from ..view import open_view
+    from ..view.core.render import check_movie_path, display_available
+
+    size = _size(args.size)
+    if args.movie:  # a bad file type is refused before anything is drawn
+        check_movie_path(Path(args.movie))
+    if args.screenshot and Path(args.screenshot).suffix.lower() != ".png":
+        from ..errors import InputError
+
+        raise InputError(f"--screenshot {args.screenshot}: a screenshot is a .png file")
+    view = open_view(args.run_dir, field=args.field, size=size)
+    written = []
+    if args.screenshot:
+        written.append(view.screenshot(args.screenshot))
+    if args.movie:
+        written.append(view.movie(args.movie))
+    if not written and display_available():
+        view.show()
+    elif not written:
+        name = f"{view.picture.title.split(':')[0]}-{view.picture.field}.png"
+        written.append(view.screenshot(name))
+    for path in written:
+        print(f"wrote {path}")
+    return EXIT_OK

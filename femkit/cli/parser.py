@@ -17,7 +17,7 @@ import argparse
 import sys
 from typing import Callable, Sequence
 
-from .commands import run_check, run_solve, run_warmup
+from .commands import run_check, run_solve, run_view, run_warmup
 from .messages import EXIT_BAD_INPUT, EXIT_OK
 
 _EPILOG = """\
@@ -270,8 +270,49 @@ def _run_list(args) -> int:
     return EXIT_OK
 
 
+# ----------------------------------------------------------------------------- view
+
+_VIEW_EPILOG = """\
+exit codes:
+  0  shown, or the files written
+  2  bad input (not a run directory, an unknown --field: the valid ones are named,
+     an unknown file type), or no pyvista (pip install femkit[view]), or neither a
+     display nor off-screen OpenGL (EGL/OSMesa: scripts/install-view.sh); one line,
+     nothing written
+
+examples:
+  femkit view runs/fichera
+  femkit view runs/fichera --screenshot fichera.png
+  femkit view runs/hanging_cloth --field stretch --movie cloth.gif
+"""
+
+
+def _add_view(sub) -> None:
+    p = sub.add_parser(
+        "view", help="look at a run's results (pyvista: pip install femkit[view])",
+        description=(
+            "Draw the results of the run in RUN_DIR (the output directory of 'femkit solve') as "
+            "its kind draws them: a Poisson solution (3D: clipped open), a solid warped by its "
+            "displacement and coloured by its stress over its rest shape, a scene with its "
+            "obstacles; a time series frame by frame. In a window with a frame slider where a "
+            "display exists; --screenshot and --movie render off screen (also where there is no "
+            "display); with neither and no display, RUN_DIR's picture is written to "
+            "<case>-<field>.png here. Files are written atomically."),
+        epilog=_VIEW_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("run_dir", metavar="RUN_DIR", help="a run directory (holding result.json)")
+    p.add_argument("--field", metavar="NAME",
+                   help="the field to colour by (default: the kind's; an unknown one lists them)")
+    p.add_argument("--screenshot", metavar="FILE", help="write the last frame to FILE (.png)")
+    p.add_argument("--movie", metavar="FILE",
+                   help="write every frame to FILE (.gif; .mp4 with imageio-ffmpeg)")
+    p.add_argument("--size", metavar="WxH", default="1280x960",
+                   help="picture size in pixels (default 1280x960)")
+    p.set_defaults(handler=run_view)
+
+
 #: Subcommands, in help order: each adds its parser to the subparsers object.
-SUBCOMMANDS: list[Callable] = [_add_solve, _add_check, _add_study, _add_list, _add_warmup]
+SUBCOMMANDS: list[Callable] = [_add_solve, _add_check, _add_study, _add_list, _add_warmup,
+                               _add_view]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -18,9 +18,10 @@ sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shar
 from _small import SMALL as CASE  # noqa: E402
 
 #: imported by nothing a solve does (each was, before): the duplicate-node check's k-d tree, the
-#: studies' timing helpers, xml.sax (and urllib.request, http.client behind it) for one escape
+#: studies' timing helpers, xml.sax (and urllib.request, http.client behind it) for one escape;
+#: and the pictures' pyvista and VTK (femkit[view]), imported by `femkit view` and plot() alone
 LAZY = ("scipy.spatial", "femkit.study.timing", "femkit.study.load", "femkit.study.run", "xml.sax",
-        "urllib.request", "http.client")
+        "urllib.request", "http.client", "pyvista", "vtkmodules", "femkit.view")
 
 IMPORTS = """
 import sys, types

@@ -35,5 +35,11 @@ def _plan(case, **kwargs):
     return plan_poisson_case(case, **kwargs)
 
 
+def _view(run, **options):
+    from .view import poisson_view
+
+    return poisson_view(run, **options)
+
+
 KIND = register_kind(Kind("poisson", "problem", _schema, _prepare, _run, _plan,
-                          default_solver="pcg"))
+                          default_solver="pcg", view=_view))

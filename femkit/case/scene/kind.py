@@ -44,5 +44,11 @@ def _plan(case, measure: bool = True):
     return plan_scene_case(case, system_size(case.spec.system), build=build, measure=measure)
 
 
+def _view(run, **options):
+    from .view import scene_view
+
+    return scene_view(run, **options)
+
+
 KIND = register_kind(Kind("mass_spring", "problem", _schema, _prepare, _run, _plan,
-                          default_solver="direct"))
+                          default_solver="direct", view=_view))

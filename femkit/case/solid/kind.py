@@ -35,5 +35,11 @@ def _plan(case, **kwargs):
     return plan_solid_case(case, **kwargs)
 
 
+def _view(run, **options):
+    from .view import solid_view
+
+    return solid_view(run, **options)
+
+
 KIND = register_kind(Kind("solid", "problem", _schema, _prepare, _run, _plan,
-                          default_solver="direct"))
+                          default_solver="direct", view=_view))

@@ -120,6 +120,7 @@ def build(report, study, result, data, stage) -> None:
                     xlabel="degrees of freedom (free unknowns)", ylabel="error norm (L2, H1 seminorm)", triangle=-1,
                     note="triangle: slope -1 (L2 ~ h^2 ~ 1/dofs in 2D)")
     report.figure("figures/error_vs_dofs.png", "Error against the number of unknowns")
+    _solution_figure(report, study, data, stage, rules[0])
 
     it_series = []
     for key in lines:
@@ -207,3 +208,29 @@ def summary(result) -> list[str]:
     report's table."""
     return [f"rate {who} / {rule} / {norm}: {slope:.3f} ({r2_text(r2)})"
             for who, rule, norm, slope, _, r2, *_ in grouped_rate_rows(result.fits)]
+
+
+def _solution_figure(report, study, data, stage, rule: str) -> None:
+    """A 3D study shows its solution on the second finest mesh, clipped open through the centre
+    (a direct solve; pyvista renders it off screen: ``femkit[view]``). Without pyvista, or
+    without off-screen OpenGL, the report says so in one sentence and is otherwise the same."""
+    meshes = data.get("meshes") or []
+    if not meshes or meshes[0].dim != 3:
+        return
+    from ...errors import ViewUnavailableError
+    from ..problem import study_problem
+
+    mesh = meshes[-2] if len(meshes) > 1 else meshes[-1]
+    try:
+        from ...case.poisson.view import solution_picture
+        from ...view.core.render import screenshot
+
+        u = study_problem(study).problem(mesh, rule).solve("direct").u
+        picture = solution_picture(mesh, u, study.name)
+        screenshot(picture, stage / "figures" / "solution_3d.png", size=(960, 720))
+    except ViewUnavailableError as exc:
+        report.paragraph(f"(No 3D picture of the solution: {exc}.)")
+        return
+    report.figure("figures/solution_3d.png",
+                  f"The discrete solution u on {mesh.n_cells} tetrahedra ({rule} load rule), clipped "
+                  "through the centre normal to (1, 1, 1); the whole boundary as a grey ghost")

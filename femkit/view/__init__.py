@@ -1,0 +1,47 @@
+"""Pictures of femkit's results with pyvista, in a notebook, in a window, or off screen
+(``femkit view RUN_DIR``; the optional extra ``femkit[view]``: ``pip install femkit[view]``).
+
+>>> import femkit.view  # imports no pyvista: the first picture does
+>>> v = femkit.view.open_view("runs/fichera")  # doctest: +SKIP
+>>> v  # a notebook shows it inline  # doctest: +SKIP
+>>> v.screenshot("fichera.png"); v.show()  # doctest: +SKIP
+>>> result.plot(field="eta")  # any result object  # doctest: +SKIP
+
+Each problem kind draws itself: its view function (:attr:`femkit.kinds.Kind.view`, declared in
+the kind's package: ``femkit/case/poisson/view.py``, ``femkit/case/solid/view.py``,
+``femkit/case/scene/view.py``) turns a result object or a run directory into a
+:class:`~femkit.view.core.picture.Picture`; a kind without one is drawn from its files
+(its ``.pvd`` time series, else ``solution.vtu``). docs/views.md.
+"""
+
+from __future__ import annotations
+
+__all__ = ["open_view"]
+
+
+def open_view(source, field: str | None = None, size: tuple[int, int] = (960, 720), **options):
+    """A :class:`~femkit.view.core.view.View` of ``source``: a result object (``RunResult``)
+    or the path of a run directory.
+
+    Parameters
+    ----------
+    source : RunResult or path
+        What to draw.
+    field : str, optional
+        The field to colour by (the kind's default when None); an unknown one is an
+        :class:`~femkit.errors.UnknownNameError` listing the valid ones.
+    size : tuple of int
+        Width and height in pixels.
+    **options
+        Passed to the kind's view function.
+
+    Returns
+    -------
+    View
+        Shown inline by a notebook; ``.screenshot(path)``, ``.movie(path)``, ``.show()``.
+    """
+    import femkit.case  # noqa: F401  registers the problem kinds (and their view functions)
+
+    from .core import view_of
+
+    return view_of(source, field=field, size=size, **options)

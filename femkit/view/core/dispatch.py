@@ -1,0 +1,30 @@
+"""The dispatch of a picture to its kind's view function, through :data:`femkit.kinds.KINDS`
+(:attr:`femkit.kinds.Kind.view`); a kind without one is drawn from its files
+(:func:`femkit.view.core.generic.generic_picture`)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ...errors import UnknownNameError
+from .picture import Picture
+from .source import open_run
+
+__all__ = ["picture_of"]
+
+
+def picture_of(source: Any, field: str | None = None, **options) -> Picture:
+    """The picture of ``source`` (a result object or a run directory) drawn by its kind's view
+    function (``options`` go to it), or the generic picture of its run directory."""
+    from ...kinds import KINDS
+
+    run = open_run(source)
+    try:
+        view = KINDS.get(run.problem, "problem").view
+    except UnknownNameError:
+        view = None  # a kind not loaded here: its files are drawn as they are
+    if view is not None:
+        return view(run, field=field, **options)
+    from .generic import generic_picture
+
+    return generic_picture(run, field=field)
