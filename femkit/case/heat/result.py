@@ -1,12 +1,12 @@
 """The result of a heat run: :class:`HeatResult`, a :class:`~femkit.case.result.RunResult`
-(through :class:`~femkit.case.transient_run.TransientResult`); ``result.json``'s keys are
+(through :class:`~femkit.case.transient.run.TransientResult`); ``result.json``'s keys are
 described in docs/heat_wave.md."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..transient_run import TransientResult
+from ..transient.run import TransientResult
 
 __all__ = ["HeatResult"]
 

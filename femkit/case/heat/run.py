@@ -1,5 +1,5 @@
-"""Prepare and run a ``problem: heat`` case (the shared steps: :mod:`femkit.case.transient`,
-:mod:`femkit.case.transient_run`)."""
+"""Prepare and run a ``problem: heat`` case (the shared steps: :mod:`femkit.case.transient.setup`,
+:mod:`femkit.case.transient.run`)."""
 
 from __future__ import annotations
 
@@ -20,12 +20,12 @@ def prepare_heat(case) -> None:
     ------
     CaseFileError
         ``rtol_t`` with an integrator that has no embedded error estimate (the valid ones
-        named), besides the common checks of :func:`femkit.case.transient.prepare_transient`.
+        named), besides the common checks of :func:`femkit.case.transient.setup.prepare_transient`.
     """
     import dataclasses
 
     from ...dynamics.mol import HEAT_INTEGRATORS
-    from ..transient import prepare_transient
+    from ..transient.setup import prepare_transient
 
     spec = prepare_transient(case, "rho_c", HEAT_INTEGRATORS)
     if spec.rtol_t is not None:
@@ -38,9 +38,9 @@ def prepare_heat(case) -> None:
 
 def run_heat(case, output_dir: str | os.PathLike | None = None, quiet: bool = False,
              write: bool = True, echo: Callable[[str], Any] | None = None) -> HeatResult:
-    """Run a prepared heat case (:func:`femkit.case.transient_run.run_transient`)."""
+    """Run a prepared heat case (:func:`femkit.case.transient.run.run_transient`)."""
     from ...dynamics.mol import HEAT_INTEGRATORS
-    from ..transient_run import run_transient
+    from ..transient.run import run_transient
 
     return run_transient(case, "rho_c", HEAT_INTEGRATORS, second_order=False,
                          output_dir=output_dir, quiet=quiet, write=write, echo=echo,

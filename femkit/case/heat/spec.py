@@ -5,12 +5,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..transient import TransientSpec
+from ..transient.setup import TransientSpec
 
 __all__ = ["HeatSpec"]
 
 
 @dataclass(frozen=True)
 class HeatSpec(TransientSpec):
-    """A :class:`~femkit.case.transient.TransientSpec` whose ``capacity`` is ``rho_c`` and whose
+    """A :class:`~femkit.case.transient.setup.TransientSpec` whose ``capacity`` is ``rho_c`` and whose
     ``rtol_t``, when set, makes the steps adaptive (implicit Euler's embedded estimate)."""

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..transient import TransientSpec
+from ..transient.setup import TransientSpec
 
 __all__ = ["WaveSpec"]
 
 
 @dataclass(frozen=True)
 class WaveSpec(TransientSpec):
-    """A :class:`~femkit.case.transient.TransientSpec` whose ``capacity`` is ``rho`` (the
+    """A :class:`~femkit.case.transient.setup.TransientSpec` whose ``capacity`` is ``rho`` (the
     initial velocity is the compiled expression ``case.functions["initial_velocity"]``)."""

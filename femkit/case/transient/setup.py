@@ -20,9 +20,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import CaseFileError, ExpressionError, InputError
-from .frozen import freeze
-from .name_checks import check_geometry_spec, lookup, resolve_file, with_prefix
+from ...errors import CaseFileError, ExpressionError, InputError
+from ..frozen import freeze
+from ..name_checks import check_geometry_spec, lookup, resolve_file, with_prefix
 
 __all__ = ["VARIABLES", "TransientSpec", "TransientOutput", "transient_schema",
            "prepare_transient", "at_time", "element_values", "build_system", "check_step",
@@ -56,8 +56,8 @@ def _positive_field(default: float) -> dict:
 def transient_schema(kind: str, capacity: str, integrators, extra: Mapping) -> dict:
     """The JSON schema of ``problem: <kind>`` (``capacity``: ``rho_c`` or ``rho``), the
     integrator enum from ``integrators`` (a registry), ``extra`` the kind's own keys."""
-    from .poisson.schema import POISSON_SCHEMA
-    from .specs import LIMITS_SCHEMA, SOLVER_SCHEMA
+    from ..poisson.schema import POISSON_SCHEMA
+    from ..specs import LIMITS_SCHEMA, SOLVER_SCHEMA
 
     base = POISSON_SCHEMA["properties"]
     names = {"enum": integrators.names()}
@@ -133,7 +133,7 @@ class TransientSpec:
 
 
 def _compile(case, key: str, text, *, check_finite: bool = True):
-    from .expressions import compile_expression
+    from ..expressions import compile_expression
 
     try:
         fn = compile_expression(text, VARIABLES, case.data.get("constants") or {},
@@ -147,7 +147,7 @@ def _compile(case, key: str, text, *, check_finite: bool = True):
 
 def _check_element(name: str) -> str:
     try:
-        from ..elements import ELEMENTS as registry  # the element registry, once it exists
+        from ...elements import ELEMENTS as registry  # the element registry, once it exists
     except ImportError:
         registry = None
     if registry is not None:
@@ -169,11 +169,11 @@ def prepare_transient(case, capacity: str, integrators, expressions: tuple = ())
         One line naming the key: an unknown geometry, integrator or solver, a bad option,
         ``dt`` or ``t_end`` not positive and finite, ``z`` on a 2D geometry.
     """
-    from ..kinds import KINDS
-    from .poisson.spec import BoundarySpec, MeshSpec
-    from .specs import limits_spec, solver_spec
-    from .timeline import time_value
-    from ..dynamics.mol import get_scheme
+    from ...kinds import KINDS
+    from ..poisson.spec import BoundarySpec, MeshSpec
+    from ..specs import limits_spec, solver_spec
+    from ..timeline import time_value
+    from ...dynamics.mol import get_scheme
 
     d = case.data
     if d.get("name"):
@@ -211,8 +211,8 @@ def prepare_transient(case, capacity: str, integrators, expressions: tuple = ())
         for i, g in enumerate(d["exact"].get("grad") or []):
             _compile(case, f"exact.grad[{i}]", g, check_finite=False)
     if "geometry" in mesh:
-        from ..mesh.geometries import GEOMETRIES
-        from .poisson.problem import check_dimension
+        from ...mesh.geometries import GEOMETRIES
+        from ..poisson.problem import check_dimension
 
         check_dimension(case, GEOMETRIES.get(mesh["geometry"]).dim, f"mesh.geometry {mesh['geometry']!r}")
     dt, t_end = time_value(case, "dt"), time_value(case, "t_end")
@@ -251,10 +251,10 @@ def element_values(case, mesh, value, key: str) -> np.ndarray:
     CaseFileError
         Cells in no listed region without a default, or a value that is not positive.
     """
-    from ..fem.coefficients import element_coefficient
+    from ...fem.coefficients import element_coefficient
 
     if isinstance(value, Mapping):
-        from ..mesh import check_tags
+        from ...mesh import check_tags
 
         out = np.full(mesh.n_cells, float(value.get("default", np.nan)))
         try:
@@ -279,7 +279,7 @@ def element_values(case, mesh, value, key: str) -> np.ndarray:
 
 def _dirichlet(case, mesh):
     """``(fixed nodes, [(nodes, expression)] in order)``: later entries win on shared nodes."""
-    from ..mesh import boundary_nodes
+    from ...mesh import boundary_nodes
 
     entries = []
     owner = np.full(mesh.n_points, -1)
@@ -298,9 +298,9 @@ def build_system(case, mesh, capacity: str):
     """The :class:`femkit.dynamics.mol.LinearSystem` of the case on ``mesh``: ``M`` (consistent
     or lumped, ``capacity`` per cell), ``K`` (``kappa`` per cell), the Dirichlet nodes and the
     time-dependent load and boundary values (evaluated once when they do not use ``t``)."""
-    from ..dynamics.mol import LinearSystem
-    from ..fem import assemble_load, assemble_neumann, assemble_stiffness
-    from ..fem.mass import mass_matrix
+    from ...dynamics.mol import LinearSystem
+    from ...fem import assemble_load, assemble_neumann, assemble_stiffness
+    from ...fem.mass import mass_matrix
 
     spec = case.spec
     lumped = spec.mass == "lumped"
@@ -354,9 +354,9 @@ def check_step(case, system, scheme) -> dict:
     BudgetExceededError
         ``dt > dt_crit``: one line naming the largest stable step (exit 2, nothing written).
     """
-    from ..dynamics.mol import critical_step
-    from ..errors import BudgetExceededError
-    from ..cost.plan import round_down
+    from ...dynamics.mol import critical_step
+    from ...errors import BudgetExceededError
+    from ...cost.plan import round_down
 
     if math.isinf(scheme.stability_bound):
         return {"dt_critical": None, "lambda_max": None}
@@ -374,8 +374,8 @@ def check_step(case, system, scheme) -> dict:
 def frame_errors(case, mesh, frames) -> dict | None:
     """L2 and H1-seminorm errors against ``exact`` at every frame time, and their maxima over
     time (None without ``exact``)."""
-    from ..fem import error_norms
-    from .expressions import Gradient
+    from ...fem import error_norms
+    from ..expressions import Gradient
 
     exact = case.functions.get("exact.u")
     if exact is None:
@@ -415,8 +415,8 @@ def plan_transient(case, *, measure: bool = True):
     each (about a tenth of a factorisation at these sizes), and the frames written."""
     from types import SimpleNamespace
 
-    from ..cost import Plan, Stage
-    from .poisson.cost import plan_poisson_case
+    from ...cost import Plan, Stage
+    from ..poisson.cost import plan_poisson_case
 
     spec = case.spec
     proxy = SimpleNamespace(
@@ -450,7 +450,7 @@ def plan_transient(case, *, measure: bool = True):
     def suggest(kind: str, limit: float) -> str:
         if kind not in ("time", "steps"):
             return ""
-        from ..cost.plan import round_down, round_up
+        from ...cost.plan import round_down, round_up
 
         k = limit / max(plan.seconds if kind == "time" else steps, 1e-300)
         return f"dt >= {round_up(spec.dt / k)} or t_end <= {round_down(spec.t_end * k)}"

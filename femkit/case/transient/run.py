@@ -19,7 +19,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .result import RunResult
+from ..result import RunResult
 
 __all__ = ["TransientResult", "run_transient", "write_transient_outputs"]
 
@@ -128,13 +128,13 @@ def run_transient(case, capacity: str, registry, *, second_order: bool,
                   write: bool = True, echo: Callable[[str], Any] | None = None,
                   result_type=TransientResult) -> TransientResult:
     """Run a prepared heat (``second_order=False``) or wave case; see the module docstring."""
-    from ..dynamics.mol import get_scheme, march, march_adaptive
-    from ..interrupt import raising
-    from ..io.atomic import EARLIER_RUN, check_output_dir
-    from ..progress import Progress
-    from ..timing import StageTimer
-    from .poisson.problem import build_mesh
-    from .transient import build_system, check_step, frame_errors, initial_values
+    from ...dynamics.mol import get_scheme, march, march_adaptive
+    from ...interrupt import raising
+    from ...io.atomic import EARLIER_RUN, check_output_dir
+    from ...progress import Progress
+    from ...timing import StageTimer
+    from ..poisson.problem import build_mesh
+    from .setup import build_system, check_step, frame_errors, initial_values
 
     spec = case.spec
     if write:
@@ -177,8 +177,8 @@ def run_transient(case, capacity: str, registry, *, second_order: bool,
 def write_transient_outputs(result: TransientResult, directory: str | os.PathLike) -> Path:
     """``frames/*.vtu`` + ``<problem>.pvd``, ``final.png`` and ``result.json`` into
     ``directory``, atomically (:func:`femkit.io.atomic.atomic_directory`)."""
-    from ..io.atomic import EARLIER_RUN, atomic_directory
-    from ..mesh.vtk import VtuFrames, write_collection
+    from ...io.atomic import EARLIER_RUN, atomic_directory
+    from ...mesh.vtk import VtuFrames, write_collection
 
     opts = result.case.spec.output
     mesh = result.mesh
@@ -199,7 +199,7 @@ def write_transient_outputs(result: TransientResult, directory: str | os.PathLik
             write_collection(tmp / pvd, [t for t, _, _ in result.frames], names)
             files += [pvd, *names]
         if opts.png and result.frames:
-            from .poisson.output import write_plot
+            from ..poisson.output import write_plot
 
             t, u, _ = result.frames[-1]
             write_plot(tmp / "final.png", mesh, u, f"{result.case.name}: u at t = {t:.4g}")
