@@ -163,3 +163,17 @@ def test_bundled_heat_and_wave_cases_run(name, tmp_path):
     assert r.converged
     if r.errors is not None:
         assert r.errors["max_over_time"]["L2"] < 5e-3
+
+
+def test_every_key_of_both_schemas_is_documented():
+    """Top-level and ``output`` keys (the shared fragments, mesh, solver and limits, are
+    documented with the Poisson files in docs/case-files.md)."""
+    from femkit.case.heat.schema import heat_schema
+    from femkit.case.wave.schema import wave_schema
+
+    keys = set()
+    for schema in (heat_schema(), wave_schema()):
+        keys |= set(schema["properties"]) | set(schema["properties"]["output"]["properties"])
+    doc = (ROOT / "docs" / "heat_wave.md").read_text()
+    missing = sorted(k for k in keys if f"`{k}`" not in doc)
+    assert not missing, f"keys missing from docs/heat_wave.md: {missing}"
