@@ -199,3 +199,18 @@ def test_central_difference_blows_up_above_its_critical_step():
     grow = march(s, scheme, u0, 0.0, 1.02 * dt_crit, 600, v0=np.zeros_like(u0)).frames[-1][1]
     keep = march(s, scheme, u0, 0.0, 0.98 * dt_crit, 600, v0=np.zeros_like(u0)).frames[-1][1]
     assert np.linalg.norm(grow) > 1e3 * np.linalg.norm(u0) > 1e3 * np.linalg.norm(keep) / 10
+
+
+def test_theta_one_is_implicit_euler_and_bad_options_are_refused():
+    from femkit.errors import InputError
+
+    mesh, s = _system(6)
+    u0 = _mode(mesh)
+    a = _final(s, "crank_nicolson", u0, 0.01, 5, theta=1.0)
+    b = _final(s, "implicit_euler", u0, 0.01, 5)
+    assert np.abs(a - b).max() <= 1e-14 * np.abs(b).max()
+    with pytest.raises(InputError, match="theta must lie in"):
+        get_scheme(HEAT_INTEGRATORS, "crank_nicolson", theta=1.5)
+    with pytest.raises(InputError, match="beta > 0"):
+        get_scheme(WAVE_INTEGRATORS, "newmark", beta=0.0)
+    assert get_scheme(WAVE_INTEGRATORS, "newmark", beta=0.0 + 1e-3, gamma=0.5).stability_bound < 100

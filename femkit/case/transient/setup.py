@@ -185,6 +185,9 @@ def prepare_transient(case, capacity: str, integrators, expressions: tuple = ())
         check_geometry_spec(mesh, "mesh")
     solver = solver_spec(d["solver"], "solver",
                          default_method=KINDS.get(case.problem, "problem").default_solver)
+    if solver.backend != "femkit":
+        raise CaseFileError(f"solver.backend: {solver.backend!r} is not offered for problem: "
+                            f"{case.problem} yet; valid: femkit")
     if solver.needs_hierarchy:
         raise CaseFileError(f"solver: method {solver.method!r} needs a mesh hierarchy, which the "
                             "time-dependent kinds do not build; use direct, cholesky or pcg")
@@ -277,6 +280,13 @@ def element_values(case, mesh, value, key: str) -> np.ndarray:
         raise with_prefix(exc, key) from None
 
 
+def _tags(mesh, tags) -> list | None:
+    """``None`` (the whole boundary, found topologically) when ``tags`` names ``boundary`` on a
+    mesh without such a group (the whole boundary covers the other tags), else the tags."""
+    tags = list(tags)
+    return None if "boundary" in tags and "boundary" not in mesh.tag_names else tags
+
+
 def _dirichlet(case, mesh):
     """``(fixed nodes, [(nodes, expression)] in order)``: later entries win on shared nodes."""
     from ...mesh import boundary_nodes
@@ -284,9 +294,7 @@ def _dirichlet(case, mesh):
     entries = []
     owner = np.full(mesh.n_points, -1)
     for i, bc in enumerate(case.spec.boundary.dirichlet):
-        tags = None if list(bc["tags"]) == ["boundary"] and "boundary" not in mesh.tag_names \
-            else list(bc["tags"])
-        nodes = boundary_nodes(mesh, tags)
+        nodes = boundary_nodes(mesh, _tags(mesh, bc["tags"]))
         owner[nodes] = i
         entries.append(case.functions[f"boundary.dirichlet[{i}].value"])
     fixed = np.flatnonzero(owner >= 0)
@@ -319,8 +327,7 @@ def build_system(case, mesh, capacity: str):
         return g
 
     source = case.functions["source"]
-    neumann = [(None if list(bc["tags"]) == ["boundary"] and "boundary" not in mesh.tag_names
-                else list(bc["tags"]), case.functions[f"boundary.neumann[{i}].flux"])
+    neumann = [(_tags(mesh, bc["tags"]), case.functions[f"boundary.neumann[{i}].flux"])
                for i, bc in enumerate(spec.boundary.neumann)]
     zero_source = source.is_constant and float(source(0.0, 0.0, 0.0, 0.0)) == 0.0
     has_load = not zero_source or bool(neumann)
