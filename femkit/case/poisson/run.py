@@ -26,10 +26,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ...errors import CaseFileError, ExpressionError, InputError
+from ...errors import CaseFileError, InputError
 from ...interrupt import Interrupted, raising
 from ...progress import Progress
-from ..expressions import compile_expression
+from ..expressions import compile_case_expression
 from ..frozen import freeze
 from ..load import Case
 from ..name_checks import check_geometry_spec, lookup, resolve_file, with_prefix
@@ -46,14 +46,7 @@ __all__ = ["prepare_poisson", "run_poisson", "build_mesh", "build_mesh_levels",
 # ----------------------------------------------------------------------------- prepare
 
 def _compile(case: Case, key: str, text, *, check_finite: bool = True):
-    try:
-        fn = compile_expression(text, VARIABLES, case.data.get("constants") or {},
-                                check_finite=check_finite)
-    except ExpressionError as exc:
-        raise ExpressionError(f"{key}: {exc}") from None
-    fn.label = key
-    case.functions[key] = fn
-    return fn
+    return compile_case_expression(case, key, text, VARIABLES, check_finite=check_finite)
 
 
 def prepare_poisson(case: Case) -> None:

@@ -133,16 +133,9 @@ class TransientSpec:
 
 
 def _compile(case, key: str, text, *, check_finite: bool = True):
-    from ..expressions import compile_expression
+    from ..expressions import compile_case_expression
 
-    try:
-        fn = compile_expression(text, VARIABLES, case.data.get("constants") or {},
-                                check_finite=check_finite)
-    except ExpressionError as exc:
-        raise ExpressionError(f"{key}: {exc}") from None
-    fn.label = key
-    case.functions[key] = fn
-    return fn
+    return compile_case_expression(case, key, text, VARIABLES, check_finite=check_finite)
 
 
 def _check_element(name: str) -> str:

@@ -6,20 +6,14 @@ from dataclasses import dataclass
 from typing import Mapping
 
 from ...errors import CaseFileError
-from ..spec import StudySpec, plain
+from ..spec import StudySpec, load_base_case, plain
 
 __all__ = ["HeatStudySpec", "prepare", "base_case"]
 
 
 def base_case(study, **overrides):
-    """``(path, case)`` of the study's base case, ``case_overrides`` and ``overrides`` merged."""
-    from ...case import load_case
-
-    d = study.spec
-    path = study.resolve(d.base_case)
-    if not path.is_file():
-        raise CaseFileError(f"base_case: file not found: {path}")
-    return path, load_case(path, **{**dict(d.case_overrides), **overrides})
+    """``(path, case)`` of the study's base case (:func:`femkit.study.spec.load_base_case`)."""
+    return load_base_case(study, **overrides)
 
 
 def prepare(study) -> None:
