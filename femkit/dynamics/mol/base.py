@@ -83,13 +83,12 @@ class WaveScheme(_Traits):
 
     def start(self, system, u0: np.ndarray, v0: np.ndarray, t0: float, dt: float) -> MolState:
         """The state at ``t0`` with the acceleration ``a0`` of ``M a0 = F - K u0`` on the free
-        rows (the boundary's acceleration from the Dirichlet data by finite differences)."""
+        rows (the boundary's acceleration from the Dirichlet data by finite differences); ``v0``
+        is taken as given on every node, so on the Dirichlet nodes it should be ``g'(t0)``."""
         u = np.array(u0, dtype=np.float64, copy=True)
         v = np.array(v0, dtype=np.float64, copy=True)
         u[system.fixed] = system.g(t0)
-        system.t0 = float(t0)
-        if not system.boundary_constant and system.fixed.size:
-            v[system.fixed] = (system.g(t0 + dt) - system.g(t0)) / dt
+        system.t0 = float(t0)  # v0 is the caller's on every node (g'(t0) on the Dirichlet nodes)
         a = acceleration(system, u, t0, dt)
         return MolState(float(t0), u, v, a)
 
