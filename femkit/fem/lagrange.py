@@ -37,7 +37,7 @@ from .dofs import DofMap, dof_map
 from .quadrature import blocks, get_rule, rule_for_degree
 
 __all__ = ["element_load", "element_neumann", "boundary_dofs", "dof_weights", "element_error_norms",
-           "evaluate"]
+           "element_energy_error", "evaluate"]
 
 #: Gauss-Legendre, 3 points on [0, 1] (degree 5): the P2 Neumann rule on edges.
 _G3 = np.array([0.5 - 0.5 * np.sqrt(0.6), 0.5, 0.5 + 0.5 * np.sqrt(0.6)])
@@ -150,11 +150,34 @@ def evaluate(mesh, u: np.ndarray, points: np.ndarray, element="P2", elements=Non
     return val, np.einsum("kqa,kad->kqd", dl, grads), vol
 
 
+def element_energy_error(mesh, u: np.ndarray, grad_exact: Callable, kappa=1.0, *, element="P2",
+                         order: int = 5) -> float:
+    """``(int kappa |grad(u - u_h)|^2)^(1/2)`` of the finite-element function ``u`` (``kappa``
+    per cell, as the assembly takes it); :func:`femkit.fem.norms.energy_error` for P1."""
+    from .coefficients import element_coefficient
+
+    return _squares(mesh, u, None, grad_exact, element, order, element_coefficient(mesh, kappa))[1] ** 0.5
+
+
 def element_error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | None = None, *,
                         element="P2", order: int = 5) -> dict:
     """``L2``, ``H1_semi`` (None without ``grad_exact``) and ``max_nodal`` (over every dof:
     vertices and edge midpoints) errors of the finite-element function ``u`` (n_dofs,), as
     :func:`femkit.fem.norms.error_norms` for P1; the rule is exact to degree ``order``."""
+    l2, h1 = _squares(mesh, u, exact, grad_exact, element, order, None)
+    dofs = dof_map(mesh, element)
+    nodal = u - evaluate_callable(exact, *dofs.points(mesh).T, name="exact")
+    out = {"L2": float(np.sqrt(l2)), "H1_semi": None if grad_exact is None else float(np.sqrt(h1)),
+           "max_nodal": float(np.abs(nodal).max()) if nodal.size else 0.0}
+    for k, v in out.items():
+        if v is not None and not np.isfinite(v):
+            raise InputError(f"error norm {k} is not finite (exact solution or u not finite)")
+    return out
+
+
+def _squares(mesh, u, exact, grad_exact, element, order: int, weight) -> tuple[float, float]:
+    """``(int (u - u_h)^2, int w |grad(u - u_h)|^2)`` block by block (``exact`` None: 0;
+    ``weight`` None: 1, else one value per cell)."""
     elem = get_element(element, mesh.dim)
     dofs = dof_map(mesh, elem)
     u = np.asarray(u, dtype=np.float64)
@@ -166,20 +189,16 @@ def element_error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callab
         idx = np.arange(part.start, part.stop)
         val, grad, vol = evaluate(mesh, u, rule.points, elem, idx)
         coords = rule.physical_points(mesh, mesh.cells[idx])
-        diff = val - evaluate_callable(exact, *coords, name="exact")
-        l2 += float(vol @ ((diff * diff) @ rule.weights))
+        if exact is not None:
+            diff = val - evaluate_callable(exact, *coords, name="exact")
+            l2 += float(vol @ ((diff * diff) @ rule.weights))
         if grad_exact is not None:
             g = grad_exact(*coords)
             try:
-                sq = sum((grad[:, :, d] - np.broadcast_to(np.asarray(g[d], dtype=np.float64), diff.shape)) ** 2
+                sq = sum((grad[:, :, d] - np.broadcast_to(np.asarray(g[d], dtype=np.float64), val.shape)) ** 2
                          for d in range(mesh.dim))
             except (TypeError, IndexError, ValueError) as exc:
                 raise InputError(f"grad_exact must return {mesh.dim} components: {exc}") from None
-            h1 += float(vol @ (sq @ rule.weights))
-    nodal = u - evaluate_callable(exact, *dofs.points(mesh).T, name="exact")
-    out = {"L2": float(np.sqrt(l2)), "H1_semi": None if grad_exact is None else float(np.sqrt(h1)),
-           "max_nodal": float(np.abs(nodal).max()) if nodal.size else 0.0}
-    for k, v in out.items():
-        if v is not None and not np.isfinite(v):
-            raise InputError(f"error norm {k} is not finite (exact solution or u not finite)")
-    return out
+            w = vol if weight is None else vol * weight[part]
+            h1 += float(w @ (sq @ rule.weights))
+    return l2, h1
