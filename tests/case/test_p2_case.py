@@ -117,3 +117,17 @@ def test_cli_refuses_p3_in_one_line_exit_2(tmp_path):
                           text=True, timeout=60)
     assert proc.returncode == 2 and proc.stderr.strip().count("\n") == 0
     assert "valid elements: P1, P2" in proc.stderr and not (tmp_path / "out").exists()
+
+
+def test_p2_is_priced_before_meshing():
+    """The plan of a P2 case counts P2's unknowns (a dof per vertex and per edge) and its denser
+    matrix: more memory than the same case with P1, unknowns near the run's."""
+    from femkit.case.poisson.cost import plan_poisson_case
+
+    big = {"mesh": {"geometry": "unit_square", "h": 0.05}, "exact": None}
+    p1 = plan_poisson_case(_case(SQUARE, element="P1", **big), measure=False)
+    p2 = plan_poisson_case(_case(SQUARE, **big), measure=False)
+    assert p2.sizes["unknowns"] > 3.5 * p1.sizes["unknowns"]
+    assert p2.peak_bytes > p1.peak_bytes and "element P2" in p2.assumptions[0]
+    result = _case(SQUARE, **big).run(quiet=True, write=False)
+    assert abs(p2.sizes["unknowns"] / result.dofs - 1) < 0.25
