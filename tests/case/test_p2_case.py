@@ -98,13 +98,21 @@ def test_unknown_element_lists_the_valid_ones(bad):
         _case(SQUARE, element=bad)
 
 
+@pytest.mark.parametrize("solver", [{"method": "fmg"}, {"method": "pcg", "preconditioner": "gmg"}],
+                         ids=["fmg", "gmg"])
+def test_p2_multigrid_through_the_p_level_equals_the_direct_solution(solver):
+    refined = {"mesh": {"geometry": "unit_square", "h": 0.25, "refine": 1}, "output": {"vtu": False}}
+    mg = _case(SQUARE, solver={**solver, "rtol": 1e-10}, **refined).run(quiet=True, write=False)
+    direct = _case(SQUARE, **refined).run(quiet=True, write=False)
+    assert mg.solve.converged and np.abs(mg.u - direct.u).max() < 1e-8
+    assert mg.errors["L2"] == pytest.approx(direct.errors["L2"], rel=1e-6)
+
+
 @pytest.mark.parametrize("change, says", [
-    ({"solver": {"method": "pcg", "preconditioner": "gmg"}, "mesh": {"geometry": "unit_square", "h": 0.25, "refine": 1}},
-     "element P2: solver pcg+gmg is not supported with P2; use method pcg with preconditioner amg_rs"),
     ({"adaptive": {"target": 0.01}}, "element P2: adaptive is not supported"),
     ({"estimator": "zz"}, "element P2: estimator 'zz' is not supported"),
     ({"quadrature": {"load": "gauss3"}}, "quadrature.load 'gauss3' (degree 2) is not exact for P2 products"),
-], ids=["gmg", "adaptive", "zz", "load-rule"])
+], ids=["adaptive", "zz", "load-rule"])
 def test_options_p2_does_not_support_are_one_line_errors(change, says):
     with pytest.raises(CaseFileError, match=says.replace("(", r"\(").replace(")", r"\)").replace("+", r"\+")):
         _case(SQUARE, **change)
