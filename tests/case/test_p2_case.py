@@ -63,6 +63,7 @@ def test_p2_solve_writes_quadratic_cells_read_back_by_meshio_and_vtk(tmp_path, d
                     [(c[a], c[b]) for a in range(4) for b in range(a + 1, 4)])})
     assert len(u) == mesh.n_points + n_edges
     assert facts["dofs"] < len(u)                     # the free dofs: boundary vertices and midpoints out
+    assert facts["mesh"]["element"] == "P2" and facts["dofs"] + facts["n_dirichlet"] == len(u)
     m = meshio.read(out / "solution.vtu")
     assert [b.type for b in m.cells] == ["triangle6" if mesh.dim == 2 else "tetra10"]
     np.testing.assert_array_equal(m.point_data["u"], u)

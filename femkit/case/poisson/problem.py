@@ -389,6 +389,7 @@ class CaseResult(RunResult):
         mesh_info[f"n_{CELLS_NAME[self.mesh.dim]}"] = self.mesh.n_cells
         mesh_info["source"] = spec.source()
         mesh_info["refine"] = spec.refine
+        mesh_info["element"] = self.case.spec.element
         return {
             "mesh": mesh_info,
             "dofs": self.dofs,
