@@ -4,7 +4,7 @@
 (explicit schemes) before anything is written, marches (:mod:`femkit.dynamics.mol`), computes
 the error history against ``exact`` and the energies per frame, and writes (atomically, into
 the output directory): ``frames/frame_NNNNN.vtu`` + ``<kind>.pvd`` (a ParaView time series of
-``u``, and ``v`` for the wave), ``final.png`` (the last frame) and ``result.json``. A bad input
+``u``, and ``v`` for the wave; P2 on VTK's quadratic cells), ``final.png`` (the last frame) and ``result.json``. A bad input
 found at run time (a time-dependent expression that is not finite at some step, a step above
 the critical one) raises before the output directory exists: nothing is written.
 """
@@ -187,13 +187,19 @@ def write_transient_outputs(result: TransientResult, directory: str | os.PathLik
     with atomic_directory(final, EARLIER_RUN) as tmp:
         if opts.vtu:
             (tmp / "frames").mkdir()
-            series = VtuFrames([("triangle" if mesh.dim == 2 else "tetra",
-                                 np.asarray(mesh.cells, dtype=np.int64))])
+            from ...fem.dofs import dof_map
+
+            dofs = dof_map(mesh, result.case.spec.element)
+            quadratic = dofs.element.degree == 2   # VTK's quadratic cells: the dofs' own order
+            kind = ("triangle6" if mesh.dim == 2 else "tetra10") if quadratic else \
+                ("triangle" if mesh.dim == 2 else "tetra")
+            series = VtuFrames([(kind, np.asarray(dofs.cells, dtype=np.int64))])
+            points = dofs.points(mesh)
             names = []
             for k, (t, u, v) in enumerate(result.frames):
                 name = f"frames/frame_{k:05d}.vtu"
                 data = {"u": u} if v is None else {"u": u, "v": v}
-                series.write(tmp / name, mesh.points, point_data=data)
+                series.write(tmp / name, points, point_data=data)
                 names.append(name)
             pvd = f"{result.case.problem}.pvd"
             write_collection(tmp / pvd, [t for t, _, _ in result.frames], names)
@@ -202,7 +208,8 @@ def write_transient_outputs(result: TransientResult, directory: str | os.PathLik
             from ..poisson.output import write_plot
 
             t, u, _ = result.frames[-1]
-            write_plot(tmp / "final.png", mesh, u, f"{result.case.name}: u at t = {t:.4g}")
+            write_plot(tmp / "final.png", mesh, u[:mesh.n_points],   # the vertex values
+                       f"{result.case.name}: u at t = {t:.4g}")
             files.append("final.png")
         result.output_dir = final
         result.write_result_json(tmp, [*files, "result.json"])

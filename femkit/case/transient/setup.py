@@ -26,14 +26,10 @@ from ..name_checks import check_geometry_spec, lookup, resolve_file, with_prefix
 
 __all__ = ["VARIABLES", "TransientSpec", "TransientOutput", "transient_schema",
            "prepare_transient", "at_time", "element_values", "build_system", "check_step",
-           "frame_errors", "initial_values", "plan_transient", "ELEMENTS"]
+           "frame_errors", "initial_values", "plan_transient", "dof_points"]
 
 #: Variables of the expressions of a time-dependent case (``z`` on tetrahedra only).
 VARIABLES = ("x", "y", "z", "t")
-
-#: The elements the time-dependent kinds assemble (P1 only until the P2 mass and stiffness
-#: are wired in).
-ELEMENTS = ("P1",)
 
 _NUMBER_OR_EXPR = {"anyOf": [{"type": "number"}, {"type": "string", "minLength": 1}],
                    "x-message": "expected a number or an expression string of x, y, z, t"}
@@ -139,15 +135,10 @@ def _compile(case, key: str, text, *, check_finite: bool = True):
 
 
 def _check_element(name: str) -> str:
-    try:
-        from ...elements import ELEMENTS as registry  # the element registry, once it exists
-    except ImportError:
-        registry = None
-    if registry is not None:
-        lookup(registry, name, "element")
-    if name not in ELEMENTS:
-        raise CaseFileError(f"element: {name!r} is not assembled by the time-dependent kinds yet; "
-                            f"valid elements: {', '.join(ELEMENTS)}")
+    """``name`` checked against :data:`femkit.elements.ELEMENTS` (one line listing the valid ones)."""
+    from ...elements import ELEMENTS as registry
+
+    lookup(registry, name, "element")
     return name
 
 
@@ -280,15 +271,24 @@ def _tags(mesh, tags) -> list | None:
     return None if "boundary" in tags and "boundary" not in mesh.tag_names else tags
 
 
-def _dirichlet(case, mesh):
-    """``(fixed nodes, [(nodes, expression)] in order)``: later entries win on shared nodes."""
-    from ...mesh import boundary_nodes
+def dof_points(case, mesh) -> np.ndarray:
+    """(n_dofs, dim) coordinates of the case's element's dofs on ``mesh`` (P1: the nodes; P2:
+    the nodes, then the edge midpoints)."""
+    from ...fem.dofs import dof_map
 
+    return dof_map(mesh, case.spec.element).points(mesh)
+
+
+def _dirichlet(case, mesh):
+    """``(fixed dofs, [(rows of fixed, expression)] in order)``: later entries win on shared dofs."""
+    from ...fem.dofs import dof_map
+    from ...fem.lagrange import boundary_dofs
+
+    dofs = dof_map(mesh, case.spec.element)
     entries = []
-    owner = np.full(mesh.n_points, -1)
+    owner = np.full(dofs.n_dofs, -1)
     for i, bc in enumerate(case.spec.boundary.dirichlet):
-        nodes = boundary_nodes(mesh, _tags(mesh, bc["tags"]))
-        owner[nodes] = i
+        owner[boundary_dofs(mesh, dofs, _tags(mesh, bc["tags"]))] = i
         entries.append(case.functions[f"boundary.dirichlet[{i}].value"])
     fixed = np.flatnonzero(owner >= 0)
     groups = [(np.flatnonzero(owner[fixed] == i), fn) for i, fn in enumerate(entries)]
@@ -301,16 +301,21 @@ def build_system(case, mesh, capacity: str):
     time-dependent load and boundary values (evaluated once when they do not use ``t``)."""
     from ...dynamics.mol import LinearSystem
     from ...fem import assemble_load, assemble_neumann, assemble_stiffness
+    from ...fem.forms import assemble_matrix
+    from ...fem.lagrange import element_load, element_neumann
     from ...fem.mass import mass_matrix
 
     spec = case.spec
     lumped = spec.mass == "lumped"
     kappa = element_values(case, mesh, spec.coefficient, "coefficient")
     density = element_values(case, mesh, spec.capacity, capacity)
-    K = assemble_stiffness(mesh, kappa)
+    p1 = spec.element == "P1"
+    K = assemble_stiffness(mesh, kappa) if p1 else \
+        assemble_matrix(mesh, "stiffness", kappa, element=spec.element)
     M = mass_matrix(mesh, element=spec.element, lumped=lumped, density=density)
+    n = K.shape[0]
     fixed, groups = _dirichlet(case, mesh)
-    pts = mesh.points[fixed].T
+    pts = dof_points(case, mesh)[fixed].T
     dim = mesh.dim
 
     def boundary(t):
@@ -325,11 +330,19 @@ def build_system(case, mesh, capacity: str):
     zero_source = source.is_constant and float(source(0.0, 0.0, 0.0, 0.0)) == 0.0
     has_load = not zero_source or bool(neumann)
 
+    rule = None if spec.load_rule == "barycentric" else spec.load_rule  # P2: its own default
+
     def load(t):
-        F = np.zeros(mesh.n_points) if zero_source else \
-            assemble_load(mesh, at_time(source, t, dim), rule=spec.load_rule)
+        if p1:
+            F = np.zeros(n) if zero_source else \
+                assemble_load(mesh, at_time(source, t, dim), rule=spec.load_rule)
+            for tags, h in neumann:
+                F += assemble_neumann(mesh, tags, at_time(h, t, dim))
+            return F
+        F = np.zeros(n) if zero_source else \
+            element_load(mesh, at_time(source, t, dim), spec.element, rule=rule)
         for tags, h in neumann:
-            F += assemble_neumann(mesh, tags, at_time(h, t, dim))
+            F += element_neumann(mesh, tags, at_time(h, t, dim), spec.element)
         return F
 
     uses_t = [fn for fn in [source, *(h for _, h in neumann)] if "t" in fn.used]
@@ -340,8 +353,10 @@ def build_system(case, mesh, capacity: str):
 
 
 def initial_values(case, mesh, key: str) -> np.ndarray:
-    """Nodal values of the expression ``key`` (``initial``, ``initial_velocity``) at ``t = 0``."""
-    return np.asarray(at_time(case.functions[key], 0.0, mesh.dim)(*mesh.points.T), dtype=np.float64)
+    """Values at the dofs of the expression ``key`` (``initial``, ``initial_velocity``) at
+    ``t = 0`` (its interpolant)."""
+    return np.asarray(at_time(case.functions[key], 0.0, mesh.dim)(*dof_points(case, mesh).T),
+                      dtype=np.float64)
 
 
 def check_step(case, system, scheme) -> dict:
@@ -386,7 +401,13 @@ def frame_errors(case, mesh, frames) -> dict | None:
         grad = None
         if parts:
             grad = Gradient([_Frozen(p, t, mesh.dim) for p in parts])
-        e = error_norms(mesh, u, at_time(exact, t, mesh.dim), grad)
+        if case.spec.element == "P1":
+            e = error_norms(mesh, u, at_time(exact, t, mesh.dim), grad)
+        else:
+            from ...fem.lagrange import element_error_norms
+
+            e = element_error_norms(mesh, u, at_time(exact, t, mesh.dim), grad,
+                                    element=case.spec.element)
         history.append({"t": float(t), "L2": e["L2"], "H1_semi": e["H1_semi"],
                         "max_nodal": e["max_nodal"]})
     top = {k: max((h[k] for h in history if h[k] is not None), default=None)
@@ -421,7 +442,7 @@ def plan_transient(case, *, measure: bool = True):
     spec = case.spec
     proxy = SimpleNamespace(
         name=case.name, functions={}, solver=spec.solver,
-        spec=SimpleNamespace(mesh=spec.mesh, adaptive=None,
+        spec=SimpleNamespace(mesh=spec.mesh, adaptive=None, element=spec.element,
                              output=SimpleNamespace(vtu=False, xdmf=False, plot=False)))
     base = plan_poisson_case(proxy, measure=measure)
     keep = [st for st in base.stages if st.name in ("mesh", "quality", "assembly", "boundary")]
