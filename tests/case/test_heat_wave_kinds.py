@@ -64,7 +64,7 @@ def test_implicit_euler_on_the_manufactured_solution_is_first_order(tmp_path):
 
 def test_heat_solve_writes_a_pvd_series_meshio_reads(tmp_path, capsys):
     meshio = pytest.importorskip("meshio")
-    path = _write(tmp_path, {**MANUFACTURED, "output": {"dir": "out", "frames": 5}})
+    path = _write(tmp_path, {**MANUFACTURED, "output": {"dir": "out", "frames": 5, "gif": True}})
     assert main(["solve", str(path)]) == 0, capsys.readouterr().err
     out = tmp_path / "out"
     data = json.loads((out / "result.json").read_text())
@@ -72,6 +72,10 @@ def test_heat_solve_writes_a_pvd_series_meshio_reads(tmp_path, capsys):
     assert data["frames"] == 6 and len(data["errors"]["history"]) == 6
     assert data["linear_solver"]["factorizations"] == 1  # one kept factor for every step
     assert (out / "final.png").stat().st_size > 1000
+    from PIL import Image
+
+    with Image.open(out / "animation.gif") as gif:
+        assert gif.n_frames == 6
     pvd = (out / "heat.pvd").read_text()
     files = [line.split('file="')[1].split('"')[0] for line in pvd.splitlines() if "file=" in line]
     assert len(files) == 6

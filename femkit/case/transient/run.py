@@ -4,7 +4,8 @@
 (explicit schemes) before anything is written, marches (:mod:`femkit.dynamics.mol`), computes
 the error history against ``exact`` and the energies per frame, and writes (atomically, into
 the output directory): ``frames/frame_NNNNN.vtu`` + ``<kind>.pvd`` (a ParaView time series of
-``u``, and ``v`` for the wave; P2 on VTK's quadratic cells), ``final.png`` (the last frame) and ``result.json``. A bad input
+``u``, and ``v`` for the wave; P2 on VTK's quadratic cells), ``final.png`` (the last frame),
+``animation.gif`` when asked, and ``result.json``. A bad input
 found at run time (a time-dependent expression that is not finite at some step, a step above
 the critical one) raises before the output directory exists: nothing is written.
 """
@@ -21,7 +22,7 @@ import numpy as np
 
 from ..result import RunResult
 
-__all__ = ["TransientResult", "run_transient", "write_transient_outputs"]
+__all__ = ["TransientResult", "run_transient", "write_transient_outputs", "write_gif"]
 
 
 @dataclass
@@ -211,6 +212,45 @@ def write_transient_outputs(result: TransientResult, directory: str | os.PathLik
             write_plot(tmp / "final.png", mesh, u[:mesh.n_points],   # the vertex values
                        f"{result.case.name}: u at t = {t:.4g}")
             files.append("final.png")
+        if opts.gif and result.frames:
+            write_gif(tmp / "animation.gif", result)
+            files.append("animation.gif")
         result.output_dir = final
         result.write_result_json(tmp, [*files, "result.json"])
     return final
+
+
+def write_gif(path, result, *, max_frames: int = 40, dpi: float = 80) -> Path:
+    """Animated GIF of at most ``max_frames`` evenly spaced frames of ``u`` (the vertex values;
+    on tetrahedra the section at mid-height), one fixed colour scale over the frames shown."""
+    from matplotlib.tri import Triangulation
+
+    from ...io.figures import new_figure
+    from ..pictures import gif_frame_times, gif_frames, rgb_image, save_gif
+
+    mesh = result.mesh
+    picks = gif_frames(len(result.frames), max_frames)
+    values = [result.frames[int(k)][1][:mesh.n_points] for k in picks]
+    if mesh.dim == 3:
+        from ..poisson.section import plane_section
+
+        zs = mesh.points[:, 2]
+        cut = plane_section(mesh, 0.5 * (zs.min() + zs.max()))
+        tri = Triangulation(cut.points[:, 0], cut.points[:, 1], cut.triangles)
+        values = [cut.interpolate(u) for u in values]
+    else:
+        tri = Triangulation(mesh.points[:, 0], mesh.points[:, 1], mesh.triangles)
+    lo = min(float(u.min()) for u in values)
+    hi = max(float(u.max()) for u in values)
+    hi = hi if hi > lo else lo + 1.0
+    images = []
+    for k, u in zip(picks, values):
+        fig = new_figure(5.5, 4.5, dpi=dpi)
+        ax = fig.add_subplot()
+        art = ax.tripcolor(tri, u, shading="gouraud", cmap="viridis", vmin=lo, vmax=hi)
+        fig.colorbar(art, ax=ax, label="u")
+        ax.set_aspect("equal")
+        ax.set_title(f"{result.case.name}: t = {result.frames[int(k)][0]:.4g}", fontsize=9)
+        images.append(rgb_image(fig).quantize(colors=128))
+    ms = [int(round(1000 * d)) for d in gif_frame_times([f[0] for f in result.frames], picks)]
+    return save_gif(path, images, ms)

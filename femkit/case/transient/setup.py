@@ -81,7 +81,8 @@ def transient_schema(kind: str, capacity: str, integrators, extra: Mapping) -> d
                    "properties": {"dir": {"type": "string", "minLength": 1},
                                   "frames": {"type": "integer", "minimum": 1, "default": 20},
                                   "vtu": {"type": "boolean", "default": True},
-                                  "png": {"type": "boolean", "default": True}}},
+                                  "png": {"type": "boolean", "default": True},
+                                  "gif": {"type": "boolean", "default": False}}},
         **extra,
     }
     return {"$schema": "https://json-schema.org/draft/2020-12/schema",
@@ -91,12 +92,13 @@ def transient_schema(kind: str, capacity: str, integrators, extra: Mapping) -> d
 
 @dataclass(frozen=True)
 class TransientOutput:
-    """``output:``: directory (absolute), frames kept (about), VTU series and PNG asked for."""
+    """``output:``: directory (absolute), frames kept (about), VTU series, PNG and GIF asked for."""
 
     dir: str
     frames: int
     vtu: bool
     png: bool
+    gif: bool = False
 
 
 @dataclass(frozen=True)
@@ -215,7 +217,8 @@ def prepare_transient(case, capacity: str, integrators, expressions: tuple = ())
         capacity=freeze(d[capacity]), mass=d["mass"], integrator=(method, freeze(options)),
         dt=t_end / steps, dt_asked=dt, t_end=t_end, steps=steps,
         rtol_t=None if rtol_t is None else float(rtol_t), solver=solver,
-        output=TransientOutput(out["dir"], int(out["frames"]), bool(out["vtu"]), bool(out["png"])),
+        output=TransientOutput(out["dir"], int(out["frames"]), bool(out["vtu"]), bool(out["png"]),
+                               bool(out["gif"])),
         load_rule=d["quadrature"]["load"])
 
 
