@@ -13,7 +13,6 @@ the critical one) raises before the output directory exists: nothing is written.
 from __future__ import annotations
 
 import os
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
