@@ -131,6 +131,7 @@ def test_negative_rho_c_is_refused(tmp_path, capsys):
 
 def test_an_unknown_element_is_refused(tmp_path, capsys):
     _refused(tmp_path, capsys, {**MANUFACTURED, "element": "P3"}, "element", "P1, P2")
+    _refused(tmp_path, capsys, {**MANUFACTURED, "element": "P2"}, "gauss3", "not exact for P2")
 
 
 def test_t_end_below_zero_is_refused(tmp_path, capsys):

@@ -136,11 +136,19 @@ def _compile(case, key: str, text, *, check_finite: bool = True):
     return compile_case_expression(case, key, text, VARIABLES, check_finite=check_finite)
 
 
-def _check_element(name: str) -> str:
-    """``name`` checked against :data:`femkit.elements.ELEMENTS` (one line listing the valid ones)."""
-    from ...elements import ELEMENTS as registry
+def _check_element(name: str, rule: str) -> str:
+    """``name`` checked against :data:`femkit.elements.ELEMENTS` (one line listing the valid
+    ones); a named load rule must integrate the element's products exactly."""
+    from ...elements import ELEMENTS as registry, get_element
+    from ...fem.quadrature import QUADRATURE, TET_QUADRATURE
 
     lookup(registry, name, "element")
+    if name != "P1" and rule != "barycentric":
+        need = get_element(name, 2).load_degree
+        degree = (QUADRATURE.get(rule) if rule in QUADRATURE else TET_QUADRATURE.get(rule)).degree
+        if degree < need:
+            raise CaseFileError(f"quadrature.load {rule!r} (degree {degree}) is not exact for "
+                                f"{name} products (degree >= {need}); leave quadrature.load out")
     return name
 
 
@@ -213,7 +221,8 @@ def prepare_transient(case, capacity: str, integrators, expressions: tuple = ())
         mesh=MeshSpec.from_mapping(freeze(mesh)),
         boundary=BoundarySpec(tuple(freeze(list(bnd.get("dirichlet") or ()))),
                               tuple(freeze(list(bnd.get("neumann") or ()))), None, None),
-        element=_check_element(d["element"]), coefficient=freeze(d["coefficient"]),
+        element=_check_element(d["element"], d["quadrature"]["load"]),
+        coefficient=freeze(d["coefficient"]),
         capacity=freeze(d[capacity]), mass=d["mass"], integrator=(method, freeze(options)),
         dt=t_end / steps, dt_asked=dt, t_end=t_end, steps=steps,
         rtol_t=None if rtol_t is None else float(rtol_t), solver=solver,
