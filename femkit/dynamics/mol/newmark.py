@@ -14,10 +14,10 @@ get ``a1 = (g(t1) - u_p) / (beta dt^2)``, so ``u1 = g(t1)`` there. Second order 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from ...errors import InputError
+from ..integrators.newmark import newmark_stability_bound
 from .base import MolState, WaveScheme
 from .registry import register_wave
 
@@ -36,9 +36,7 @@ class Newmark(WaveScheme):
 
     @property
     def stability_bound(self) -> float:  # type: ignore[override]
-        if 2.0 * self.beta >= self.gamma >= 0.5:
-            return math.inf
-        return 1.0 / math.sqrt(max(self.gamma / 2.0 - self.beta, 1e-300))
+        return newmark_stability_bound(self.beta, self.gamma)
 
     def validate(self) -> None:
         if not (self.beta > 0.0 and self.gamma >= 0.5):
