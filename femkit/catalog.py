@@ -50,6 +50,18 @@ def _integrators():
     return INTEGRATORS
 
 
+def _heat_integrators():
+    from .dynamics.mol import HEAT_INTEGRATORS
+
+    return HEAT_INTEGRATORS
+
+
+def _wave_integrators():
+    from .dynamics.mol import WAVE_INTEGRATORS
+
+    return WAVE_INTEGRATORS
+
+
 def _forces():
     from .case.scene.forces import FORCES
 
@@ -95,6 +107,8 @@ GROUPS: dict[str, tuple[str, Callable]] = {
     "preconditioners": ("solver.preconditioner", _preconditioners),
     "backends": ("solver.backend (--backend)", _backends),
     "integrators": ("integrator.method of a scene", _integrators),
+    "heat_integrators": ("integrator of a heat case (problem: heat)", _heat_integrators),
+    "wave_integrators": ("integrator of a wave case (problem: wave)", _wave_integrators),
     "forces": ("forces of a scene", _forces),
     "systems": ("system.type of a scene", _systems),
     "materials": ("material of an elastic solid", _materials),

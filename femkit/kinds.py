@@ -24,15 +24,15 @@ Adding a kind is one module::
 
     from femkit.kinds import Kind, register_kind
 
-    register_kind(Kind("heat", "problem", schema=heat_schema, prepare=prepare, run=run))
+    register_kind(Kind("heatbar", "problem", schema=heatbar_schema, prepare=prepare, run=run))
 
 >>> import femkit.case  # hands KINDS the finder of the problem kinds
 >>> sorted(n for n in KINDS.names("problem"))[:2]
-['mass_spring', 'poisson']
->>> KINDS.get("heat", "problem")
+['heat', 'mass_spring']
+>>> KINDS.get("heatbar", "problem")
 Traceback (most recent call last):
 ...
-femkit.errors.UnknownNameError: unknown problem 'heat'; valid problems: mass_spring, poisson, solid
+femkit.errors.UnknownNameError: unknown problem 'heatbar'; valid problems: heat, mass_spring, poisson, solid, wave
 """
 
 from __future__ import annotations

@@ -44,7 +44,8 @@ import numpy as np
 
 from ..errors import ExpressionError
 
-__all__ = ["compile_expression", "Expression", "Gradient", "FUNCTIONS", "CONSTANTS", "MAX_LENGTH"]
+__all__ = ["compile_expression", "compile_case_expression", "Expression", "Gradient", "FUNCTIONS",
+           "CONSTANTS", "MAX_LENGTH"]
 
 #: Functions an expression may call: name -> (numpy function, number of arguments).
 FUNCTIONS: dict[str, tuple[Callable, int]] = {
@@ -332,3 +333,23 @@ def _build(node, text, variables, names, constants, used) -> Callable[[dict], ob
         return lambda env: f(*(a(env) for a in args))
     what = _DESCRIBE.get(type(node), f"{type(node).__name__} syntax")
     raise _fail(text, node, what, variables, constants)
+
+
+def compile_case_expression(case, key: str, text, variables: Sequence[str], *,
+                            check_finite: bool = True) -> Expression:
+    """Compile the expression of a case file's ``key`` with the file's ``constants``, label it
+    with ``key`` (its error messages start with it) and keep it in ``case.functions[key]``.
+
+    Raises
+    ------
+    ExpressionError
+        Prefixed with ``key``.
+    """
+    try:
+        fn = compile_expression(text, variables, case.data.get("constants") or {},
+                                check_finite=check_finite)
+    except ExpressionError as exc:
+        raise ExpressionError(f"{key}: {exc}") from None
+    fn.label = key
+    case.functions[key] = fn
+    return fn

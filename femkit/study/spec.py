@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-__all__ = ["StudySpec", "plain"]
+__all__ = ["StudySpec", "plain", "load_base_case"]
 
 
 @dataclass(frozen=True)
@@ -39,3 +39,22 @@ def plain(value: Any) -> Any:
     from ..case.frozen import freeze
 
     return freeze(value)
+
+
+def load_base_case(study, **overrides):
+    """``(path, case)`` of the study's ``base_case`` (relative to the study file), with the
+    spec's ``case_overrides`` and then ``overrides`` merged.
+
+    Raises
+    ------
+    CaseFileError
+        The file does not exist.
+    """
+    from ..case import load_case
+    from ..errors import CaseFileError
+
+    d = study.spec
+    path = study.resolve(d.base_case)
+    if not path.is_file():
+        raise CaseFileError(f"base_case: file not found: {path}")
+    return path, load_case(path, **{**dict(d.case_overrides), **overrides})

@@ -25,7 +25,7 @@ def test_the_case_layer_loads_no_study_module():
     """Every problem kind, and a case file loaded, without one femkit.study module imported: the
     registry is a leaf (femkit.kinds) and each family's package finds its own kinds."""
     code = ("import sys, femkit.case; from femkit.kinds import KINDS; "
-            "assert KINDS.names('problem') == ['mass_spring', 'poisson', 'solid'], KINDS.names('problem'); "
+            "assert KINDS.names('problem') == ['heat', 'mass_spring', 'poisson', 'solid', 'wave'], KINDS.names('problem'); "
             "femkit.case.case_from_dict({'problem': 'poisson', 'mesh': {'geometry': 'unit_square', "
             "'h': 0.5}, 'source': '1', 'boundary': {'dirichlet': [{'tags': ['boundary'], 'value': 0}]}}); "
             "bad = sorted(m for m in sys.modules if m.startswith('femkit.study')); assert not bad, bad")
@@ -59,8 +59,8 @@ def test_study_entries_resolve(name):
 
 
 def test_unknown_problem_lists_the_valid_ones_of_its_family():
-    with pytest.raises(UnknownNameError, match="valid problems: mass_spring, poisson, solid$"):
-        KINDS.get("heat", "problem")
+    with pytest.raises(UnknownNameError, match="valid problems: heat, mass_spring, poisson, solid, wave$"):
+        KINDS.get("heatbar", "problem")
     with pytest.raises(UnknownNameError, match="unknown study kind 'poisson'"):
         KINDS.get("poisson", "kind")  # a problem is not a study kind
     with pytest.raises(CaseFileError, match="missing required key 'problem'"):

@@ -41,6 +41,18 @@ def _roundoff_floor(system) -> float:
     return 100.0 * np.finfo(float).eps * float(np.max(system.k * system.rest))
 
 
+def newmark_stability_bound(beta: float, gamma: float) -> float:
+    """The largest ``h omega`` for which Newmark's method stays bounded on the undamped
+    oscillator: ``inf`` for ``2 beta >= gamma >= 1/2``, else ``1 / sqrt(gamma / 2 - beta)``.
+
+    >>> newmark_stability_bound(0.25, 0.5), newmark_stability_bound(0.0, 0.5)
+    (inf, 2.0)
+    """
+    if 2.0 * beta >= gamma >= 0.5:
+        return float("inf")
+    return float(1.0 / np.sqrt(max(gamma / 2.0 - beta, 1e-300)))
+
+
 @register("newmark")
 @dataclass(frozen=True)
 class Newmark(Integrator):
@@ -66,10 +78,7 @@ class Newmark(Integrator):
 
     @property
     def stability_bound(self) -> float:  # type: ignore[override]
-        if 2.0 * self.beta >= self.gamma >= 0.5:
-            return float("inf")
-        # conditional stability limit of Newmark (undamped): h w <= 1/sqrt(gamma/2 - beta)
-        return float(1.0 / np.sqrt(max(self.gamma / 2.0 - self.beta, 1e-300)))
+        return newmark_stability_bound(self.beta, self.gamma)
 
     def start(self, system, x, v, t, dt, ctx):
         state = super().start(system, x, v, t, dt, ctx)

@@ -37,14 +37,14 @@ def get_integrator(name: str, **options):
         An option the integrator does not have, or an invalid option value.
     """
     cls = INTEGRATORS.get(name)
-    _check_options(name, cls, options)
+    check_options(name, cls, options)
     try:
         return cls(**options)
     except (TypeError, ValueError) as exc:
         raise InputError(f"integrator {name!r}: invalid options {sorted(options)}: {exc}") from None
 
 
-def _check_options(name: str, cls, options: dict) -> None:
+def check_options(name: str, cls, options: dict) -> None:
     """Option names against the integrator's dataclass fields (the valid ones listed, the nearest
     suggested) and option values against the fields' types, before the class sees them."""
     import dataclasses

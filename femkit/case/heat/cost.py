@@ -1,0 +1,13 @@
+"""The plan of a heat case (``femkit solve --dry-run``, the time budget):
+:func:`femkit.case.transient.setup.plan_transient`."""
+
+from __future__ import annotations
+
+__all__ = ["plan_heat_case"]
+
+
+def plan_heat_case(case, *, measure: bool = True):
+    """The :class:`femkit.cost.Plan` of a prepared heat case."""
+    from ..transient.setup import plan_transient
+
+    return plan_transient(case, measure=measure)

@@ -1,0 +1,196 @@
+"""The semi-discrete linear system the method-of-lines schemes step: :class:`LinearSystem`.
+
+``M u' + K u = F(t)`` (heat) or ``M u'' + K u = F(t)`` (wave) on all ``n`` nodes, with the
+Dirichlet nodes ``fixed`` held at ``g(t)``. A scheme forms its full-size right-hand side ``r``
+and a matrix ``A = a M + b K``; :meth:`LinearSystem.solve` solves the free rows
+``A_ff x_f = r_f - A_fb g`` with the boundary values ``g`` in place (so time-dependent
+Dirichlet data enter every scheme the way its own discretisation of ``M u'`` says, with no
+separate ``g'``). Each distinct ``A`` is factorised once and kept for the whole run
+(:func:`femkit.solvers.kept_factor.factorize_kept`; SuperLU in symmetric mode, or the sparse
+Cholesky engines) when the linear solver is ``direct`` or ``cholesky``; any other solver
+(``pcg`` with a preconditioner, ``cg``) solves each step warm-started from the previous step's
+solution. A lumped (diagonal) ``M`` alone is inverted by a division.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+
+from ...errors import InputError
+from ...solvers.spec import SolverSpec
+
+__all__ = ["LinearSystem", "ConstrainedOperator", "KEPT_FACTOR_METHODS"]
+
+#: Solver methods whose factor is kept across steps; any other is an iterative solve per step.
+KEPT_FACTOR_METHODS = frozenset({"direct", "cholesky"})
+
+
+@dataclass
+class ConstrainedOperator:
+    """``A = a M + b K`` restricted to the free rows: the kept factor of ``A_ff`` (or its
+    diagonal, or the solver spec for iterative solves) and the coupling ``A_fb``."""
+
+    A_ff: sp.csr_matrix
+    A_fb: sp.csr_matrix
+    factor: object = None
+    diagonal: np.ndarray | None = None
+    spec: SolverSpec | None = None
+    last: np.ndarray | None = None
+
+    def solve_free(self, rhs: np.ndarray) -> np.ndarray:
+        """``A_ff^-1 rhs``: a division, the kept factor's substitutions, or a warm-started
+        iterative solve (a failed one raises :class:`~femkit.errors.SolverError`)."""
+        if self.diagonal is not None:
+            return rhs / self.diagonal
+        if self.factor is not None:
+            return self.factor.solve(rhs)
+        from ...errors import SolverError
+
+        res = self.spec.solve(self.A_ff, rhs, x0=self.last)
+        if not res.converged:
+            raise SolverError(f"linear solve of a time step: {res.message}")
+        self.last = res.x
+        return res.x
+
+
+@dataclass
+class LinearSystem:
+    """``M``, ``K`` (``n x n`` CSR), the Dirichlet nodes and the time-dependent data.
+
+    Parameters
+    ----------
+    M : sparse (n, n)
+        Mass matrix (consistent, or diagonal when ``lumped``), ``rho_c`` / ``rho`` included.
+    K : sparse (n, n)
+        Stiffness matrix (``kappa`` included).
+    fixed : (k,) int
+        Dirichlet nodes (sorted, unique).
+    load : callable ``t -> (n,)`` or None
+        ``F(t)``: source and Neumann fluxes assembled at ``t`` (None: zero).
+    boundary : callable ``t -> (k,)`` or None
+        Values at ``fixed`` at ``t`` (None: zero).
+    load_constant, boundary_constant : bool
+        The data do not depend on ``t`` (evaluated once).
+    lumped : bool
+        ``M`` is diagonal.
+    solver : SolverSpec
+        Linear solver of the implicit steps (``direct``: one kept factor per matrix).
+    """
+
+    M: sp.csr_matrix
+    K: sp.csr_matrix
+    fixed: np.ndarray
+    load: Callable[[float], np.ndarray] | None = None
+    boundary: Callable[[float], np.ndarray] | None = None
+    load_constant: bool = True
+    boundary_constant: bool = True
+    lumped: bool = False
+    solver: SolverSpec = field(default_factory=lambda: SolverSpec("direct"))
+    stats: dict = field(default_factory=dict)
+    _ops: dict = field(default_factory=dict, repr=False)
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self):
+        self.M = sp.csr_matrix(self.M)
+        self.K = sp.csr_matrix(self.K)
+        n = self.K.shape[0]
+        if self.M.shape != (n, n):
+            raise InputError(f"M is {self.M.shape}, K is {self.K.shape}: they must match")
+        self.fixed = np.unique(np.asarray(self.fixed, dtype=np.int64))
+        mask = np.ones(n, dtype=bool)
+        mask[self.fixed] = False
+        self.free = np.flatnonzero(mask)
+        self.n = n
+        self.K_f = self.K[self.free]   # free rows, all columns: one SpMV per product
+        self.M_f = self.M[self.free]
+        self.stats.setdefault("factorizations", 0)
+        self.stats.setdefault("solves", 0)
+        self.stats.setdefault("factor_seconds", 0.0)
+
+    # ------------------------------------------------------------------ data
+    def F(self, t: float) -> np.ndarray:
+        """``F(t)`` on all nodes (zeros when there is no load)."""
+        if self.load is None:
+            return np.zeros(self.n)
+        if self.load_constant:
+            if "F" not in self._cache:
+                self._cache["F"] = np.asarray(self.load(0.0), dtype=np.float64)
+            return self._cache["F"]
+        return np.asarray(self.load(t), dtype=np.float64)
+
+    def g(self, t: float) -> np.ndarray:
+        """Dirichlet values at ``fixed`` at time ``t``."""
+        if self.boundary is None or self.fixed.size == 0:
+            return np.zeros(self.fixed.size)
+        if self.boundary_constant:
+            if "g" not in self._cache:
+                self._cache["g"] = np.asarray(self.boundary(0.0), dtype=np.float64)
+            return self._cache["g"]
+        return np.asarray(self.boundary(t), dtype=np.float64)
+
+    @property
+    def has_load(self) -> bool:
+        return self.load is not None
+
+    # ------------------------------------------------------------------ operators
+    def operator(self, a: float, b: float) -> ConstrainedOperator:
+        """The kept :class:`ConstrainedOperator` of ``A = a M + b K`` (built on first use)."""
+        key = (float(a), float(b))
+        op = self._ops.get(key)
+        if op is not None:
+            return op
+        A = (a * self.M + b * self.K).tocsr() if b != 0.0 else (a * self.M).tocsr()
+        A_f = A[self.free]
+        A_ff = A_f[:, self.free].tocsr()
+        A_fb = A_f[:, self.fixed].tocsr()
+        op = ConstrainedOperator(A_ff, A_fb)
+        if b == 0.0 and self.lumped:
+            op.diagonal = A_ff.diagonal()
+        elif self.solver.method in KEPT_FACTOR_METHODS:
+            from ...solvers.kept_factor import factorize_kept
+
+            t0 = time.perf_counter()
+            op.factor = factorize_kept(A_ff, method=self.solver.method)
+            self.stats["factorizations"] += 1
+            self.stats["factor_seconds"] += time.perf_counter() - t0
+        else:
+            op.spec = self.solver
+        self._ops[key] = op
+        return op
+
+    def rows(self, a: float, b: float) -> sp.csr_matrix:
+        """``(a M + b K)[free]`` (free rows, all columns), kept: one SpMV per step."""
+        key = ("rows", float(a), float(b))
+        if key not in self._cache:
+            self._cache[key] = (a * self.M_f + b * self.K_f).tocsr() if b != 0.0 else \
+                (a * self.M_f).tocsr() if a != 1.0 else self.M_f
+        return self._cache[key]
+
+    def solve(self, a: float, b: float, rhs_free: np.ndarray, t: float, *,
+              values: np.ndarray | None = None) -> np.ndarray:
+        """The full vector ``x`` with ``x[fixed] = g(t)`` (or ``values``) and
+        ``(a M + b K) x = r`` on the free rows, ``rhs_free`` being ``r`` there."""
+        op = self.operator(a, b)
+        g = self.g(t) if values is None else values
+        x = np.empty(self.n)
+        x[self.fixed] = g
+        rhs = rhs_free - op.A_fb @ g if g.size and g.any() else rhs_free
+        x[self.free] = op.solve_free(rhs)
+        self.stats["solves"] += 1
+        return x
+
+    def energy(self, u: np.ndarray, v: np.ndarray | None = None) -> dict:
+        """``1/2 u^T K u`` (``potential``), ``1/2 v^T M v`` (``kinetic``, with ``v``) and their
+        ``total``; for the heat equation ``1/2 u^T M u`` is its ``thermal`` energy."""
+        out = {"potential": 0.5 * float(u @ (self.K @ u))}
+        if v is None:
+            out["thermal"] = 0.5 * float(u @ (self.M @ u))
+            return out
+        out["kinetic"] = 0.5 * float(v @ (self.M @ v))
+        out["total"] = out["potential"] + out["kinetic"]
+        return out
