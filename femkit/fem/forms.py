@@ -43,9 +43,6 @@ from .coefficients import element_coefficient
 from .dofs import dof_map
 from .quadrature import blocks, rule_for_degree
 from . import sparsity
-from ..warmup_registry import register_kernels
-
-register_kernels("P1 assembly", "femkit.fem._kernels", "_scatter", "_element_stiffness", rank=1)
 
 __all__ = ["reference_stiffness", "reference_mass", "local_matrices", "assemble_matrix", "FORMS"]
 
