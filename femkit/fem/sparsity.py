@@ -41,6 +41,9 @@ from ..warmup_registry import register_kernels, register_threshold
 NUMBA_THRESHOLD = 200_000
 register_threshold(__name__, "NUMBA_THRESHOLD")
 register_kernels("P1 assembly", "femkit.fem._kernels", "_incidences", "_pattern", "_pattern_cells", rank=1)
+# the element-generic assembly's (femkit.fem.forms, not imported by the P1 pipeline; its kernels are
+# declared with the stack's pattern so that the warm-up, which compiles them, knows them)
+register_kernels("P1 assembly", "femkit.fem._kernels", "_scatter", "_element_stiffness", rank=1)
 
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 _ELEMENT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()

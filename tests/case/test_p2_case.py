@@ -110,10 +110,9 @@ def test_p2_multigrid_through_the_p_level_equals_the_direct_solution(solver):
 
 
 @pytest.mark.parametrize("change, says", [
-    ({"adaptive": {"target": 0.01}}, "element P2: adaptive is not supported"),
     ({"estimator": "zz"}, "element P2: estimator 'zz' is not supported"),
     ({"quadrature": {"load": "gauss3"}}, "quadrature.load 'gauss3' (degree 2) is not exact for P2 products"),
-], ids=["adaptive", "zz", "load-rule"])
+], ids=["zz", "load-rule"])
 def test_options_p2_does_not_support_are_one_line_errors(change, says):
     with pytest.raises(CaseFileError, match=says.replace("(", r"\(").replace(")", r"\)").replace("+", r"\+")):
         _case(SQUARE, **change)
@@ -140,3 +139,21 @@ def test_p2_is_priced_before_meshing():
     assert p2.peak_bytes > p1.peak_bytes and "element P2" in p2.assumptions[0]
     result = _case(SQUARE, **big).run(quiet=True, write=False)
     assert abs(p2.sizes["unknowns"] / result.dofs - 1) < 0.25
+
+
+def test_adaptive_p2_on_the_l_shape_reaches_the_optimal_rate():
+    """Energy error ~ N^-1 (P2's optimal rate in 2D) under Doerfler marking at the re-entrant
+    corner, where uniform P2 gains nothing over P1 (N^-1/3); effectivity in [0.5, 3] on every level."""
+    from pathlib import Path
+
+    from femkit.case import load_case
+
+    path = Path(__file__).resolve().parents[2] / "cases" / "poisson_lshape_adaptive.yaml"
+    case = load_case(path, element="P2", solver={"method": "direct", "preconditioner": "none"},
+                     adaptive={"target": 1e-5, "theta": 0.5, "max_dofs": 12000, "max_time": 60})
+    levels = case.run(quiet=True, write=False).adaptive["levels"]
+    dofs = np.array([lv["dofs"] for lv in levels])
+    err = np.array([lv["error"] for lv in levels])
+    half = len(levels) // 2
+    assert np.polyfit(np.log(dofs[half:]), np.log(err[half:]), 1)[0] < -0.85
+    assert all(0.5 <= lv["effectivity"] <= 3.0 for lv in levels)

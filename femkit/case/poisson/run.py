@@ -152,7 +152,6 @@ def _prepare_element(d: dict, solver) -> None:
     name = d["element"]
     unsupported = [
         (solver.backend == "petsc", "solver.backend 'petsc'", "the default backend"),
-        (bool(d.get("adaptive")), "adaptive", "uniform refinement (mesh.refine)"),
         (d["estimator"] != "residual", f"estimator {d['estimator']!r}", "estimator 'residual'"),
         (bool(d["output"].get("xdmf")), "output.xdmf", "output.vtu (quadratic cells)"),
     ]
