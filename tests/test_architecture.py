@@ -122,7 +122,7 @@ def test_library_layers_do_not_write_femkit_files(layer):
 @pytest.mark.parametrize("layer, below", [
     ("mesh", ("fem", "solvers", "dynamics", "solids", "elements")),
     ("solvers", ("mesh", "fem", "dynamics", "solids", "elements")),
-    ("fem", ("dynamics", "solids", "elements")),
+    ("fem", ("dynamics", "solids")),
     ("solids", ("dynamics",)),
     ("dynamics", ("solids",)),
     ("elements", ("mesh", "fem", "solvers", "dynamics", "solids"))],

@@ -369,6 +369,7 @@ def warm_up() -> None:
     _, nnz3, _, _ = _pattern_cells(tet, 4, ind3, slots3, p3, np.ones(1), True, True)
     _stiffness_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, slots3, nnz3)
     _load_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, 4)
+    _scatter(np.zeros(nnz3), slots3, np.zeros(1, np.int64), np.ones((1, 16)))
 
 
 @numba.njit(cache=True)
@@ -435,3 +436,19 @@ def eliminate_kernel(K, F, is_fixed, g_full, overwrite: bool):
                       shape=(n_free, n_free), copy=not overwrite)
     A.has_sorted_indices = True
     return A, b
+
+
+@numba.njit(cache=True)
+def _scatter(data, slots, rows, local):  # pragma: no cover - compiled
+    """``data[slots[rows[k], j]] += local[k, j]``: a block of local matrices into CSR data."""
+    for k in range(local.shape[0]):
+        e = rows[k]
+        for j in range(local.shape[1]):
+            data[slots[e, j]] += local[k, j]
+
+
+def scatter_kernel(data: np.ndarray, slots: np.ndarray, rows: np.ndarray, local: np.ndarray) -> None:
+    """Add the local matrices ``local`` (k, w * w) of the cells ``rows`` into ``data`` through
+    the slot map ``slots`` (m, w * w) (int32, from the compiled pattern builder)."""
+    _scatter(data, slots, np.ascontiguousarray(rows, dtype=np.int64),
+             np.ascontiguousarray(local, dtype=np.float64))

@@ -1,10 +1,18 @@
-"""The CSR sparsity pattern of P1 assembly, computed once per mesh and reused.
+"""The CSR sparsity pattern of finite-element assembly, computed once per mesh and reused.
 
-A :class:`SparsityPattern` holds ``indptr`` and ``indices`` of the global matrix and
-``slots`` (m, w * w): the position in CSR ``data`` of each local entry ``(e, a, b)`` (row
-``cells[e, a]``, column ``cells[e, b]``, flattened as ``w a + b``; ``w`` = 3 for triangles,
-4 for tetrahedra).  Assembling a
-new set of local matrices on the same mesh is then one ``np.bincount``.
+This is femkit's one assembly stack: a :class:`SparsityPattern` holds ``indptr`` and ``indices``
+of the global matrix and ``slots`` (m, w * w): the position in CSR ``data`` of each local entry
+``(e, a, b)`` (row ``cells[e, a]``, column ``cells[e, b]``, flattened as ``w a + b``).  Assembling
+a new set of local matrices on the same cells is then one ``np.bincount`` (:meth:`assemble`);
+Dirichlet elimination is :func:`femkit.fem.dirichlet.apply_dirichlet` (a compiled pass from its
+threshold on).
+
+- P1 on a mesh: ``w`` = 3 for triangles, 4 for tetrahedra (:meth:`SparsityPattern.for_mesh`,
+  cached; the P1 stiffness may fill the pattern and its values in one compiled pass).
+- Any dofs per cell and any block size: :meth:`SparsityPattern.from_cells` with a dof map's
+  cells (P2: 6 or 10 per cell, :mod:`femkit.fem.dofs`) and ``block=b`` for vector fields (dof
+  ``b i + c`` is component ``c`` of node ``i``, node-major; local entries ordered the same way,
+  so ``w = b * dofs per cell``); :func:`pattern_for` caches one per mesh, element and block.
 
 >>> import numpy as np
 >>> from femkit.mesh import Mesh
@@ -35,6 +43,7 @@ register_threshold(__name__, "NUMBA_THRESHOLD")
 register_kernels("P1 assembly", "femkit.fem._kernels", "_incidences", "_pattern", "_pattern_cells", rank=1)
 
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_ELEMENT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True, eq=False)
@@ -126,6 +135,43 @@ class SparsityPattern:
             _CACHE[mesh] = pat
         return pat
 
+    @classmethod
+    def from_cells(cls, cells: np.ndarray, n: int, *, block: int = 1,
+                   backend: str = "auto") -> "SparsityPattern":
+        """The pattern of local dofs ``cells`` (m, k) among ``n`` global ones, each dof a block of
+        ``block`` components (node-major: global dof ``block * i + c``).
+
+        Parameters
+        ----------
+        cells : (m, k) int array
+            Global dof (or node) numbers of each cell's local dofs (a :class:`~femkit.fem.dofs.DofMap`'s
+            ``cells``).
+        n : int
+            Number of global dofs (nodes) before blocking; the matrix is ``n * block`` square.
+        block : int
+            Components per dof; local matrices are then ``(k * block)`` square, row ``block a + c``
+            for component ``c`` of local dof ``a``.
+        backend : {"auto", "numpy", "numba"}
+            As :meth:`from_mesh` (the compiled builder works for any ``k``).
+        """
+        cells = np.asarray(cells, dtype=np.int64)
+        if block < 1:
+            raise InputError(f"block size must be a positive integer, got {block}")
+        if block > 1:
+            cells = (cells[:, :, None] * block + np.arange(block)).reshape(len(cells), -1)
+        size = int(n) * block
+        if backend == "auto":
+            backend = "numba" if len(cells) >= NUMBA_THRESHOLD else "numpy"
+        if backend == "numpy":
+            indptr, indices, slots = _pattern_numpy(cells, size)
+        elif backend == "numba":
+            from ._kernels import pattern_kernel
+
+            indptr, indices, slots, _ = pattern_kernel(cells, size)
+        else:
+            raise InputError(f"unknown sparsity backend {backend!r}; valid: auto, numba, numpy")
+        return cls._from_arrays(size, indptr, indices, slots)
+
     def check(self, mesh) -> None:
         """Raise :class:`InputError` if this pattern does not belong to ``mesh``'s size."""
         width = int(round(np.sqrt(self.slots.shape[1]))) if self.slots.ndim == 2 else 3
@@ -157,6 +203,20 @@ class SparsityPattern:
                             shape=(self.n, self.n), copy=False)
         mat.has_sorted_indices = True
         return mat
+
+
+def pattern_for(mesh, dofs, block: int = 1) -> SparsityPattern:
+    """The pattern of a dof map ``dofs`` (:func:`femkit.fem.dofs.dof_map`) on ``mesh`` with
+    ``block`` components per dof, built on first use and cached while the mesh lives (P1 with
+    ``block=1`` is the mesh's own cached P1 pattern, :meth:`SparsityPattern.for_mesh`)."""
+    if dofs.element.name == "P1" and block == 1:
+        return SparsityPattern.for_mesh(mesh)
+    per_mesh = _ELEMENT_CACHE.setdefault(mesh, {})
+    key = (dofs.element.name, int(block))
+    pat = per_mesh.get(key)
+    if pat is None:
+        pat = per_mesh[key] = SparsityPattern.from_cells(dofs.cells, dofs.n_dofs, block=block)
+    return pat
 
 
 def _normalise(pattern: SparsityPattern, elements):
