@@ -115,6 +115,8 @@ class Projective(Integrator):
     #: needs an elastic solid (no springs) and integrates its own ARAP energy, not the body's
     #: material: generic every-integrator tests leave it out
     solids_only = True
+    #: its local step projects one deformation gradient per element: P1 only
+    elements = ("P1",)
 
     def __post_init__(self):
         check_iteration_options(self.name, self.iterations, self.tol, option="iterations")
