@@ -290,6 +290,12 @@ class PoissonProblem:
         Pure Neumann: largest accepted ``|int f + int h| / sum |F|`` (default 1e-3).
     pin_node, pin_value : int, float
         Pure Neumann, ``nullspace="pin"``: the node fixed and its value.
+    element : {"P1", "P2"}
+        The finite element (:data:`femkit.elements.ELEMENTS`). P2: the stiffness and mass of
+        :mod:`femkit.fem.forms`, the load, fluxes, Dirichlet dofs (vertices and edge midpoints)
+        and errors of :mod:`femkit.fem.lagrange`; ``u`` then has one value per dof
+        (:func:`femkit.fem.dofs.dof_map`: the nodes first). P2's load rule is the degree-4 rule
+        unless ``load_rule`` names another than P1's default ``barycentric``.
 
     Attributes
     ----------
@@ -304,7 +310,10 @@ class PoissonProblem:
                  dirichlet: Sequence = ((None, 0.0),), neumann: Sequence = (),
                  load_rule: str = "barycentric", nullspace: str | None = None,
                  compatibility_rtol: float = COMPATIBILITY_RTOL, pin_node: int = 0,
-                 pin_value: float = 0.0):
+                 pin_value: float = 0.0, element: str = "P1"):
+        from ..elements import get_element
+
+        self.element = get_element(element, mesh.dim)
         self.mesh = mesh
         self.kappa = kappa
         self.f = f
@@ -342,6 +351,8 @@ class PoissonProblem:
         """
         self._timer = StageTimer()
         t = self._timer
+        if self.element.name != "P1":
+            return self._assemble_element()
         with t("pattern"):
             pattern = (SparsityPattern.for_mesh(self.mesh) if keep_pattern
                        else SparsityPattern.cached(self.mesh))
@@ -354,8 +365,43 @@ class PoissonProblem:
         self.neumann_load = F_flux
         return K, F + F_flux
 
+    def _assemble_element(self) -> tuple:
+        """:meth:`assemble_matrices` for an element other than P1 (:mod:`femkit.fem.forms`,
+        :mod:`femkit.fem.lagrange`)."""
+        from .forms import assemble_matrix
+        from .lagrange import element_load
+        from .sparsity import pattern_for
+
+        t = self._timer
+        with t("pattern"):
+            pattern_for(self.mesh, self.dofs)
+        with t("stiffness"):
+            K = assemble_matrix(self.mesh, "stiffness", self.kappa, element=self.element)
+        with t("load"):
+            rule = None if self.load_rule == "barycentric" else self.load_rule
+            F = element_load(self.mesh, self.f, self.element, rule=rule)
+        with t("neumann"):
+            F_flux = self.neumann_vector()
+        self.neumann_load = F_flux
+        return K, F + F_flux
+
+    @property
+    def dofs(self):
+        """The :class:`~femkit.fem.dofs.DofMap` of the problem's element on its mesh."""
+        from .dofs import dof_map
+
+        return dof_map(self.mesh, self.element)
+
+    @property
+    def n_dofs(self) -> int:
+        """Unknowns before boundary conditions (nodes for P1; nodes + edges for P2)."""
+        return self.mesh.n_points if self.element.name == "P1" else self.dofs.n_dofs
+
     def dirichlet_data(self) -> tuple[np.ndarray, np.ndarray]:
-        """Dirichlet nodes (sorted) and their values; a later entry wins on shared nodes."""
+        """Dirichlet dofs (sorted) and their values; a later entry wins on shared dofs. P1: the
+        nodes; P2: the nodes and edge midpoints of the tagged facets (``g`` interpolated)."""
+        if self.element.name != "P1":
+            return self._element_dirichlet()
         g = np.full(self.mesh.n_points, np.nan)
         for tags, value in self.dirichlet:
             nodes = boundary_nodes(self.mesh, tags)
@@ -363,12 +409,39 @@ class PoissonProblem:
         fixed = np.flatnonzero(~np.isnan(g))
         return fixed, g[fixed]
 
+    def _element_dirichlet(self) -> tuple[np.ndarray, np.ndarray]:
+        from types import SimpleNamespace
+
+        from .lagrange import boundary_dofs
+
+        dofs = self.dofs
+        at = SimpleNamespace(points=dofs.points(self.mesh))  # g at the dof points
+        g = np.full(dofs.n_dofs, np.nan)
+        for tags, value in self.dirichlet:
+            ids = boundary_dofs(self.mesh, dofs, tags)
+            g[ids] = dirichlet_values(at, ids, value)
+        fixed = np.flatnonzero(~np.isnan(g))
+        return fixed, g[fixed]
+
     def neumann_vector(self) -> np.ndarray:
-        """``int h N_i ds`` summed over the Neumann entries, shape (n,)."""
-        F_flux = np.zeros(self.mesh.n_points)
+        """``int h N_i ds`` summed over the Neumann entries, shape (n_dofs,)."""
+        F_flux = np.zeros(self.n_dofs)
         for tags, h in self.neumann:
-            F_flux += assemble_neumann(self.mesh, tags, h)
+            if self.element.name == "P1":
+                F_flux += assemble_neumann(self.mesh, tags, h)
+            else:
+                from .lagrange import element_neumann
+
+                F_flux += element_neumann(self.mesh, tags, h, self.element)
         return F_flux
+
+    def weights(self) -> np.ndarray:
+        """``int phi_i dx`` per dof (:func:`node_weights` for P1)."""
+        if self.element.name == "P1":
+            return node_weights(self.mesh)
+        from .lagrange import dof_weights
+
+        return dof_weights(self.mesh, self.element)
 
     def reduce(self, K, F, method: str = "direct", *, overwrite: bool = False) -> DirichletSystem | NullspaceSystem:
         """The system a solver gets: Dirichlet nodes eliminated (SPD), or, pure Neumann, the
@@ -377,7 +450,7 @@ class PoissonProblem:
         may reuse ``K``'s arrays (:func:`apply_dirichlet`; ``K`` is not to be used after)."""
         with self._timer("dirichlet"):
             if self.nullspace is not None:
-                w = node_weights(self.mesh)
+                w = self.weights()
                 F_flux = getattr(self, "neumann_load", np.zeros_like(F))
                 F, info = check_compatibility(F - F_flux, F_flux, weights=w,
                                               rtol=self.compatibility_rtol)
@@ -425,6 +498,14 @@ class PoissonProblem:
         """
         from .norms import error_norms
 
+        if self.element.name != "P1":
+            from .lagrange import element_error_norms
+
+            if self.nullspace is not None:
+                _, ue, area = mean_shift_parts(self.mesh, np.zeros(self.mesh.n_points), exact, order=order)
+                u = u - (float(self.weights() @ u) - ue) / area
+            errs = element_error_norms(self.mesh, u, exact, grad_exact, element=self.element, order=order)
+            return {k: (None if v is None else float(v)) for k, v in errs.items()}
         if self.nullspace is not None:
             u = u - mean_shift(self.mesh, u, exact, order=order)
         errs = error_norms(self.mesh, u, exact, grad_exact, order=order)

@@ -262,6 +262,7 @@ def _write_appended(f, header: bytes, arrays: list) -> None:
 
 #: VTK's cell type numbers of the cells femkit writes (others: meshio's table).
 _CELL_TYPES = {"vertex": 1, "line": 3, "triangle": 5, "quad": 9, "tetra": 10, "hexahedron": 12,
+               "triangle6": 22, "tetra10": 24,
                "wedge": 13, "pyramid": 14}
 
 

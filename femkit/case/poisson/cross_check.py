@@ -2,7 +2,8 @@
 
 Compared quantities and their documented tolerances (docs/cli.md):
 
-- stiffness K: ``||K - K_skfem||_F / ||K_skfem||_F`` <= 1e-12;
+- stiffness K: ``||K - K_skfem||_F / ||K_skfem||_F`` <= 1e-12 (``element: P2``: scikit-fem's
+  ``ElementTriP2`` / ``ElementTetP2``, its dofs renumbered to femkit's; the load with P2's rule);
 - load F (the case's ``quadrature.load`` rule, scikit-fem's ``Basis`` given the same points and
   weights): ``||F - F_skfem|| / ||F_skfem||`` <= 1e-12;
 - solution vs skfem (condense + direct solve): ``||u - u_skfem|| / ||u_skfem||`` <=
@@ -91,8 +92,17 @@ def cross_check(case: Case) -> list[CheckRow]:
     kappa = problem.kappa
     neumann = problem.neumann_load
     rule = problem.load_rule  # the case's quadrature.load: scikit-fem integrates with it too
-    F_source = assemble_load(mesh, problem.f, rule=rule)  # the source's part of F alone
-    K_sk, F_sk = reference.assemble(mesh, kappa, case.functions["source"], rule=rule)
+    element = problem.element.name
+    if element == "P1":
+        F_source = assemble_load(mesh, problem.f, rule=rule)  # the source's part of F alone
+    else:
+        from ...fem.lagrange import element_load
+        from ...fem.quadrature import rule_for_degree
+
+        if rule == "barycentric":  # P2's own rule (the cheapest exact for its products)
+            rule = rule_for_degree(problem.element.load_degree, mesh.dim).name
+        F_source = element_load(mesh, problem.f, problem.element, rule=rule)
+    K_sk, F_sk = reference.assemble(mesh, kappa, case.functions["source"], rule=rule, element=element)
     rows = [
         CheckRow("stiffness K vs scikit-fem", float(spla.norm(K - K_sk) / spla.norm(K_sk)),
                  MATRIX_TOL, f"{K.shape[0]}x{K.shape[1]}, nnz {K.nnz}"),
@@ -120,7 +130,7 @@ def cross_check(case: Case) -> list[CheckRow]:
             pure_neumann_system,
         )
 
-        w = node_weights(mesh)
+        w = node_weights(mesh) if element == "P1" else problem.weights()
         F_sk = check_compatibility(F_sk, weights=w, rtol=case.spec.boundary.compatibility_rtol)[0]
         nodes, values = np.array([0]), np.array([0.0])
 

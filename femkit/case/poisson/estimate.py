@@ -30,7 +30,12 @@ def estimate_facts(case, problem, u: np.ndarray, grad_exact=None, est=None):
     facts = {"estimator": est.estimator, "energy": est.energy, "per_region": est.per_region(problem.mesh)}
     eff = None
     if grad_exact is not None:
-        err = energy_error(problem.mesh, u, grad_exact, problem.kappa)
+        if problem.element.name == "P1":
+            err = energy_error(problem.mesh, u, grad_exact, problem.kappa)
+        else:
+            from ...fem.lagrange import element_energy_error
+
+            err = element_energy_error(problem.mesh, u, grad_exact, problem.kappa, element=problem.element)
         facts["true_energy_error"] = err
         eff = est.effectivity(err) if err > 0 else None
     return facts, eff, est

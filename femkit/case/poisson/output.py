@@ -26,13 +26,20 @@ RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs",
 
 
 def write_solution(path: str | os.PathLike, mesh, u: np.ndarray,
-                   kappa: np.ndarray | float | None = None, extra_point_data: dict | None = None, compression: str | None = None) -> Path:
+                   kappa: np.ndarray | float | None = None, extra_point_data: dict | None = None,
+                   compression: str | None = None, element: str = "P1") -> Path:
     """Write the mesh with point data ``u`` and cell data ``kappa`` and ``tag`` (vtu/xdmf by extension).
 
+    ``element="P2"``: quadratic cells (VTK_QUADRATIC_TRIANGLE 22 / VTK_QUADRATIC_TETRA 24, meshio's
+    ``triangle6`` / ``tetra10``) whose nodes are the mesh's points followed by the edge midpoints,
+    ``u`` given on every one of them (:func:`femkit.fem.dofs.dof_map`'s numbering); ``.vtu`` only.
     Not atomic by itself (meshio may write sibling files); use it inside
     :func:`femkit.io.atomic.atomic_directory`.
     """
     from ...mesh import write_mesh
+
+    if element != "P1":
+        return _write_quadratic(Path(path), mesh, u, kappa, compression, element)
 
     point_data = {"u": np.asarray(u, dtype=np.float64)}
     point_data.update(extra_point_data or {})
@@ -46,6 +53,37 @@ def write_solution(path: str | os.PathLike, mesh, u: np.ndarray,
     target = Path(path)
     write_mesh(target, mesh, point_data=point_data, cell_data=cell_data, compression=compression)
     return target
+
+
+def _write_quadratic(target: Path, mesh, u, kappa, compression, element: str) -> Path:
+    """:func:`write_solution` of a P2 field: quadratic cells, ``u`` at every node."""
+    from ...fem.dofs import dof_map
+    from ...mesh.vtk import write_cells
+
+    dofs = dof_map(mesh, element)
+    kind = "triangle6" if mesh.dim == 2 else "tetra10"
+    cell_data = {"tag": [np.asarray(mesh.cell_tags, dtype=np.int32)]}
+    if kappa is not None:
+        kappa = np.asarray(kappa, dtype=np.float64)
+        cell_data["kappa"] = [np.full(mesh.n_cells, float(kappa)) if kappa.ndim == 0 else kappa]
+    write_cells(target, dofs.points(mesh), [(kind, dofs.cells)],
+                point_data={"u": np.asarray(u, dtype=np.float64)}, cell_data=cell_data,
+                **({} if compression is None else {"compression": compression}))
+    return target
+
+
+def plot_triangulation(mesh, u: np.ndarray):
+    """``(points, triangles, values, parent)`` to draw a 2D field: the mesh itself for a P1
+    ``u`` (one value per node), for a P2 ``u`` each triangle split into four at its edge
+    midpoints (the P2 nodal values on the sub-triangles; ``parent`` maps them to their cell)."""
+    if len(u) == mesh.n_points:
+        return mesh.points, mesh.triangles, u, np.arange(mesh.n_cells)
+    from ...fem.dofs import dof_map
+
+    dofs = dof_map(mesh, "P2")
+    c = dofs.cells                                            # v0 v1 v2 e01 e12 e02
+    sub = np.concatenate([c[:, [0, 3, 5]], c[:, [3, 1, 4]], c[:, [5, 4, 2]], c[:, [3, 4, 5]]])
+    return dofs.points(mesh), sub, u, np.tile(np.arange(mesh.n_cells), 4)
 
 
 def write_plot(path: str | os.PathLike, mesh, u: np.ndarray, title: str = "",
@@ -62,6 +100,7 @@ def write_plot(path: str | os.PathLike, mesh, u: np.ndarray, title: str = "",
     u = np.asarray(u, dtype=np.float64)
     total = None if indicators is None else float(np.sqrt(np.sum(np.asarray(indicators) ** 2)))
     if mesh.dim == 3:
+        u = u[:mesh.n_points]  # a P2 field: its vertex values (the section interpolates linearly)
         from .section import plane_section
 
         zs = mesh.points[:, 2]
@@ -72,7 +111,10 @@ def write_plot(path: str | os.PathLike, mesh, u: np.ndarray, title: str = "",
             indicators = np.asarray(indicators)[cut.cells]
         title = f"{title}\nsection z = {cut.z:.4g}" if title else f"section z = {cut.z:.4g}"
     else:
-        tri = Triangulation(mesh.points[:, 0], mesh.points[:, 1], mesh.triangles)
+        pts, triangles, u, parent = plot_triangulation(mesh, u)
+        tri = Triangulation(pts[:, 0], pts[:, 1], triangles)
+        if indicators is not None:
+            indicators = np.asarray(indicators)[parent]
     panels = 1 if indicators is None else 2
     fig = new_figure(6 * panels, 5, dpi=120)
     ax = fig.add_subplot(1, panels, 1)
@@ -143,7 +185,8 @@ class SolutionFile:
 
     NAME = "solution.vtu"
 
-    def __init__(self, directory: Path, mesh, u: np.ndarray, kappa, compression: str | None):
+    def __init__(self, directory: Path, mesh, u: np.ndarray, kappa, compression: str | None,
+                 element: str = "P1"):
         import tempfile
 
         from ...io.background import BackgroundWriter
@@ -153,7 +196,7 @@ class SolutionFile:
                                                           dir=directory.parent))
         self._writer = BackgroundWriter(depth=1, name="femkit solution writer")
         self._writer.submit(write_solution, self.staging / self.NAME, mesh, u, kappa, None,
-                            compression)
+                            compression, element)
 
     def move_into(self, directory: Path) -> None:
         """Wait for the file, then move it and its sidecars into ``directory`` (renames)."""
@@ -183,7 +226,7 @@ def solution_file(case, target: Path | None, mesh, u: np.ndarray, kappa):
     run writes its outputs (``target``), else a context that holds ``None``."""
     if target is None or not case.spec.output.vtu:
         return contextlib.nullcontext(None)
-    return SolutionFile(target, mesh, u, kappa, case.spec.output.compression)
+    return SolutionFile(target, mesh, u, kappa, case.spec.output.compression, case.spec.element)
 
 
 def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None,
@@ -210,7 +253,7 @@ def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None,
             solution.move_into(tmp)
         elif opts.vtu:
             write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa,
-                           compression=opts.compression)
+                           compression=opts.compression, element=result.case.spec.element)
         if result.u is None:
             result.parallel["not_written"] = [f"solution.{e}" for e, k in
                                               (("xdmf", "xdmf"), ("png", "plot")) if getattr(opts, k)]

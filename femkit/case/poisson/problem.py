@@ -300,7 +300,8 @@ def poisson_problem(case: Case, mesh, *, load_rule: str | None = None,
     return PoissonProblem(mesh, element_kappa(case, mesh) if kappa is None else kappa,
                           case.functions["source"],
                           dirichlet=dirichlet, neumann=neumann,
-                          load_rule=load_rule or case.spec.load_rule, **extra)
+                          load_rule=load_rule or case.spec.load_rule, element=case.spec.element,
+                          **extra)
 
 
 def is_pure_neumann(case: Case) -> bool:

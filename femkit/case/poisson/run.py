@@ -118,6 +118,7 @@ def prepare_poisson(case: Case) -> None:
     from ...fem.estimators import ESTIMATORS
 
     lookup(ESTIMATORS, d["estimator"], "estimator")
+    _prepare_element(d, solver)
     if d.get("adaptive"):
         from ...fem.adaptive import check_settings
 
@@ -143,7 +144,42 @@ def prepare_poisson(case: Case) -> None:
         adaptive=freeze(d["adaptive"]) if d.get("adaptive") else None, solver=solver,
         output=PoissonOutputSpec(out["dir"], bool(out["vtu"]), bool(out["xdmf"]),
                                  bool(out["plot"]), out.get("gather_limit"),
-                                 out.get("compression", "none")))
+                                 out.get("compression", "none")),
+        element=d["element"])
+
+
+def _prepare_element(d: dict, solver) -> None:
+    """``element:``: a registered element; P2 with an option it does not support is one line
+    naming the option and what to use instead."""
+    from ...elements import ELEMENTS
+
+    lookup(ELEMENTS, d["element"], "element")
+    if d["element"] == "P1":
+        return
+    name = d["element"]
+    unsupported = [
+        (solver.backend == "petsc", "solver.backend 'petsc'", "the default backend"),
+        (bool(d.get("adaptive")), "adaptive", "uniform refinement (mesh.refine)"),
+        (solver.needs_hierarchy, f"solver {solver.method}+{solver.preconditioner}",
+         "method pcg with preconditioner amg_rs"),
+        (d["estimator"] != "residual", f"estimator {d['estimator']!r}", "estimator 'residual'"),
+        (bool(d["output"].get("xdmf")), "output.xdmf", "output.vtu (quadratic cells)"),
+    ]
+    for bad, what, instead in unsupported:
+        if bad:
+            raise CaseFileError(f"element {name}: {what} is not supported with {name}; use {instead} "
+                                "or element P1")
+    rule = d["quadrature"]["load"]
+    if rule != "barycentric":
+        from ...elements import get_element
+        from ...fem.quadrature import QUADRATURE, TET_QUADRATURE
+
+        need = get_element(name, 2).load_degree
+        degree = (QUADRATURE.get(rule) if rule in QUADRATURE else TET_QUADRATURE.get(rule)).degree
+        if degree < need:
+            raise CaseFileError(f"quadrature.load {rule!r} (degree {degree}) is not exact for {name} "
+                                f"products: {name} needs degree >= {need} (leave quadrature.load out "
+                                "for the cheapest such rule)")
 
 
 def _prepare_nullspace(bnd: dict) -> None:

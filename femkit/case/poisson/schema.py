@@ -120,6 +120,8 @@ POISSON_SCHEMA: dict = {
         # error estimator of result.json and of adaptive refinement (checked against the
         # femkit.fem.estimators registry at load time)
         "estimator": {"type": "string", "minLength": 1, "default": "residual"},
+        # finite element (checked against femkit.elements.ELEMENTS at load time)
+        "element": {"type": "string", "minLength": 1, "default": "P1"},
         "adaptive": _ADAPTIVE,
         "quadrature": {
             "type": "object", "additionalProperties": False, "default": {},

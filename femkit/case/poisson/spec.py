@@ -79,3 +79,4 @@ class PoissonSpec:
     adaptive: Mapping | None
     solver: Any
     output: PoissonOutputSpec
+    element: str = "P1"

@@ -35,4 +35,21 @@ def estimate(problem, u: np.ndarray, estimator: str = "residual") -> ErrorEstima
     >>> estimate(prob, u, "residual").energy, estimate(prob, u, "zz").energy   # u_h = u exactly
     (0.0, 0.0)
     """
+    element = getattr(problem, "element", None)
+    if element is not None and element.name != "P1":
+        return _higher_order(problem, u, estimator)
     return ESTIMATORS.get(estimator)(problem.mesh, u, **problem_data(problem))
+
+
+def _higher_order(problem, u: np.ndarray, estimator: str) -> ErrorEstimate:
+    """The estimators of a P2 solution: ``residual`` (:mod:`.residual_p2`); any other registered
+    name is an InputError naming the one that applies."""
+    from ...errors import InputError
+
+    ESTIMATORS.get(estimator)  # an unknown name: the registry's message
+    if estimator != "residual":
+        raise InputError(f"estimator {estimator!r} is not available for element "
+                         f"{problem.element.name}; valid: residual")
+    from .residual_p2 import residual_estimator_p2
+
+    return residual_estimator_p2(problem.mesh, u, **problem_data(problem))
