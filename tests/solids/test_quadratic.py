@@ -150,3 +150,17 @@ def test_p2_loads_are_the_consistent_ones(d):
     b = body_forces(body, np.eye(d)[0] * 2.0)
     xx = body.rest_positions[:, 0]
     assert b[:, 0] @ xx ** 2 == pytest.approx(2.0 / 3.0, rel=1e-12)   # int x^2 over the unit box
+
+
+@pytest.mark.parametrize("element", ["P1", "P2"])
+def test_the_block_pattern_is_the_assembly_stacks_block_pattern(element):
+    """The solids' node-slot pattern and femkit's one assembly pattern with block size ``d``
+    (:meth:`SparsityPattern.from_cells`) are the same CSR structure, P1 and P2."""
+    from femkit.fem.sparsity import SparsityPattern
+
+    body = ElasticBody.from_mesh(Mesh(*tet_box(2, 1, 1)), material("linear", mu=1.0, lam=1.0),
+                                 element)
+    pat = body.pattern
+    ref = SparsityPattern.from_cells(body.rest.cells, body.n, block=3)
+    np.testing.assert_array_equal(pat.indptr, ref.indptr)
+    np.testing.assert_array_equal(pat.indices, ref.indices)

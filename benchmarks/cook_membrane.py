@@ -1,0 +1,125 @@
+"""Cook's membrane with femkit's P1 and P2 triangles: the tables of docs/solids.md.
+
+``--linear`` (default): linear plane strain, E = 1, total shear 1, nu = 1/3 and 0.4999, on the
+bundled gmsh geometry at h = 4, 2, 1: the vertical displacement of the corner (48, 60) and of the
+mid-edge (48, 52), as fractions of the converged reference (``scripts/cook_reference.py``), with
+the unknowns and the solve's seconds (error against work, P1 against P2).
+
+``--hyperelastic``: the finite-strain Cook membrane of deal.II's code gallery ("Quasi-static
+finite-strain compressible elasticity", J-P. V. Pelteret and A. McBride, 2016): compressible
+neo-Hookean ``W = mu/2 (J^(-2/3) tr b - 3) + kappa/4 (J^2 - 1 - 2 ln J)``, ``kappa = 2 mu (1 +
+nu) / (3 (1 - 2 nu))``, mu = 0.4225 MPa, nu = 0.3, in millimetres; total load 1 N on the right
+face of a 1 mm thick slab, i.e. a traction 1/16 N/mm^2; plane strain (their z displacement held
+everywhere); 10 load steps as their 10 time steps. Meshes: the panel's ``n x n`` mapped grid of
+their table (each quadrilateral cut into two triangles), ``n`` = 1 .. 32 elements per edge; the
+tip (48, 60) vertical displacement in mm beside their published Q1 and Q2 values.
+
+Usage::
+
+    python benchmarks/cook_membrane.py               # linear table (a few seconds)
+    python benchmarks/cook_membrane.py --hyperelastic
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+#: converged vertical displacements (corner, mid-edge), scikit-fem P4 + Aitken
+REFERENCE = {1.0 / 3.0: (22.610, 21.525), 0.4999: (19.428, 18.512)}
+#: deal.II code gallery, tip y-displacement in mm at 1, 2, 4, ..., 64 elements per edge
+DEALII = {"Q1": (5.15, 8.72, 12.02, 13.61, 14.13, 14.28, 14.32),
+          "Q2": (12.19, 13.83, 14.22, 14.30, 14.32, 14.33, 14.33)}
+NEO_HOOKE = "mu/2*(J**(-2/3)*(s1**2 + s2**2 + s3**2) - 3) + kappa/4*(J**2 - 1 - 2*log(J))"
+
+
+def mapped_mesh(n: int):
+    """The panel's ``n x n`` grid under the bilinear map of the unit square (as deal.II's
+    ``subdivided_hyper_rectangle`` + transform), each cell cut along one diagonal, with the
+    tags ``clamped`` (x = 0) and ``loaded`` (x = 48)."""
+    from femkit.mesh import Mesh
+    from femkit.mesh.structured import grid_triangles
+
+    t = np.linspace(0.0, 1.0, n + 1)
+    xi, eta = (a.ravel() for a in np.meshgrid(t, t, indexing="xy"))
+    pts = np.column_stack([48.0 * xi, 44.0 * xi + eta * (44.0 - 28.0 * xi)])
+    cells = grid_triangles(n + 1, n + 1)
+    k = np.arange(n)
+    left = np.column_stack([(k + 1) * (n + 1), k * (n + 1)])
+    right = np.column_stack([k * (n + 1) + n, (k + 1) * (n + 1) + n])
+    return Mesh(pts, cells, boundary_facets=np.vstack([left, right]),
+                boundary_tags=np.repeat([1, 2], n), tag_names={"clamped": 1, "loaded": 2})
+
+
+def solve(mesh, mat, element: str, traction, load_steps: int = 1):
+    """The static equilibrium; returns ``(body, u, seconds)``."""
+    from femkit.solids import Dirichlet, ElasticBody, solve_static, tagged_facets, traction_forces
+    from femkit.solids.quadratic import facet_nodes
+
+    def facets(tag):
+        f = tagged_facets(mesh, tag)
+        return f if element == "P1" else facet_nodes(mesh, f, element)
+
+    t0 = time.perf_counter()
+    body = ElasticBody.from_mesh(mesh, mat, element)
+    bc = Dirichlet(body.n, 2).fix(np.unique(facets("clamped")))
+    f = traction_forces(body.rest_positions, facets("loaded"), traction)
+    u = solve_static(body, bc, f, load_steps=load_steps).u
+    return body, u, time.perf_counter() - t0
+
+
+def _at(body, point) -> int:
+    return int(np.flatnonzero(np.all(np.isclose(body.rest_positions, point), axis=1))[0])
+
+
+def linear_table() -> None:
+    from femkit.mesh import generate
+    from femkit.solids import material
+
+    print("| nu | h | element | unknowns | corner (48, 60) | mid-edge (48, 52) | solve s |")
+    print("|---|---|---|---|---|---|---|")
+    for nu, (rc, rm) in REFERENCE.items():
+        for h in (4.0, 2.0, 1.0):
+            mesh = generate("cook_membrane", h)
+            for element in ("P1", "P2"):
+                mat = material("linear", E=1.0, nu=nu)
+                solve(mesh, mat, element, [0.0, 1.0 / 16.0])           # compile, caches
+                body, u, sec = solve(mesh, mat, element, [0.0, 1.0 / 16.0])
+                c, m = u[_at(body, (48.0, 60.0)), 1], u[_at(body, (48.0, 52.0)), 1]
+                print(f"| {nu:.4g} | {h:g} | {element} | {body.ndof:,} | {c:.4f} ({c / rc:.1%}) "
+                      f"| {m:.4f} ({m / rm:.1%}) | {sec:.3f} |")
+
+
+def hyperelastic_table(sizes) -> None:
+    from femkit.solids.materials import EnergyMaterial
+
+    mu, nu = 0.4225, 0.3
+    kappa = 2.0 * mu * (1.0 + nu) / (3.0 * (1.0 - 2.0 * nu))
+    mat = EnergyMaterial.from_energy({"W": NEO_HOOKE}, {"mu": mu, "kappa": kappa})
+    print("| elements per edge | femkit P1 | femkit P2 | P2 unknowns | deal.II Q1 | deal.II Q2 |")
+    print("|---|---|---|---|---|---|")
+    for n in sizes:
+        k = int(round(np.log2(n)))
+        row = []
+        for element in ("P1", "P2"):
+            body, u, _ = solve(mapped_mesh(n), mat, element, [0.0, 1.0 / 16.0], load_steps=10)
+            row.append((u[_at(body, (48.0, 60.0)), 1], body.ndof))
+        print(f"| {n} | {row[0][0]:.2f} | {row[1][0]:.2f} | {row[1][1]:,} | {DEALII['Q1'][k]:.2f} "
+              f"| {DEALII['Q2'][k]:.2f} |")
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--hyperelastic", action="store_true")
+    ap.add_argument("--sizes", type=int, nargs="+", default=[1, 2, 4, 8, 16, 32])
+    args = ap.parse_args(argv)
+    if args.hyperelastic:
+        hyperelastic_table(args.sizes)
+    else:
+        linear_table()
+
+
+if __name__ == "__main__":
+    main()
