@@ -391,6 +391,48 @@ def point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no cover - c
     return psi
 
 
+@numba.njit(cache=True, inline="always")
+def _mode_vectors(lam, work, h, nn, v, project, w, wl, d):  # pragma: no cover - compiled
+    """The mode vectors of ``dP/dF``'s eigenpairs on ``nn`` nodes, ``w[n d + a, k] = (U M_k
+    h_n)_a`` (``h_n = V^T g_n``: the rows of ``h``), and ``wl = v lam_k w``, for the kept modes
+    (with ``project`` a negative eigenvalue's mode is left out). Returns ``(kept modes, sum of
+    the negative eigenvalues' magnitudes)``. Shared by both element passes."""
+    U, E = work[0], work[4]
+    ng = 0.0
+    na = 0                          # the modes kept (a clamped one adds nothing)
+    for k in range(d):
+        if lam[k] < 0.0:
+            ng -= lam[k]
+            if project:
+                continue
+        for n in range(nn):
+            for a in range(d):
+                acc = 0.0
+                for i in range(d):
+                    acc += U[a, i] * E[i, k] * h[n, i]
+                w[n * d + a, na] = acc
+                wl[n * d + a, na] = v * lam[k] * acc
+        na += 1
+    k = d
+    for i in range(d):
+        for j in range(i + 1, d):
+            for sign in range(2):
+                lk = lam[k + sign]
+                if lk < 0.0:
+                    ng -= lk
+                    if project:
+                        continue
+                sg = _R2 if sign == 0 else -_R2
+                for n in range(nn):
+                    for a in range(d):
+                        acc = _R2 * U[a, i] * h[n, j] + sg * U[a, j] * h[n, i]
+                        w[n * d + a, na] = acc
+                        wl[n * d + a, na] = v * lk * acc
+                na += 1
+            k += 2
+    return na, ng
+
+
 # ---------------------------------------------------------------- element pass
 #: floating-point licences of the element pass: contraction to FMA, reassociation, reciprocals,
 #: signless zeros -- results move by rounding only (~1e-14 relative, checked by the tests against
@@ -456,7 +498,7 @@ def _element_pass(code, x, cells, grads, vol, elems, params, level, project, nod
         add_nodal_forces(grad, cells, grads, e, P, v)
         if level < 2:
             continue
-        U, V, E = work[0], work[1], work[4]
+        V = work[1]
         g2 = 0.0
         for n in range(nv):
             for b in range(d):
@@ -467,38 +509,7 @@ def _element_pass(code, x, cells, grads, vol, elems, params, level, project, nod
                 for b in range(d):
                     acc += V[b, i] * grads[e, n + 1, b]
                 h[n, i] = acc
-        ng = 0.0
-        na = 0                          # the modes kept (a clamped one adds nothing)
-        for k in range(d):
-            if lam[k] < 0.0:
-                ng -= lam[k]
-                if project:
-                    continue
-            for n in range(d):
-                for a in range(d):
-                    acc = 0.0
-                    for i in range(d):
-                        acc += U[a, i] * E[i, k] * h[n, i]
-                    w[n * d + a, na] = acc
-                    wl[n * d + a, na] = v * lam[k] * acc
-            na += 1
-        k = d
-        for i in range(d):
-            for j in range(i + 1, d):
-                for sign in range(2):
-                    lk = lam[k + sign]
-                    if lk < 0.0:
-                        ng -= lk
-                        if project:
-                            continue
-                    sg = _R2 if sign == 0 else -_R2
-                    for n in range(d):
-                        for a in range(d):
-                            acc = _R2 * U[a, i] * h[n, j] + sg * U[a, j] * h[n, i]
-                            w[n * d + a, na] = acc
-                            wl[n * d + a, na] = v * lk * acc
-                    na += 1
-                k += 2
+        na, ng = _mode_vectors(lam, work, h, d, v, project, w, wl, d)
         neg[e] = v * ng * g2
         # vertices 1..d: B[d + i, d + j] = sum_k wl[i, k] w[j, k] (symmetric)
         for i in range(nd):
@@ -612,7 +623,7 @@ def _element_pass_points(code, x, cells, grads, weights, nq, elems, params, leve
                     grad[node, a] += v * acc
             if level < 2:
                 continue
-            U, V, E = work[0], work[1], work[4]
+            V = work[1]
             g2 = 0.0
             for n in range(nv):
                 for i in range(d):
@@ -622,37 +633,8 @@ def _element_pass_points(code, x, cells, grads, weights, nq, elems, params, leve
                         if i == 0:
                             g2 += grads[p, n, b] * grads[p, n, b]
                     h[n, i] = acc
-            na = 0
-            for k in range(d):
-                if lam[k] < 0.0:
-                    ng -= v * lam[k] * g2
-                    if project:
-                        continue
-                for n in range(nv):
-                    for a in range(d):
-                        acc = 0.0
-                        for i in range(d):
-                            acc += U[a, i] * E[i, k] * h[n, i]
-                        w[n * d + a, na] = acc
-                        wl[n * d + a, na] = v * lam[k] * acc
-                na += 1
-            k = d
-            for i in range(d):
-                for j in range(i + 1, d):
-                    for sign in range(2):
-                        lk = lam[k + sign]
-                        if lk < 0.0:
-                            ng -= v * lk * g2
-                            if project:
-                                continue
-                        sg = _R2 if sign == 0 else -_R2
-                        for n in range(nv):
-                            for a in range(d):
-                                acc = _R2 * U[a, i] * h[n, j] + sg * U[a, j] * h[n, i]
-                                w[n * d + a, na] = acc
-                                wl[n * d + a, na] = v * lk * acc
-                        na += 1
-                    k += 2
+            na, negative = _mode_vectors(lam, work, h, nv, v, project, w, wl, d)
+            ng += v * negative * g2
             for i in range(nd):
                 for j in range(i, nd):
                     acc = 0.0
