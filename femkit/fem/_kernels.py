@@ -370,6 +370,9 @@ def warm_up() -> None:
     _stiffness_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, slots3, nnz3)
     _load_tet(tet, p3, np.zeros(1, np.int64), False, np.ones(1), True, 4)
     _scatter(np.zeros(nnz3), slots3, np.zeros(1, np.int64), np.ones((1, 16)))
+    for cells, pts, slots, nnz_ in ((tri, pts, slots, nnz), (tet, p3, slots3, nnz3)):
+        w = cells.shape[1]
+        _element_stiffness(cells, pts, np.ones(1), True, np.ones((w * w, w * w)), slots, nnz_)
 
 
 @numba.njit(cache=True)
@@ -452,3 +455,49 @@ def scatter_kernel(data: np.ndarray, slots: np.ndarray, rows: np.ndarray, local:
     the slot map ``slots`` (m, w * w) (int32, from the compiled pattern builder)."""
     _scatter(data, slots, np.ascontiguousarray(rows, dtype=np.int64),
              np.ascontiguousarray(local, dtype=np.float64))
+
+
+@numba.njit(cache=True)
+def _element_stiffness(cells, points, kappa, scalar_kappa, table, slots, nnz):  # pragma: no cover - compiled
+    """Stiffness of any Lagrange element on affine cells, summed into CSR data in one pass:
+    per cell the P1 matrix ``k1_ab = kappa |T| grad lambda_a . grad lambda_b`` (the same scaled
+    edge or face-normal products as :func:`_add_local_stiffness` / :func:`_add_tet_stiffness`),
+    then ``local_j = sum_ab k1_ab table[ab, j]`` (``table`` = the reference tensor, ((d+1)^2, n^2))
+    scattered through ``slots``. Returns (data, number of degenerate cells)."""
+    m, nv = cells.shape
+    n2 = table.shape[1]
+    data = np.zeros(nnz)
+    g = np.zeros((4, 3))
+    k1 = np.empty(nv * nv)
+    bad = 0
+    for e in range(m):
+        if nv == 3:
+            _, _, _, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(cells, points, e)
+            ok, s = _element_scale(area, 4.0, kappa, scalar_kappa, e)
+            g[0, 0], g[0, 1], g[1, 0], g[1, 1], g[2, 0], g[2, 1] = ex0, ey0, ex1, ey1, ex2, ey2
+        else:
+            vol6 = abs(_tetrahedron(cells, points, e, g))
+            ok, s = _element_scale(vol6, 6.0, kappa, scalar_kappa, e)
+        if not ok:
+            bad += 1
+            continue
+        for a in range(nv):
+            for b in range(nv):
+                k1[a * nv + b] = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
+        for j in range(n2):
+            v = 0.0
+            for ab in range(nv * nv):
+                v += k1[ab] * table[ab, j]
+            data[slots[e, j]] += v
+    return data, bad
+
+
+def element_stiffness_kernel(mesh, kappa, table: np.ndarray, pattern):
+    """CSR data of the stiffness of every cell of ``mesh`` for the reference tensor ``table``
+    ((d+1)^2, n^2) into ``pattern`` (slots of the element's dofs), or None if a cell is
+    degenerate (the caller's numpy path then names it). ``kappa``: a float or one per cell."""
+    data, bad = _element_stiffness(np.ascontiguousarray(mesh.cells, dtype=np.int64),
+                                   np.ascontiguousarray(mesh.points, dtype=np.float64),
+                                   *_values(kappa), np.ascontiguousarray(table, dtype=np.float64),
+                                   pattern.slots, pattern.nnz)
+    return None if bad else data

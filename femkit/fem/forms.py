@@ -11,7 +11,9 @@ and ``M^T_ij = rho_T |T| R_ij`` with ``R_ij = (1/|T|) int_T phi_i phi_j``. The r
 the local matrices of a block of cells are ``(m, (d+1)^2) @ ((d+1)^2, n^2)``. They go into the
 CSR pattern of the dof map (:func:`femkit.fem.sparsity.pattern_for`) by ``np.bincount``, or,
 from :data:`~femkit.fem.sparsity.NUMBA_THRESHOLD` cells on, block by block through one compiled
-scatter (:func:`femkit.fem._kernels.scatter_kernel`), so no (m, n^2) array is ever whole.
+scatter (:func:`femkit.fem._kernels.scatter_kernel`), so no (m, n^2) array is ever whole; the
+whole mesh's stiffness there is one compiled pass (geometry, local matrix, scatter:
+:func:`femkit.fem._kernels.element_stiffness_kernel`).
 
 Coefficients (``kappa``, ``rho``) are constant per cell, as in the P1 assembly: a float, one
 value per cell, a ``{tag or name: value}`` table or a callable evaluated at the cell centroids
@@ -41,9 +43,6 @@ from .coefficients import element_coefficient
 from .dofs import dof_map
 from .quadrature import blocks, rule_for_degree
 from . import sparsity
-from ..warmup_registry import register_kernels
-
-register_kernels("P1 assembly", "femkit.fem._kernels", "_scatter", rank=1)
 
 __all__ = ["reference_stiffness", "reference_mass", "local_matrices", "assemble_matrix", "FORMS"]
 
@@ -139,7 +138,13 @@ def assemble_matrix(mesh, form: str, coefficient=1.0, *, element="P1", elements=
     count = mesh.n_cells if idx is None else len(idx)
     if count < sparsity.NUMBA_THRESHOLD or pattern.slots.dtype != np.int32:
         return pattern.assemble(_local(mesh, elem, form, scale, idx), elements=idx)
-    from ._kernels import scatter_kernel
+    from ._kernels import element_stiffness_kernel, scatter_kernel
+
+    if form == "stiffness" and idx is None:  # one compiled pass: geometry, local matrix, scatter
+        n = elem.n_dofs
+        data = element_stiffness_kernel(mesh, scale, reference_stiffness(elem).reshape(-1, n * n), pattern)
+        if data is not None:
+            return pattern.matrix(data)
 
     cells = np.arange(mesh.n_cells) if idx is None else idx
     data = np.zeros(pattern.nnz)

@@ -8,7 +8,7 @@ polygonal approximation of a curved domain keeps the geometric error O(h^2) (the
 hold on polygonal domains).
 
 - load ``F_i = int f phi_i`` by a rule exact for P2 products (degree 4: ``gauss6`` on triangles,
-  ``stroud27`` on tetrahedra, :func:`femkit.fem.quadrature.rule_for_degree`); a constant ``f``
+  ``sym14`` on tetrahedra, :func:`load_rule`); a constant ``f``
   exactly (``f |T| int phi_i / |T|``);
 - Neumann ``int_facet h phi_i ds`` with the facet's P2 trace (3 dofs per edge, 6 per face) by a
   degree-5 Gauss rule on edges and ``gauss6`` on faces;
@@ -55,12 +55,18 @@ def dof_weights(mesh, element="P2") -> np.ndarray:
     return np.bincount(dofs.cells.ravel(), weights=np.outer(vol, ref).ravel(), minlength=dofs.n_dofs)
 
 
+def load_rule(element: Element):
+    """The default load rule of ``element``: the cheapest registered rule exact for its products
+    (degree :attr:`~femkit.elements.base.Element.load_degree`; P2: ``gauss6``, tetrahedra ``sym14``)."""
+    return rule_for_degree(element.load_degree, element.dim, every=True)
+
+
 def element_load(mesh, f, element="P2", *, rule: str | None = None) -> np.ndarray:
     """Load vector ``int f phi_i`` (n_dofs,) of ``element``; ``rule`` a quadrature rule name
     (default: the cheapest registered rule of degree :attr:`Element.load_degree`)."""
     elem = get_element(element, mesh.dim)
     dofs = dof_map(mesh, elem)
-    quad = get_rule(rule, mesh.dim) if rule else rule_for_degree(elem.load_degree, mesh.dim)
+    quad = get_rule(rule, mesh.dim) if rule else load_rule(elem)
     phi = elem.basis(quad.points)                                    # (q, n)
     _, vol, cells = simplex_gradients(mesh, None)
     if not callable(f):

@@ -5,9 +5,13 @@ triangle area).  Registry :data:`QUADRATURE`: ``barycentric`` (1 point, degree 1
 (3 interior points, degree 2), ``gauss6`` (Dunavant, degree 4), ``gauss7`` (Dunavant, degree 5).
 
 Tetrahedra have their own registry :data:`TET_QUADRATURE` (``get_rule(name, dim=3)``):
-``barycentric`` (1 point, degree 1), ``gauss4`` (4 points, degree 2; Keast 1986) and the
+``barycentric`` (1 point, degree 1), ``gauss4`` (4 points, degree 2; Keast 1986), the
 conical-product (Stroud 1971, collapsed Gauss-Jacobi) rules ``stroud8`` (degree 3),
-``stroud27`` (degree 5) and ``stroud64`` (degree 7).
+``stroud27`` (degree 5) and ``stroud64`` (degree 7), and ``sym14``, the fully symmetric
+14-point rule of degree 5 (orbits of 4, 4 and 6 points, positive weights; exactness checked
+monomial by monomial in tests/fem/test_p2_quadrature.py), P2's load rule on tetrahedra. ``sym14``
+is not an automatic choice of :func:`rule_for_degree` (which P1's error norms and estimators
+use, so their numbers stay those of ``stroud27``) unless asked with ``every=True``.
 
 >>> rule = get_rule("gauss6")
 >>> rule.degree, rule.points.shape, round(float(rule.weights.sum()), 15)
@@ -35,6 +39,7 @@ class TriangleRule:
     points: np.ndarray
     weights: np.ndarray
     degree: int
+    auto: bool = True
 
     def physical_points(self, mesh, tri: np.ndarray) -> tuple[np.ndarray, ...]:
         """Coordinates ``(x, y)`` (``(x, y, z)`` on tetrahedra) of the points on each cell,
@@ -76,10 +81,10 @@ def _orbit3(a: float) -> list[tuple[float, float, float]]:
     return [(b, a, a), (a, b, a), (a, a, b)]
 
 
-def _rule(name, pts, wts, degree):
+def _rule(name, pts, wts, degree, auto=True):
     pts = np.asarray(pts, dtype=np.float64)
     wts = np.asarray(wts, dtype=np.float64)
-    _REGISTRIES[pts.shape[1] - 1].register(name, TriangleRule(name, pts, wts / wts.sum(), degree))
+    _REGISTRIES[pts.shape[1] - 1].register(name, TriangleRule(name, pts, wts / wts.sum(), degree, auto))
 
 
 def gauss_jacobi(n: int, alpha: float) -> tuple[np.ndarray, np.ndarray]:
@@ -138,15 +143,30 @@ for _n, _deg in ((2, 3), (3, 5), (4, 7)):
     _rule(f"stroud{_n ** 3}", *conical_product_points(_n), _deg)
 
 
+def _orbit4(a: float) -> list[tuple[float, ...]]:
+    b = 1.0 - 3.0 * a
+    return [tuple(b if i == j else a for i in range(4)) for j in range(4)]
+
+
+def _orbit6(a: float) -> list[tuple[float, ...]]:
+    b = 0.5 - a
+    return [tuple(b if i in (j, k) else a for i in range(4)) for j in range(4) for k in range(j + 1, 4)]
+
+
+_rule("sym14", _orbit4(0.0927352503108912) + _orbit4(0.3108859192633006) + _orbit6(0.4544962958743504),
+      [0.01224884051939366] * 4 + [0.01878132095300264] * 4 + [0.007091003462846911] * 6, 5, auto=False)
+
+
 def get_rule(name: str, dim: int = 2) -> TriangleRule:
     """The rule registered as ``name`` for triangles (``dim=2``) or tetrahedra (``dim=3``);
     :class:`~femkit.errors.UnknownNameError` (listing the valid names) otherwise."""
     return _REGISTRIES[dim].get(name)
 
 
-def rule_for_degree(degree: int, dim: int = 2) -> TriangleRule:
+def rule_for_degree(degree: int, dim: int = 2, *, every: bool = False) -> TriangleRule:
     """The cheapest registered rule exact for polynomials of total degree ``degree`` on
-    triangles (``dim=2``) or tetrahedra (``dim=3``).
+    triangles (``dim=2``) or tetrahedra (``dim=3``); ``every``: also among the rules kept out of
+    the automatic choice (``sym14``).
 
     Raises
     ------
@@ -154,7 +174,8 @@ def rule_for_degree(degree: int, dim: int = 2) -> TriangleRule:
         No registered rule is exact for that degree (the highest available is named).
     """
     reg = _REGISTRIES[dim]
-    rules = sorted((reg.get(n) for n in reg), key=lambda r: (len(r.weights), r.degree))
+    rules = sorted((reg.get(n) for n in reg if every or reg.get(n).auto),
+                   key=lambda r: (len(r.weights), r.degree))
     for r in rules:
         if r.degree >= degree:
             return r

@@ -41,6 +41,9 @@ from ..warmup_registry import register_kernels, register_threshold
 NUMBA_THRESHOLD = 200_000
 register_threshold(__name__, "NUMBA_THRESHOLD")
 register_kernels("P1 assembly", "femkit.fem._kernels", "_incidences", "_pattern", "_pattern_cells", rank=1)
+# the element-generic assembly's (femkit.fem.forms, not imported by the P1 pipeline; its kernels are
+# declared with the stack's pattern so that the warm-up, which compiles them, knows them)
+register_kernels("P1 assembly", "femkit.fem._kernels", "_scatter", "_element_stiffness", rank=1)
 
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 _ELEMENT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -48,7 +51,8 @@ _ELEMENT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 @dataclass(frozen=True, eq=False)
 class SparsityPattern:
-    """CSR structure of the P1 matrices of one mesh plus the local-entry -> slot map.
+    """CSR structure of the matrices of one set of cells (a P1 mesh, a dof map) plus the
+    local-entry -> slot map.
 
     Attributes
     ----------
@@ -86,19 +90,7 @@ class SparsityPattern:
             O(m) counting-sort kernel (imported lazily, cached on disk);
             ``auto``: numba for meshes of at least :data:`NUMBA_THRESHOLD` cells.
         """
-        tri = mesh.cells
-        n = mesh.n_points
-        if backend == "auto":
-            backend = "numba" if len(tri) >= NUMBA_THRESHOLD else "numpy"
-        if backend == "numpy":
-            indptr, indices, slots = _pattern_numpy(tri, n)
-        elif backend == "numba":
-            from ._kernels import pattern_kernel
-
-            indptr, indices, slots, _ = pattern_kernel(tri, n)
-        else:
-            raise InputError(f"unknown sparsity backend {backend!r}; valid: auto, numba, numpy")
-        return cls._from_arrays(n, indptr, indices, slots)
+        return cls.from_cells(mesh.cells, mesh.n_points, backend=backend)
 
     @classmethod
     def _from_arrays(cls, n, indptr, indices, slots) -> "SparsityPattern":
@@ -154,10 +146,10 @@ class SparsityPattern:
         backend : {"auto", "numpy", "numba"}
             As :meth:`from_mesh` (the compiled builder works for any ``k``).
         """
-        cells = np.asarray(cells, dtype=np.int64)
         if block < 1:
             raise InputError(f"block size must be a positive integer, got {block}")
         if block > 1:
+            cells = np.asarray(cells, dtype=np.int64)
             cells = (cells[:, :, None] * block + np.arange(block)).reshape(len(cells), -1)
         size = int(n) * block
         if backend == "auto":

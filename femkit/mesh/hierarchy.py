@@ -194,6 +194,20 @@ class _Levels:
 
 
 @dataclass(frozen=True, eq=False)
+class QuadraticNodes:
+    """The nodes of P2 on ``mesh`` (its vertices, then one per edge), as the finest level of a
+    :class:`MeshHierarchy` (:meth:`MeshHierarchy.with_quadratic_level`): what multigrid reads
+    of a level, its node count ``n_points``, and ``dim``."""
+
+    mesh: Mesh
+    n_points: int
+
+    @property
+    def dim(self) -> int:
+        return self.mesh.dim
+
+
+@dataclass(frozen=True, eq=False)
 class MeshHierarchy(_Levels):
     """Nested meshes, coarsest first, and the prolongations between consecutive levels.
 
@@ -341,6 +355,32 @@ class MeshHierarchy(_Levels):
             fixed[frees[lvl]] = False
             out.append((_fixed_columns(P.tocsr(), frees[lvl + 1], fixed), np.flatnonzero(fixed)))
         return out
+
+    def with_quadratic_level(self) -> "MeshHierarchy":
+        """This hierarchy with one more, finest level: the P2 nodes of its finest mesh (the
+        p-level of P2 multigrid). Its "mesh" is :class:`QuadraticNodes` (the vertices, then one
+        node per edge: the numbering of :func:`femkit.fem.dofs.dof_map`), its prolongation the
+        interpolation of a P1 field into P2 (vertex values kept, an edge node the mean of its
+        ends): the matrix of one red refinement (:func:`prolongation`), since the P2 nodes of a
+        mesh are the vertices of its refinement. The Galerkin product of a P2 stiffness matrix
+        with it is the P1 stiffness matrix of the same mesh (P1 is a subspace of P2).
+
+        >>> sq = Mesh(points=[[0, 0], [1, 0], [1, 1], [0, 1]], triangles=[[0, 1, 2], [0, 2, 3]])
+        >>> H = MeshHierarchy.from_refinement(sq, 1).with_quadratic_level()
+        >>> H.n_levels, H.finest.n_points, H.prolongations[-1].shape
+        (3, 25, (25, 9))
+        """
+        from dataclasses import replace
+
+        from .edges import edges
+
+        fine = self.finest
+        edge_nodes, _ = edges(fine)
+        n = fine.n_points
+        top = QuadraticNodes(fine, n + len(edge_nodes))
+        return replace(self, meshes=self.meshes + (top,),
+                       prolongations=self.prolongations + (prolongation(n, edge_nodes),),
+                       injections=self.injections + (np.arange(n, dtype=np.int64),))
 
     def without_coarse_meshes(self) -> "MeshHierarchy":
         """The same levels and transfers with the coarser meshes dropped (``None``; the finest

@@ -5,6 +5,12 @@ reads it).
 The numbers come from ``case.spec``: a geometry's measure (:func:`femkit.case.cost.geometry_domain`)
 or a ``.msh`` header's element count, priced by :func:`femkit.cost.plan_poisson`; tetrahedral runs
 by the 3D memory laws (:func:`femkit.case.cost.with_3d_memory`).
+
+``element: P2`` is priced before meshing as P1 on the mesh refined once more: P2 has a dof per
+vertex and per edge, exactly the vertices of that refined mesh, and its stages after the mesh
+work on as many unknowns; their memory is scaled by the ratio of the matrices' nonzeros
+(:data:`P2_NONZERO_RATIO`, P2 on a mesh against P1 on the mesh refined once, measured on
+femkit's meshes), the mesh stages are the refined mesh's (an upper bound).
 """
 
 from __future__ import annotations
@@ -12,7 +18,11 @@ from __future__ import annotations
 from ...cost import Plan, plan_poisson
 from ..cost import TET_AS_TRIANGLES, geometry_domain, tets_per_h3, with_3d_memory
 
-__all__ = ["plan_poisson_case", "case_dimension"]
+__all__ = ["plan_poisson_case", "case_dimension", "P2_NONZERO_RATIO"]
+
+#: nnz(P2 stiffness on a mesh) / nnz(P1 stiffness on that mesh refined once), by dimension
+#: (a unit-square mesh: 1.64; a structured Kuhn cube: 1.90).
+P2_NONZERO_RATIO = {2: 1.64, 3: 1.90}
 
 
 def case_dimension(case) -> int | None:
@@ -39,7 +49,8 @@ def plan_poisson_case(case, *, measure: bool = True) -> Plan:
     spec = case.spec
     mesh, out = spec.mesh, spec.output
     outputs = tuple(k for k, on in (("vtu", out.vtu), ("xdmf", out.xdmf), ("png", out.plot)) if on)
-    common = dict(refine=mesh.refine, method=case.solver.method,
+    p2 = spec.element != "P1"
+    common = dict(refine=mesh.refine + (1 if p2 else 0), method=case.solver.method,
                   speed=machine_speed() if measure else 1.0,
                   preconditioner=case.solver.preconditioner, rtol=case.solver.rtol,
                   outputs=outputs, errors="exact.u" in case.functions)
@@ -64,10 +75,27 @@ def plan_poisson_case(case, *, measure: bool = True) -> Plan:
             plan = plan_poisson(area=size, line_length=length, h=mesh.h, name=mesh.geometry,
                                 params=params, **common)
     plan.title = f"{case.name}: {plan.title}"
+    if p2:
+        _price_element(plan, spec.element, case_dimension(case) or 2)
     if spec.adaptive:
         plan.assumptions.append("adaptive refinement: only the first level is costed; the "
                                 "adaptive budgets (max_dofs, max_time, max_levels) bound the rest")
     return plan
+
+
+def _price_element(plan: Plan, element: str, dim: int) -> None:
+    """Turn the plan of P1 on the mesh refined once more into the plan of ``element`` (P2) on the
+    case's mesh (module docstring): the stages after the mesh priced for P2's denser matrix."""
+    factor = P2_NONZERO_RATIO[dim]
+    for st in plan.stages:
+        if st.name not in ("mesh", "refine"):
+            st.peak_bytes *= factor
+    if "nonzeros" in plan.sizes:
+        plan.sizes["nonzeros"] = plan.sizes["nonzeros"] * factor
+    plan.title = f"{plan.title}, element {element}"
+    plan.assumptions.insert(0, f"element {element}: priced as P1 on the mesh refined once more (the "
+                            f"same unknowns: a dof per vertex and per edge), memory after the mesh "
+                            f"x{factor:g} for {element}'s denser rows")
 
 
 def _tetrahedral_plan(tets: float, source: str, title: str, common: dict, *,

@@ -149,6 +149,10 @@ def multigrid_inputs(case: Case, hierarchy, system) -> dict:
     levels = None
     if spec.method == "fmg" and not is_pure_neumann(case):
         levels = [level_system(case, m, spec.method) for m in hierarchy.meshes[:-1]]
+    if case.spec.element != "P1":  # P2: a p-level above the P1 hierarchy (P1 -> P2 on one mesh)
+        if levels is not None:
+            levels.append(level_system(case, hierarchy.finest, spec.method, element="P1"))
+        hierarchy = hierarchy.with_quadratic_level()
     # the solve reads the coarser levels' sizes and transfers only: their meshes are released
     # with the caller's hierarchy (run_poisson drops it before the solve)
     out = multigrid_overrides(spec, hierarchy.without_coarse_meshes(), system.free, levels)
@@ -157,6 +161,11 @@ def multigrid_inputs(case: Case, hierarchy, system) -> dict:
         # the same products in the same element order; elimination drops rows and columns
         # alike): fmg's symmetry check of the finest matrix would only confirm it
         out["options"]["check_symmetry"] = False
+        if case.spec.element != "P1":
+            # fmg's discretisation-error estimate compares consecutive levels' solutions: across
+            # the p-level that is P1's error (O(h)), not P2's (O(h^2)), so the estimate test would
+            # stop on the P2 level far above its discretisation error; the residual rule stops it
+            out["options"]["target"] = "residual"
     return out
 
 
@@ -177,7 +186,7 @@ def on_free_nodes(overrides: dict) -> dict:
     return overrides
 
 
-def level_system(case: Case, mesh, method: str):
+def level_system(case: Case, mesh, method: str, *, element: str = "P1"):
     """A coarser level's system for ``fmg``, which takes its right-hand side and Dirichlet
     values (its operator is the Galerkin product of the finer one's, built by the solver).
 
@@ -188,7 +197,7 @@ def level_system(case: Case, mesh, method: str):
     from ...fem import assemble_load
     from ...fem.dirichlet import DirichletSystem
 
-    problem = poisson_problem(case, mesh, scalar_kappa=True)  # only its load is needed here
+    problem = poisson_problem(case, mesh, scalar_kappa=True, element=element)  # its load alone
     fixed, values = problem.dirichlet_data()
     if np.any(values != 0):
         return problem.assemble(method)
@@ -268,7 +277,7 @@ def constant_kappa(case: Case) -> float | None:
 
 
 def poisson_problem(case: Case, mesh, *, load_rule: str | None = None,
-                    scalar_kappa: bool = False):
+                    scalar_kappa: bool = False, element: str | None = None):
     """The case on ``mesh`` as a :class:`femkit.fem.PoissonProblem` (the one translation).
 
     Dirichlet entries naming the whole boundary together with other tags cover both (a later
@@ -276,6 +285,7 @@ def poisson_problem(case: Case, mesh, *, load_rule: str | None = None,
     edge once. Pure Neumann with ``nullspace: pin`` pins node 0 to the exact solution's value
     there when ``exact`` is given, else to 0. ``scalar_kappa``: a constant coefficient stays one
     number (:func:`constant_kappa`) instead of one value per cell (:func:`element_kappa`).
+    ``element``: instead of the case's (the P1 levels below a P2 problem in multigrid).
     """
     from ...fem import PoissonProblem
 
@@ -300,7 +310,8 @@ def poisson_problem(case: Case, mesh, *, load_rule: str | None = None,
     return PoissonProblem(mesh, element_kappa(case, mesh) if kappa is None else kappa,
                           case.functions["source"],
                           dirichlet=dirichlet, neumann=neumann,
-                          load_rule=load_rule or case.spec.load_rule, element=case.spec.element,
+                          load_rule=load_rule or case.spec.load_rule,
+                          element=element or case.spec.element,
                           **extra)
 
 
@@ -378,6 +389,7 @@ class CaseResult(RunResult):
         mesh_info[f"n_{CELLS_NAME[self.mesh.dim]}"] = self.mesh.n_cells
         mesh_info["source"] = spec.source()
         mesh_info["refine"] = spec.refine
+        mesh_info["element"] = self.case.spec.element
         return {
             "mesh": mesh_info,
             "dofs": self.dofs,

@@ -159,9 +159,6 @@ def _prepare_element(d: dict, solver) -> None:
     name = d["element"]
     unsupported = [
         (solver.backend == "petsc", "solver.backend 'petsc'", "the default backend"),
-        (bool(d.get("adaptive")), "adaptive", "uniform refinement (mesh.refine)"),
-        (solver.needs_hierarchy, f"solver {solver.method}+{solver.preconditioner}",
-         "method pcg with preconditioner amg_rs"),
         (d["estimator"] != "residual", f"estimator {d['estimator']!r}", "estimator 'residual'"),
         (bool(d["output"].get("xdmf")), "output.xdmf", "output.vtu (quadratic cells)"),
     ]

@@ -140,9 +140,10 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
     ----------
     solve_on : callable ``(mesh, x0) -> (problem, u, result)``
         Builds and solves the problem on ``mesh``; ``x0`` is the previous level's solution
-        interpolated to ``mesh`` (``None`` on the first level), ``problem`` a
-        :class:`~femkit.fem.PoissonProblem` (its data feed the estimator), ``u`` the nodal solution
-        and ``result`` the solver's :class:`~femkit.solvers.SolveResult`.
+        interpolated to ``mesh`` (``None`` on the first level, and for P2), ``problem`` a
+        :class:`~femkit.fem.PoissonProblem` (its data feed the estimator; a P2 problem gets the
+        P2 residual estimator and energy error), ``u`` the solution and ``result`` the solver's
+        :class:`~femkit.solvers.SolveResult`.
     mesh : Mesh
         The initial mesh (its triangles are relabelled longest-edge-first for bisection).
     theta : float in (0, 1]
@@ -172,6 +173,8 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
         ``stop_reason`` says which budget.
     """
     from ...mesh.bisect import bisect, label_longest_edge
+    from ..estimators import estimate
+    from ..lagrange import element_energy_error
     from ..norms import energy_error
 
     settings = check_settings(theta=theta, target=target, max_dofs=max_dofs, max_time=max_time,
@@ -196,11 +199,14 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
         t0 = time.perf_counter()
         problem, u, result = solve_on(mesh, x0)
         t1 = time.perf_counter()
-        est = estimate_fn(mesh, u, **problem_data(problem))
+        higher = getattr(getattr(problem, "element", None), "name", "P1") != "P1"   # P2: its own
+        est = (estimate(problem, u, estimator) if higher
+               else estimate_fn(mesh, u, **problem_data(problem)))
         t2 = time.perf_counter()
         error = eff = None
         if grad_exact is not None:
-            error = energy_error(mesh, u, grad_exact, problem.kappa)
+            error = (element_energy_error(mesh, u, grad_exact, problem.kappa, element=problem.element)
+                     if higher else energy_error(mesh, u, grad_exact, problem.kappa))
             eff = est.effectivity(error)
         elapsed = t2 - t_start - excluded          # earlier levels' true-error evaluations removed
         excluded += time.perf_counter() - t2
@@ -236,7 +242,8 @@ def adaptive_solve(solve_on: Callable, mesh, *, theta: float = 0.5, target: floa
             return AdaptiveResult(levels=levels, mesh=mesh, u=u, problem=problem, estimate=est,
                                   target_met=stop == "target", stop_reason=stop, settings=settings,
                                   result=result)
-        x0 = step.prolong(u)
+        # a P2 solution (one value per dof) has no nodal prolongation here: the next level starts cold
+        x0 = None if len(u) != mesh.n_points else step.prolong(u)
         mesh = step.mesh
         state = step if state is not None else None
 
