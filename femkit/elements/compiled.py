@@ -433,6 +433,25 @@ def _mode_vectors(lam, work, h, nn, v, project, w, wl, d):  # pragma: no cover -
     return na, ng
 
 
+@numba.njit(cache=True, inline="always")
+def _scatter_blocks(data, cells, e, node_slots, node_indptr, B, d):  # pragma: no cover - compiled
+    """Add element ``e``'s Hessian ``B`` (``(nv d)^2``, node-major) into the CSR ``data`` of a
+    :class:`~femkit.solids.pattern.BlockPattern`: the ``nv^2`` blocks ``d x d``, entry ``(n, a),
+    (m, c)`` at ``d^2 r0 + (slot - r0) d + a row + c`` (``r0`` the node row's start, ``row`` its
+    dof width). Shared by both element passes."""
+    nv = cells.shape[1]
+    dd = d * d
+    for n in range(nv):
+        r = cells[e, n]
+        r0 = node_indptr[r]
+        row = d * (node_indptr[r + 1] - r0)
+        for m in range(nv):
+            pos = dd * r0 + (node_slots[e, n * nv + m] - r0) * d
+            for a in range(d):
+                for c in range(d):
+                    data[pos + a * row + c] += B[n * d + a, m * d + c]
+
+
 # ---------------------------------------------------------------- element pass
 #: floating-point licences of the element pass: contraction to FMA, reassociation, reciprocals,
 #: signless zeros -- results move by rounding only (~1e-14 relative, checked by the tests against
@@ -533,16 +552,7 @@ def _element_pass(code, x, cells, grads, vol, elems, params, level, project, nod
                 for m in range(d):
                     acc -= B[a, d + m * d + c]
                 B[a, c] = acc
-        # scatter the (d+1)^2 blocks: CSR position of entry (n, a), (m, c), see BlockPattern
-        for n in range(nv):
-            r = cells[e, n]
-            r0 = node_indptr[r]
-            row = d * (node_indptr[r + 1] - r0)
-            for m in range(nv):
-                pos = dd * r0 + (node_slots[e, n * nv + m] - r0) * d
-                for a in range(d):
-                    for c in range(d):
-                        data[pos + a * row + c] += B[n * d + a, m * d + c]
+        _scatter_blocks(data, cells, e, node_slots, node_indptr, B, d)
 
 
 # ---------------------------------------------------------------- element pass at quadrature points
@@ -648,12 +658,4 @@ def _element_pass_points(code, x, cells, grads, weights, nq, elems, params, leve
         for i in range(nd):
             for j in range(i + 1, nd):
                 B[j, i] = B[i, j]
-        for n in range(nv):
-            r = cells[e, n]
-            r0 = node_indptr[r]
-            row = d * (node_indptr[r + 1] - r0)
-            for m in range(nv):
-                pos = dd * r0 + (node_slots[e, n * nv + m] - r0) * d
-                for a in range(d):
-                    for c in range(d):
-                        data[pos + a * row + c] += B[n * d + a, m * d + c]
+        _scatter_blocks(data, cells, e, node_slots, node_indptr, B, d)
