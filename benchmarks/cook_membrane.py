@@ -23,6 +23,7 @@ Usage::
 
     python benchmarks/cook_membrane.py               # linear table (a few seconds)
     python benchmarks/cook_membrane.py --hyperelastic
+    python benchmarks/cook_membrane.py --check-skfem   # femkit's P2 solution in scikit-fem's weak form
 """
 
 from __future__ import annotations
@@ -119,14 +120,68 @@ def hyperelastic_table(sizes, energy: str = DEALII_2D) -> None:
               f"| {DEALII['Q2'][k]:.2f} |", flush=True)
 
 
+def skfem_residual(n: int = 8) -> None:
+    """An independent check of femkit's nonlinear P2 solid: femkit's P2 solution of deal.II's 2D
+    model on the ``n x n`` mapped mesh, put into scikit-fem's ``ElementVector(ElementTriP2())``
+    (dofs matched by position) and the weak form ``int P(F) : grad v = int t . v`` assembled by
+    scikit-fem with ``P = mu (F/J - tr(C)/(2J) F^-T) + kappa/2 (J^2 - 1) F^-T`` written by hand:
+    the residual relative to the load, with femkit's 3-point rule and with a 6th-order one."""
+    import skfem
+    from skfem.helpers import ddot, grad
+
+    from femkit.solids.materials import EnergyMaterial
+
+    mu, nu = 0.4225, 0.3
+    kappa = 2.0 * mu * (1.0 + nu) / (3.0 * (1.0 - 2.0 * nu))
+    mat = EnergyMaterial.from_energy({"W": DEALII_2D}, {"mu": mu, "kappa": kappa})
+    mesh = mapped_mesh(n)
+    body, u, _ = solve(mesh, mat, "P2", [0.0, 1.0 / 16.0], load_steps=10)
+    m = skfem.MeshTri(mesh.points.T.copy(), mesh.cells.T.copy())
+    e = skfem.ElementVector(skfem.ElementTriP2())
+
+    @skfem.LinearForm
+    def internal(v, w):
+        F = grad(w["u"]) + np.eye(2)[:, :, None, None]
+        J = F[0, 0] * F[1, 1] - F[0, 1] * F[1, 0]
+        finv_t = np.array([[F[1, 1], -F[1, 0]], [-F[0, 1], F[0, 0]]]) / J
+        P = mu * (F / J - (F ** 2).sum(axis=(0, 1)) / (2 * J) * finv_t) \
+            + kappa / 2 * (J ** 2 - 1) * finv_t
+        return ddot(P, grad(v))
+
+    @skfem.LinearForm
+    def load(v, w):
+        return v[1] / 16.0
+
+    fb = skfem.FacetBasis(m, e, facets=m.facets_satisfying(lambda x: np.isclose(x[0], 48.0)),
+                          intorder=4)
+    f = load.assemble(fb)
+    for order in (2, 6):
+        basis = skfem.Basis(m, e, intorder=order)
+        where = {(round(p[0], 9), round(p[1], 9), c): i for i, (p, c) in
+                 enumerate(zip(basis.doflocs.T, np.tile([0, 1], basis.N // 2)))}
+        U = np.zeros(basis.N)
+        for i, p in enumerate(body.rest_positions):
+            for c in range(2):
+                U[where[(round(p[0], 9), round(p[1], 9), c)]] = u[i, c]
+        r = internal.assemble(basis, u=basis.interpolate(U)) - f
+        free = np.setdiff1d(np.arange(basis.N),
+                            basis.get_dofs(lambda x: np.isclose(x[0], 0.0)).flatten())
+        print(f"n = {n}, scikit-fem intorder {order}: |residual| / |load| = "
+              f"{np.linalg.norm(r[free]) / np.linalg.norm(f):.3e}")
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--hyperelastic", action="store_true")
     ap.add_argument("--sizes", type=int, nargs="+", default=[1, 2, 4, 8, 16, 32])
     ap.add_argument("--energy-3d", action="store_true",
                     help="the dim = 3 form of the energy in plane strain instead of deal.II's 2D one")
+    ap.add_argument("--check-skfem", action="store_true",
+                    help="femkit's hyperelastic P2 solution in scikit-fem's own weak form")
     args = ap.parse_args(argv)
-    if args.hyperelastic:
+    if args.check_skfem:
+        skfem_residual()
+    elif args.hyperelastic:
         hyperelastic_table(args.sizes, NEO_HOOKE_3D if args.energy_3d else DEALII_2D)
     else:
         linear_table()
