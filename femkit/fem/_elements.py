@@ -99,6 +99,18 @@ def simplex_gradients(mesh, idx: np.ndarray | None):
     return grads, area, tri
 
 
+def cell_measures(mesh, idx: np.ndarray | None):
+    """``(measure (m,), cells)``: the areas or volumes of the selected cells, without their
+    gradients (what a mass matrix or a load needs); raises :class:`DegenerateMeshError` naming
+    zero-measure cells."""
+    from ..mesh.mesh import signed_volumes
+
+    cells = mesh.cells if idx is None else mesh.cells[idx]
+    measure = np.abs(signed_volumes(mesh.points, cells))
+    check_areas(measure, idx, mesh.dim)
+    return measure, cells
+
+
 def p1_gradients(e: np.ndarray, signed: np.ndarray, ue: np.ndarray) -> np.ndarray:
     """Constant gradient (m, 2) of the P1 function with vertex values ``ue`` (m, 3) on each triangle.
 

@@ -38,7 +38,7 @@ import scipy.sparse as sp
 
 from ..elements import Element, get_element
 from ..errors import InputError
-from ._elements import select_elements, simplex_gradients
+from ._elements import cell_measures, select_elements, simplex_gradients
 from .coefficients import element_coefficient
 from .dofs import dof_map
 from .quadrature import blocks, rule_for_degree
@@ -98,11 +98,12 @@ def local_matrices(mesh, form: str, coefficient=1.0, *, element="P1", elements=N
 def _local(mesh, elem: Element, form: str, scale: np.ndarray, idx) -> np.ndarray:
     """(k, n * n) local matrices of the cells ``idx`` (None: all) with per-cell ``scale``."""
     n = elem.n_dofs
-    grads, vol, _ = simplex_gradients(mesh, idx)
     if form == "mass":
+        vol, _ = cell_measures(mesh, idx)
         return (scale * vol)[:, None] * reference_mass(elem).reshape(1, n * n)
     if form != "stiffness":
         raise InputError(f"unknown form {form!r}; valid forms: {', '.join(FORMS)}")
+    grads, vol, _ = simplex_gradients(mesh, idx)
     G = np.einsum("kad,kbd->kab", grads, grads).reshape(len(vol), -1)
     G *= (scale * vol)[:, None]
     return G @ reference_stiffness(elem).reshape(-1, n * n)

@@ -31,7 +31,7 @@ import numpy as np
 
 from ..elements import Element, get_element
 from ..errors import InputError
-from ._elements import simplex_gradients
+from ._elements import cell_measures, simplex_gradients
 from .coefficients import evaluate_callable
 from .dofs import DofMap, dof_map
 from .quadrature import blocks, get_rule, rule_for_degree
@@ -49,7 +49,7 @@ def dof_weights(mesh, element="P2") -> np.ndarray:
     triangles and negative on tetrahedra)."""
     elem = get_element(element, mesh.dim)
     dofs = dof_map(mesh, elem)
-    _, vol, _ = simplex_gradients(mesh, None)
+    vol, _ = cell_measures(mesh, None)
     rule = rule_for_degree(elem.degree, mesh.dim)
     ref = rule.weights @ elem.basis(rule.points)                     # (n,) int phi / |T|
     return np.bincount(dofs.cells.ravel(), weights=np.outer(vol, ref).ravel(), minlength=dofs.n_dofs)
@@ -68,7 +68,7 @@ def element_load(mesh, f, element="P2", *, rule: str | None = None) -> np.ndarra
     dofs = dof_map(mesh, elem)
     quad = get_rule(rule, mesh.dim) if rule else load_rule(elem)
     phi = elem.basis(quad.points)                                    # (q, n)
-    _, vol, cells = simplex_gradients(mesh, None)
+    vol, cells = cell_measures(mesh, None)
     if not callable(f):
         from .load import _scalar
 

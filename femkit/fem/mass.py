@@ -26,7 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..elements import get_element
-from ._elements import select_elements, simplex_gradients
+from ._elements import cell_measures, select_elements
 from .coefficients import element_coefficient
 from .dofs import dof_map
 from .forms import assemble_matrix, reference_mass
@@ -72,7 +72,7 @@ def mass_matrix(mesh, *, element: str = "P1", lumped: bool = False, density=None
     elem = get_element(element, mesh.dim)
     dofs = dof_map(mesh, elem)
     idx = select_elements(mesh, elements)
-    _, vol, _ = simplex_gradients(mesh, idx)
+    vol, _ = cell_measures(mesh, idx)
     cell_mass = element_coefficient(mesh, rho, idx) * vol
     cells = dofs.cells if idx is None else dofs.cells[idx]
     weights = lumping_weights(elem)
