@@ -391,6 +391,67 @@ def point(code, F, params, level, P, lam, Q, work, vec):  # pragma: no cover - c
     return psi
 
 
+@numba.njit(cache=True, inline="always")
+def _mode_vectors(lam, work, h, nn, v, project, w, wl, d):  # pragma: no cover - compiled
+    """The mode vectors of ``dP/dF``'s eigenpairs on ``nn`` nodes, ``w[n d + a, k] = (U M_k
+    h_n)_a`` (``h_n = V^T g_n``: the rows of ``h``), and ``wl = v lam_k w``, for the kept modes
+    (with ``project`` a negative eigenvalue's mode is left out). Returns ``(kept modes, sum of
+    the negative eigenvalues' magnitudes)``. Shared by both element passes."""
+    U, E = work[0], work[4]
+    ng = 0.0
+    na = 0                          # the modes kept (a clamped one adds nothing)
+    for k in range(d):
+        if lam[k] < 0.0:
+            ng -= lam[k]
+            if project:
+                continue
+        for n in range(nn):
+            for a in range(d):
+                acc = 0.0
+                for i in range(d):
+                    acc += U[a, i] * E[i, k] * h[n, i]
+                w[n * d + a, na] = acc
+                wl[n * d + a, na] = v * lam[k] * acc
+        na += 1
+    k = d
+    for i in range(d):
+        for j in range(i + 1, d):
+            for sign in range(2):
+                lk = lam[k + sign]
+                if lk < 0.0:
+                    ng -= lk
+                    if project:
+                        continue
+                sg = _R2 if sign == 0 else -_R2
+                for n in range(nn):
+                    for a in range(d):
+                        acc = _R2 * U[a, i] * h[n, j] + sg * U[a, j] * h[n, i]
+                        w[n * d + a, na] = acc
+                        wl[n * d + a, na] = v * lk * acc
+                na += 1
+            k += 2
+    return na, ng
+
+
+@numba.njit(cache=True, inline="always")
+def _scatter_blocks(data, cells, e, node_slots, node_indptr, B, d):  # pragma: no cover - compiled
+    """Add element ``e``'s Hessian ``B`` (``(nv d)^2``, node-major) into the CSR ``data`` of a
+    :class:`~femkit.solids.pattern.BlockPattern`: the ``nv^2`` blocks ``d x d``, entry ``(n, a),
+    (m, c)`` at ``d^2 r0 + (slot - r0) d + a row + c`` (``r0`` the node row's start, ``row`` its
+    dof width). Shared by both element passes."""
+    nv = cells.shape[1]
+    dd = d * d
+    for n in range(nv):
+        r = cells[e, n]
+        r0 = node_indptr[r]
+        row = d * (node_indptr[r + 1] - r0)
+        for m in range(nv):
+            pos = dd * r0 + (node_slots[e, n * nv + m] - r0) * d
+            for a in range(d):
+                for c in range(d):
+                    data[pos + a * row + c] += B[n * d + a, m * d + c]
+
+
 # ---------------------------------------------------------------- element pass
 #: floating-point licences of the element pass: contraction to FMA, reassociation, reciprocals,
 #: signless zeros -- results move by rounding only (~1e-14 relative, checked by the tests against
@@ -456,7 +517,7 @@ def _element_pass(code, x, cells, grads, vol, elems, params, level, project, nod
         add_nodal_forces(grad, cells, grads, e, P, v)
         if level < 2:
             continue
-        U, V, E = work[0], work[1], work[4]
+        V = work[1]
         g2 = 0.0
         for n in range(nv):
             for b in range(d):
@@ -467,38 +528,7 @@ def _element_pass(code, x, cells, grads, vol, elems, params, level, project, nod
                 for b in range(d):
                     acc += V[b, i] * grads[e, n + 1, b]
                 h[n, i] = acc
-        ng = 0.0
-        na = 0                          # the modes kept (a clamped one adds nothing)
-        for k in range(d):
-            if lam[k] < 0.0:
-                ng -= lam[k]
-                if project:
-                    continue
-            for n in range(d):
-                for a in range(d):
-                    acc = 0.0
-                    for i in range(d):
-                        acc += U[a, i] * E[i, k] * h[n, i]
-                    w[n * d + a, na] = acc
-                    wl[n * d + a, na] = v * lam[k] * acc
-            na += 1
-        k = d
-        for i in range(d):
-            for j in range(i + 1, d):
-                for sign in range(2):
-                    lk = lam[k + sign]
-                    if lk < 0.0:
-                        ng -= lk
-                        if project:
-                            continue
-                    sg = _R2 if sign == 0 else -_R2
-                    for n in range(d):
-                        for a in range(d):
-                            acc = _R2 * U[a, i] * h[n, j] + sg * U[a, j] * h[n, i]
-                            w[n * d + a, na] = acc
-                            wl[n * d + a, na] = v * lk * acc
-                    na += 1
-                k += 2
+        na, ng = _mode_vectors(lam, work, h, d, v, project, w, wl, d)
         neg[e] = v * ng * g2
         # vertices 1..d: B[d + i, d + j] = sum_k wl[i, k] w[j, k] (symmetric)
         for i in range(nd):
@@ -522,13 +552,110 @@ def _element_pass(code, x, cells, grads, vol, elems, params, level, project, nod
                 for m in range(d):
                     acc -= B[a, d + m * d + c]
                 B[a, c] = acc
-        # scatter the (d+1)^2 blocks: CSR position of entry (n, a), (m, c), see BlockPattern
-        for n in range(nv):
-            r = cells[e, n]
-            r0 = node_indptr[r]
-            row = d * (node_indptr[r + 1] - r0)
-            for m in range(nv):
-                pos = dd * r0 + (node_slots[e, n * nv + m] - r0) * d
+        _scatter_blocks(data, cells, e, node_slots, node_indptr, B, d)
+
+
+# ---------------------------------------------------------------- element pass at quadrature points
+@numba.njit(cache=True, fastmath=FASTMATH)
+def element_pass_points(code, x, cells, grads, weights, nq, elems, params, level, project,
+                        node_slots, node_indptr, energy, grad, data, neg, stress):  # pragma: no cover - compiled
+    """The element pass of elements whose deformation gradient varies inside them (P2: linear
+    in the element), by a quadrature rule of ``nq`` points per element.
+
+    Element ``e`` has the nodes ``cells[e]`` (any number ``nv``: 6 for P2 triangles, 10 for P2
+    tetrahedra) and at its point ``q`` (row ``p = e nq + q`` of ``grads`` ``(m nq, nv, d)`` and
+    ``weights`` ``(m nq,)``) the shape-function gradients ``g_n`` and the weight ``w_p``
+    (quadrature weight times the rest Jacobian). Then ``F_p = sum_n x_n g_n^T``, energy
+    ``sum_q w_p psi(F_p)``, gradient ``w_p P_p g_n`` and Hessian ``sum_q w_p g^T (dP/dF)_p g``, the
+    latter from the eigenpairs of ``dP/dF`` at each point, every negative one clamped at 0 when
+    ``project`` (so the element Hessian, a sum of PSD terms, is PSD). ``neg[e]`` sums
+    ``w_p |lam_k^-| |g|_F^2`` over the points (as :func:`element_pass`), ``stress`` ``(m nq, d,
+    d)`` (when non-empty) receives ``P_p``. The element's ``(nv d)^2`` Hessian is summed over its
+    points, then scattered once through ``node_slots`` (a pattern of ``(m, nv)`` cells).
+    """
+    if x.shape[1] == 3:
+        _element_pass_points(code, x, cells, grads, weights, nq, elems, params, level, project,
+                             node_slots, node_indptr, energy, grad, data, neg, stress, 3)
+    else:
+        _element_pass_points(code, x, cells, grads, weights, nq, elems, params, level, project,
+                             node_slots, node_indptr, energy, grad, data, neg, stress, 2)
+
+
+@numba.njit(cache=True, inline="always")
+def _element_pass_points(code, x, cells, grads, weights, nq, elems, params, level, project,
+                         node_slots, node_indptr, energy, grad, data, neg, stress, d):  # pragma: no cover - compiled
+    """The body of :func:`element_pass_points` for dimension ``d`` (a constant after inlining):
+    the mode vectors on every node, ``w_k[n] = U M_k h_n`` with ``h_n = V^T g_n``, as in
+    :func:`_element_pass` but without eliminating a vertex (the nodes are not ``d + 1``)."""
+    nv = cells.shape[1]
+    dd = d * d
+    nd = nv * d
+    F = np.empty((d, d))
+    P = np.zeros((d, d))
+    lam = np.zeros(dd)
+    work = np.zeros((6, d, d))
+    vec = np.zeros((2, d))
+    h = np.empty((nv, d))
+    w = np.empty((nd, dd))
+    wl = np.empty((nd, dd))
+    B = np.empty((nd, nd))
+    for t in range(elems.shape[0]):
+        e = elems[t]
+        total = 0.0
+        ng = 0.0
+        if level >= 2:
+            for i in range(nd):
+                for j in range(nd):
+                    B[i, j] = 0.0
+        for q in range(nq):
+            p = e * nq + q
+            for a in range(d):
+                for b in range(d):
+                    acc = 0.0
+                    for n in range(nv):
+                        acc += x[cells[e, n], a] * grads[p, n, b]
+                    F[a, b] = acc
+            psi = frame(code, F, params, level, P, lam, work, vec)
+            v = weights[p]
+            total += v * psi
+            if level < 1:
+                continue
+            if stress.shape[0] > 0:
                 for a in range(d):
-                    for c in range(d):
-                        data[pos + a * row + c] += B[n * d + a, m * d + c]
+                    for b in range(d):
+                        stress[p, a, b] = P[a, b]
+            for n in range(nv):
+                node = cells[e, n]
+                for a in range(d):
+                    acc = 0.0
+                    for b in range(d):
+                        acc += P[a, b] * grads[p, n, b]
+                    grad[node, a] += v * acc
+            if level < 2:
+                continue
+            V = work[1]
+            g2 = 0.0
+            for n in range(nv):
+                for i in range(d):
+                    acc = 0.0
+                    for b in range(d):
+                        acc += V[b, i] * grads[p, n, b]
+                        if i == 0:
+                            g2 += grads[p, n, b] * grads[p, n, b]
+                    h[n, i] = acc
+            na, negative = _mode_vectors(lam, work, h, nv, v, project, w, wl, d)
+            ng += v * negative * g2
+            for i in range(nd):
+                for j in range(i, nd):
+                    acc = 0.0
+                    for kk in range(na):
+                        acc += wl[i, kk] * w[j, kk]
+                    B[i, j] += acc
+        energy[e] = total
+        if level < 2:
+            continue
+        neg[e] = ng
+        for i in range(nd):
+            for j in range(i + 1, nd):
+                B[j, i] = B[i, j]
+        _scatter_blocks(data, cells, e, node_slots, node_indptr, B, d)

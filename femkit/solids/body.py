@@ -1,10 +1,12 @@
-"""An elastic body: P1 elements of a mesh, a material per region, energy/gradient/Hessian.
+"""An elastic body: P1 or P2 elements of a mesh, a material per region, energy/gradient/Hessian.
 
 ``ElasticBody(points, cells, material)`` precomputes the rest data once
 (:func:`~femkit.solids.kinematics.rest_shape`) and, on the first Hessian, the CSR pattern
 (:class:`~femkit.solids.pattern.BlockPattern`); each evaluation is one compiled pass per material
 group (:mod:`femkit.elements.compiled`). Positions are node-major ``(n, d)`` arrays, the flat
-dof index ``i*d + a`` as in :mod:`femkit.dynamics`.
+dof index ``i*d + a`` as in :mod:`femkit.dynamics`. With ``element="P2"`` the nodes are the
+mesh's vertices followed by its edge midpoints and every cell is evaluated at the points of a
+quadrature rule (:mod:`femkit.solids.quadratic`).
 
 >>> import numpy as np
 >>> from femkit.solids.materials import StableNeoHookean
@@ -43,7 +45,7 @@ def point_tangent(material: Material, F, *, project: bool = False):
 
 
 class ElasticBody:
-    """Elastic P1 body (triangles in plane strain, or tetrahedra).
+    """Elastic body of P1 or P2 elements (triangles in plane strain, or tetrahedra).
 
     Parameters
     ----------
@@ -53,6 +55,10 @@ class ElasticBody:
         or tag name when ``tag_names`` is given); every cell must get a material.
     cell_tags : (m,) int, optional.
     tag_names : mapping name -> tag id, optional.
+    element : ``"P1"`` (default) or ``"P2"`` (:data:`femkit.elements.ELEMENTS`): P2 adds a node
+        at every edge midpoint (:attr:`rest_positions` holds them after the vertices).
+    mesh : the :class:`femkit.mesh.Mesh` of ``points`` and ``cells``, optional (P2 numbers its
+        edges; :meth:`from_mesh` passes it).
 
     Raises
     ------
@@ -60,11 +66,28 @@ class ElasticBody:
         Inverted or zero-volume elements in the rest mesh (named).
     InputError
         Bad shapes, unknown region, cells without a material.
+    UnknownNameError
+        An unknown ``element`` (the valid ones listed).
     """
 
-    def __init__(self, points, cells, material, *, cell_tags=None, tag_names: Mapping | None = None):
-        self.rest: RestShape = rest_shape(points, cells)
-        self.rest_positions = np.ascontiguousarray(points, dtype=float)
+    def __init__(self, points, cells, material, *, cell_tags=None, tag_names: Mapping | None = None,
+                 element: str = "P1", mesh=None):
+        if element == "P1":
+            self.rest: RestShape = rest_shape(points, cells)
+            self.rest_positions = np.ascontiguousarray(points, dtype=float)
+        else:
+            from ..elements import get_element
+            from .quadratic import node_positions, quadratic_rest
+
+            if mesh is None:
+                from ..mesh import Mesh
+
+                rest_shape(points, cells)               # the shapes and orientation, checked first
+                mesh = Mesh(points, cells)
+            get_element(element, mesh.dim)              # UnknownNameError listing the valid ones
+            self.rest = quadratic_rest(mesh, element)
+            self.rest_positions = node_positions(mesh, element)
+        self.element = self.rest.element
         self.n, self.dim = self.rest_positions.shape
         self.ndof = self.n * self.dim
         m = self.rest.n_cells
@@ -98,11 +121,12 @@ class ElasticBody:
         self._pattern = None
 
     @classmethod
-    def from_mesh(cls, mesh, material) -> "ElasticBody":
+    def from_mesh(cls, mesh, material, element: str = "P1") -> "ElasticBody":
         """The body of a :class:`femkit.mesh.Mesh` (triangles: plane strain; tetrahedra);
-        ``material`` one :class:`Material` or ``{region name or tag: Material}``."""
+        ``material`` one :class:`Material` or ``{region name or tag: Material}``; ``element``
+        ``"P1"`` or ``"P2"``."""
         return cls(mesh.points, mesh.cells, material, cell_tags=mesh.cell_tags,
-                   tag_names=mesh.tag_names)
+                   tag_names=mesh.tag_names, element=element, mesh=mesh)
 
     # ------------------------------------------------------------------ data
     @property
@@ -126,14 +150,26 @@ class ElasticBody:
         return rho
 
     def lumped_masses(self) -> np.ndarray:
-        """Lumped (row-sum) P1 masses ``(n,)``: each element's ``rho vol`` split equally among
-        its ``d + 1`` vertices."""
-        w = np.repeat(self.density() * self.rest.volumes / (self.dim + 1), self.dim + 1)
-        return np.bincount(self.rest.cells.ravel(), weights=w, minlength=self.n)
+        """Lumped masses ``(n,)``, all positive: P1 row sums (each element's ``rho vol`` split
+        equally among its ``d + 1`` vertices); P2 HRZ diagonal scaling
+        (:func:`femkit.fem.mass.lumping_weights`: a triangle's vertex gets 3/57 of its mass, an
+        edge node 16/57; a tetrahedron's 1/36 and 4/27), where row sums would give zero or
+        negative vertex masses."""
+        if self.element == "P1":
+            w = np.repeat(self.density() * self.rest.volumes / (self.dim + 1), self.dim + 1)
+            return np.bincount(self.rest.cells.ravel(), weights=w, minlength=self.n)
+        from ..elements import get_element
+        from ..fem.mass import lumping_weights
+
+        share = lumping_weights(get_element(self.element, self.dim))
+        w = (self.density() * self.rest.volumes)[:, None] * share[None, :]
+        return np.bincount(self.rest.cells.ravel(), weights=w.ravel(), minlength=self.n)
 
     def inverted(self, x) -> np.ndarray:
-        """Ids of the elements with ``det F <= 0`` at ``x`` (inverted or flat)."""
-        return np.flatnonzero(np.linalg.det(self.deformation_gradients(x)) <= 0.0)
+        """Ids of the elements with ``det F <= 0`` at ``x`` (inverted or flat; P2: at any of
+        their quadrature points)."""
+        bad = np.flatnonzero(np.linalg.det(self.deformation_gradients(x)) <= 0.0)
+        return np.unique(bad // self.rest.n_points)
 
     def deformation_gradients(self, x) -> np.ndarray:
         return deformation_gradients(self._state(x), self.rest)
@@ -152,7 +188,8 @@ class ElasticBody:
         None, negative (m,) or None)``; ``level`` 0, 1 or 2 as in the kernel. ``negative[e]``
         bounds the negative part of element ``e``'s unprojected Hessian (see
         :meth:`negative_bound`). ``stress``: an ``(m, d, d)`` array to receive the first
-        Piola-Kirchhoff stress per element (``level >= 1``)."""
+        Piola-Kirchhoff stress per element (``level >= 1``); P2: ``(m q, d, d)``, one per
+        quadrature point."""
         x = self._state(x)
         m = self.rest.n_cells
         energy = np.zeros(m)
@@ -166,8 +203,14 @@ class ElasticBody:
         r = self.rest
         P = np.zeros((0, self.dim, self.dim)) if stress is None else stress
         for elems, mat in self.groups:
-            mat.kernels().element_pass(mat.code, x, r.cells, r.gradients, r.volumes, elems, mat.params(),
-                         int(level), bool(project), slots, indptr, energy, grad, data, neg, P)
+            if r.weights is None:
+                mat.kernels().element_pass(mat.code, x, r.cells, r.gradients, r.volumes, elems,
+                                           mat.params(), int(level), bool(project), slots, indptr,
+                                           energy, grad, data, neg, P)
+            else:
+                mat.kernels().element_pass_points(
+                    mat.code, x, r.cells, r.gradients, r.weights, r.n_points, elems, mat.params(),
+                    int(level), bool(project), slots, indptr, energy, grad, data, neg, P)
         if not np.all(np.isfinite(energy)):
             bad = np.flatnonzero(~np.isfinite(energy))
             raise SolverError(f"elastic energy not finite on {len(bad)} elements, first {int(bad[0])}")
@@ -187,8 +230,9 @@ class ElasticBody:
         return self.evaluate(x, 2, project=project)[2]
 
     def stresses(self, x) -> np.ndarray:
-        """First Piola-Kirchhoff stress ``P = dpsi/dF`` per element, ``(m, d, d)``."""
-        P = np.zeros((self.rest.n_cells, self.dim, self.dim))
+        """First Piola-Kirchhoff stress ``P = dpsi/dF`` per element, ``(m, d, d)`` (P2: per
+        quadrature point, ``(m q, d, d)``, row ``e q + k``)."""
+        P = np.zeros((self.rest.n_cells * self.rest.n_points, self.dim, self.dim))
         self.evaluate(x, 1, stress=P)
         return P
 
@@ -198,7 +242,9 @@ class ElasticBody:
         (``sigma = P F^T / J``) and ``von_mises`` ``(m,)`` of the in-plane (2D) or full (3D)
         Cauchy stress, ``sqrt(3/2 |dev sigma|^2)`` (in 2D the plane-strain ``sigma_zz`` is left
         out). Elements with ``J <= 0`` get NaN in ``cauchy`` and ``von_mises`` (their Cauchy
-        stress is undefined); :meth:`inverted` names them."""
+        stress is undefined); :meth:`inverted` names them. P2: each field is the mean over the
+        cell's quadrature points (weighted: ``sum volumes J`` is the deformed volume by the
+        rule), computed point by point first."""
         from .kinematics import invertible_svd
 
         F = self.deformation_gradients(x)
@@ -210,12 +256,18 @@ class ElasticBody:
         sigma[ok] = np.einsum("mab,mcb->mac", P[ok], F[ok]) / J[ok, None, None]
         dev = sigma - np.einsum("maa->m", sigma)[:, None, None] / self.dim * np.eye(self.dim)
         vm = np.sqrt(1.5 * np.einsum("mab,mab->m", dev, dev))
-        return {"principal_stretches": s, "J": J, "cauchy": sigma, "von_mises": vm}
+        fields = {"principal_stretches": s, "J": J, "cauchy": sigma, "von_mises": vm}
+        q = self.rest.n_points
+        if q == 1:
+            return fields
+        share = (self.rest.weights / np.repeat(self.rest.volumes, q)).reshape(-1, q)
+        return {k: np.einsum("mq,mq...->m...", share, v.reshape(-1, q, *v.shape[1:]))
+                for k, v in fields.items()}
 
     def negative_bound(self, x) -> np.ndarray:
         """Per-node ``e_i >= 0`` with ``z^T H(x) z >= -sum_i e_i |z_i|^2``: each element's
         ``vol sum |lam_k^-| |g|_F^2`` (negative eigenvalues of ``dP/dF``; ``|w_k| <= |g|_F``)
         added to its vertices."""
         neg = self.evaluate(x, 2)[3]
-        return np.bincount(self.rest.cells.ravel(), weights=np.repeat(neg, self.dim + 1),
+        return np.bincount(self.rest.cells.ravel(), weights=np.repeat(neg, self.rest.cells.shape[1]),
                            minlength=self.n)

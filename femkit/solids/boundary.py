@@ -127,32 +127,55 @@ def facet_measures(points, facets) -> np.ndarray:
 
 def traction_forces(points, facets, traction) -> np.ndarray:
     """Nodal forces ``(n, d)`` of a traction ``t`` (a ``d``-vector or one per facet) on
-    ``facets`` (``(k, d)`` vertex indices of boundary edges/triangles), measured on the rest
-    configuration: ``|facet| t / d`` to each facet vertex."""
+    ``facets``, measured on the rest configuration: P1 facets ``(k, d)`` (vertex indices of
+    boundary edges/triangles) get ``|facet| t / d`` to each vertex; quadratic facets ``(k, 3)``
+    in 2D or ``(k, 6)`` in 3D (:func:`femkit.solids.quadratic.facet_nodes`: vertices, then edge
+    midpoints) the consistent shares of :func:`femkit.solids.quadratic.facet_load_weights`."""
     P = np.asarray(points, dtype=float)
     n, d = P.shape
-    f = np.asarray(facets, dtype=np.int64).reshape(-1, d)
+    f = np.asarray(facets, dtype=np.int64)
+    width = f.shape[1] if f.ndim == 2 and f.shape[1] == (3 if d == 2 else 6) else d
+    f = f.reshape(-1, width)
     t = np.broadcast_to(np.asarray(traction, dtype=float), (len(f), d))
     if not np.all(np.isfinite(t)):
         raise InputError("traction must be finite")
-    w = facet_measures(P, f)[:, None] * t / d
     out = np.zeros((n, d))
+    if width == d:                                  # P1: the same arithmetic as ever
+        w = facet_measures(P, f)[:, None] * t / d
+        for a in range(d):
+            out[:, a] = np.bincount(f.ravel(), weights=np.repeat(w[:, a], d), minlength=n)
+        return out
+    from .quadratic import facet_load_weights
+
+    w = facet_measures(P, f[:, :d])[:, None] * t
+    share = facet_load_weights(d)
     for a in range(d):
-        out[:, a] = np.bincount(f.ravel(), weights=np.repeat(w[:, a], d), minlength=n)
+        out[:, a] = np.bincount(f.ravel(), weights=(w[:, a, None] * share).ravel(), minlength=n)
     return out
 
 
 def body_forces(body, force_density: Callable | np.ndarray) -> np.ndarray:
     """Nodal forces ``(n, d)`` of a force per unit volume ``b`` (a ``d``-vector, or one per
-    element): ``vol b / (d + 1)`` to each vertex. Gravity is ``b = rho g``
+    element): P1 ``vol b / (d + 1)`` to each vertex, P2 the integrals of the basis functions
+    (:func:`femkit.solids.quadratic.cell_load_weights`). Gravity is ``b = rho g``
     (``body.density()[:, None] * g``)."""
     m, d = body.rest.n_cells, body.dim
     b = np.broadcast_to(np.asarray(force_density, dtype=float), (m, d))
-    w = body.rest.volumes[:, None] * b / (d + 1)
-    out = np.zeros((body.n, d))
     cells = body.rest.cells
+    out = np.zeros((body.n, d))
+    if cells.shape[1] == d + 1:                     # P1: the same arithmetic as ever
+        w = body.rest.volumes[:, None] * b / (d + 1)
+        for a in range(d):
+            out[:, a] = np.bincount(cells.ravel(), weights=np.repeat(w[:, a], d + 1),
+                                    minlength=body.n)
+        return out
+    from .quadratic import cell_load_weights
+
+    share = cell_load_weights(d)
+    w = body.rest.volumes[:, None] * b
     for a in range(d):
-        out[:, a] = np.bincount(cells.ravel(), weights=np.repeat(w[:, a], d + 1), minlength=body.n)
+        out[:, a] = np.bincount(cells.ravel(), weights=(w[:, a, None] * share).ravel(),
+                                minlength=body.n)
     return out
 
 

@@ -30,16 +30,27 @@ class RestShape:
 
     Attributes
     ----------
-    cells : (m, d+1) int64 vertex indices.
+    cells : (m, d+1) int64 vertex indices (P2: ``(m, 6 | 10)`` node indices, vertices then
+        edge midpoints, :mod:`femkit.solids.quadratic`).
     dm_inv : (m, d, d) inverse rest edge matrices ``Dm^-1``.
     volumes : (m,) rest volumes (areas in 2D; plane strain per unit thickness).
-    gradients : (m, d+1, d) shape-function gradients ``g_n`` (``F = sum_n x_n g_n^T``).
+    gradients : (m, d+1, d) shape-function gradients ``g_n`` (``F = sum_n x_n g_n^T``); P2:
+        ``(m q, nv, d)``, at the ``q`` quadrature points of each cell (row ``e q + k``).
+    weights : (m q,) quadrature weight times cell volume (P2), or None (P1: one point, the
+        volumes).
+    n_points : ``q``, quadrature points per cell (1 for P1).
+    element : the element's name, ``"P1"`` or ``"P2"``.
+    n_nodes : number of nodes (P2: vertices + edges), or None (P1: the points).
     """
 
     cells: np.ndarray
     dm_inv: np.ndarray
     volumes: np.ndarray
     gradients: np.ndarray
+    weights: np.ndarray | None = None
+    n_points: int = 1
+    element: str = "P1"
+    n_nodes: int | None = None
 
     @property
     def dim(self) -> int:
@@ -100,9 +111,14 @@ def rest_shape(points, cells, *, rel_tol: float = 1e-12) -> RestShape:
 
 
 def deformation_gradients(x, rest: RestShape) -> np.ndarray:
-    """``F = Ds Dm^-1`` of every element at positions ``x`` (``(n, d)``), shape ``(m, d, d)``."""
+    """``F = Ds Dm^-1`` of every element at positions ``x`` (``(n, d)``), shape ``(m, d, d)``;
+    for P2 at every quadrature point, ``(m q, d, d)`` (row ``e q + k``)."""
     x = np.asarray(x, dtype=float)
-    return np.einsum("mna,mnb->mab", x[rest.cells], rest.gradients)
+    if rest.n_points == 1:
+        return np.einsum("mna,mnb->mab", x[rest.cells], rest.gradients)
+    q = rest.n_points
+    g = rest.gradients.reshape(rest.n_cells, q, *rest.gradients.shape[1:])
+    return np.einsum("mna,mqnb->mqab", x[rest.cells], g).reshape(-1, x.shape[1], x.shape[1])
 
 
 def invertible_svd(F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

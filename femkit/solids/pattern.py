@@ -1,7 +1,8 @@
-"""The CSR pattern of a vector P1 matrix (``d x d`` blocks per vertex pair), built once per mesh.
+"""The CSR pattern of a vector matrix (``d x d`` blocks per node pair), built once per mesh.
 
-The node-level pattern (which vertex pairs share an element) is built as in
-:mod:`femkit.fem.sparsity` (one ``np.unique`` over the element pairs) and every node pair
+The node-level pattern (which node pairs share an element: P1 vertices, or P2's six or ten
+nodes) is femkit's one assembly pattern, :meth:`femkit.fem.sparsity.SparsityPattern.from_cells`
+(its CSR structure and the slot of each element's node pair), and every node pair
 becomes a dense ``d x d`` block of the dof-level CSR matrix (dof ``i*d + a``, node-major as the
 dynamics' state arrays). Row ``r*d + a`` starts at ``d^2 indptr[r] + a d w_r`` (``w_r`` = number
 of node columns in node row ``r``), and the block of node column position ``p`` occupies
@@ -23,37 +24,35 @@ __all__ = ["BlockPattern"]
 
 
 class BlockPattern:
-    """Dof-level CSR pattern of a vector P1 matrix and the node-pair slots of each element.
+    """Dof-level CSR pattern of a vector matrix and the node-pair slots of each element.
 
     Parameters
     ----------
-    cells : (m, d+1) int array.
-    n : number of vertices.
+    cells : (m, k) int array: each element's nodes (``k = d + 1`` for P1, 6 or 10 for P2).
+    n : number of nodes.
     dim : ``d``.
 
     Attributes
     ----------
     node_indptr : (n+1,) int64, node-level CSR row pointer.
-    node_slots : (m, (d+1)^2) int64, node-level data position of entry ``(cells[e,p], cells[e,q])``
-        at ``p (d+1) + q``.
+    node_slots : (m, k^2) int64, node-level data position of entry ``(cells[e,p], cells[e,q])``
+        at ``p k + q``.
     indptr, indices : the dof-level CSR structure (sorted columns; int32 when it fits).
     """
 
     def __init__(self, cells: np.ndarray, n: int, dim: int):
+        from ..fem.sparsity import SparsityPattern
+
         cells = np.asarray(cells, dtype=np.int64)
-        m, nv = cells.shape
         d = dim
-        rows = np.repeat(cells, nv, axis=1).ravel()
-        cols = np.tile(cells, (1, nv)).ravel()
-        uniq, inv = np.unique(rows * np.int64(n) + cols, return_inverse=True)
-        nrow, ncol = uniq // n, uniq % n
-        width = np.bincount(nrow, minlength=n)
-        ip = np.zeros(n + 1, dtype=np.int64)
-        np.cumsum(width, out=ip[1:])
+        node = SparsityPattern.from_cells(cells, n)
+        ip = node.indptr.astype(np.int64)
+        ncol = node.indices.astype(np.int64)
+        width = np.diff(ip)
         self.node_indptr = ip
-        self.node_slots = np.ascontiguousarray(inv.reshape(m, nv * nv).astype(np.int64))
+        self.node_slots = np.ascontiguousarray(node.slots, dtype=np.int64)
         self.n, self.dim, self.ndof = n, d, n * d
-        self.nnz = int(len(uniq) * d * d)
+        self.nnz = int(len(ncol) * d * d)
         # dof rows: node row r, component a -> its node columns, each expanded to d columns
         row_len = np.repeat(width * d, d)
         indptr = np.zeros(n * d + 1, dtype=np.int64)

@@ -3,8 +3,9 @@
 The built-in materials' kernels are generated from their energy expressions
 (:mod:`femkit.solids.materials.builtin_kernels`) into femkit's cache directory and compiled by numba on
 first use (about a minute on a loaded machine). :func:`warm_up` does both now, on a tiny
-triangle and tetrahedron body: the element pass (every level, projected or not: one
-compilation, the arguments' types are those of any body), the point function and the stretch
+triangle and tetrahedron body, P1 and P2: the element pass and its form at quadrature points
+(every level, projected or not: one compilation each, the arguments' types are those of any
+body), the point function and the stretch
 energy. Afterwards a process loads the module and its machine code from the cache, without
 SymPy. A material a user designs by its energy is generated and compiled on its own first use.
 """
@@ -29,10 +30,11 @@ def warm_up() -> float:
     for name in ("linear", "stable_neo_hookean"):
         mat = material(name, mu=1.0, lam=1.0)
         for X, cells in (tri, tet):
-            body = ElasticBody(X, cells, mat)
-            x = X * 1.1
-            body.evaluate(x, 2, project=True)
-            body.stresses(x)
+            for element in ("P1", "P2"):          # P2: the element pass at quadrature points
+                body = ElasticBody(X, cells, mat, element=element)
+                x = body.rest_positions * 1.1
+                body.evaluate(x, 2, project=True)
+                body.stresses(x)
             point_tangent(mat, np.eye(X.shape[1]))
         if name != "linear":
             mat.stretch_derivatives(np.ones(3))

@@ -266,6 +266,8 @@ BUNDLED = {
     "solid_cantilever": {"mesh": {"h": 0.5}, "output": {"gif": True}},
     "solid_beam_vibration": {"t_end": 0.05, "output": {"every": 2}},
     "solid_block_stretch": {},
+    "solid_cook_membrane": {"mesh": {"h": 8.0}},       # P2 (tests/case/test_solid_p2_case.py: h = 2)
+    "solid_cook_membrane_p1": {"mesh": {"h": 8.0}},
 }
 
 

@@ -44,3 +44,40 @@ def facets_on(points, cells, axis: int, value: float, tol: float = 1e-12):
 
 def nodes_on(points, axis: int, value: float, tol: float = 1e-12):
     return np.flatnonzero(np.abs(points[:, axis] - value) <= tol)
+
+
+#: finite-difference steps of the derivative checks (Kim & Eberle's protocol: the smallest
+#: relative difference over the sweep counts)
+STEPS = 10.0 ** -np.arange(4, 9)
+
+
+def min_rel(exact, approx_of_h) -> float:
+    """The smallest relative difference ``|approx(h) - exact| / |exact|`` over :data:`STEPS`."""
+    scale = max(np.linalg.norm(exact), 1e-300)
+    return min(np.linalg.norm(approx_of_h(h) - exact) / scale for h in STEPS)
+
+
+def assembled_fd_errors(body, x) -> tuple[float, float]:
+    """:func:`min_rel` of a body's assembled gradient against central differences of its
+    energy, and of its Hessian against central differences of its gradient, at ``x``."""
+    _, g, H, _ = body.evaluate(x)
+    flat = np.asarray(x, dtype=float).ravel()
+    n = flat.size
+
+    def grad_fd(h):
+        out = np.zeros(n)
+        for i in range(n):
+            e = np.zeros(n)
+            e[i] = h
+            out[i] = (body.energy(flat + e) - body.energy(flat - e)) / (2 * h)
+        return out
+
+    def hess_fd(h):
+        cols = []
+        for i in range(n):
+            e = np.zeros(n)
+            e[i] = h
+            cols.append((body.gradient(flat + e) - body.gradient(flat - e)).ravel() / (2 * h))
+        return np.column_stack(cols)
+
+    return min_rel(g.ravel(), grad_fd), min_rel(H.toarray(), hess_fd)

@@ -14,9 +14,8 @@ import pytest
 from femkit.solids import MATERIALS, ElasticBody, invertible_svd, point_tangent
 
 sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared helpers
-from _meshes import mesh_by_dim, random_rotation  # noqa: E402
+from _meshes import assembled_fd_errors, mesh_by_dim, min_rel, random_rotation  # noqa: E402
 
-STEPS = 10.0 ** -np.arange(4, 9)
 NAMES = ["linear", "corotational", "stvk", "stable_neo_hookean"]
 FLIP_SYMMETRIC = ["linear", "stvk", "stable_neo_hookean"]  # energy unchanged by s_i, s_j -> -s_i, -s_j
 
@@ -55,11 +54,6 @@ POINT_CASES = [pytest.param(name, d, kind, id=f"{name}-{d}d-{kind}")
                if not (kind == "opposite_pair" and name not in FLIP_SYMMETRIC)]
 
 
-def _min_rel(exact, approx_of_h):
-    scale = max(np.linalg.norm(exact), 1e-300)
-    return min(np.linalg.norm(approx_of_h(h) - exact) / scale for h in STEPS)
-
-
 def test_invertible_svd_signs(rng):
     for kind, negatives in (("one_reflection", 1), ("three_reflections", 1), ("random", None)):
         F = _F(kind, 3, rng)
@@ -94,8 +88,8 @@ def assert_point_derivatives(mat, F):
         return np.column_stack(cols)
 
     assert np.isfinite(psi)
-    assert _min_rel(P, dpsi) <= 1e-6
-    assert _min_rel(A, dP) <= 1e-6
+    assert min_rel(P, dpsi) <= 1e-6
+    assert min_rel(A, dP) <= 1e-6
 
 
 @pytest.mark.parametrize("name,d,kind", POINT_CASES)
@@ -122,27 +116,9 @@ def test_assembled_gradient_and_hessian_match_finite_differences(name, d, rng):
     body = ElasticBody(X, cells, _mat(name))
     x = X + 0.15 * rng.standard_normal(X.shape)
     inverted = (np.linalg.det(body.deformation_gradients(x)) < 0).sum()
-    E, g, H, _ = body.evaluate(x)
-    n = x.size
-
-    def grad_fd(h):
-        out = np.zeros(n)
-        for i in range(n):
-            e = np.zeros(n)
-            e[i] = h
-            out[i] = (body.energy(x.ravel() + e) - body.energy(x.ravel() - e)) / (2 * h)
-        return out
-
-    def hess_fd(h):
-        cols = []
-        for i in range(n):
-            e = np.zeros(n)
-            e[i] = h
-            cols.append((body.gradient(x.ravel() + e) - body.gradient(x.ravel() - e)).ravel() / (2 * h))
-        return np.column_stack(cols)
-
-    assert _min_rel(g.ravel(), grad_fd) <= 1e-6
-    assert _min_rel(H.toarray(), hess_fd) <= 1e-6
+    grad_err, hess_err = assembled_fd_errors(body, x)
+    assert grad_err <= 1e-6 and hess_err <= 1e-6
+    H = body.hessian(x)
     np.testing.assert_allclose(H.toarray(), H.toarray().T, atol=1e-12 * abs(H).max())
     assert inverted >= 0  # recorded: random positions of this size invert some elements
 

@@ -11,7 +11,11 @@ assumptions: gmsh's tetrahedra number about ``4.13 V / h^3 + 1.44 A / h^2`` (fit
 ``2.3 A / h^2``; P1 rows hold
 about 15 nodes in 3D and 7 in 2D; a sparse direct factor of a 3D stiffness matrix fills in
 about ``n^(1/3)`` times its nonzeros (nested dissection), 2D ``log n``; the compiled element pass
-runs at least 5e4 elements/s (gradient + projected Hessian, docs/benchmarks.md).
+runs at least 5e4 elements/s (gradient + projected Hessian, docs/benchmarks.md). P2 (``element:
+P2``) adds a node per edge, about ``points + cells`` of them (Euler's formula: exact in 2D,
+within 10 % on gmsh's tetrahedra), rows of about 12 (2D) and 27 (3D) nodes, and a cell costs
+the pass up to :data:`P2_PASS_COST` P1 cells (its points' SVDs and a 12 x 12 or 30 x 30
+Hessian: measured 2.5e5 triangles/s and 2.1e4 tetrahedra/s, against 3e6 and 3.3e5 for P1).
 
 :func:`check_solid_fits` is the memory guard the runner calls before gmsh starts (the role
 :func:`femkit.case.cost.check_mesh_fits` has for the other kinds, in tetrahedra as well).
@@ -35,8 +39,12 @@ CELLS_PER_BOUNDARY = {2: 0.0, 3: 1.44}
 #: a generated mesh predicted smaller than this is generated and counted by the plan
 COUNT_BELOW = 5000
 ROW_NODES = {2: 7.0, 3: 15.0}
+P2_ROW_NODES = {2: 12.0, 3: 27.0}
+#: what one P2 cell costs the element pass, in P1 cells
+P2_PASS_COST = {2: 12.0, 3: 16.0}
 ELEMENTS_PER_SECOND = 5e4
-REST_BYTES_PER_CELL = 400.0     # rest data, element fields and the pass's work arrays
+REST_BYTES_PER_CELL = 400.0     # rest data, element fields and the pass's work arrays (P2: 5x,
+                                # gradients at every quadrature point and 36 or 100 node slots)
 
 
 def solid_sizes(mesh: dict) -> tuple[int, float, float]:
@@ -74,15 +82,18 @@ def plan_solid_case(case, *, measure: bool = True) -> Plan:
     calibrated by a timed run (its seconds are an order of magnitude)."""
     spec = case.spec
     dim, cells, points = solid_sizes(spec.mesh)
+    p2 = spec.element == "P2"
+    if p2:
+        points = points + (points + cells)            # a node per edge
     dofs = dim * points
-    nnz = dim * dim * ROW_NODES[dim] * points
+    nnz = dim * dim * (P2_ROW_NODES if p2 else ROW_NODES)[dim] * points
     fill = max(1.0, dofs ** (1.0 / 3.0)) if dim == 3 else max(1.0, math.log(max(dofs, 2.0)))
     factor_bytes = 12.0 * nnz * fill
     steps = spec.steps
     per_step, what_iterates = _iterations_per_step(spec)
     iterations = steps * per_step
     frames = steps // spec.output.every + 1
-    pass_s = cells / ELEMENTS_PER_SECOND
+    pass_s = cells * (P2_PASS_COST[dim] if p2 else 1.0) / ELEMENTS_PER_SECOND
     # Newton factors the tangent each iteration; projective dynamics solves with a kept factor
     factor_s = nnz * fill * (2e-8 if what_iterates == "Newton" else 4e-9)
     frame_bytes = 8.0 * (6 * points + (dim + 1) * cells + (dim + 3) * cells)
@@ -95,7 +106,7 @@ def plan_solid_case(case, *, measure: bool = True) -> Plan:
         Stage("mesh", cells * 2e-5, cells * (8.0 * (dim + 1) + 64.0), 0.0,
               f"{what} {'' if counted else '~'}{cells:,.0f}"),
         Stage("solve", iterations * (pass_s + factor_s),
-              cells * REST_BYTES_PER_CELL + 3 * 12.0 * nnz + factor_bytes
+              cells * REST_BYTES_PER_CELL * (5.0 if p2 else 1.0) + 3 * 12.0 * nnz + factor_bytes
               + frames * 16.0 * dofs, 0.0,
               f"{iterations:,} {what_iterates} iterations ({'up to ' if what_iterates != 'Newton' else '~'}"
               f"{per_step:,} per {'load' if spec.static else 'time'} step)"),

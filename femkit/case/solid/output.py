@@ -32,6 +32,8 @@ def write_solid_frames(directory: str | os.PathLike, result, stop=None) -> list[
     the names of the frames written so far are returned."""
     body = result.problem.body
     ctype = "tetra" if body.dim == 3 else "triangle"
+    if body.element == "P2":    # VTK_QUADRATIC_TRIANGLE 22 / VTK_QUADRATIC_TETRA 24
+        ctype += "10" if body.dim == 3 else "6"
     cells = [(ctype, np.asarray(body.rest.cells, dtype=np.int64))]
     region = np.asarray(result.problem.mesh.cell_tags, dtype=np.int32)
     names = []

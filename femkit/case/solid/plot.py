@@ -99,7 +99,7 @@ def _draw_3d(fig, result, x, vm, norm, cmap, lim):
 
     body = result.problem.body
     ax = fig.add_axes((0.0, 0.17, 0.94, 0.75), projection="3d")
-    faces, owner = surface_faces(body.rest.cells)
+    faces, owner = surface_faces(body.rest.cells[:, :4])      # P2: the vertex cells
     tri = x[faces]
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
@@ -131,7 +131,7 @@ def _draw_2d(fig, result, x, vm, norm, cmap, lim):
     ax = fig.add_axes((0.1, 0.25, 0.85, 0.62))
     outline = body.rest_positions[boundary_edges_topological(result.problem.mesh)]
     ax.add_collection(LineCollection(outline, colors="0.6", linewidths=0.6))
-    ax.tripcolor(x[:, 0], x[:, 1], body.rest.cells, facecolors=vm, cmap=cmap, norm=norm,
+    ax.tripcolor(x[:, 0], x[:, 1], body.rest.cells[:, :3], facecolors=vm, cmap=cmap, norm=norm,
                  edgecolors="k", linewidth=0.1)
     ax.set_xlim(*lim[:, 0]), ax.set_ylim(*lim[:, 1])
     ax.set_aspect("equal")

@@ -132,6 +132,7 @@ def prepare_solid(case) -> None:
                             "'static' and 'integrator' exclude each other: give one")
     boundaries = _boundaries(d)
     dim = _check_geometry_tags(d, boundaries)
+    element = d["element"]
     for key in ("gravity", "velocity"):
         if dim is not None and key in d and len(d[key]) != dim:
             raise CaseFileError(f"{key}: needs {dim} components for a {dim}D mesh, got {len(d[key])}")
@@ -153,6 +154,7 @@ def prepare_solid(case) -> None:
             if key not in d:
                 raise CaseFileError(f"{key}: a time integration needs 'dt' and 't_end'")
         integ = IntegratorSpec.from_mapping(d["integrator"], "integrator")
+        _check_element(integ, element)
         dt, t_end = time_value(case, "dt"), time_value(case, "t_end")
         steps = int(round(t_end / dt))
         if steps < 1:
@@ -173,7 +175,18 @@ def prepare_solid(case) -> None:
         gravity=tuple(d["gravity"]) if "gravity" in d else None, static=static_spec,
         integrator=integ, solver=solver, dt=dt, t_end=t_end, steps=steps,
         velocity=tuple(d["velocity"]) if "velocity" in d else None,
-        output=SolidOutput(directory, every, bool(out["vtu"]), bool(out["png"]), bool(out["gif"])))
+        output=SolidOutput(directory, every, bool(out["vtu"]), bool(out["png"]), bool(out["gif"])),
+        element=element)
+
+
+def _check_element(integ: IntegratorSpec, element: str) -> None:
+    """An integrator that declares the elements it integrates (``Integrator.elements``, e.g.
+    projective dynamics' P1 local step) refuses the others in one line."""
+    allowed = getattr(integ.build(), "elements", None)
+    if allowed is not None and element not in allowed:
+        raise CaseFileError(f"element: {element} is not supported by the integrator "
+                            f"{integ.method!r} (it integrates {', '.join(allowed)} only); use "
+                            f"element: {allowed[0]} or another integrator")
 
 
 # ----------------------------------------------------------------------------- build
@@ -297,19 +310,24 @@ def build_problem(case) -> SolidProblem:
         material = regions
     else:
         material = default
-    body = ElasticBody(mesh.points, mesh.cells, material, cell_tags=mesh.cell_tags)
+    body = ElasticBody(mesh.points, mesh.cells, material, cell_tags=mesh.cell_tags,
+                       element=spec.element, mesh=mesh)
     traction = np.zeros((body.n, d))
     fixes = []
     for i, b in enumerate(spec.boundaries):
         where = f"boundaries[{i}]"
         try:
             facets = tagged_facets(mesh, b.tag)
+            if spec.element != "P1":          # the facets' edge midpoints are nodes too
+                from ...solids.quadratic import facet_nodes
+
+                facets = facet_nodes(mesh, facets, spec.element)
             for what in ("displacement", "traction"):
                 v = getattr(b, what)
                 if v and len(v) != d:
                     raise CaseFileError(f"{what}: needs {d} components, got {len(v)}")
             if b.kind == "traction":
-                traction += traction_forces(mesh.points, facets, b.traction)
+                traction += traction_forces(body.rest_positions, facets, b.traction)
             else:
                 nodes = np.unique(facets)
                 disp = np.zeros(d)
@@ -405,6 +423,7 @@ class SolidResult(RunResult):
         return {
             "mesh": {"dim": body.dim, "points": int(body.n), "cells": int(body.rest.n_cells),
                      "cell_type": "tetra" if body.dim == 3 else "triangle",
+                     "element": body.element,
                      "fixed_dofs": int(len(self.problem.dirichlet().dofs))},
             "materials": [{"model": m.name, "mu": m.mu, "lam": m.lam, "E": m.young,
                            "nu": m.poisson, "density": m.density} for m in body.materials],
@@ -454,8 +473,9 @@ class SolidResult(RunResult):
                f"{d['integrator']['method']}, dt {d['dt']:.4g}, t_end {d['t_end']:.4g}")
         stopped = f" (interrupted by {self.interrupted})" if self.interrupted else ""
         e = d["energies"][-1]
-        lines = [f"solid     {self.case.name}: {m['cells']} {m['cell_type']} cells, {m['points']} "
-                 f"nodes ({m['dim']}D), {mats}",
+        lines = [f"solid     {self.case.name}: {m['cells']} "
+                 f"{'' if m['element'] == 'P1' else m['element'] + ' '}{m['cell_type']} cells, "
+                 f"{m['points']} nodes ({m['dim']}D), {mats}",
                  f"method    {how}",
                  f"result    max displacement {d['max_displacement']:.6g}, tip "
                  f"[{', '.join(f'{c:.6g}' for c in d['tip_displacement'])}], volume "

@@ -1,9 +1,9 @@
 """JSON schema (Draft 2020-12) of ``problem: solid`` case files.
 
 Closed objects throughout (a misspelt key lists the valid ones). The enums -- material
-``model``, mesh ``geometry`` and ``integrator`` method -- are derived from their registries
-(:data:`femkit.solids.MATERIALS`, :data:`femkit.mesh.GEOMETRIES`,
-:data:`femkit.dynamics.integrators.INTEGRATORS`) each time the schema is built
+``model``, mesh ``geometry``, ``element`` and ``integrator`` method -- are derived from their
+registries (:data:`femkit.solids.MATERIALS`, :data:`femkit.mesh.GEOMETRIES`,
+:data:`femkit.elements.ELEMENTS`, :data:`femkit.dynamics.integrators.INTEGRATORS`) each time the schema is built
 (:func:`solid_schema`), so a material, geometry or integrator registered later is accepted.
 Value ranges of the material constants (``E > 0``, ``-1 < nu < 1/2``, ``density > 0``) are
 checked by the material itself (:func:`femkit.solids.materials.material_from_spec`), whose
@@ -86,6 +86,8 @@ def _boundary() -> dict:
 
 def solid_schema() -> dict:
     """The whole schema, its enums read from the registries now."""
+    from ...elements import element_names
+
     material = _material()
     return {
         "$schema": "https://json-schema.org/draft/2020-12/schema",
@@ -99,6 +101,7 @@ def solid_schema() -> dict:
             "description": {"type": "string"},
             "constants": {"type": "object", "additionalProperties": _NUM, "default": {}},
             "mesh": _mesh(),
+            "element": {"enum": element_names(), "default": "P1"},
             "material": material,
             "regions": {"type": "object", "additionalProperties": material, "default": {}},
             # none for a body in free flight (dynamics); a static run needs a support (prepare)

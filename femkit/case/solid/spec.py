@@ -64,6 +64,8 @@ class SolidSpec:
         Time steps (dynamic) or load steps (static).
     velocity : tuple or None
     output : SolidOutput
+    element : str
+        ``"P1"`` or ``"P2"`` (:data:`femkit.elements.ELEMENTS`).
     """
 
     mesh: Mapping
@@ -78,3 +80,4 @@ class SolidSpec:
     steps: int
     velocity: tuple | None
     output: SolidOutput
+    element: str = "P1"

@@ -127,6 +127,9 @@ class Integrator:
     solves_per_step = 4.0
     #: The work-precision method families that run this integrator (none by default).
     work_precision = {}
+    #: The elements of an elastic body it integrates (names of :data:`femkit.elements.ELEMENTS`),
+    #: or None: any (an integrator that sees only the system's forces and masses).
+    elements = None
 
     def start(self, system, x, v, t: float, dt: float, ctx: StepContext) -> StepperState:
         """Initial state: copies of ``x``, ``v`` with pinned velocities zeroed."""

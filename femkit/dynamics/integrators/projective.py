@@ -68,6 +68,10 @@ def _elastic_force(system):
                          f"no springs (femkit.dynamics.system.elastic_system); got "
                          f"{len(found)} elastic force(s) and {system.n_springs} springs "
                          "(use fast_mass_spring for springs)")
+    element = getattr(found[0].body, "element", "P1")
+    if element not in Projective.elements:
+        raise InputError(f"projective dynamics integrates {', '.join(Projective.elements)} "
+                         f"bodies only (one deformation gradient per element), got {element}")
     return found[0]
 
 
@@ -115,6 +119,8 @@ class Projective(Integrator):
     #: needs an elastic solid (no springs) and integrates its own ARAP energy, not the body's
     #: material: generic every-integrator tests leave it out
     solids_only = True
+    #: its local step projects one deformation gradient per element: P1 only
+    elements = ("P1",)
 
     def __post_init__(self):
         check_iteration_options(self.name, self.iterations, self.tol, option="iterations")

@@ -6,7 +6,8 @@ gmsh plumbing every gmsh-built geometry shares, and :func:`geo_file`; gmsh is im
 its functions only, so ``import femkit.mesh`` stays cheap and a case that reads a ``.msh``
 file never loads it), :mod:`~femkit.mesh.geometries.planar` (the 2D geometries),
 :mod:`~femkit.mesh.geometries.solid` (the 3D gmsh ones) and :mod:`~femkit.mesh.geometries.kuhn`
-(Kuhn-cube tetrahedral meshes without gmsh, for 3D bisection).
+(Kuhn-cube tetrahedral meshes without gmsh, for 3D bisection) and
+:mod:`~femkit.mesh.geometries.cook` (Cook's membrane, a benchmark of the elastic solids).
 
 Every geometry is one entry of :data:`GEOMETRIES`, a :class:`Geometry` record; call it through
 :func:`generate`::
@@ -58,6 +59,7 @@ from .planar import (annulus, checkerboard, disk, l_shape, rectangle, square_wit
                      unit_square)
 from . import solid  # noqa: F401  (the solid geometries)
 from . import kuhn  # noqa: F401  (the Kuhn-type ones for 3D bisection)
+from . import cook  # noqa: F401  (Cook's membrane, the solids' benchmark panel)
 
 __all__ = ["GEOMETRIES", "Geometry", "register_geometry", "generate", "geo_file", "rectangle",
            "unit_square", "l_shape", "disk", "annulus", "checkerboard", "square_with_inclusion"]
