@@ -120,7 +120,9 @@ def _linear_facts(system, march, spec) -> dict:
     return {"method": spec.solver.method, "factorizations": int(st["factorizations"]),
             "factor_seconds": float(st["factor_seconds"]), "solves": int(st["solves"]),
             "seconds_per_step": float(march.seconds_per_step),
-            "kept_factor": spec.solver.method in ("direct", "cholesky")}
+            "kept_factor": spec.solver.method in ("direct", "cholesky"),
+            "preconditioner_setups": int(st.get("preconditioner_setups", 0)),
+            "iterations": int(st.get("linear_iterations", 0))}
 
 
 def run_transient(case, capacity: str, registry, *, second_order: bool,

@@ -469,7 +469,7 @@ def plan_transient(case, *, measure: bool = True):
     stages = keep + [
         Stage("factor", solve, peak, 0.0,
               f"{spec.solver.method}: one factor kept" if spec.solver.method in ("direct", "cholesky")
-              else f"{spec.solver.method}: one solve's setup, warm-started solves per step"),
+              else f"{spec.solver.method}: one preconditioner kept, warm-started solves per step"),
         Stage("steps", steps * per_step, peak + frames * 8.0 * points, 0.0,
               f"{steps:,} steps of {spec.integrator[0]}"),
         Stage("output", frames * frame_bytes / 2e7, frame_bytes, frames * frame_bytes,

@@ -5,11 +5,15 @@ Dirichlet nodes ``fixed`` held at ``g(t)``. A scheme forms its full-size right-h
 and a matrix ``A = a M + b K``; :meth:`LinearSystem.solve` solves the free rows
 ``A_ff x_f = r_f - A_fb g`` with the boundary values ``g`` in place (so time-dependent
 Dirichlet data enter every scheme the way its own discretisation of ``M u'`` says, with no
-separate ``g'``). Each distinct ``A`` is factorised once and kept for the whole run
-(:func:`femkit.solvers.kept_factor.factorize_kept`; SuperLU in symmetric mode, or the sparse
-Cholesky engines) when the linear solver is ``direct`` or ``cholesky``; any other solver
-(``pcg`` with a preconditioner, ``cg``) solves each step warm-started from the previous step's
-solution. A lumped (diagonal) ``M`` alone is inverted by a division.
+separate ``g'``). All solves go through one :class:`~femkit.solvers.session.LinearSession`
+(its counters are the system's ``stats``). Each distinct ``A`` is factorised once and kept for
+the whole run (:meth:`LinearSession.factorize`; SuperLU in symmetric mode, or the sparse
+Cholesky engines) when the linear solver is ``direct`` or ``cholesky``; with an iterative solver
+its preconditioner (AMG hierarchy, IC(0) factor) is built once and kept the same way
+(:meth:`LinearSession.solve_kept`, ``stats["preconditioner_setups"]``), and each step's solve
+starts from the linear extrapolation ``2 x_n - x_{n-1}`` of that matrix's last two solutions. A
+new ``dt`` (adaptive steps) is a new ``A``: factorised or set up afresh. A lumped (diagonal)
+``M`` alone is inverted by a division.
 """
 
 from __future__ import annotations
@@ -33,29 +37,40 @@ KEPT_FACTOR_METHODS = frozenset({"direct", "cholesky"})
 @dataclass
 class ConstrainedOperator:
     """``A = a M + b K`` restricted to the free rows: the kept factor of ``A_ff`` (or its
-    diagonal, or the solver spec for iterative solves) and the coupling ``A_fb``."""
+    diagonal, or the session whose kept preconditioner solves it) and the coupling ``A_fb``."""
 
     A_ff: sp.csr_matrix
     A_fb: sp.csr_matrix
     factor: object = None
     diagonal: np.ndarray | None = None
-    spec: SolverSpec | None = None
-    last: np.ndarray | None = None
+    session: object = None
+    key: object = None
+    keep_preconditioner: bool = True
+    history: list = field(default_factory=list)
+
+    def initial_guess(self) -> np.ndarray | None:
+        """The warm start: ``2 x_n - x_{n-1}`` of the last two solutions, the last one alone
+        after one solve, none before."""
+        if len(self.history) == 2:
+            return 2.0 * self.history[1] - self.history[0]
+        return self.history[-1] if self.history else None
 
     def solve_free(self, rhs: np.ndarray) -> np.ndarray:
         """``A_ff^-1 rhs``: a division, the kept factor's substitutions, or a warm-started
-        iterative solve (a failed one raises :class:`~femkit.errors.SolverError`)."""
+        iterative solve with the kept preconditioner (rebuilt every solve when
+        ``keep_preconditioner`` is false: the comparison path); a failed one raises
+        :class:`~femkit.errors.SolverError`."""
         if self.diagonal is not None:
             return rhs / self.diagonal
         if self.factor is not None:
             return self.factor.solve(rhs)
-        from ...errors import SolverError
-
-        res = self.spec.solve(self.A_ff, rhs, x0=self.last)
-        if not res.converged:
-            raise SolverError(f"linear solve of a time step: {res.message}")
-        self.last = res.x
-        return res.x
+        x0 = self.initial_guess()
+        if self.keep_preconditioner:
+            x = self.session.solve_kept(self.A_ff, rhs, x0, key=self.key)
+        else:
+            x = self.session.solve(self.A_ff, rhs, x0)
+        self.history = (self.history + [x])[-2:]
+        return x
 
 
 @dataclass
@@ -80,6 +95,9 @@ class LinearSystem:
         ``M`` is diagonal.
     solver : SolverSpec
         Linear solver of the implicit steps (``direct``: one kept factor per matrix).
+    keep_preconditioner : bool
+        Iterative solvers keep one preconditioner per matrix (default); false rebuilds it
+        every solve (the comparison path of the tests and the benchmark).
     """
 
     M: sp.csr_matrix
@@ -91,6 +109,7 @@ class LinearSystem:
     boundary_constant: bool = True
     lumped: bool = False
     solver: SolverSpec = field(default_factory=lambda: SolverSpec("direct"))
+    keep_preconditioner: bool = True
     stats: dict = field(default_factory=dict)
     _ops: dict = field(default_factory=dict, repr=False)
     _cache: dict = field(default_factory=dict, repr=False)
@@ -111,6 +130,7 @@ class LinearSystem:
         self.stats.setdefault("factorizations", 0)
         self.stats.setdefault("solves", 0)
         self.stats.setdefault("factor_seconds", 0.0)
+        self.session = self.solver.session(stats=self.stats)
 
     # ------------------------------------------------------------------ data
     def F(self, t: float) -> np.ndarray:
@@ -152,14 +172,12 @@ class LinearSystem:
         if b == 0.0 and self.lumped:
             op.diagonal = A_ff.diagonal()
         elif self.solver.method in KEPT_FACTOR_METHODS:
-            from ...solvers.kept_factor import factorize_kept
-
             t0 = time.perf_counter()
-            op.factor = factorize_kept(A_ff, method=self.solver.method)
-            self.stats["factorizations"] += 1
+            op.factor = self.session.factorize(A_ff)
             self.stats["factor_seconds"] += time.perf_counter() - t0
         else:
-            op.spec = self.solver
+            op.session, op.key = self.session, key
+            op.keep_preconditioner = self.keep_preconditioner
         self._ops[key] = op
         return op
 
