@@ -76,6 +76,54 @@ def per_step(refine: int, steps: int = 20) -> dict:
             "ratio": step / pair}
 
 
+def solver_costs(method: str, mesh, steps: int = 10, dt: float = DT) -> dict:
+    """Setup (the first step: matrix, factorisation or preconditioner) and seconds per later
+    implicit Euler step of one linear solver on ``mesh`` (``u_t = lap u``, zero boundary)."""
+    from femkit.dynamics.mol import HEAT_INTEGRATORS, LinearSystem, get_scheme, march
+    from femkit.fem import assemble_stiffness
+    from femkit.fem.mass import mass_matrix
+    from femkit.mesh import boundary_nodes
+    from femkit.solvers import SolverSpec
+
+    pts = mesh.points
+    u0 = np.prod(np.sin(np.pi * pts), axis=1)
+    spec = SolverSpec.from_mapping(SOLVERS[method])
+    system = LinearSystem(mass_matrix(mesh), assemble_stiffness(mesh, 1.0),
+                          boundary_nodes(mesh, None), solver=spec)
+    scheme = get_scheme(HEAT_INTEGRATORS, "implicit_euler")
+    first = march(system, scheme, u0, 0.0, dt, 1)
+    run = march(system, scheme, first.frames[-1][1], dt, dt, steps)
+    st = system.stats
+    return {"method": method, "unknowns": int(system.free.size), "setup_s": first.step_seconds,
+            "step_s": run.seconds_per_step,
+            "iterations": st.get("linear_iterations", 0) / max(1, st.get("linear_solves", 1)),
+            "u": run.frames[-1][1]}
+
+
+SOLVERS = {"direct": {"method": "direct"}, "cholesky": {"method": "cholesky"},
+           "pcg+amg": {"method": "pcg", "preconditioner": "amg"},
+           "pcg+amg_rs": {"method": "pcg", "preconditioner": "amg_rs"},
+           "pcg+ic0": {"method": "pcg", "preconditioner": "ic0"}}
+
+
+def compare_solvers(methods: list[str], sizes: list[str]) -> None:
+    """Print setup and per-step seconds of each solver on 2D grids (``2d:N``: N x N squares)
+    and 3D Kuhn boxes (``3d:N``), and the largest difference from the first solver's state."""
+    from femkit.mesh.structured import structured_box, structured_mesh
+
+    for size in sizes:
+        dim, n = size.split(":")
+        mesh = structured_mesh(int(n), int(n)) if dim == "2d" else structured_box(*(int(n),) * 3)
+        ref = None
+        for method in methods:
+            r = solver_costs(method, mesh)
+            diff = 0.0 if ref is None else float(np.abs(r["u"] - ref).max() / np.abs(ref).max())
+            ref = r["u"] if ref is None else ref
+            print(f"solvers    {dim} {r['unknowns']:,} unknowns {method:11s} setup {r['setup_s']:7.2f} s, "
+                  f"step {r['step_s'] * 1e3:8.1f} ms ({r['iterations']:.1f} it/step), "
+                  f"state vs {methods[0]} {diff:.1e}", flush=True)
+
+
 CASE = """\
 problem: heat
 name: bench_heat
@@ -182,7 +230,14 @@ def main() -> None:
     ap.add_argument("--refine", type=int, default=3, help="per-step mesh: h 0.0125 refined k times")
     ap.add_argument("--whole-refine", type=int, default=3, help="whole solve: h 0.0175 refined k times")
     ap.add_argument("--skip-whole", action="store_true", help="the per-step measurement only")
+    ap.add_argument("--solvers", nargs="*", metavar="METHOD",
+                    help=f"compare the step solvers ({', '.join(SOLVERS)}) instead")
+    ap.add_argument("--sizes", nargs="*", default=["2d:245", "2d:500", "3d:58"],
+                    help="with --solvers: 2d:N (N x N squares) or 3d:N (N^3 Kuhn cubes)")
     args = ap.parse_args()
+    if args.solvers is not None:
+        compare_solvers(args.solvers or list(SOLVERS), args.sizes)
+        return
     a = per_step(args.refine)
     print(f"per step   {a['unknowns']:,} unknowns: implicit Euler step {a['step_s'] * 1e3:.1f} ms, "
           f"one substitution pair {a['pair_s'] * 1e3:.1f} ms: ratio {a['ratio']:.2f} (goal <= 1.5); "

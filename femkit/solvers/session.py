@@ -279,9 +279,13 @@ class LinearSession:
             self._time("time_preconditioner_setup", time.perf_counter() - t0)
             self._count("preconditioner_setups")
             kept = self._kept_pc[key] = (A, pc)
+            checked = {}                           # the first solve checks A's symmetry ...
+        else:
+            checked = {"check_symmetry": False}    # ... which later solves of A need not repeat
         self._count("linear_solves")
         res = self.run(A, b, x0, spec=replace(spec, preconditioner=kept[1],
-                                              preconditioner_options={}))
+                                              preconditioner_options={},
+                                              options={**spec.options, **checked}))
         self._count("linear_iterations", int(res.iterations))
         if not res.converged:
             raise SolverError(
