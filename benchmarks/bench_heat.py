@@ -106,17 +106,28 @@ SOLVERS = {"direct": {"method": "direct"}, "cholesky": {"method": "cholesky"},
            "pcg+ic0": {"method": "pcg", "preconditioner": "ic0"}}
 
 
-def compare_solvers(methods: list[str], sizes: list[str]) -> None:
-    """Print setup and per-step seconds of each solver on 2D grids (``2d:N``: N x N squares)
-    and 3D Kuhn boxes (``3d:N``), and the largest difference from the first solver's state."""
+def grid(size: str):
+    """``2d:N`` (N x N squares cut in triangles), ``3d:N`` (N^3 Kuhn cubes) or ``msh:H:K`` (the
+    gmsh unit square of size H refined K times: an unstructured node numbering)."""
+    from femkit.mesh import generate, refine as refine_mesh
     from femkit.mesh.structured import structured_box, structured_mesh
 
+    kind, *arg = size.split(":")
+    if kind == "msh":
+        return refine_mesh(generate("unit_square", float(arg[0])), int(arg[1]))
+    n = int(arg[0])
+    return structured_mesh(n, n) if kind == "2d" else structured_box(n, n, n)
+
+
+def compare_solvers(methods: list[str], sizes: list[str], dt: float = DT) -> None:
+    """Print setup and per-step seconds of each solver on each :func:`grid` and the largest
+    difference from the first solver's state."""
     for size in sizes:
-        dim, n = size.split(":")
-        mesh = structured_mesh(int(n), int(n)) if dim == "2d" else structured_box(*(int(n),) * 3)
+        dim = size.split(":")[0]
+        mesh = grid(size)
         ref = None
         for method in methods:
-            r = solver_costs(method, mesh)
+            r = solver_costs(method, mesh, dt=dt)
             diff = 0.0 if ref is None else float(np.abs(r["u"] - ref).max() / np.abs(ref).max())
             ref = r["u"] if ref is None else ref
             print(f"solvers    {dim} {r['unknowns']:,} unknowns {method:11s} setup {r['setup_s']:7.2f} s, "
@@ -233,10 +244,11 @@ def main() -> None:
     ap.add_argument("--solvers", nargs="*", metavar="METHOD",
                     help=f"compare the step solvers ({', '.join(SOLVERS)}) instead")
     ap.add_argument("--sizes", nargs="*", default=["2d:245", "2d:500", "3d:58"],
-                    help="with --solvers: 2d:N (N x N squares) or 3d:N (N^3 Kuhn cubes)")
+                    help="with --solvers: 2d:N (N x N squares), 3d:N (N^3 Kuhn cubes), msh:H:K")
+    ap.add_argument("--dt", type=float, default=DT, help="with --solvers: the step")
     args = ap.parse_args()
     if args.solvers is not None:
-        compare_solvers(args.solvers or list(SOLVERS), args.sizes)
+        compare_solvers(args.solvers or list(SOLVERS), args.sizes, args.dt)
         return
     a = per_step(args.refine)
     print(f"per step   {a['unknowns']:,} unknowns: implicit Euler step {a['step_s'] * 1e3:.1f} ms, "

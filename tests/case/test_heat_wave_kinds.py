@@ -243,3 +243,21 @@ def test_p2_heat_converges_at_order_three_and_writes_quadratic_frames(tmp_path):
     frame = meshio.read(tmp_path / "out_P2_0.125" / "frames" / "frame_00001.vtu")
     assert frame.cells[0].type == "triangle6"
     assert frame.point_data["u"].shape == (len(frame.points),)
+
+
+def test_default_step_solver_follows_the_size_rule_and_a_named_one_is_kept(tmp_path, monkeypatch):
+    """Without a named method the steps factorise up to DIRECT_LIMIT unknowns and above it use
+    PCG with one kept AMG hierarchy (here the limit lowered to 0 so a small mesh crosses it);
+    the manufactured solution stays exact to round-off either way."""
+    from femkit.dynamics.mol import system as mol_system
+
+    small = load_case(_write(tmp_path, MANUFACTURED)).run(write=False, quiet=True)
+    assert small.linear["method"] == "direct" and small.linear["factorizations"] == 1
+    monkeypatch.setitem(mol_system.DIRECT_LIMIT, 2, 0)
+    large = load_case(_write(tmp_path, MANUFACTURED)).run(write=False, quiet=True)
+    lin = large.linear
+    assert (lin["method"], lin["preconditioner"]) == ("pcg", "amg_rs")
+    assert lin["factorizations"] == 0 and lin["preconditioner_setups"] == 1   # one matrix
+    assert large.errors["max_over_time"]["max_nodal"] < 1e-9
+    named = load_case(_write(tmp_path, {**MANUFACTURED, "solver": {"method": "direct"}}))
+    assert named.run(write=False, quiet=True).linear["method"] == "direct"

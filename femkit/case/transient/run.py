@@ -115,12 +115,13 @@ class TransientResult(RunResult):
         return lines
 
 
-def _linear_facts(system, march, spec) -> dict:
+def _linear_facts(system, march) -> dict:
     st = system.stats
-    return {"method": spec.solver.method, "factorizations": int(st["factorizations"]),
+    return {"method": system.solver.method, "preconditioner": system.solver.preconditioner,
+            "factorizations": int(st["factorizations"]),
             "factor_seconds": float(st["factor_seconds"]), "solves": int(st["solves"]),
             "seconds_per_step": float(march.seconds_per_step),
-            "kept_factor": spec.solver.method in ("direct", "cholesky"),
+            "kept_factor": system.solver.method in ("direct", "cholesky"),
             "preconditioner_setups": int(st.get("preconditioner_setups", 0)),
             "iterations": int(st.get("linear_iterations", 0))}
 
@@ -165,7 +166,7 @@ def run_transient(case, capacity: str, registry, *, second_order: bool,
     energies = [{"t": float(t), **system.energy(u, v)} for t, u, v in run.frames]
     result = result_type(case=case, mesh=mesh, frames=run.frames, march=run, scheme=scheme,
                          stability=stability, errors=errors, energies=energies,
-                         linear=_linear_facts(system, run, spec), timings=timer.times,
+                         linear=_linear_facts(system, run), timings=timer.times,
                          stopped=stop.name if run.interrupted else None)
     if write:
         with timer("output"):

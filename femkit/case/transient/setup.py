@@ -128,6 +128,7 @@ class TransientSpec:
     solver: Any
     output: TransientOutput
     load_rule: str = "barycentric"
+    solver_default: bool = False  # no method named: the size rule (dynamics.mol.step_solver)
 
 
 def _compile(case, key: str, text, *, check_finite: bool = True):
@@ -228,7 +229,8 @@ def prepare_transient(case, capacity: str, integrators, expressions: tuple = ())
         rtol_t=None if rtol_t is None else float(rtol_t), solver=solver,
         output=TransientOutput(out["dir"], int(out["frames"]), bool(out["vtu"]), bool(out["png"]),
                                bool(out["gif"])),
-        load_rule=d["quadrature"]["load"])
+        load_rule=d["quadrature"]["load"],
+        solver_default=isinstance(d["solver"], dict) and "method" not in d["solver"])
 
 
 # ----------------------------------------------------------------------------- the system
@@ -311,7 +313,7 @@ def build_system(case, mesh, capacity: str):
     """The :class:`femkit.dynamics.mol.LinearSystem` of the case on ``mesh``: ``M`` (consistent
     or lumped, ``capacity`` per cell), ``K`` (``kappa`` per cell), the Dirichlet nodes and the
     time-dependent load and boundary values (evaluated once when they do not use ``t``)."""
-    from ...dynamics.mol import LinearSystem
+    from ...dynamics.mol import LinearSystem, step_solver
     from ...fem import assemble_load, assemble_neumann, assemble_stiffness
     from ...fem.forms import assemble_matrix
     from ...fem.lagrange import element_load, element_neumann
@@ -361,7 +363,8 @@ def build_system(case, mesh, capacity: str):
     return LinearSystem(M, K, fixed, load=load if has_load else None,
                         boundary=boundary if groups else None, load_constant=not uses_t,
                         boundary_constant=not any("t" in fn.used for _, fn in groups),
-                        lumped=lumped, solver=spec.solver)
+                        lumped=lumped, solver=step_solver(mesh.dim, n - fixed.size, spec.solver)
+                        if spec.solver_default else spec.solver)
 
 
 def initial_values(case, mesh, key: str) -> np.ndarray:

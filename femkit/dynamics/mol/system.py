@@ -28,10 +28,34 @@ import scipy.sparse as sp
 from ...errors import InputError
 from ...solvers.spec import SolverSpec
 
-__all__ = ["LinearSystem", "ConstrainedOperator", "KEPT_FACTOR_METHODS"]
+__all__ = ["LinearSystem", "ConstrainedOperator", "KEPT_FACTOR_METHODS", "DIRECT_LIMIT",
+           "step_solver"]
 
 #: Solver methods whose factor is kept across steps; any other is an iterative solve per step.
 KEPT_FACTOR_METHODS = frozenset({"direct", "cholesky"})
+
+#: The most free unknowns, by dimension, for which the default step solver is a kept SuperLU
+#: factor; above it, PCG with a kept Ruge-Stueben AMG hierarchy, warm-started. Measured with
+#: ``benchmarks/bench_heat.py --solvers`` (docs/heat_wave.md: figures and why).
+DIRECT_LIMIT = {2: 100_000, 3: 30_000}
+
+#: What the large systems use: robust in ``dt / h^2`` (3-5 iterations per step from
+#: ``dt / h^2 = 25`` to ``250``, where IC(0) needs 11 to 58).
+ITERATIVE_STEP_SOLVER = {"method": "pcg", "preconditioner": "amg_rs"}
+
+
+def step_solver(dim: int, n_free: int, spec: SolverSpec | None = None) -> SolverSpec:
+    """The default linear solver of the implicit steps of a system of ``n_free`` unknowns on a
+    ``dim``-dimensional mesh: ``spec`` (default ``direct``) up to :data:`DIRECT_LIMIT`, else
+    ``spec`` turned into :data:`ITERATIVE_STEP_SOLVER` (its tolerances kept).
+
+    >>> step_solver(2, 50_000).method, step_solver(3, 200_000).preconditioner
+    ('direct', 'amg_rs')
+    """
+    spec = SolverSpec("direct") if spec is None else spec
+    if n_free <= DIRECT_LIMIT.get(dim, DIRECT_LIMIT[3]):
+        return spec
+    return spec.replace(**ITERATIVE_STEP_SOLVER)
 
 
 @dataclass
