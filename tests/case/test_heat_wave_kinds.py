@@ -255,9 +255,13 @@ def test_default_step_solver_follows_the_size_rule_and_a_named_one_is_kept(tmp_p
     assert small.linear["method"] == "direct" and small.linear["factorizations"] == 1
     monkeypatch.setitem(mol_system.DIRECT_LIMIT, 2, 0)
     large = load_case(_write(tmp_path, MANUFACTURED)).run(write=False, quiet=True)
-    lin = large.linear
-    assert (lin["method"], lin["preconditioner"]) == ("pcg", "amg_rs")
+    lin = large.linear   # stiffness ratio ~ 8 dt kappa / (rho_c h^2) ~ 7: IC(0)
+    assert (lin["method"], lin["preconditioner"]) == ("pcg", "ic0")
     assert lin["factorizations"] == 0 and lin["preconditioner_setups"] == 1   # one matrix
     assert large.errors["max_over_time"]["max_nodal"] < 1e-9
+    monkeypatch.setattr(mol_system, "IC0_LIMIT", 0.1)   # as if dt were far larger: AMG
+    stiff = load_case(_write(tmp_path, MANUFACTURED)).run(write=False, quiet=True)
+    assert stiff.linear["preconditioner"] == "amg_rs"
+    assert stiff.errors["max_over_time"]["max_nodal"] < 1e-9
     named = load_case(_write(tmp_path, {**MANUFACTURED, "solver": {"method": "direct"}}))
     assert named.run(write=False, quiet=True).linear["method"] == "direct"

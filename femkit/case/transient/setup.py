@@ -313,7 +313,7 @@ def build_system(case, mesh, capacity: str):
     """The :class:`femkit.dynamics.mol.LinearSystem` of the case on ``mesh``: ``M`` (consistent
     or lumped, ``capacity`` per cell), ``K`` (``kappa`` per cell), the Dirichlet nodes and the
     time-dependent load and boundary values (evaluated once when they do not use ``t``)."""
-    from ...dynamics.mol import LinearSystem, step_solver
+    from ...dynamics.mol import LinearSystem, step_solver, stiffness_ratio
     from ...fem import assemble_load, assemble_neumann, assemble_stiffness
     from ...fem.forms import assemble_matrix
     from ...fem.lagrange import element_load, element_neumann
@@ -360,11 +360,15 @@ def build_system(case, mesh, capacity: str):
         return F
 
     uses_t = [fn for fn in [source, *(h for _, h in neumann)] if "t" in fn.used]
+    solver = spec.solver
+    if spec.solver_default:   # the size rule; the step matrix M + b K: b = dt (heat), dt^2 / 4
+        free = np.setdiff1d(np.arange(n), fixed)
+        b = spec.dt if capacity == "rho_c" else spec.dt ** 2 / 4.0
+        solver = step_solver(dim, free.size, solver, stiffness_ratio(M, K, free, b))
     return LinearSystem(M, K, fixed, load=load if has_load else None,
                         boundary=boundary if groups else None, load_constant=not uses_t,
                         boundary_constant=not any("t" in fn.used for _, fn in groups),
-                        lumped=lumped, solver=step_solver(mesh.dim, n - fixed.size, spec.solver)
-                        if spec.solver_default else spec.solver)
+                        lumped=lumped, solver=solver)
 
 
 def initial_values(case, mesh, key: str) -> np.ndarray:

@@ -29,33 +29,51 @@ from ...errors import InputError
 from ...solvers.spec import SolverSpec
 
 __all__ = ["LinearSystem", "ConstrainedOperator", "KEPT_FACTOR_METHODS", "DIRECT_LIMIT",
-           "step_solver"]
+           "IC0_LIMIT", "step_solver", "stiffness_ratio"]
 
 #: Solver methods whose factor is kept across steps; any other is an iterative solve per step.
 KEPT_FACTOR_METHODS = frozenset({"direct", "cholesky"})
 
 #: The most free unknowns, by dimension, for which the default step solver is a kept SuperLU
-#: factor; above it, PCG with a kept Ruge-Stueben AMG hierarchy, warm-started. Measured with
+#: factor; above it, PCG with a kept IC(0) or AMG preconditioner (:data:`IC0_LIMIT`), warm-started. Measured with
 #: ``benchmarks/bench_heat.py --solvers`` (docs/heat_wave.md: figures and why).
 DIRECT_LIMIT = {2: 100_000, 3: 30_000}
 
-#: What the large systems use: robust in ``dt / h^2`` (3-5 iterations per step from
-#: ``dt / h^2 = 25`` to ``250``, where IC(0) needs 11 to 58).
-ITERATIVE_STEP_SOLVER = {"method": "pcg", "preconditioner": "amg_rs"}
+#: The preconditioner of the large systems by the stiffness of the step matrix ``a M + b K``,
+#: ``r = b median(K_ii / M_ii)`` (about ``8 dt / h^2`` for a heat step on a P1 triangle grid):
+#: IC(0) up to :data:`IC0_LIMIT` (its iterations grow as ``sqrt(r)``: 3 at ``r ~ 3``, 11 at
+#: ``r = 200``, 58 at ``r = 2000``; cheap per iteration), Ruge-Stueben AMG above (3-5 iterations
+#: whatever ``r``, each about 4 IC(0) iterations' cost in 2D and 20 in 3D).
+IC0_LIMIT = 1000.0
 
 
-def step_solver(dim: int, n_free: int, spec: SolverSpec | None = None) -> SolverSpec:
+def step_solver(dim: int, n_free: int, spec: SolverSpec | None = None,
+                stiffness: float = 0.0) -> SolverSpec:
     """The default linear solver of the implicit steps of a system of ``n_free`` unknowns on a
-    ``dim``-dimensional mesh: ``spec`` (default ``direct``) up to :data:`DIRECT_LIMIT`, else
-    ``spec`` turned into :data:`ITERATIVE_STEP_SOLVER` (its tolerances kept).
+    ``dim``-dimensional mesh whose step matrix has stiffness ratio ``stiffness``
+    (:data:`IC0_LIMIT`): ``spec`` (default ``direct``) up to :data:`DIRECT_LIMIT`, else
+    ``spec`` turned into PCG with a kept IC(0) (``stiffness <= IC0_LIMIT``) or Ruge-Stueben
+    AMG preconditioner, its tolerances kept.
 
-    >>> step_solver(2, 50_000).method, step_solver(3, 200_000).preconditioner
-    ('direct', 'amg_rs')
+    >>> step_solver(2, 50_000).method, step_solver(3, 200_000, stiffness=5.0).preconditioner
+    ('direct', 'ic0')
+    >>> step_solver(2, 250_000, stiffness=2000.0).preconditioner
+    'amg_rs'
     """
     spec = SolverSpec("direct") if spec is None else spec
     if n_free <= DIRECT_LIMIT.get(dim, DIRECT_LIMIT[3]):
         return spec
-    return spec.replace(**ITERATIVE_STEP_SOLVER)
+    pc = "ic0" if stiffness <= IC0_LIMIT else "amg_rs"
+    return spec.replace(method="pcg", preconditioner=pc)
+
+
+def stiffness_ratio(M, K, free: np.ndarray, b: float) -> float:
+    """``b median(K_ii / M_ii)`` over the free rows: how far ``M + b K`` is from the mass
+    matrix (:data:`IC0_LIMIT`)."""
+    m = np.asarray(M.diagonal())[free]
+    k = np.asarray(K.diagonal())[free]
+    ok = m > 0
+    return float(b * np.median(k[ok] / m[ok])) if ok.any() else float("inf")
 
 
 @dataclass
