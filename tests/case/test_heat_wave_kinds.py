@@ -265,3 +265,17 @@ def test_default_step_solver_follows_the_size_rule_and_a_named_one_is_kept(tmp_p
     assert stiff.errors["max_over_time"]["max_nodal"] < 1e-9
     named = load_case(_write(tmp_path, {**MANUFACTURED, "solver": {"method": "direct"}}))
     assert named.run(write=False, quiet=True).linear["method"] == "direct"
+
+
+def test_heat_on_the_petsc_backend_equals_femkit_step_by_step(tmp_path):
+    """``solver.backend: petsc`` (one process, every step a PETSc KSP solve, warm-started):
+    the states equal femkit's kept factor's to 1e-8 (the PETSc solve's tolerance 1e-12)."""
+    pytest.importorskip("petsc4py")
+    base = {**MANUFACTURED, "integrator": "implicit_euler", "mesh": {"geometry": "unit_square", "h": 0.1}}
+    ref = load_case(_write(tmp_path, base)).run(write=False, quiet=True)
+    petsc = {**base, "solver": {"method": "pcg", "preconditioner": "jacobi", "backend": "petsc",
+                                "rtol": 1e-12}}
+    r = load_case(_write(tmp_path, petsc, "petsc.yaml")).run(write=False, quiet=True)
+    assert r.linear["method"] == "pcg" and r.linear["factorizations"] == 0
+    for (t, u, _), (s, v, _) in zip(r.march.frames, ref.march.frames):
+        assert t == s and np.abs(u - v).max() < 1e-8 * np.abs(v).max()

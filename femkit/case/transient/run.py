@@ -126,6 +126,19 @@ def _linear_facts(system, march) -> dict:
             "iterations": int(st.get("linear_iterations", 0))}
 
 
+def _one_petsc_process(problem: str) -> None:
+    """The time-dependent kinds solve their steps on PETSc in one process: ``mpirun -n N``
+    with ``N > 1`` is refused in one line (the distributed path, femkit/fem/distributed,
+    assembles and solves a stationary Poisson problem; it has no mass matrix or time loop)."""
+    from ...errors import InputError
+    from ...solvers.petsc.env import world
+
+    size = world().getSize()
+    if size > 1:
+        raise InputError(f"problem: {problem} with solver.backend petsc runs on one process; "
+                         f"got {size} MPI ranks (the distributed path solves Poisson only)")
+
+
 def run_transient(case, capacity: str, registry, *, second_order: bool,
                   output_dir: str | os.PathLike | None = None, quiet: bool = False,
                   write: bool = True, echo: Callable[[str], Any] | None = None,
@@ -140,6 +153,8 @@ def run_transient(case, capacity: str, registry, *, second_order: bool,
     from .setup import build_system, check_step, frame_errors, initial_values
 
     spec = case.spec
+    if spec.solver.backend == "petsc":
+        _one_petsc_process(case.problem)
     if write:
         check_output_dir(output_dir or spec.output.dir, EARLIER_RUN)
     timer = StageTimer()

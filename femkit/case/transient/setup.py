@@ -180,9 +180,9 @@ def prepare_transient(case, capacity: str, integrators, expressions: tuple = ())
         check_geometry_spec(mesh, "mesh")
     solver = solver_spec(d["solver"], "solver",
                          default_method=KINDS.get(case.problem, "problem").default_solver)
-    if solver.backend != "femkit":
+    if solver.backend not in ("femkit", "petsc"):
         raise CaseFileError(f"solver.backend: {solver.backend!r} is not offered for problem: "
-                            f"{case.problem} yet; valid: femkit")
+                            f"{case.problem}; valid: femkit, petsc")
     if solver.needs_hierarchy:
         raise CaseFileError(f"solver: method {solver.method!r} needs a mesh hierarchy, which the "
                             "time-dependent kinds do not build; use direct, cholesky or pcg")

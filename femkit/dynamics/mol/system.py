@@ -12,8 +12,9 @@ Cholesky engines) when the linear solver is ``direct`` or ``cholesky``; with an 
 its preconditioner (AMG hierarchy, IC(0) factor) is built once and kept the same way
 (:meth:`LinearSession.solve_kept`, ``stats["preconditioner_setups"]``), and each step's solve
 starts from the linear extrapolation ``2 x_n - x_{n-1}`` of that matrix's last two solutions. A
-new ``dt`` (adaptive steps) is a new ``A``: factorised or set up afresh. A lumped (diagonal)
-``M`` alone is inverted by a division.
+new ``dt`` (adaptive steps) is a new ``A``: factorised or set up afresh. Another backend
+(``petsc``: :data:`femkit.solvers.registry.BACKENDS`, one process) solves every step by its own
+KSP, warm-started, nothing kept. A lumped (diagonal) ``M`` alone is inverted by a division.
 """
 
 from __future__ import annotations
@@ -215,7 +216,7 @@ class LinearSystem:
         op = ConstrainedOperator(A_ff, A_fb)
         if b == 0.0 and self.lumped:
             op.diagonal = A_ff.diagonal()
-        elif self.solver.method in KEPT_FACTOR_METHODS:
+        elif self.solver.method in KEPT_FACTOR_METHODS and self.solver.backend == "femkit":
             t0 = time.perf_counter()
             op.factor = self.session.factorize(A_ff)
             self.stats["factor_seconds"] += time.perf_counter() - t0
