@@ -452,7 +452,8 @@ def plan_transient(case, *, measure: bool = True):
     """The plan of a heat or wave case: the mesh and assembly stages of the Poisson model on
     the same mesh (:func:`femkit.case.poisson.cost.plan_poisson_case`), its solve priced as
     the one factorisation, then ``steps`` steps of one SpMV and one pair of triangular solves
-    each (about a tenth of a factorisation at these sizes), and the frames written."""
+    each (about a tenth of a factorisation at these sizes; an explicit scheme on a lumped mass:
+    no factorisation, one SpMV per step), and the frames written."""
     from types import SimpleNamespace
 
     from ...cost import Plan, Stage
@@ -472,6 +473,8 @@ def plan_transient(case, *, measure: bool = True):
     steps = spec.steps
     frames = min(steps, spec.output.frames) + 1
     per_step = 0.1 * solve + 2e-8 * nnz
+    if spec.mass == "lumped" and spec.integrator[0] in ("explicit_euler", "central_difference"):
+        solve, per_step = 0.0, 2e-8 * nnz   # no matrix to factorise: an SpMV and a division
     frame_bytes = 16.0 * points + 200.0
     stages = keep + [
         Stage("factor", solve, peak, 0.0,
