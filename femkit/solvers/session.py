@@ -240,12 +240,17 @@ class LinearSession:
             if keep is not None:
                 return self._solve_reusing_factor(A, b, keep, x0)
             return self._solve_direct(A, b)
+        return self._counted_run(A, b, x0, spec, f"{spec.method}/{spec.preconditioner}")
+
+    def _counted_run(self, A, b, x0, spec, label: str) -> np.ndarray:
+        """:meth:`run` counted in ``stats``, its ``x`` if it met the stopping rule, else
+        :class:`~femkit.errors.SolverError` naming ``label``."""
         self._count("linear_solves")
         res = self.run(A, b, x0, spec=spec)
         self._count("linear_iterations", int(res.iterations))
         if not res.converged:
             raise SolverError(
-                f"linear solve ({spec.method}/{spec.preconditioner}) did not converge: {res.reason}; "
+                f"linear solve ({label}) did not converge: {res.reason}; "
                 f"relative residual {res.relative_residual:.3e} after {res.iterations} iterations")
         return np.asarray(res.x, dtype=float)
 
@@ -282,16 +287,10 @@ class LinearSession:
             checked = {}                           # the first solve checks A's symmetry ...
         else:
             checked = {"check_symmetry": False}    # ... which later solves of A need not repeat
-        self._count("linear_solves")
-        res = self.run(A, b, x0, spec=replace(spec, preconditioner=kept[1],
-                                              preconditioner_options={},
-                                              options={**spec.options, **checked}))
-        self._count("linear_iterations", int(res.iterations))
-        if not res.converged:
-            raise SolverError(
-                f"linear solve (pcg/{spec.preconditioner}, kept) did not converge: {res.reason}; "
-                f"relative residual {res.relative_residual:.3e} after {res.iterations} iterations")
-        return np.asarray(res.x, dtype=float)
+        return self._counted_run(A, b, x0, replace(spec, preconditioner=kept[1],
+                                                   preconditioner_options={},
+                                                   options={**spec.options, **checked}),
+                                 f"pcg/{spec.preconditioner}, kept")
 
     # ------------------------------------------------------------------ kept factors
     def factorize(self, A) -> Factor:

@@ -279,3 +279,15 @@ def test_heat_on_the_petsc_backend_equals_femkit_step_by_step(tmp_path):
     assert r.linear["method"] == "pcg" and r.linear["factorizations"] == 0
     for (t, u, _), (s, v, _) in zip(r.march.frames, ref.march.frames):
         assert t == s and np.abs(u - v).max() < 1e-8 * np.abs(v).max()
+
+
+def test_a_forced_unstable_run_reports_no_norm_for_overflowing_frames(tmp_path):
+    """Explicit Euler forced far above its critical step grows by ~5x a step: frames past
+    1e100 get no error norm (their squares overflow) instead of stopping the run."""
+    data = {**MANUFACTURED, "integrator": "explicit_euler", "dt": 0.05, "t_end": 5.0,
+            "output": {"dir": "out", "frames": 50}}
+    r = load_case(_write(tmp_path, data)).with_options(force=True).run(write=False, quiet=True)
+    hist = r.errors["history"]
+    assert hist[0]["L2"] is not None and hist[0]["L2"] < 1e-12
+    assert any(h["L2"] is None for h in hist)
+    assert all(h["L2"] is None or h["L2"] < 1e100 for h in hist)

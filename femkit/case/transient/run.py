@@ -102,9 +102,11 @@ class TransientResult(RunResult):
                      f"{lin['solves']} solves, {lin['seconds_per_step'] * 1e3:.3g} ms per step")
         if self.errors is not None:
             top, fin = self.errors["max_over_time"], self.errors["final"]
-            lines.append(f"errors    max over time: L2 {top['L2']:.4e}, H1 "
-                         f"{top['H1_semi'] if top['H1_semi'] is None else format(top['H1_semi'], '.4e')}; "
-                         f"at t = {fin['t']:.4g}: L2 {fin['L2']:.4e}")
+
+            def num(v):  # None: no norm (H1 without a gradient, an overflowing unstable frame)
+                return "none" if v is None else format(v, ".4e")
+            lines.append(f"errors    max over time: L2 {num(top['L2'])}, H1 "
+                         f"{num(top['H1_semi'])}; at t = {fin['t']:.4g}: L2 {num(fin['L2'])}")
         e0, e1 = self.energies[0], self.energies[-1]
         key = "total" if "total" in e0 else "thermal"
         lines.append(f"energy    {key} {e0[key]:.6g} -> {e1[key]:.6g}")

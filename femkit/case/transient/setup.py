@@ -405,9 +405,14 @@ def check_step(case, system, scheme) -> dict:
     return {"dt_critical": float(dt_crit), "lambda_max": float(lam)}
 
 
+#: Nodal values this large (an unstable run forced past its critical step) get no error norms:
+#: their squares overflow. The frame's norms are None.
+OVERFLOW = 1e100
+
+
 def frame_errors(case, mesh, frames) -> dict | None:
     """L2 and H1-seminorm errors against ``exact`` at every frame time, and their maxima over
-    time (None without ``exact``)."""
+    time (None without ``exact``; None at a frame whose values reach :data:`OVERFLOW`)."""
     from ...fem import error_norms
     from ..expressions import Gradient
 
@@ -417,6 +422,9 @@ def frame_errors(case, mesh, frames) -> dict | None:
     parts = [case.functions[f"exact.grad[{i}]"] for i in range(3) if f"exact.grad[{i}]" in case.functions]
     history = []
     for t, u, _ in frames:
+        if not np.abs(u).max(initial=0.0) < OVERFLOW:  # an unstable run (--force): no norm
+            history.append({"t": float(t), "L2": None, "H1_semi": None, "max_nodal": None})
+            continue
         grad = None
         if parts:
             grad = Gradient([_Frozen(p, t, mesh.dim) for p in parts])
