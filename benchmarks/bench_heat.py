@@ -76,6 +76,102 @@ def per_step(refine: int, steps: int = 20) -> dict:
             "ratio": step / pair}
 
 
+def solver_costs(method: str, mesh, steps: int = 10, dt: float = DT) -> dict:
+    """Setup (the first step: matrix, factorisation or preconditioner) and seconds per later
+    implicit Euler step of one linear solver on ``mesh`` (``u_t = lap u``, zero boundary)."""
+    from femkit.dynamics.mol import HEAT_INTEGRATORS, LinearSystem, get_scheme, march
+    from femkit.fem import assemble_stiffness
+    from femkit.fem.mass import mass_matrix
+    from femkit.mesh import boundary_nodes
+    from femkit.solvers import SolverSpec
+
+    pts = mesh.points
+    u0 = np.prod(np.sin(np.pi * pts), axis=1)
+    spec = SolverSpec.from_mapping(SOLVERS[method])
+    system = LinearSystem(mass_matrix(mesh), assemble_stiffness(mesh, 1.0),
+                          boundary_nodes(mesh, None), solver=spec)
+    scheme = get_scheme(HEAT_INTEGRATORS, "implicit_euler")
+    first = march(system, scheme, u0, 0.0, dt, 1)
+    run = march(system, scheme, first.frames[-1][1], dt, dt, steps)
+    st = system.stats
+    return {"method": method, "unknowns": int(system.free.size), "setup_s": first.step_seconds,
+            "step_s": run.seconds_per_step,
+            "iterations": st.get("linear_iterations", 0) / max(1, st.get("linear_solves", 1)),
+            "u": run.frames[-1][1]}
+
+
+SOLVERS = {"direct": {"method": "direct"}, "cholesky": {"method": "cholesky"},
+           "pcg+amg": {"method": "pcg", "preconditioner": "amg"},
+           "pcg+amg_rs": {"method": "pcg", "preconditioner": "amg_rs"},
+           "pcg+ic0": {"method": "pcg", "preconditioner": "ic0"}}
+
+
+def grid(size: str):
+    """``2d:N`` (N x N squares cut in triangles), ``3d:N`` (N^3 Kuhn cubes) or ``msh:H:K`` (the
+    gmsh unit square of size H refined K times: an unstructured node numbering)."""
+    from femkit.mesh import generate, refine as refine_mesh
+    from femkit.mesh.structured import structured_box, structured_mesh
+
+    kind, *arg = size.split(":")
+    if kind == "msh":
+        return refine_mesh(generate("unit_square", float(arg[0])), int(arg[1]))
+    n = int(arg[0])
+    return structured_mesh(n, n) if kind == "2d" else structured_box(n, n, n)
+
+
+def compare_solvers(methods: list[str], sizes: list[str], dt: float = DT) -> None:
+    """Print setup and per-step seconds of each solver on each :func:`grid` and the largest
+    difference from the first solver's state."""
+    for size in sizes:
+        dim = size.split(":")[0]
+        mesh = grid(size)
+        ref = None
+        for method in methods:
+            r = solver_costs(method, mesh, dt=dt)
+            diff = 0.0 if ref is None else float(np.abs(r["u"] - ref).max() / np.abs(ref).max())
+            ref = r["u"] if ref is None else ref
+            print(f"solvers    {dim} {r['unknowns']:,} unknowns {method:11s} setup {r['setup_s']:7.2f} s, "
+                  f"step {r['step_s'] * 1e3:8.1f} ms ({r['iterations']:.1f} it/step), "
+                  f"state vs {methods[0]} {diff:.1e}", flush=True)
+
+
+def heat_3d(n: int, steps: int = 5, dt: float = DT) -> dict:
+    """3D heat on ``n^3`` Kuhn cubes with the default rule's step solver
+    (:func:`femkit.dynamics.mol.step_solver`: kept preconditioner, warm start): setup and
+    seconds per step, against one stationary solve ``K u = f`` of the same mesh by the Poisson
+    default (``pcg`` + smoothed-aggregation AMG, setup included) from zero."""
+    from femkit.dynamics.mol import (HEAT_INTEGRATORS, LinearSystem, get_scheme, march,
+                                     step_solver, stiffness_ratio)
+    from femkit.fem import assemble_stiffness
+    from femkit.fem.mass import mass_matrix
+    from femkit.mesh import boundary_nodes
+    from femkit.mesh.structured import structured_box
+    from femkit.solvers import SolverSpec
+
+    t0 = time.perf_counter()
+    mesh = structured_box(n, n, n)
+    M, K, fixed = mass_matrix(mesh), assemble_stiffness(mesh, 1.0), boundary_nodes(mesh, None)
+    build = time.perf_counter() - t0
+    free = np.setdiff1d(np.arange(mesh.n_points), fixed)
+    spec = step_solver(3, free.size, None, stiffness_ratio(M, K, free, dt))
+    system = LinearSystem(M, K, fixed, solver=spec)
+    u0 = np.prod(np.sin(np.pi * mesh.points), axis=1)
+    scheme = get_scheme(HEAT_INTEGRATORS, "implicit_euler")
+    first = march(system, scheme, u0, 0.0, dt, 1)
+    run = march(system, scheme, first.frames[-1][1], dt, dt, steps)
+    st = dict(system.stats)
+    K_ff = K[free][:, free].tocsr()
+    b = M[free] @ np.ones(mesh.n_points)
+    t0 = time.perf_counter()
+    res = SolverSpec("pcg").solve(K_ff, b)
+    stationary = time.perf_counter() - t0
+    return {"unknowns": int(free.size), "solver": f"{spec.method}+{spec.preconditioner}",
+            "build_s": build, "setup_s": first.step_seconds, "step_s": run.seconds_per_step,
+            "iterations": st.get("linear_iterations", 0) / max(1, st.get("linear_solves", 1)),
+            "stationary_s": stationary, "stationary_iterations": int(res.iterations),
+            "ratio": run.seconds_per_step / stationary}
+
+
 CASE = """\
 problem: heat
 name: bench_heat
@@ -173,6 +269,7 @@ def whole_solve(refine: int) -> dict:
     out["femkit_max_L2"] = fk["errors"]["max_over_time"]["L2"]
     out["skfem_max_L2"] = sk["max"]
     out["femkit_timings"] = fk["timings"]
+    out["femkit_solver"] = fk["linear_solver"]
     out["ratio"] = out["femkit_s"] / out["skfem_s"]
     return out
 
@@ -182,12 +279,32 @@ def main() -> None:
     ap.add_argument("--refine", type=int, default=3, help="per-step mesh: h 0.0125 refined k times")
     ap.add_argument("--whole-refine", type=int, default=3, help="whole solve: h 0.0175 refined k times")
     ap.add_argument("--skip-whole", action="store_true", help="the per-step measurement only")
+    ap.add_argument("--skip-step", action="store_true", help="the whole solve only")
+    ap.add_argument("--solvers", nargs="*", metavar="METHOD",
+                    help=f"compare the step solvers ({', '.join(SOLVERS)}) instead")
+    ap.add_argument("--sizes", nargs="*", default=["2d:245", "2d:500", "3d:58"],
+                    help="with --solvers: 2d:N (N x N squares), 3d:N (N^3 Kuhn cubes), msh:H:K")
+    ap.add_argument("--dt", type=float, default=DT, help="with --solvers: the step")
+    ap.add_argument("--heat-3d", type=int, metavar="N",
+                    help="3D heat on N^3 Kuhn cubes (N = 100: 1.03M nodes) against a stationary solve")
     args = ap.parse_args()
-    a = per_step(args.refine)
-    print(f"per step   {a['unknowns']:,} unknowns: implicit Euler step {a['step_s'] * 1e3:.1f} ms, "
-          f"one substitution pair {a['pair_s'] * 1e3:.1f} ms: ratio {a['ratio']:.2f} (goal <= 1.5); "
-          f"first step (matrix, factorisation) {a['setup_s']:.2f} s of which factorisation "
-          f"{a['factor_s']:.2f} s, assembly {a['assembly_s']:.2f} s", flush=True)
+    if args.heat_3d:
+        r = heat_3d(args.heat_3d, dt=args.dt)
+        print(f"3d heat    {r['unknowns']:,} unknowns, {r['solver']} (kept, warm-started): step "
+              f"{r['step_s']:.2f} s ({r['iterations']:.1f} it/step), first step {r['setup_s']:.2f} s; "
+              f"one stationary solve (pcg+amg, setup included) {r['stationary_s']:.2f} s "
+              f"({r['stationary_iterations']} it): ratio {r['ratio']:.3f}; mesh and matrices "
+              f"{r['build_s']:.1f} s", flush=True)
+        return
+    if args.solvers is not None:
+        compare_solvers(args.solvers or list(SOLVERS), args.sizes, args.dt)
+        return
+    a = None if args.skip_step else per_step(args.refine)
+    if a:
+        print(f"per step   {a['unknowns']:,} unknowns: implicit Euler step {a['step_s'] * 1e3:.1f} ms, "
+              f"one substitution pair {a['pair_s'] * 1e3:.1f} ms: ratio {a['ratio']:.2f} (goal <= 1.5); "
+              f"first step (matrix, factorisation) {a['setup_s']:.2f} s of which factorisation "
+              f"{a['factor_s']:.2f} s, assembly {a['assembly_s']:.2f} s", flush=True)
     if args.skip_whole:
         return
     b = whole_solve(args.whole_refine)
@@ -195,6 +312,7 @@ def main() -> None:
           f"scikit-fem + splu {b['skfem_s']:.2f} s: ratio {b['ratio']:.2f} (goal <= 0.3); "
           f"max L2 error femkit {b['femkit_max_L2']:.4e}, scikit-fem {b['skfem_max_L2']:.4e}")
     print("femkit stages: " + ", ".join(f"{k} {v:.2f} s" for k, v in b["femkit_timings"].items()))
+    print("femkit linear solver: " + json.dumps(b["femkit_solver"]))
 
 
 if __name__ == "__main__":

@@ -24,12 +24,16 @@ session owns:
   (:meth:`~femkit.solvers.factor.Factor.refactor`);
 * **preconditioner reuse** (``keep=``): a kept factorisation preconditions the PCG solves of
   later, slowly changing matrices, renewed by a cost rule (:meth:`LinearSession.solve`);
-* a **factor kept for the whole run** (:meth:`LinearSession.factorize`).
+* a **factor kept for the whole run** (:meth:`LinearSession.factorize`), and its iterative
+  counterpart, a **preconditioner kept for a fixed matrix** (:meth:`LinearSession.solve_kept`:
+  the AMG hierarchy, IC(0) factor or GMG hierarchy of one matrix built once under a key and
+  reused by every later PCG solve with that same matrix, as the time steps of a fixed ``dt``
+  do; a new matrix under the key is set up afresh, ``stats["preconditioner_setups"]``).
 
 Counters and times accumulate in :attr:`LinearSession.stats`: ``linear_solves``,
 ``linear_iterations``, ``factorizations``, ``orderings``, ``symbolic_reuses``,
-``refactorizations``, ``time_permute``, ``time_factorization``, ``time_solve``, ``time_pcg``
-(seconds).
+``refactorizations``, ``preconditioner_setups``, ``time_permute``, ``time_factorization``,
+``time_solve``, ``time_pcg``, ``time_preconditioner_setup`` (seconds).
 
 Every answer meets the stopping rule ``||b - A x|| <= max(rtol ||b||, atol)`` of the spec, the
 direct ones on the true residual; otherwise :class:`~femkit.errors.SolverError`.
@@ -148,6 +152,7 @@ class LinearSession:
         self._ordering: tuple | None = None       # (indptr, indices, perm) of the last pattern
         self._kept: dict[str, _Kept] = {}          # preconditioner reuse, by caller's key
         self._pattern: dict[str, tuple] = {}       # symbolic reuse on a fixed pattern, by key
+        self._kept_pc: dict[Any, tuple] = {}       # (matrix, preconditioner) kept, by key
 
     # ------------------------------------------------------------------ facts and counters
     @property
@@ -235,14 +240,57 @@ class LinearSession:
             if keep is not None:
                 return self._solve_reusing_factor(A, b, keep, x0)
             return self._solve_direct(A, b)
+        return self._counted_run(A, b, x0, spec, f"{spec.method}/{spec.preconditioner}")
+
+    def _counted_run(self, A, b, x0, spec, label: str) -> np.ndarray:
+        """:meth:`run` counted in ``stats``, its ``x`` if it met the stopping rule, else
+        :class:`~femkit.errors.SolverError` naming ``label``."""
         self._count("linear_solves")
         res = self.run(A, b, x0, spec=spec)
         self._count("linear_iterations", int(res.iterations))
         if not res.converged:
             raise SolverError(
-                f"linear solve ({spec.method}/{spec.preconditioner}) did not converge: {res.reason}; "
+                f"linear solve ({label}) did not converge: {res.reason}; "
                 f"relative residual {res.relative_residual:.3e} after {res.iterations} iterations")
         return np.asarray(res.x, dtype=float)
+
+    def solve_kept(self, A, b: np.ndarray, x0: np.ndarray | None = None, *, key: Any = "kept",
+                   preconditioner_options: dict | None = None) -> np.ndarray:
+        """Solve ``A x = b`` with the spec's iterative method, ``pcg``'s preconditioner built
+        once for the matrix ``A`` under ``key`` and kept for every later solve with the same
+        matrix object (the step matrix of a fixed ``dt``): the iterative counterpart of
+        :meth:`factorize`. A different matrix under ``key`` is set up afresh and replaces it.
+        Methods without a preconditioner (``cg``, ``jacobi``, ``fmg``) solve as :meth:`solve`.
+
+        Parameters
+        ----------
+        A : sparse matrix
+            Kept by the caller unchanged while it is reused (identity decides reuse).
+        x0 : array, optional
+            Initial guess (warm start).
+        key : hashable
+            Which kept preconditioner (one per distinct matrix of the caller).
+        preconditioner_options : dict, optional
+            Run-time objects added to the spec's (the mesh hierarchy of ``gmg``).
+        """
+        spec = self.spec
+        if spec.method != PRECONDITIONED_METHOD or spec.backend != "femkit":
+            return self.solve(A, b, x0)
+        kept = self._kept_pc.get(key)
+        if kept is None or kept[0] is not A:
+            opts = {**spec.preconditioner_options, **(preconditioner_options or {})}
+            t0 = time.perf_counter()
+            pc = PRECONDITIONERS.get(spec.preconditioner)(A, **opts)
+            self._time("time_preconditioner_setup", time.perf_counter() - t0)
+            self._count("preconditioner_setups")
+            kept = self._kept_pc[key] = (A, pc)
+            checked = {}                           # the first solve checks A's symmetry ...
+        else:
+            checked = {"check_symmetry": False}    # ... which later solves of A need not repeat
+        return self._counted_run(A, b, x0, replace(spec, preconditioner=kept[1],
+                                                   preconditioner_options={},
+                                                   options={**spec.options, **checked}),
+                                 f"pcg/{spec.preconditioner}, kept")
 
     # ------------------------------------------------------------------ kept factors
     def factorize(self, A) -> Factor:

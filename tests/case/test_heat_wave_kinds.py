@@ -243,3 +243,51 @@ def test_p2_heat_converges_at_order_three_and_writes_quadratic_frames(tmp_path):
     frame = meshio.read(tmp_path / "out_P2_0.125" / "frames" / "frame_00001.vtu")
     assert frame.cells[0].type == "triangle6"
     assert frame.point_data["u"].shape == (len(frame.points),)
+
+
+def test_default_step_solver_follows_the_size_rule_and_a_named_one_is_kept(tmp_path, monkeypatch):
+    """Without a named method the steps factorise up to DIRECT_LIMIT unknowns and above it use
+    PCG with one kept AMG hierarchy (here the limit lowered to 0 so a small mesh crosses it);
+    the manufactured solution stays exact to round-off either way."""
+    from femkit.dynamics.mol import system as mol_system
+
+    small = load_case(_write(tmp_path, MANUFACTURED)).run(write=False, quiet=True)
+    assert small.linear["method"] == "direct" and small.linear["factorizations"] == 1
+    monkeypatch.setitem(mol_system.DIRECT_LIMIT, 2, 0)
+    large = load_case(_write(tmp_path, MANUFACTURED)).run(write=False, quiet=True)
+    lin = large.linear   # stiffness ratio ~ 8 dt kappa / (rho_c h^2) ~ 7: IC(0)
+    assert (lin["method"], lin["preconditioner"]) == ("pcg", "ic0")
+    assert lin["factorizations"] == 0 and lin["preconditioner_setups"] == 1   # one matrix
+    assert large.errors["max_over_time"]["max_nodal"] < 1e-9
+    monkeypatch.setattr(mol_system, "IC0_LIMIT", 0.1)   # as if dt were far larger: AMG
+    stiff = load_case(_write(tmp_path, MANUFACTURED)).run(write=False, quiet=True)
+    assert stiff.linear["preconditioner"] == "amg_rs"
+    assert stiff.errors["max_over_time"]["max_nodal"] < 1e-9
+    named = load_case(_write(tmp_path, {**MANUFACTURED, "solver": {"method": "direct"}}))
+    assert named.run(write=False, quiet=True).linear["method"] == "direct"
+
+
+def test_heat_on_the_petsc_backend_equals_femkit_step_by_step(tmp_path):
+    """``solver.backend: petsc`` (one process, every step a PETSc KSP solve, warm-started):
+    the states equal femkit's kept factor's to 1e-8 (the PETSc solve's tolerance 1e-12)."""
+    pytest.importorskip("petsc4py")
+    base = {**MANUFACTURED, "integrator": "implicit_euler", "mesh": {"geometry": "unit_square", "h": 0.1}}
+    ref = load_case(_write(tmp_path, base)).run(write=False, quiet=True)
+    petsc = {**base, "solver": {"method": "pcg", "preconditioner": "jacobi", "backend": "petsc",
+                                "rtol": 1e-12}}
+    r = load_case(_write(tmp_path, petsc, "petsc.yaml")).run(write=False, quiet=True)
+    assert r.linear["method"] == "pcg" and r.linear["factorizations"] == 0
+    for (t, u, _), (s, v, _) in zip(r.march.frames, ref.march.frames):
+        assert t == s and np.abs(u - v).max() < 1e-8 * np.abs(v).max()
+
+
+def test_a_forced_unstable_run_reports_no_norm_for_overflowing_frames(tmp_path):
+    """Explicit Euler forced far above its critical step grows by ~5x a step: frames past
+    1e100 get no error norm (their squares overflow) instead of stopping the run."""
+    data = {**MANUFACTURED, "integrator": "explicit_euler", "dt": 0.05, "t_end": 5.0,
+            "output": {"dir": "out", "frames": 50}}
+    r = load_case(_write(tmp_path, data)).with_options(force=True).run(write=False, quiet=True)
+    hist = r.errors["history"]
+    assert hist[0]["L2"] is not None and hist[0]["L2"] < 1e-12
+    assert any(h["L2"] is None for h in hist)
+    assert all(h["L2"] is None or h["L2"] < 1e100 for h in hist)

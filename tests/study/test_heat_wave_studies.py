@@ -40,3 +40,21 @@ def test_wave_energy_drift(tmp_path):
     cd = [r["drift"] for r in by["central_difference"] if r["stable"]]
     assert 3.0 < cd[-2] / cd[-1] < 5.0  # second order: the drift falls as dt^2
     assert (tmp_path / "r" / "figures" / "energy_drift.png").exists()
+
+
+def test_stiff_heat_study_only_the_implicit_schemes_take_long_steps(tmp_path):
+    """The stiff variant at h = 1/64: explicit Euler's critical
+    step is below every dt given, so each of its runs is unstable, while the implicit schemes
+    are stable at every dt and Crank-Nicolson / BDF2 at the larger dt already meet the error
+    of the smaller one within 2x (the time error is no longer what limits them)."""
+    study = load_study(ROOT / "studies" / "heat_work_precision_stiff.yaml", quick=True,
+                       dt=[0.0003125, 0.000078125], h=[0.015625])
+    recs = study.run(tmp_path / "r", progress=False).records
+    for r in recs:
+        if r["explicit"]:
+            assert r["dt_critical"] < 0.000078125 and not r["stable"], r
+        else:
+            assert r["stable"], r
+    for name in ("crank_nicolson", "bdf2"):
+        big, small = (r["error"] for r in recs if r["integrator"] == name)
+        assert big < 2.0 * small, (name, big, small)

@@ -102,9 +102,11 @@ class TransientResult(RunResult):
                      f"{lin['solves']} solves, {lin['seconds_per_step'] * 1e3:.3g} ms per step")
         if self.errors is not None:
             top, fin = self.errors["max_over_time"], self.errors["final"]
-            lines.append(f"errors    max over time: L2 {top['L2']:.4e}, H1 "
-                         f"{top['H1_semi'] if top['H1_semi'] is None else format(top['H1_semi'], '.4e')}; "
-                         f"at t = {fin['t']:.4g}: L2 {fin['L2']:.4e}")
+
+            def num(v):  # None: no norm (H1 without a gradient, an overflowing unstable frame)
+                return "none" if v is None else format(v, ".4e")
+            lines.append(f"errors    max over time: L2 {num(top['L2'])}, H1 "
+                         f"{num(top['H1_semi'])}; at t = {fin['t']:.4g}: L2 {num(fin['L2'])}")
         e0, e1 = self.energies[0], self.energies[-1]
         key = "total" if "total" in e0 else "thermal"
         lines.append(f"energy    {key} {e0[key]:.6g} -> {e1[key]:.6g}")
@@ -115,12 +117,28 @@ class TransientResult(RunResult):
         return lines
 
 
-def _linear_facts(system, march, spec) -> dict:
+def _linear_facts(system, march) -> dict:
     st = system.stats
-    return {"method": spec.solver.method, "factorizations": int(st["factorizations"]),
+    return {"method": system.solver.method, "preconditioner": system.solver.preconditioner,
+            "factorizations": int(st["factorizations"]),
             "factor_seconds": float(st["factor_seconds"]), "solves": int(st["solves"]),
             "seconds_per_step": float(march.seconds_per_step),
-            "kept_factor": spec.solver.method in ("direct", "cholesky")}
+            "kept_factor": system.solver.method in ("direct", "cholesky"),
+            "preconditioner_setups": int(st.get("preconditioner_setups", 0)),
+            "iterations": int(st.get("linear_iterations", 0))}
+
+
+def _one_petsc_process(problem: str) -> None:
+    """The time-dependent kinds solve their steps on PETSc in one process: ``mpirun -n N``
+    with ``N > 1`` is refused in one line (the distributed path, femkit/fem/distributed,
+    assembles and solves a stationary Poisson problem; it has no mass matrix or time loop)."""
+    from ...errors import InputError
+    from ...solvers.petsc.env import world
+
+    size = world().getSize()
+    if size > 1:
+        raise InputError(f"problem: {problem} with solver.backend petsc runs on one process; "
+                         f"got {size} MPI ranks (the distributed path solves Poisson only)")
 
 
 def run_transient(case, capacity: str, registry, *, second_order: bool,
@@ -137,6 +155,8 @@ def run_transient(case, capacity: str, registry, *, second_order: bool,
     from .setup import build_system, check_step, frame_errors, initial_values
 
     spec = case.spec
+    if spec.solver.backend == "petsc":
+        _one_petsc_process(case.problem)
     if write:
         check_output_dir(output_dir or spec.output.dir, EARLIER_RUN)
     timer = StageTimer()
@@ -163,7 +183,7 @@ def run_transient(case, capacity: str, registry, *, second_order: bool,
     energies = [{"t": float(t), **system.energy(u, v)} for t, u, v in run.frames]
     result = result_type(case=case, mesh=mesh, frames=run.frames, march=run, scheme=scheme,
                          stability=stability, errors=errors, energies=energies,
-                         linear=_linear_facts(system, run, spec), timings=timer.times,
+                         linear=_linear_facts(system, run), timings=timer.times,
                          stopped=stop.name if run.interrupted else None)
     if write:
         with timer("output"):

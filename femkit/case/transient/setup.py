@@ -128,6 +128,7 @@ class TransientSpec:
     solver: Any
     output: TransientOutput
     load_rule: str = "barycentric"
+    solver_default: bool = False  # no method named: the size rule (dynamics.mol.step_solver)
 
 
 def _compile(case, key: str, text, *, check_finite: bool = True):
@@ -179,9 +180,9 @@ def prepare_transient(case, capacity: str, integrators, expressions: tuple = ())
         check_geometry_spec(mesh, "mesh")
     solver = solver_spec(d["solver"], "solver",
                          default_method=KINDS.get(case.problem, "problem").default_solver)
-    if solver.backend != "femkit":
+    if solver.backend not in ("femkit", "petsc"):
         raise CaseFileError(f"solver.backend: {solver.backend!r} is not offered for problem: "
-                            f"{case.problem} yet; valid: femkit")
+                            f"{case.problem}; valid: femkit, petsc")
     if solver.needs_hierarchy:
         raise CaseFileError(f"solver: method {solver.method!r} needs a mesh hierarchy, which the "
                             "time-dependent kinds do not build; use direct, cholesky or pcg")
@@ -228,7 +229,8 @@ def prepare_transient(case, capacity: str, integrators, expressions: tuple = ())
         rtol_t=None if rtol_t is None else float(rtol_t), solver=solver,
         output=TransientOutput(out["dir"], int(out["frames"]), bool(out["vtu"]), bool(out["png"]),
                                bool(out["gif"])),
-        load_rule=d["quadrature"]["load"])
+        load_rule=d["quadrature"]["load"],
+        solver_default=isinstance(d["solver"], dict) and "method" not in d["solver"])
 
 
 # ----------------------------------------------------------------------------- the system
@@ -311,7 +313,7 @@ def build_system(case, mesh, capacity: str):
     """The :class:`femkit.dynamics.mol.LinearSystem` of the case on ``mesh``: ``M`` (consistent
     or lumped, ``capacity`` per cell), ``K`` (``kappa`` per cell), the Dirichlet nodes and the
     time-dependent load and boundary values (evaluated once when they do not use ``t``)."""
-    from ...dynamics.mol import LinearSystem
+    from ...dynamics.mol import LinearSystem, step_solver, stiffness_ratio
     from ...fem import assemble_load, assemble_neumann, assemble_stiffness
     from ...fem.forms import assemble_matrix
     from ...fem.lagrange import element_load, element_neumann
@@ -358,10 +360,15 @@ def build_system(case, mesh, capacity: str):
         return F
 
     uses_t = [fn for fn in [source, *(h for _, h in neumann)] if "t" in fn.used]
+    solver = spec.solver
+    if spec.solver_default:   # the size rule; the step matrix M + b K: b = dt (heat), dt^2 / 4
+        free = np.setdiff1d(np.arange(n), fixed)
+        b = spec.dt if capacity == "rho_c" else spec.dt ** 2 / 4.0
+        solver = step_solver(dim, free.size, solver, stiffness_ratio(M, K, free, b))
     return LinearSystem(M, K, fixed, load=load if has_load else None,
                         boundary=boundary if groups else None, load_constant=not uses_t,
                         boundary_constant=not any("t" in fn.used for _, fn in groups),
-                        lumped=lumped, solver=spec.solver)
+                        lumped=lumped, solver=solver)
 
 
 def initial_values(case, mesh, key: str) -> np.ndarray:
@@ -398,9 +405,14 @@ def check_step(case, system, scheme) -> dict:
     return {"dt_critical": float(dt_crit), "lambda_max": float(lam)}
 
 
+#: Nodal values this large (an unstable run forced past its critical step) get no error norms:
+#: their squares overflow. The frame's norms are None.
+OVERFLOW = 1e100
+
+
 def frame_errors(case, mesh, frames) -> dict | None:
     """L2 and H1-seminorm errors against ``exact`` at every frame time, and their maxima over
-    time (None without ``exact``)."""
+    time (None without ``exact``; None at a frame whose values reach :data:`OVERFLOW`)."""
     from ...fem import error_norms
     from ..expressions import Gradient
 
@@ -410,6 +422,9 @@ def frame_errors(case, mesh, frames) -> dict | None:
     parts = [case.functions[f"exact.grad[{i}]"] for i in range(3) if f"exact.grad[{i}]" in case.functions]
     history = []
     for t, u, _ in frames:
+        if not np.abs(u).max(initial=0.0) < OVERFLOW:  # an unstable run (--force): no norm
+            history.append({"t": float(t), "L2": None, "H1_semi": None, "max_nodal": None})
+            continue
         grad = None
         if parts:
             grad = Gradient([_Frozen(p, t, mesh.dim) for p in parts])
@@ -445,7 +460,8 @@ def plan_transient(case, *, measure: bool = True):
     """The plan of a heat or wave case: the mesh and assembly stages of the Poisson model on
     the same mesh (:func:`femkit.case.poisson.cost.plan_poisson_case`), its solve priced as
     the one factorisation, then ``steps`` steps of one SpMV and one pair of triangular solves
-    each (about a tenth of a factorisation at these sizes), and the frames written."""
+    each (about a tenth of a factorisation at these sizes; an explicit scheme on a lumped mass:
+    no factorisation, one SpMV per step), and the frames written."""
     from types import SimpleNamespace
 
     from ...cost import Plan, Stage
@@ -465,11 +481,13 @@ def plan_transient(case, *, measure: bool = True):
     steps = spec.steps
     frames = min(steps, spec.output.frames) + 1
     per_step = 0.1 * solve + 2e-8 * nnz
+    if spec.mass == "lumped" and spec.integrator[0] in ("explicit_euler", "central_difference"):
+        solve, per_step = 0.0, 2e-8 * nnz   # no matrix to factorise: an SpMV and a division
     frame_bytes = 16.0 * points + 200.0
     stages = keep + [
         Stage("factor", solve, peak, 0.0,
               f"{spec.solver.method}: one factor kept" if spec.solver.method in ("direct", "cholesky")
-              else f"{spec.solver.method}: one solve's setup, warm-started solves per step"),
+              else f"{spec.solver.method}: one preconditioner kept, warm-started solves per step"),
         Stage("steps", steps * per_step, peak + frames * 8.0 * points, 0.0,
               f"{steps:,} steps of {spec.integrator[0]}"),
         Stage("output", frames * frame_bytes / 2e7, frame_bytes, frames * frame_bytes,

@@ -13,12 +13,15 @@ from .base import HeatScheme, MolState, WaveScheme
 from .march import MarchResult, march, march_adaptive
 from .registry import HEAT_INTEGRATORS, WAVE_INTEGRATORS, get_scheme
 from .stability import critical_step, largest_eigenvalue
-from .system import KEPT_FACTOR_METHODS, LinearSystem
+from .system import (DIRECT_LIMIT, IC0_LIMIT, KEPT_FACTOR_METHODS, LinearSystem, step_solver,
+                     stiffness_ratio)
 from . import (  # noqa: F401  (registration side effects)
     explicit_euler, theta, bdf2, newmark, central_difference, variational_symplectic,
     implicit_euler_wave,
 )
 
 __all__ = ["HEAT_INTEGRATORS", "WAVE_INTEGRATORS", "get_scheme", "HeatScheme", "WaveScheme",
-           "MolState", "LinearSystem", "KEPT_FACTOR_METHODS", "critical_step",
+           "MolState", "LinearSystem", "KEPT_FACTOR_METHODS", "DIRECT_LIMIT", "IC0_LIMIT", "step_solver",
+           "stiffness_ratio",
+           "critical_step",
            "largest_eigenvalue", "march", "march_adaptive", "MarchResult"]

@@ -5,11 +5,16 @@ Dirichlet nodes ``fixed`` held at ``g(t)``. A scheme forms its full-size right-h
 and a matrix ``A = a M + b K``; :meth:`LinearSystem.solve` solves the free rows
 ``A_ff x_f = r_f - A_fb g`` with the boundary values ``g`` in place (so time-dependent
 Dirichlet data enter every scheme the way its own discretisation of ``M u'`` says, with no
-separate ``g'``). Each distinct ``A`` is factorised once and kept for the whole run
-(:func:`femkit.solvers.kept_factor.factorize_kept`; SuperLU in symmetric mode, or the sparse
-Cholesky engines) when the linear solver is ``direct`` or ``cholesky``; any other solver
-(``pcg`` with a preconditioner, ``cg``) solves each step warm-started from the previous step's
-solution. A lumped (diagonal) ``M`` alone is inverted by a division.
+separate ``g'``). All solves go through one :class:`~femkit.solvers.session.LinearSession`
+(its counters are the system's ``stats``). Each distinct ``A`` is factorised once and kept for
+the whole run (:meth:`LinearSession.factorize`; SuperLU in symmetric mode, or the sparse
+Cholesky engines) when the linear solver is ``direct`` or ``cholesky``; with an iterative solver
+its preconditioner (AMG hierarchy, IC(0) factor) is built once and kept the same way
+(:meth:`LinearSession.solve_kept`, ``stats["preconditioner_setups"]``), and each step's solve
+starts from the linear extrapolation ``2 x_n - x_{n-1}`` of that matrix's last two solutions. A
+new ``dt`` (adaptive steps) is a new ``A``: factorised or set up afresh. Another backend
+(``petsc``: :data:`femkit.solvers.registry.BACKENDS`, one process) solves every step by its own
+KSP, warm-started, nothing kept. A lumped (diagonal) ``M`` alone is inverted by a division.
 """
 
 from __future__ import annotations
@@ -24,38 +29,93 @@ import scipy.sparse as sp
 from ...errors import InputError
 from ...solvers.spec import SolverSpec
 
-__all__ = ["LinearSystem", "ConstrainedOperator", "KEPT_FACTOR_METHODS"]
+__all__ = ["LinearSystem", "ConstrainedOperator", "KEPT_FACTOR_METHODS", "DIRECT_LIMIT",
+           "IC0_LIMIT", "step_solver", "stiffness_ratio"]
 
 #: Solver methods whose factor is kept across steps; any other is an iterative solve per step.
 KEPT_FACTOR_METHODS = frozenset({"direct", "cholesky"})
+
+#: The most free unknowns, by dimension, for which the default step solver is a kept SuperLU
+#: factor; above it, PCG with a kept IC(0) or AMG preconditioner (:data:`IC0_LIMIT`), warm-started. Measured with
+#: ``benchmarks/bench_heat.py --solvers`` (docs/heat_wave.md: figures and why).
+DIRECT_LIMIT = {2: 100_000, 3: 30_000}
+
+#: The preconditioner of the large systems by the stiffness of the step matrix ``a M + b K``,
+#: ``r = b median(K_ii / M_ii)`` (about ``8 dt / h^2`` for a heat step on a P1 triangle grid):
+#: IC(0) up to :data:`IC0_LIMIT` (its iterations grow as ``sqrt(r)``: 3 at ``r ~ 3``, 11 at
+#: ``r = 200``, 58 at ``r = 2000``; cheap per iteration), Ruge-Stueben AMG above (3-5 iterations
+#: whatever ``r``, each about 4 IC(0) iterations' cost in 2D and 20 in 3D).
+IC0_LIMIT = 1000.0
+
+
+def step_solver(dim: int, n_free: int, spec: SolverSpec | None = None,
+                stiffness: float = 0.0) -> SolverSpec:
+    """The default linear solver of the implicit steps of a system of ``n_free`` unknowns on a
+    ``dim``-dimensional mesh whose step matrix has stiffness ratio ``stiffness``
+    (:data:`IC0_LIMIT`): ``spec`` (default ``direct``) up to :data:`DIRECT_LIMIT`, else
+    ``spec`` turned into PCG with a kept IC(0) (reverse Cuthill-McKee ordered;
+    ``stiffness <= IC0_LIMIT``) or Ruge-Stueben AMG preconditioner, its tolerances kept.
+
+    >>> step_solver(2, 50_000).method, step_solver(3, 200_000, stiffness=5.0).preconditioner
+    ('direct', 'ic0')
+    >>> step_solver(2, 250_000, stiffness=2000.0).preconditioner
+    'amg_rs'
+    """
+    spec = SolverSpec("direct") if spec is None else spec
+    if n_free <= DIRECT_LIMIT.get(dim, DIRECT_LIMIT[3]):
+        return spec
+    if stiffness <= IC0_LIMIT:   # RCM: 19 iterations instead of 28 on a refined gmsh mesh
+        return spec.replace(method="pcg", preconditioner="ic0",
+                            preconditioner_options={"ordering": "rcm"})
+    return spec.replace(method="pcg", preconditioner="amg_rs", preconditioner_options={})
+
+
+def stiffness_ratio(M, K, free: np.ndarray, b: float) -> float:
+    """``b median(K_ii / M_ii)`` over the free rows: how far ``M + b K`` is from the mass
+    matrix (:data:`IC0_LIMIT`)."""
+    m = np.asarray(M.diagonal())[free]
+    k = np.asarray(K.diagonal())[free]
+    ok = m > 0
+    return float(b * np.median(k[ok] / m[ok])) if ok.any() else float("inf")
 
 
 @dataclass
 class ConstrainedOperator:
     """``A = a M + b K`` restricted to the free rows: the kept factor of ``A_ff`` (or its
-    diagonal, or the solver spec for iterative solves) and the coupling ``A_fb``."""
+    diagonal, or the session whose kept preconditioner solves it) and the coupling ``A_fb``."""
 
     A_ff: sp.csr_matrix
     A_fb: sp.csr_matrix
     factor: object = None
     diagonal: np.ndarray | None = None
-    spec: SolverSpec | None = None
-    last: np.ndarray | None = None
+    session: object = None
+    key: object = None
+    keep_preconditioner: bool = True
+    history: list = field(default_factory=list)
+
+    def initial_guess(self) -> np.ndarray | None:
+        """The warm start: ``2 x_n - x_{n-1}`` of the last two solutions, the last one alone
+        after one solve, none before."""
+        if len(self.history) == 2:
+            return 2.0 * self.history[1] - self.history[0]
+        return self.history[-1] if self.history else None
 
     def solve_free(self, rhs: np.ndarray) -> np.ndarray:
         """``A_ff^-1 rhs``: a division, the kept factor's substitutions, or a warm-started
-        iterative solve (a failed one raises :class:`~femkit.errors.SolverError`)."""
+        iterative solve with the kept preconditioner (rebuilt every solve when
+        ``keep_preconditioner`` is false: the comparison path); a failed one raises
+        :class:`~femkit.errors.SolverError`."""
         if self.diagonal is not None:
             return rhs / self.diagonal
         if self.factor is not None:
             return self.factor.solve(rhs)
-        from ...errors import SolverError
-
-        res = self.spec.solve(self.A_ff, rhs, x0=self.last)
-        if not res.converged:
-            raise SolverError(f"linear solve of a time step: {res.message}")
-        self.last = res.x
-        return res.x
+        x0 = self.initial_guess()
+        if self.keep_preconditioner:
+            x = self.session.solve_kept(self.A_ff, rhs, x0, key=self.key)
+        else:
+            x = self.session.solve(self.A_ff, rhs, x0)
+        self.history = (self.history + [x])[-2:]
+        return x
 
 
 @dataclass
@@ -80,6 +140,9 @@ class LinearSystem:
         ``M`` is diagonal.
     solver : SolverSpec
         Linear solver of the implicit steps (``direct``: one kept factor per matrix).
+    keep_preconditioner : bool
+        Iterative solvers keep one preconditioner per matrix (default); false rebuilds it
+        every solve (the comparison path of the tests and the benchmark).
     """
 
     M: sp.csr_matrix
@@ -91,6 +154,7 @@ class LinearSystem:
     boundary_constant: bool = True
     lumped: bool = False
     solver: SolverSpec = field(default_factory=lambda: SolverSpec("direct"))
+    keep_preconditioner: bool = True
     stats: dict = field(default_factory=dict)
     _ops: dict = field(default_factory=dict, repr=False)
     _cache: dict = field(default_factory=dict, repr=False)
@@ -111,6 +175,7 @@ class LinearSystem:
         self.stats.setdefault("factorizations", 0)
         self.stats.setdefault("solves", 0)
         self.stats.setdefault("factor_seconds", 0.0)
+        self.session = self.solver.session(stats=self.stats)
 
     # ------------------------------------------------------------------ data
     def F(self, t: float) -> np.ndarray:
@@ -151,15 +216,13 @@ class LinearSystem:
         op = ConstrainedOperator(A_ff, A_fb)
         if b == 0.0 and self.lumped:
             op.diagonal = A_ff.diagonal()
-        elif self.solver.method in KEPT_FACTOR_METHODS:
-            from ...solvers.kept_factor import factorize_kept
-
+        elif self.solver.method in KEPT_FACTOR_METHODS and self.solver.backend == "femkit":
             t0 = time.perf_counter()
-            op.factor = factorize_kept(A_ff, method=self.solver.method)
-            self.stats["factorizations"] += 1
+            op.factor = self.session.factorize(A_ff)
             self.stats["factor_seconds"] += time.perf_counter() - t0
         else:
-            op.spec = self.solver
+            op.session, op.key = self.session, key
+            op.keep_preconditioner = self.keep_preconditioner
         self._ops[key] = op
         return op
 

