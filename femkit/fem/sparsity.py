@@ -44,6 +44,8 @@ register_kernels("P1 assembly", "femkit.fem._kernels", "_incidences", "_pattern"
 # the element-generic assembly's (femkit.fem.forms, not imported by the P1 pipeline; its kernels are
 # declared with the stack's pattern so that the warm-up, which compiles them, knows them)
 register_kernels("P1 assembly", "femkit.fem._kernels", "_scatter", "_element_stiffness", rank=1)
+register_kernels("P1 assembly", "femkit.fem._element_kernels", "_element_pattern", "_quadrature_coordinates",
+                 "_element_load", rank=1)
 
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 _ELEMENT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -207,7 +209,13 @@ def pattern_for(mesh, dofs, block: int = 1) -> SparsityPattern:
     key = (dofs.element.name, int(block))
     pat = per_mesh.get(key)
     if pat is None:
-        pat = per_mesh[key] = SparsityPattern.from_cells(dofs.cells, dofs.n_dofs, block=block)
+        if block == 1 and len(dofs.cells) >= NUMBA_THRESHOLD:  # row by row from the dof map
+            from ._element_kernels import element_pattern_kernel
+
+            pat = SparsityPattern._from_arrays(dofs.n_dofs, *element_pattern_kernel(dofs.cells, dofs.n_dofs))
+        else:
+            pat = SparsityPattern.from_cells(dofs.cells, dofs.n_dofs, block=block)
+        per_mesh[key] = pat
     return pat
 
 
