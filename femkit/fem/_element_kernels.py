@@ -1,5 +1,5 @@
 """Compiled (numba) passes of the element-generic assembly (P2 and any dof map): the CSR pattern
-built row by row from the dof map, the quadrature points of a load and the load itself. Serial,
+built row by row from the dof map, the stiffness, the quadrature points of a load and the load. Serial,
 cached on disk (``cache=True``), imported only when a large mesh asks for them
 (:data:`femkit.fem.sparsity.NUMBA_THRESHOLD`).
 
@@ -7,8 +7,9 @@ The pattern pass (:func:`_element_pattern`) differs from the P1 builder
 (:func:`femkit.fem._kernels._pattern_cells`) in what an incidence carries: the P1 builder copies
 every cell's ``w`` vertices into each of its ``w`` incidences ((w m, w) entries, written at
 random, read twice); here an incidence is only ``w e + a`` (cell ``e``, local dof ``a``) and the
-cell's dofs are read from the dof map when its row is built and the slots written (a fifth of
-the memory traffic for P2's 6 or 10 dofs per cell). The same rows and slots, entry for entry.
+cell's dofs are read from the dof map when its row is built and the slots written (``w m``
+incidence entries instead of ``w^2 m``: P2 has 6 or 10 dofs per cell). The same rows and slots,
+entry for entry (tests/fem/test_p2_compiled_passes.py).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ._kernels import _insert_sorted, _vertex_starts
+from ._kernels import _element_scale, _insert_sorted, _vertex_starts
 from .cells.kernels import _tetrahedron, _triangle
 
 
@@ -145,5 +146,68 @@ def warm_up() -> None:
         w = elem.n_dofs
         cells = np.arange(w, dtype=np.int64)[None, :]   # one cell; only its vertices are read as points
         element_pattern_kernel(cells, w)
+        _element_stiffness(cells, pts, np.ones(1), True, np.ones(((nv * (nv + 1)) // 2, w * w)),
+                           np.arange(w * w, dtype=np.int32).reshape(1, -1), w * w)
         quadrature_coordinates(cells, pts, np.full((1, nv), 1.0 / nv))
         element_load_kernel(cells, pts, np.ones((1, 1)), np.ones((1, w)), w)
+
+
+@numba.njit(cache=True)
+def _element_stiffness(cells, points, kappa, scalar_kappa, table, slots, nnz):  # pragma: no cover - compiled
+    """Stiffness of an element other than P1 on affine cells into CSR data: per cell the P1
+    products ``k1_ab`` (symmetric: the ``a <= b`` ones, ``table`` row ``p`` for pair ``p`` holding
+    ``S_ab + S_ba``, or ``S_aa``), then ``local += k1_ab table[p]`` row by row (independent sums
+    over the ``w^2`` entries, which the compiler vectorises; the P1 kernel's order,
+    :func:`femkit.fem._kernels._element_stiffness`, sums each entry's products in one chain), then
+    scattered through ``slots``. Returns (data, number of degenerate cells)."""
+    m = cells.shape[0]
+    nv = 3 if points.shape[1] == 2 else 4
+    n2 = table.shape[1]
+    data = np.zeros(nnz)
+    g = np.zeros((4, 3))
+    local = np.empty(n2)
+    bad = 0
+    for e in range(m):
+        if nv == 3:
+            _, _, _, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(cells, points, e)
+            ok, s = _element_scale(area, 4.0, kappa, scalar_kappa, e)
+            g[0, 0], g[0, 1], g[1, 0], g[1, 1], g[2, 0], g[2, 1] = ex0, ey0, ex1, ey1, ex2, ey2
+        else:
+            vol6 = abs(_tetrahedron(cells, points, e, g))
+            ok, s = _element_scale(vol6, 6.0, kappa, scalar_kappa, e)
+        if not ok:
+            bad += 1
+            continue
+        for j in range(n2):
+            local[j] = 0.0
+        p = 0
+        for a in range(nv):
+            for b in range(a, nv):
+                k = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
+                for j in range(n2):
+                    local[j] += k * table[p, j]
+                p += 1
+        for j in range(n2):
+            data[slots[e, j]] += local[j]
+    return data, bad
+
+
+def symmetric_table(table: np.ndarray, nv: int) -> np.ndarray:
+    """The reference tensor ``table`` ((nv^2, n^2), row ``nv a + b``) folded for the symmetric
+    P1 products: row ``p`` of pair ``a <= b`` is ``S_ab + S_ba`` (``S_aa`` on the diagonal)."""
+    T = np.asarray(table, dtype=np.float64).reshape(nv, nv, -1)
+    rows = [T[a, a] if a == b else T[a, b] + T[b, a] for a in range(nv) for b in range(a, nv)]
+    return np.ascontiguousarray(np.array(rows))
+
+
+def element_stiffness_kernel(mesh, kappa, table: np.ndarray, pattern):
+    """CSR data of the stiffness of every cell of ``mesh`` for the reference tensor ``table``
+    ((d+1)^2, n^2) into ``pattern``, or None if a cell is degenerate (the caller's numpy path
+    then names it). ``kappa``: a float or one per cell."""
+    from ._kernels import _values
+
+    nv = mesh.dim + 1
+    data, bad = _element_stiffness(np.ascontiguousarray(mesh.cells, dtype=np.int64),
+                                   np.ascontiguousarray(mesh.points, dtype=np.float64),
+                                   *_values(kappa), symmetric_table(table, nv), pattern.slots, pattern.nnz)
+    return None if bad else data

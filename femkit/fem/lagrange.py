@@ -35,7 +35,7 @@ from ._elements import cell_measures, simplex_gradients
 from .coefficients import evaluate_callable
 from .dofs import DofMap, dof_map
 from .quadrature import blocks, get_rule, rule_for_degree
-from .sparsity import NUMBA_THRESHOLD
+from . import sparsity
 
 __all__ = ["element_load", "element_neumann", "boundary_dofs", "dof_weights", "element_error_norms",
            "element_energy_error", "evaluate"]
@@ -69,7 +69,7 @@ def element_load(mesh, f, element="P2", *, rule: str | None = None) -> np.ndarra
     dofs = dof_map(mesh, elem)
     quad = get_rule(rule, mesh.dim) if rule else load_rule(elem)
     phi = elem.basis(quad.points)                                    # (q, n)
-    if callable(f) and mesh.n_cells >= NUMBA_THRESHOLD:
+    if callable(f) and mesh.n_cells >= sparsity.NUMBA_THRESHOLD:  # the assembly's threshold
         F = _load_compiled(mesh, dofs, f, quad, phi)
         if F is not None:
             return F

@@ -25,7 +25,6 @@ def _source(dim):
 @pytest.fixture
 def compiled(monkeypatch):
     monkeypatch.setattr(sparsity, "NUMBA_THRESHOLD", 0)
-    monkeypatch.setattr(lagrange, "NUMBA_THRESHOLD", 0)
 
 
 @pytest.mark.parametrize("mesh", [structured_mesh(5, 4), structured_box(2, 3, 2)], ids=["tri", "tet"])
@@ -41,7 +40,6 @@ def test_p2_compiled_pattern_stiffness_and_load_equal_the_numpy_paths(mesh, comp
     assert np.array_equal(pat.slots, ref.slots)
     other = Mesh(mesh.points.copy(), mesh.cells.copy())   # a new mesh: nothing cached
     monkeypatch.setattr(sparsity, "NUMBA_THRESHOLD", 10 ** 9)
-    monkeypatch.setattr(lagrange, "NUMBA_THRESHOLD", 10 ** 9)
     K_np = forms.assemble_matrix(other, "stiffness", kappa, element="P2")
     F_np = lagrange.element_load(other, _source(mesh.dim), "P2")
     assert abs(K - K_np).max() <= 1e-13 * abs(K_np).max()
