@@ -57,7 +57,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_pipeline import _stages, measure  # noqa: E402
+from bench_pipeline import SAVE_MESH, _stages, measure  # noqa: E402
 
 PI = np.pi
 RTOLS = [10.0 ** -k for k in range(1, 13)]
@@ -83,13 +83,6 @@ SOLVERS = {
     "fmg": "{method: fmg, rtol: 1.0e-10}",
     "pcg_gmg": "{method: pcg, preconditioner: gmg, rtol: 1.0e-10}",
 }
-
-SAVE_MESH = """
-import numpy as np
-from femkit.mesh import generate, refine
-m = refine(generate("unit_square", {h}), {k})
-np.savez({path!r}, points=m.points, triangles=m.triangles)
-"""
 
 PEER = r"""
 import time

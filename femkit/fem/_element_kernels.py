@@ -17,7 +17,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ._kernels import _element_scale, _insert_sorted, _vertex_starts
+from ._kernels import _cell_gradients, _insert_sorted, _vertex_starts
 from .cells.kernels import _tetrahedron, _triangle
 
 
@@ -168,13 +168,7 @@ def _element_stiffness(cells, points, kappa, scalar_kappa, table, slots, nnz):  
     local = np.empty(n2)
     bad = 0
     for e in range(m):
-        if nv == 3:
-            _, _, _, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(cells, points, e)
-            ok, s = _element_scale(area, 4.0, kappa, scalar_kappa, e)
-            g[0, 0], g[0, 1], g[1, 0], g[1, 1], g[2, 0], g[2, 1] = ex0, ey0, ex1, ey1, ex2, ey2
-        else:
-            vol6 = abs(_tetrahedron(cells, points, e, g))
-            ok, s = _element_scale(vol6, 6.0, kappa, scalar_kappa, e)
+        ok, s = _cell_gradients(cells, points, e, nv, kappa, scalar_kappa, g)
         if not ok:
             bad += 1
             continue
