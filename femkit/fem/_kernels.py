@@ -373,6 +373,9 @@ def warm_up() -> None:
     for cells, pts, slots, nnz_ in ((tri, pts, slots, nnz), (tet, p3, slots3, nnz3)):
         w = cells.shape[1]
         _element_stiffness(cells, pts, np.ones(1), True, np.ones((w * w, w * w)), slots, nnz_)
+    from ._element_kernels import warm_up as element_kernels
+
+    element_kernels()  # P2's pattern, stiffness and load passes
 
 
 @numba.njit(cache=True)
@@ -457,6 +460,19 @@ def scatter_kernel(data: np.ndarray, slots: np.ndarray, rows: np.ndarray, local:
              np.ascontiguousarray(local, dtype=np.float64))
 
 
+@numba.njit(cache=True, inline="always")
+def _cell_gradients(cells, points, e, nv, kappa, scalar_kappa, g):  # pragma: no cover - compiled
+    """The scaled barycentric gradients of cell ``e`` (``nv`` = 3: a triangle, 4: a tetrahedron)
+    into ``g`` and ``(ok, scale)`` of :func:`_element_scale`: ``k1_ab = scale g_a . g_b`` is the
+    P1 stiffness ``kappa |T| grad lambda_a . grad lambda_b``."""
+    if nv == 3:
+        _, _, _, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(cells, points, e)
+        g[0, 0], g[0, 1], g[1, 0], g[1, 1], g[2, 0], g[2, 1] = ex0, ey0, ex1, ey1, ex2, ey2
+        return _element_scale(area, 4.0, kappa, scalar_kappa, e)
+    vol6 = abs(_tetrahedron(cells, points, e, g))
+    return _element_scale(vol6, 6.0, kappa, scalar_kappa, e)
+
+
 @numba.njit(cache=True)
 def _element_stiffness(cells, points, kappa, scalar_kappa, table, slots, nnz):  # pragma: no cover - compiled
     """Stiffness of any Lagrange element on affine cells, summed into CSR data in one pass:
@@ -471,13 +487,7 @@ def _element_stiffness(cells, points, kappa, scalar_kappa, table, slots, nnz):  
     k1 = np.empty(nv * nv)
     bad = 0
     for e in range(m):
-        if nv == 3:
-            _, _, _, ex0, ey0, ex1, ey1, ex2, ey2, area = _triangle(cells, points, e)
-            ok, s = _element_scale(area, 4.0, kappa, scalar_kappa, e)
-            g[0, 0], g[0, 1], g[1, 0], g[1, 1], g[2, 0], g[2, 1] = ex0, ey0, ex1, ey1, ex2, ey2
-        else:
-            vol6 = abs(_tetrahedron(cells, points, e, g))
-            ok, s = _element_scale(vol6, 6.0, kappa, scalar_kappa, e)
+        ok, s = _cell_gradients(cells, points, e, nv, kappa, scalar_kappa, g)
         if not ok:
             bad += 1
             continue

@@ -143,6 +143,8 @@ def assemble_matrix(mesh, form: str, coefficient=1.0, *, element="P1", elements=
 
     if form == "stiffness" and idx is None:  # one compiled pass: geometry, local matrix, scatter
         n = elem.n_dofs
+        if elem.name != "P1":  # the symmetric products, vectorised (P1 keeps its kernel's bits)
+            from ._element_kernels import element_stiffness_kernel
         data = element_stiffness_kernel(mesh, scale, reference_stiffness(elem).reshape(-1, n * n), pattern)
         if data is not None:
             return pattern.matrix(data)

@@ -35,6 +35,7 @@ from ._elements import cell_measures, simplex_gradients
 from .coefficients import evaluate_callable
 from .dofs import DofMap, dof_map
 from .quadrature import blocks, get_rule, rule_for_degree
+from . import sparsity
 
 __all__ = ["element_load", "element_neumann", "boundary_dofs", "dof_weights", "element_error_norms",
            "element_energy_error", "evaluate"]
@@ -68,6 +69,10 @@ def element_load(mesh, f, element="P2", *, rule: str | None = None) -> np.ndarra
     dofs = dof_map(mesh, elem)
     quad = get_rule(rule, mesh.dim) if rule else load_rule(elem)
     phi = elem.basis(quad.points)                                    # (q, n)
+    if callable(f) and mesh.n_cells >= sparsity.NUMBA_THRESHOLD:  # the assembly's threshold
+        F = _load_compiled(mesh, dofs, f, quad, phi)
+        if F is not None:
+            return F
     vol, cells = cell_measures(mesh, None)
     if not callable(f):
         from .load import _scalar
@@ -79,6 +84,22 @@ def element_load(mesh, f, element="P2", *, rule: str | None = None) -> np.ndarra
         fq = _source_values(mesh, f, quad, cells, None)              # (m, q)
         local = ((fq * quad.weights) @ phi) * vol[:, None]
     return np.bincount(dofs.cells.ravel(), weights=local.ravel(), minlength=dofs.n_dofs)
+
+
+def _load_compiled(mesh, dofs: DofMap, f, quad, phi: np.ndarray) -> np.ndarray | None:
+    """:func:`element_load` of a callable ``f`` by the compiled passes
+    (:mod:`femkit.fem._element_kernels`: the points' coordinates, then measures, products and sums
+    in one pass over the cells); None when ``f`` is not finite somewhere or a cell is degenerate
+    (the NumPy path then raises naming them)."""
+    from ._element_kernels import element_load_kernel, quadrature_coordinates
+    from .fused import source_values
+
+    fq = source_values(mesh, f, quad)
+    if fq is None:
+        fq = evaluate_callable(f, *quadrature_coordinates(dofs.cells, mesh.points, quad.points), name="f")
+    if not np.isfinite(fq).all():
+        return None
+    return element_load_kernel(dofs.cells, mesh.points, fq, quad.weights[:, None] * phi, dofs.n_dofs)
 
 
 def _facet_dofs(mesh, dofs: DofMap, facets: np.ndarray) -> np.ndarray:

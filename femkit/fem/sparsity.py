@@ -12,7 +12,9 @@ threshold on).
 - Any dofs per cell and any block size: :meth:`SparsityPattern.from_cells` with a dof map's
   cells (P2: 6 or 10 per cell, :mod:`femkit.fem.dofs`) and ``block=b`` for vector fields (dof
   ``b i + c`` is component ``c`` of node ``i``, node-major; local entries ordered the same way,
-  so ``w = b * dofs per cell``); :func:`pattern_for` caches one per mesh, element and block.
+  so ``w = b * dofs per cell``); :func:`pattern_for` caches one per mesh, element and block
+  (one component on a large mesh: built row by row from the dof map,
+  :func:`femkit.fem._element_kernels.element_pattern_kernel`).
 
 >>> import numpy as np
 >>> from femkit.mesh import Mesh
@@ -44,6 +46,8 @@ register_kernels("P1 assembly", "femkit.fem._kernels", "_incidences", "_pattern"
 # the element-generic assembly's (femkit.fem.forms, not imported by the P1 pipeline; its kernels are
 # declared with the stack's pattern so that the warm-up, which compiles them, knows them)
 register_kernels("P1 assembly", "femkit.fem._kernels", "_scatter", "_element_stiffness", rank=1)
+register_kernels("P1 assembly", "femkit.fem._element_kernels", "_element_pattern", "_element_stiffness",
+                 "_quadrature_coordinates", "_element_load", rank=1)
 
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 _ELEMENT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -207,7 +211,13 @@ def pattern_for(mesh, dofs, block: int = 1) -> SparsityPattern:
     key = (dofs.element.name, int(block))
     pat = per_mesh.get(key)
     if pat is None:
-        pat = per_mesh[key] = SparsityPattern.from_cells(dofs.cells, dofs.n_dofs, block=block)
+        if block == 1 and len(dofs.cells) >= NUMBA_THRESHOLD:  # row by row from the dof map
+            from ._element_kernels import element_pattern_kernel
+
+            pat = SparsityPattern._from_arrays(dofs.n_dofs, *element_pattern_kernel(dofs.cells, dofs.n_dofs))
+        else:
+            pat = SparsityPattern.from_cells(dofs.cells, dofs.n_dofs, block=block)
+        per_mesh[key] = pat
     return pat
 
 
