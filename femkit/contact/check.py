@@ -17,17 +17,15 @@ import numpy as np
 __all__ = ["intersecting_pairs", "segment_crosses_triangle"]
 
 
-def _candidate_pairs(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """Pairs ``(i, j)``, ``i < j``, of boxes ``[lo, hi]`` that overlap, by a uniform grid whose
-    cell is the largest box extent (so a box touches at most 2^d cells)."""
+def _grid_pairs(lo: np.ndarray, hi: np.ndarray, cell: float) -> np.ndarray:
+    """Pairs ``(i, j)``, ``i < j``, of boxes no wider than ``cell`` that share a grid cell
+    (each box touches at most 2^d cells)."""
     k, d = lo.shape
-    if k < 2:
-        return np.zeros((0, 2), np.int64)
-    cell = float(np.max(hi - lo)) or 1.0
-    c0 = np.floor((lo - lo.min(axis=0)) / cell).astype(np.int64)
-    c1 = np.floor((hi - lo.min(axis=0)) / cell).astype(np.int64)
+    origin = lo.min(axis=0) if k else np.zeros(d)
+    c0 = np.floor((lo - origin) / cell).astype(np.int64)
+    c1 = np.floor((hi - origin) / cell).astype(np.int64)
+    span = (c1.max(axis=0) if k else np.zeros(d, np.int64)) + 2
     owners, keys = [], []
-    span = c1.max(axis=0) + 2
     for offset in np.ndindex(*(2,) * d):
         c = c0 + np.array(offset)
         inside = np.all(c <= c1, axis=1)
@@ -38,15 +36,34 @@ def _candidate_pairs(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     owners, keys = owners[order], keys[order]
     starts = np.flatnonzero(np.r_[True, keys[1:] != keys[:-1]])
     sizes = np.diff(np.r_[starts, len(keys)])
-    pairs = []
-    for s, n in zip(starts[sizes > 1], sizes[sizes > 1]):
-        members = owners[s:s + n]
+    pairs = [np.zeros((0, 2), np.int64)]
+    for n in np.unique(sizes[sizes > 1]):   # cells of equal occupancy together
+        groups = owners[starts[sizes == n][:, None] + np.arange(n)]
         i, j = np.triu_indices(n, 1)
-        pairs.append(np.stack([members[i], members[j]], axis=1))
-    if not pairs:
+        pairs.append(np.stack([groups[:, i].ravel(), groups[:, j].ravel()], axis=1))
+    return np.concatenate(pairs)
+
+
+def _candidate_pairs(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Pairs ``(i, j)``, ``i < j``, of boxes ``[lo, hi]`` that overlap: a uniform grid of twice
+    the median box width for the boxes that fit in a cell, each wider box (a large obstacle
+    facet) against all."""
+    k, d = lo.shape
+    if k < 2:
         return np.zeros((0, 2), np.int64)
+    width = np.max(hi - lo, axis=1)
+    cell = 2.0 * float(np.median(width)) or float(width.max()) or 1.0
+    small = np.flatnonzero(width <= cell)
+    pairs = [small[_grid_pairs(lo[small], hi[small], cell)]]
+    for i in np.flatnonzero(width > cell):
+        j = np.flatnonzero(np.all((lo <= hi[i]) & (lo[i] <= hi), axis=1))
+        j = j[j != i]
+        pairs.append(np.stack([np.full(len(j), i), j], axis=1))
     p = np.sort(np.concatenate(pairs), axis=1)
-    p = np.unique(p, axis=0)
+    if not len(p):
+        return p
+    key = np.unique(p[:, 0] * np.int64(k) + p[:, 1])
+    p = np.stack([key // k, key % k], axis=1)
     overlap = np.all((lo[p[:, 0]] <= hi[p[:, 1]]) & (lo[p[:, 1]] <= hi[p[:, 0]]), axis=1)
     return p[overlap]
 
