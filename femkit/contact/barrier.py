@@ -39,6 +39,10 @@ __all__ = ["BarrierModel", "require_ipctk", "DHAT_SCALE", "REPORT_SCALE"]
 DHAT_SCALE = 1e-3
 #: Minimum distances are reported up to this many ``dhat`` (farther: ``None``).
 REPORT_SCALE = 10.0
+#: Tight-Inclusion CCD's iteration cap per primitive pair (ipctk's default, 1e7, let one nearly
+#: parallel face pair at a tiny gap -- a cube resting on a cube -- cost tens of seconds; at the
+#: cap the root finder returns its conservative lower bound, so the guarantee stands).
+CCD_MAX_ITERATIONS = 10_000
 
 
 def require_ipctk():
@@ -125,6 +129,7 @@ class BarrierModel:
         self.component = self._components()
         self.mesh = self._collision_mesh(x0)
         self.barrier = ipctk.BarrierPotential(self.dhat, 1.0)
+        self.ccd = ipctk.TightInclusionCCD(1e-6, CCD_MAX_ITERATIONS)
         self.kappa = self.fixed_stiffness
         self.kappa_max = np.inf
         self.friction = ipctk.FrictionPotential(self.eps_v) if self.mu > 0 else None
@@ -246,7 +251,7 @@ class BarrierModel:
 
         t0 = time.perf_counter()
         t = float(self._ipc.compute_collision_free_stepsize(
-            self.mesh, self.vertices(x0), self.vertices(x1)))
+            self.mesh, self.vertices(x0), self.vertices(x1), narrow_phase_ccd=self.ccd))
         self.stats["ccd_calls"] += 1
         self.seconds["ccd"] += time.perf_counter() - t0
         return t

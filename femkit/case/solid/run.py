@@ -45,6 +45,7 @@ from ...errors import (CaseFileError, DegenerateMeshError, EquilibriumError, Inp
 from ...io.atomic import EARLIER_RUN, check_output_dir
 from ...kinds import KINDS
 from ...timing import StageTimer
+from ..contact import ContactRecorder, build_contact, check_contact_integrator, resolve_obstacle_files
 from ..frozen import freeze
 from ..name_checks import check_geometry_spec, resolve_file
 from ..result import RunResult
@@ -166,6 +167,15 @@ def prepare_solid(case) -> None:
         integ, dt, t_end = None, None, None
         static_spec = StaticSpec(**({} if static is True else dict(static)))
         steps, every = static_spec.load_steps, int(out.get("every", 1))
+    contact = dict(d["contact"]) if d.get("contact") is not None else None
+    if contact is not None:
+        if dynamic:
+            check_contact_integrator(integ.method)
+        if not dynamic and contact.get("friction"):
+            raise CaseFileError("contact.friction: friction needs a time integration (it lives "
+                                "on the step's velocity); a static run is frictionless")
+        contact["obstacles"] = [dict(o) for o in contact.get("obstacles") or []]
+        resolve_obstacle_files(contact, case.base_dir)
     directory = str((case.base_dir / out.get("dir", os.path.join("runs", case.name))).resolve())
     out["dir"] = directory
     case.spec = SolidSpec(
@@ -173,7 +183,8 @@ def prepare_solid(case) -> None:
         gravity=tuple(d["gravity"]) if "gravity" in d else None, static=static_spec,
         integrator=integ, solver=solver, dt=dt, t_end=t_end, steps=steps,
         velocity=tuple(d["velocity"]) if "velocity" in d else None,
-        output=SolidOutput(directory, every, bool(out["vtu"]), bool(out["png"]), bool(out["gif"])))
+        output=SolidOutput(directory, every, bool(out["vtu"]), bool(out["png"]), bool(out["gif"])),
+        contact=None if contact is None else freeze(contact))
 
 
 # ----------------------------------------------------------------------------- build
@@ -367,6 +378,8 @@ class SolidResult(RunResult):
     stats: dict = field(default_factory=dict)
     output_dir: Any = None
     files: list = field(default_factory=list)
+    contact: Any = None            # ContactRecorder of a run with barrier contact
+    contact_forces: list = field(default_factory=list)   # (n, 3) per frame
     steps: int = 0                   # time or load steps done
     stopped: str | None = None       # the signal that stopped the solve ("SIGINT" ...), if one did
     output_stop: str | None = None   # the signal that stopped the output, if one did
@@ -438,6 +451,7 @@ class SolidResult(RunResult):
             "stats": dict(self.stats),
             "wall_time": float(self.wall_time), "timings": dict(self.timings),
             "files": list(self.files),
+            **({} if self.contact is None else {"contact": self.contact.facts()}),
         }
 
     def summary_lines(self) -> list[str]:
@@ -469,6 +483,8 @@ class SolidResult(RunResult):
                  f"{d['frames']} frames",
                  f"verdict   {self.verdict}" + (f": {self.failure}" if self.failure else ""),
                  self.timings_line()]
+        if self.contact is not None:
+            lines.append(self.contact.summary_line())
         if self.output_dir is not None:
             lines.append(self.output_line())
         return lines
@@ -495,11 +511,15 @@ def _run_static(case, problem: SolidProblem, stop) -> dict:
         out["v"].append(np.zeros_like(x))
         out["energies"].append(frame_energies(problem, x, load_factor=rec.load_factor))
 
+    barrier = None
+    if spec.contact is not None:
+        out["contact"] = solid_contact(spec.contact, x, body)
+        barrier = out["contact"].model
     try:
         solve_static(body, problem.dirichlet(1.0), problem.traction + problem.weight,
                      load_steps=K, project=st.project, rtol=st.rtol,
                      max_iterations=st.max_iterations, linear_solver=spec.solver,
-                     on_step=keep, stop=stop)
+                     on_step=keep, stop=stop, contact=barrier)
     except SolverError as exc:   # Newton or a linear solve failed: the load steps before are kept
         k = len(out["records"]) + 1
         out["failure"] = (f"load step {k}/{K} (load factor {k / K:g}): " + " ".join(str(exc).split()))
@@ -510,6 +530,24 @@ def _run_static(case, problem: SolidProblem, stop) -> dict:
     out["stopped"] = "failure" not in out and len(out["records"]) < K
     out["steps"] = len(out["records"])
     return out
+
+
+def solid_contact(contact, x0, body):
+    """The barrier contact force of a solid's ``contact:`` mapping on its boundary surface; the
+    initial state checked (one line naming a pair of intersecting elements, CaseFileError)."""
+    try:
+        force = build_contact(contact, x0, body.rest.cells)
+        force.model = None
+        from ...contact.barrier import BarrierModel
+
+        force.model = BarrierModel(np.asarray(x0, float).reshape(body.n, body.dim), force.surface,
+                                   force.obstacles, **force.options)
+        force.model.check_intersection_free(x0)
+    except CaseFileError:
+        raise
+    except InputError as exc:
+        raise CaseFileError(str(exc)) from None
+    return force
 
 
 def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
@@ -535,8 +573,13 @@ def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
     x0[bc.dofs] += bc.values
     system = elastic_system(body, x0=x0.reshape(body.n, body.dim), v0=v0,
                             pinned=held.reshape(body.n, body.dim), forces=forces)
+    if spec.contact is not None:
+        system.attach(solid_contact(spec.contact, system.x0, body))
+        out_contact = system.forces[-1]
+    else:
+        out_contact = None
     check_explicit_step(case, system)    # a step that can only blow up: refused, nothing written
-    out: dict = {}
+    out: dict = {} if out_contact is None else {"contact": out_contact}
     try:
         traj = simulate(system, spec.integrator.build(), spec.dt, spec.t_end,
                         ctx=StepContext(spec.solver), record_every=spec.output.every,
@@ -619,6 +662,10 @@ def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = F
                          verdict=_verdict(case, run, stop), wall_time=time.perf_counter() - t0,
                          timings=timer.times, stats=run.get("stats", {}),
                          steps=run["steps"], stopped=stop.name if run.get("stopped") else None, warnings=messages)
+    if run.get("contact") is not None:   # every frame: distances, pairs, the independent check
+        result.contact = ContactRecorder(run["contact"])
+        result.contact_forces = [result.contact.record(t, x)["contact_force"]
+                                 for t, x in zip(result.times, result.x)]
     for w in () if quiet else messages:
         print(f"femkit: warning: {w}", file=sys.stderr)
     if write:

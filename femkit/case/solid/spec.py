@@ -64,6 +64,8 @@ class SolidSpec:
         Time steps (dynamic) or load steps (static).
     velocity : tuple or None
     output : SolidOutput
+    contact : Mapping or None
+        The ``contact:`` mapping (barrier contact, :mod:`femkit.case.contact`), None without.
     """
 
     mesh: Mapping
@@ -78,3 +80,4 @@ class SolidSpec:
     steps: int
     velocity: tuple | None
     output: SolidOutput
+    contact: Mapping | None = None
