@@ -3,7 +3,6 @@
 three solids, and the bad inputs (one line, exit 2, nothing written)."""
 
 import json
-import subprocess
 import sys
 from pathlib import Path
 
@@ -37,13 +36,21 @@ output: {{vtu: true, png: false}}
 """
 
 
-def _solve(tmp_path, text, name="case.yaml"):
+class _Run:
+    def __init__(self, code, err):
+        self.returncode, self.stderr = code, err
+
+
+def _solve(tmp_path, text, capsys, name="case.yaml"):
+    """``femkit solve`` in this process (its exit code and stderr) and the output directory."""
+    from femkit.cli import main
+
     f = tmp_path / name
     f.write_text(text)
     out = tmp_path / "out"
-    p = subprocess.run([sys.executable, "-m", "femkit", "solve", str(f), "-o", str(out), "--quiet"],
-                       capture_output=True, text=True, cwd=ROOT, timeout=300)
-    return p, out
+    capsys.readouterr()
+    code = main(["solve", str(f), "-o", str(out), "--quiet"])
+    return _Run(code, capsys.readouterr().err), out
 
 
 def _frames(out):
@@ -52,9 +59,9 @@ def _frames(out):
     return [meshio.read(p) for p in sorted((out / "frames").glob("frame_*.vtu"))]
 
 
-def test_a_solid_dropped_on_a_plane_never_crosses_it(tmp_path):
+def test_a_solid_dropped_on_a_plane_never_crosses_it(tmp_path, capsys):
     p, out = _solve(tmp_path, SOLID.format(
-        integrator="newton", contact="{obstacles: [{type: plane, point: [0, 0, -0.01]}]}"))
+        integrator="newton", contact="{obstacles: [{type: plane, point: [0, 0, -0.01]}]}"), capsys)
     assert p.returncode == 0, p.stderr
     res = json.loads((out / "result.json").read_text())["contact"]
     assert res["intersections"] == 0 and 0.0 < res["min_distance"] < res["dhat"]
@@ -75,8 +82,8 @@ CLOTH = (ROOT / "cases/scenes/cloth_on_sphere.yaml").read_text().replace(
     "dir: ../../runs/cloth_on_sphere", "dir: out")
 
 
-def test_a_small_cloth_on_the_sphere_keeps_every_frame_intersection_free(tmp_path):
-    p, out = _solve(tmp_path, CLOTH)
+def test_a_small_cloth_on_the_sphere_keeps_every_frame_intersection_free(tmp_path, capsys):
+    p, out = _solve(tmp_path, CLOTH, capsys)
     assert p.returncode == 0, p.stderr
     res = json.loads((out / "result.json").read_text())["contact"]
     assert res["intersections"] == 0 and max(f["active_contacts"] for f in res["frames"]) > 0
@@ -117,12 +124,13 @@ def test_a_stack_of_three_solids_rests_with_each_contact_carrying_the_weight_abo
     ("newton", "{friction: -0.1}", ["friction"]),
     ("newton", "{obstacles: [{type: file, file: vol.msh}]}", ["not a surface", "tetra"]),
 ])
-def test_bad_contact_input_is_one_line_and_writes_nothing(tmp_path, integrator, contact, words):
+def test_bad_contact_input_is_one_line_and_writes_nothing(tmp_path, capsys, integrator, contact,
+                                                        words):
     import meshio
 
     P, T = cube(1, 1.0, (3.0, 3.0, 3.0))
     meshio.write(tmp_path / "vol.msh", meshio.Mesh(P, [("tetra", T)]), file_format="gmsh22")
-    p, out = _solve(tmp_path, SOLID.format(integrator=integrator, contact=contact))
+    p, out = _solve(tmp_path, SOLID.format(integrator=integrator, contact=contact), capsys)
     assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, p.stderr
     assert all(w in p.stderr for w in words), p.stderr
     assert not out.exists()
