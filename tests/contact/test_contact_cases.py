@@ -134,3 +134,18 @@ def test_bad_contact_input_is_one_line_and_writes_nothing(tmp_path, capsys, inte
     assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, p.stderr
     assert all(w in p.stderr for w in words), p.stderr
     assert not out.exists()
+
+
+def test_the_plan_prices_contact_and_refuses_a_scene_past_its_time_budget(tmp_path, capsys):
+    text = CLOTH.replace("t_end: 0.2", "t_end: 4.0") + "limits: {time: 5}\n"
+    p, out = _solve(tmp_path, text, capsys)
+    assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, p.stderr
+    assert "time" in p.stderr and not out.exists()
+    from femkit import load_case
+    from femkit.case.scene.cost import plan_scene_case
+    from femkit.case.scene.systems import system_size
+
+    case = load_case(tmp_path / "case.yaml")
+    stages = {s.name: s for s in plan_scene_case(case, system_size(case.spec.system),
+                                                 measure=False).stages}
+    assert stages["contact"].seconds > 5.0
