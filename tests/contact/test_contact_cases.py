@@ -28,8 +28,8 @@ mesh: {{geometry: unit_cube, h: 1.0}}
 material: {{model: stable_neo_hookean, E: 1.0e5, nu: 0.3, density: 1000.0}}
 gravity: [0, 0, -9.81]
 integrator: {integrator}
-dt: 0.005
-t_end: 0.04
+dt: 0.01
+t_end: 0.05
 velocity: [0, 0, -1.0]
 contact: {contact}
 output: {{vtu: true, png: false}}
@@ -67,7 +67,7 @@ def test_a_solid_dropped_on_a_plane_never_crosses_it(tmp_path, capsys):
     assert res["intersections"] == 0 and 0.0 < res["min_distance"] < res["dhat"]
     plane = plane_obstacle([0.5, 0.5, -0.01], [0, 0, 1], 20.0, 3)
     frames = _frames(out)
-    assert len(frames) == len(res["frames"]) > 5
+    assert len(frames) == len(res["frames"]) > 3
     for m in frames:       # the written frames, read back, checked without ipctk
         x = m.points + m.point_data["displacement"]
         surf = body_surface(m.cells_dict["tetra"], 3)
