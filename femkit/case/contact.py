@@ -56,13 +56,10 @@ def check_contact_integrator(method: str) -> None:
     """Refuse (CaseFileError) an integrator that does not keep barrier contact, naming those
     that do (from the integrators' ``keeps_contact`` trait)."""
     from ..dynamics.integrators import INTEGRATORS
-    from ..dynamics.integrators.base import contact_integrators
+    from ..dynamics.integrators.base import contact_refusal
 
     if not getattr(INTEGRATORS.get(method), "keeps_contact", False):
-        raise CaseFileError(
-            f"contact: integrator '{method}' cannot keep barrier contact intersection-free "
-            "(its steps are not minimisations bounded by continuous collision detection); use "
-            f"{' or '.join(contact_integrators())}")
+        raise CaseFileError(contact_refusal(method))
 
 
 def resolve_obstacle_files(contact: dict, base: Path) -> None:

@@ -46,6 +46,9 @@ __all__ = [
     "NonlinearConvergenceWarning",
     "NewtonStepError",
     "note_unconverged",
+    "check_contact",
+    "contact_integrators",
+    "contact_refusal",
 ]
 
 
@@ -180,15 +183,19 @@ def contact_integrators() -> list[str]:
     return [n for n in INTEGRATORS.names() if getattr(INTEGRATORS.get(n), "keeps_contact", False)]
 
 
+def contact_refusal(name: str) -> str:
+    """The one-line refusal of barrier contact under integrator ``name``."""
+    return (f"contact: integrator '{name}' cannot keep barrier contact intersection-free (its "
+            "steps are not minimisations bounded by continuous collision detection); use "
+            f"{' or '.join(contact_integrators())}")
+
+
 def check_contact(integrator, system) -> None:
     """Refuse (one-line :class:`~femkit.errors.InputError`) a force that requires
     CCD-bounded steps under an integrator that does not keep contact."""
     needs = [f for f in system.forces if getattr(f, "requires_bounded_steps", False)]
     if needs and not integrator.keeps_contact:
-        raise InputError(
-            f"contact: integrator '{integrator.name}' cannot keep barrier contact intersection-"
-            "free (its steps are not minimisations bounded by continuous collision detection); "
-            f"use {' or '.join(contact_integrators())}")
+        raise InputError(contact_refusal(integrator.name))
 
 
 # ----------------------------------------------------------------------------- iterative steps
