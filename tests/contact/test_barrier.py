@@ -187,3 +187,18 @@ def test_a_block_on_an_incline_sticks_below_the_friction_angle_and_slides_above_
     else:
         a = np.polyfit(dt * np.arange(15, 31), vx[15:], 1)[0]
         assert a == pytest.approx(g * (np.sin(theta) - mu * np.cos(theta)), rel=0.02)
+
+
+def test_a_2d_body_on_its_boundary_segments_lands_on_a_line_without_crossing_it():
+    from femkit.mesh import structured_mesh
+
+    mesh = structured_mesh(3, 3, 0.2, 0.2, origin=(0.0, 0.01))
+    P, T = np.asarray(mesh.points, float), np.asarray(mesh.triangles)
+    surface = body_surface(T, 2)
+    assert surface.shape == (12, 2)                      # the square's 12 boundary segments
+    force = BarrierContact(surface, [plane_obstacle([0.1, 0.0], [0.0, 1.0], 1.0, 2)])
+    s = elastic_system(_body(P, T, E=1e5), forces=[Gravity(9.81), force],
+                       v0=np.tile([0.3, -1.0], (len(P), 1)))
+    frames, f = _run(s, 25, 2e-3)
+    assert max(f.model.active(fr.x) for fr in frames) > 0
+    assert min(fr.x[:, 1].min() for fr in frames) > 0.0
