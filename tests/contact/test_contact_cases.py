@@ -149,3 +149,43 @@ def test_the_plan_prices_contact_and_refuses_a_scene_past_its_time_budget(tmp_pa
     stages = {s.name: s for s in plan_scene_case(case, system_size(case.spec.system),
                                                  measure=False).stages}
     assert stages["contact"].seconds > 5.0
+
+
+BODIES = """problem: solid
+mesh: {geometry: unit_cube, h: 1.0}
+material: {model: stable_neo_hookean, E: 1.0e5, nu: 0.3, density: 1000.0}
+bodies:
+  - {offset: [0, 0, 0], velocity: [2.0, 0, 0]}
+  - {offset: [1.02, 0.1, 0.05], velocity: [-2.0, 0, 0],
+     material: {model: stable_neo_hookean, E: 1.0e5, nu: 0.3, density: 1000.0}}
+integrator: newton
+dt: 0.005
+t_end: 0.03
+contact: {self: false}
+output: {vtu: true, png: false}
+"""
+
+
+def test_two_bodies_of_one_file_meet_head_on_without_crossing(tmp_path, capsys):
+    p, out = _solve(tmp_path, BODIES, capsys)
+    assert p.returncode == 0, p.stderr
+    res = json.loads((out / "result.json").read_text())
+    c = res["contact"]
+    assert c["intersections"] == 0 and max(f["active_contacts"] for f in c["frames"]) > 0
+    assert c["min_distance"] > 0
+    frames = _frames(out)
+    m0 = frames[0]
+    tags = m0.cell_data["region"][0]
+    cells = m0.cells_dict["tetra"]
+    a, b = np.unique(cells[tags == 1]), np.unique(cells[tags == 2])
+    assert m0.point_data["velocity"][a, 0].min() == 2.0 and m0.point_data["velocity"][b, 0].max() == -2.0
+    P = m0.points
+    vol = np.abs(np.einsum("ij,ij->i", np.cross(P[cells[:, 1]] - P[cells[:, 0]],
+                                                P[cells[:, 2]] - P[cells[:, 0]]),
+                           P[cells[:, 3]] - P[cells[:, 0]])) / 6.0
+    mass = np.zeros(len(P))
+    np.add.at(mass, cells.ravel(), np.repeat(1000.0 * vol / 4.0, 4))   # lumped masses
+    p0 = mass @ m0.point_data["velocity"]
+    v_last = frames[-1].point_data["velocity"]
+    assert np.abs(mass @ v_last - p0).max() <= 1e-8 * (mass @ np.abs(m0.point_data["velocity"])).sum()
+    assert v_last[a, 0].mean() < 2.0                          # they pushed each other

@@ -103,6 +103,35 @@ def _check_geometry_tags(d, boundaries) -> int | None:
     return entry.dim
 
 
+def _bodies(d, base, mesh: dict, material, dynamic: bool) -> tuple | None:
+    """``bodies:`` checked: each body's mesh (default the file's ``mesh``), material (default
+    ``material``), offset and velocity; only for a time integration without boundaries or
+    regions (their tags would be ambiguous among the bodies)."""
+    if not d.get("bodies"):
+        return None
+    from ...solids.materials import material_from_spec
+
+    if not dynamic or d["boundaries"] or d["regions"]:
+        raise CaseFileError("bodies: several bodies take a time integration with neither "
+                            "'boundaries' nor 'regions' (free bodies in contact)")
+    out = []
+    for i, b in enumerate(d["bodies"]):
+        where = f"bodies[{i}]"
+        m = dict(b.get("mesh") or mesh)
+        if "mesh" in b and "file" in m:
+            resolve_file(m, f"{where}.mesh", base)
+        elif "mesh" in b:
+            check_geometry_spec(m, f"{where}.mesh")
+        try:
+            mat = material_from_spec(b["material"]) if "material" in b else material
+        except InputError as exc:
+            raise with_prefix(exc, f"{where}.material") from None
+        vel = b.get("velocity", d.get("velocity"))
+        out.append(freeze({"mesh": m, "material": mat, "offset": tuple(b["offset"]),
+                           "velocity": None if vel is None else tuple(vel)}))
+    return tuple(out)
+
+
 def prepare_solid(case) -> None:
     """Check a validated solid case and build its :class:`SolidSpec` (``case.spec``).
 
@@ -167,6 +196,7 @@ def prepare_solid(case) -> None:
         integ, dt, t_end = None, None, None
         static_spec = StaticSpec(**({} if static is True else dict(static)))
         steps, every = static_spec.load_steps, int(out.get("every", 1))
+    bodies = _bodies(d, case.base_dir, mesh, materials[None], dynamic)
     contact = dict(d["contact"]) if d.get("contact") is not None else None
     if contact is not None:
         if dynamic:
@@ -184,7 +214,7 @@ def prepare_solid(case) -> None:
         integrator=integ, solver=solver, dt=dt, t_end=t_end, steps=steps,
         velocity=tuple(d["velocity"]) if "velocity" in d else None,
         output=SolidOutput(directory, every, bool(out["vtu"]), bool(out["png"]), bool(out["gif"])),
-        contact=None if contact is None else freeze(contact))
+        contact=None if contact is None else freeze(contact), bodies=bodies)
 
 
 # ----------------------------------------------------------------------------- build
@@ -233,9 +263,32 @@ def build_mesh(spec: SolidSpec):
     order re-oriented, saying how many); refused with
     :class:`~femkit.errors.DegenerateMeshError` naming the elements when some are inverted
     (cells folded over a neighbour: :func:`folded_cells`)."""
+    if spec.bodies is not None:
+        return _merged_bodies(spec.bodies)
+    return _one_mesh(spec.mesh)
+
+
+def _merged_bodies(bodies):
+    """One mesh of every body's mesh moved by its offset, cells tagged by body (1, 2, ...)."""
+    from ...mesh import Mesh
+
+    points, cells, tags, off = [], [], [], 0
+    for k, b in enumerate(bodies):
+        m = _one_mesh(b["mesh"])
+        offset = np.asarray(b["offset"], float)
+        if len(offset) != m.dim:
+            raise CaseFileError(f"bodies[{k}].offset: needs {m.dim} components, got {len(offset)}")
+        points.append(m.points + offset)
+        cells.append(m.cells + off)
+        tags.append(np.full(m.n_cells, k + 1))
+        off += m.n_points
+    return Mesh(np.concatenate(points), np.concatenate(cells), cell_tags=np.concatenate(tags))
+
+
+def _one_mesh(m):
+    """The validated mesh of one ``mesh:`` mapping (see :func:`build_mesh`)."""
     from ...mesh import generate, read_mesh, validate
 
-    m = spec.mesh
     where = f"mesh.file {m['file']}" if "file" in m else f"mesh.geometry {m['geometry']}"
     try:
         flipped = 0
@@ -302,7 +355,9 @@ def build_problem(case) -> SolidProblem:
             regions[mesh.tag(name)] = mat
         except InputError as exc:
             raise with_prefix(exc, f"regions.{name}") from None
-    if regions:
+    if spec.bodies is not None:   # cells tagged by body
+        material = {k + 1: b["material"] for k, b in enumerate(spec.bodies)}
+    elif regions:
         tags = np.unique(mesh.cell_tags)
         regions.update({int(t): default for t in tags if int(t) not in regions})
         material = regions
@@ -565,6 +620,12 @@ def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
     v0 = None
     if spec.velocity is not None:
         v0 = np.broadcast_to(np.asarray(spec.velocity, float), (body.n, body.dim)).copy()
+    if spec.bodies is not None:   # each body's velocity on its nodes
+        v0 = np.zeros((body.n, body.dim))
+        cells, tags = np.asarray(problem.mesh.cells), np.asarray(problem.mesh.cell_tags)
+        for k, b in enumerate(spec.bodies):
+            if b["velocity"] is not None:
+                v0[np.unique(cells[tags == k + 1])] = np.asarray(b["velocity"], float)[:body.dim]
     # every fixed or roller component is held where its displacement puts it, from t = 0
     bc = problem.dirichlet(1.0)
     held = np.zeros(body.ndof, dtype=bool)

@@ -117,6 +117,9 @@ def solid_schema() -> dict:
             "dt": _TIME,
             "t_end": _TIME,
             "velocity": _VEC,
+            "bodies": {"type": "array", "minItems": 1, "items": closed(
+                {"mesh": _mesh(), "material": material, "offset": _VEC, "velocity": _VEC},
+                ["offset"])},
             "contact": CONTACT_SCHEMA,
             "linear_solver": {**SOLVER_SCHEMA, "default": {}},
             "limits": LIMITS_SCHEMA,

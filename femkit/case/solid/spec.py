@@ -66,6 +66,9 @@ class SolidSpec:
     output : SolidOutput
     contact : Mapping or None
         The ``contact:`` mapping (barrier contact, :mod:`femkit.case.contact`), None without.
+    bodies : tuple of Mapping or None
+        ``bodies:``: per body its ``mesh`` (absolute file), ``material`` (a Material),
+        ``offset`` and ``velocity`` (defaults: the file's ``mesh``, ``material``, ``velocity``).
     """
 
     mesh: Mapping
@@ -81,3 +84,4 @@ class SolidSpec:
     velocity: tuple | None
     output: SolidOutput
     contact: Mapping | None = None
+    bodies: tuple | None = None
