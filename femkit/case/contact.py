@@ -28,7 +28,8 @@ import numpy as np
 from ..errors import CaseFileError, InputError, with_prefix
 from .fragments import NONNEG, POS, VEC, closed
 
-__all__ = ["CONTACT_SCHEMA", "check_contact_integrator", "build_contact", "ContactRecorder"]
+__all__ = ["CONTACT_SCHEMA", "check_contact_integrator", "build_contact", "ContactRecorder",
+           "contact_stage", "obstacle_facets", "CONTACT_ITERATIONS", "CONTACT_SECONDS_PER_FACET"]
 
 _OBSTACLES = {
     "plane": closed({"type": {"const": "plane"}, "point": VEC, "normal": VEC, "size": POS},
@@ -114,6 +115,33 @@ def build_contact(contact, x0, cells):
                            eps_v=float(contact.get("eps_v", 1e-3)),
                            lagging=int(contact.get("lagging", 1)))
     return force
+
+
+#: Barrier contact's price: Newton iterations of a step in contact (IPC's line search bounded by
+#: CCD; 7 on the small cloth_on_sphere, benchmarks/bench_contact.py) and seconds per surface
+#: facet per iteration of the broad phase, CCD and barrier Hessian together (2.5e-5 s measured
+#: there on the shared 2-core machine).
+CONTACT_ITERATIONS = 8.0
+CONTACT_SECONDS_PER_FACET = 2.5e-5
+
+
+def contact_stage(steps: int, facets: float):
+    """The contact overhead of ``steps`` steps on ``facets`` surface facets (obstacles included),
+    priced from the numbers before the run (first steps are often contact-free, so a measured
+    first batch would miss it)."""
+    from ..cost.plan import Stage
+
+    sec = steps * CONTACT_ITERATIONS * facets * CONTACT_SECONDS_PER_FACET
+    return Stage("contact", sec, 0.0, detail=f"barrier contact: ~{facets:.3g} facets, "
+                 f"{CONTACT_ITERATIONS:g} CCD-bounded Newton iterations per step")
+
+
+def obstacle_facets(contact) -> float:
+    """Facets of a ``contact:`` mapping's obstacles from its numbers (a sphere ``20 * 4^level``,
+    a plane 2; a file's counted as 2,000)."""
+    sizes = {"sphere": lambda o: 20 * 4 ** o.get("level", 3), "plane": lambda o: 2,
+             "file": lambda o: 2000}
+    return float(sum(sizes[o["type"]](o) for o in contact.get("obstacles") or []))
 
 
 class ContactRecorder:

@@ -9,7 +9,7 @@ step are timed on a first batch (:func:`femkit.case.cost.measure_step_seconds`).
 from __future__ import annotations
 
 from ...cost import Plan, check_budget, plan_mesh, plan_scene
-from ...cost.plan import Stage
+from ..contact import contact_stage, obstacle_facets
 from ..cost import OVERRIDE, measure_step_seconds
 
 __all__ = ["plan_scene_case", "check_scene_fits"]
@@ -51,31 +51,12 @@ def plan_scene_case(case, size, *, build=None, measure: bool = True) -> Plan:
     return _with_contact(_with_mesh(plan_scene(**common, step_seconds=per_step), mesh), spec, nodes)
 
 
-#: Barrier contact's price: Newton iterations of a step in contact (IPC's line search bounded by
-#: CCD; 7 on the small cloth_on_sphere, benchmarks/bench_contact.py) and seconds per surface
-#: facet per iteration of the broad phase, CCD and barrier Hessian together (2.5e-5 s measured
-#: there on the shared 2-core machine).
-CONTACT_ITERATIONS = 8.0
-CONTACT_SECONDS_PER_FACET = 2.5e-5
-
-
-def contact_stage(steps: int, facets: float) -> Stage:
-    """The contact overhead of ``steps`` steps on ``facets`` surface facets (obstacles included),
-    priced from the numbers before the run (first steps are often contact-free, so a measured
-    first batch would miss it)."""
-    sec = steps * CONTACT_ITERATIONS * facets * CONTACT_SECONDS_PER_FACET
-    return Stage("contact", sec, 0.0, detail=f"barrier contact: ~{facets:.3g} facets, "
-                 f"{CONTACT_ITERATIONS:g} CCD-bounded Newton iterations per step")
-
-
 def _with_contact(plan: Plan, spec, nodes: float) -> Plan:
     """``plan`` with barrier contact's stage when the scene declares ``contact:`` (a surface of
     ~2 triangles per node, a sphere obstacle's 20 * 4^level)."""
     if getattr(spec, "contact", None) is None:
         return plan
-    facets = 2.0 * nodes + sum(20 * 4 ** o.get("level", 3) if o["type"] == "sphere" else 2
-                               for o in spec.contact.get("obstacles") or [])
-    plan.stages.append(contact_stage(spec.steps, facets))
+    plan.stages.append(contact_stage(spec.steps, 2.0 * nodes + obstacle_facets(spec.contact)))
     return plan
 
 

@@ -8,13 +8,13 @@ from ..cost import runs_plan
 __all__ = ["plan"]
 
 #: Seconds per Newton step per cloth vertex (penalty runs; barrier runs priced by the scene
-#: plan's contact stage, :func:`femkit.case.scene.cost.contact_stage`).
+#: plan's contact stage, :func:`femkit.case.contact.contact_stage`).
 SECONDS_PER_NODE_STEP = 2e-4
 
 
 def plan(study) -> Plan:
     """One stage per penalty stiffness and one for barrier contact."""
-    from ...case.scene.cost import contact_stage
+    from ...case.contact import contact_stage
 
     s = study.spec
     steps = max(1, round(s.t_end / s.dt))
