@@ -100,9 +100,9 @@ def _obstacles(contact, x0: np.ndarray) -> list:
 
 
 def build_contact(contact, x0, cells):
-    """The :class:`~femkit.dynamics.forces.BarrierContact` of a ``contact:`` mapping for bodies
-    at ``x0`` with ``cells`` (tetrahedra, triangles or segments); the initial state checked for
-    intersections (one line naming a pair of elements)."""
+    """The (unbound) :class:`~femkit.dynamics.forces.BarrierContact` of a ``contact:`` mapping
+    for bodies at ``x0`` with ``cells`` (tetrahedra, triangles or segments); the caller checks
+    the initial state (:meth:`~femkit.contact.barrier.BarrierModel.check_intersection_free`)."""
     from ..contact import body_surface
     from ..dynamics.forces import BarrierContact
 

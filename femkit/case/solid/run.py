@@ -590,11 +590,10 @@ def _run_static(case, problem: SolidProblem, stop) -> dict:
 def solid_contact(contact, x0, body):
     """The barrier contact force of a solid's ``contact:`` mapping on its boundary surface; the
     initial state checked (one line naming a pair of intersecting elements, CaseFileError)."""
+    from ...contact.barrier import BarrierModel
+
     try:
         force = build_contact(contact, x0, body.rest.cells)
-        force.model = None
-        from ...contact.barrier import BarrierModel
-
         force.model = BarrierModel(np.asarray(x0, float).reshape(body.n, body.dim), force.surface,
                                    force.obstacles, **force.options)
         force.model.check_intersection_free(x0)

@@ -46,6 +46,16 @@ into the free-dof pattern cached for the run (the clamp applied in the same pass
 once per step on the same pattern) and refactorised by CHOLMOD on the symbolic analysis of the
 first iteration (:meth:`femkit.solvers.session.LinearSession.solve_on_pattern`).
 
+Barrier contact (:class:`~femkit.dynamics.forces.BarrierContact`, IPC: Li et al. 2020): a
+system with a force that ``requires_bounded_steps`` is run the IPC way -- each step starts from
+``x_n`` (``y`` may lie past a contact) after the forces' ``begin_step`` (the barrier stiffness,
+lagged friction); every line search starts from ``t_max = min(1, step_bound)``, the
+collision-free step size of CCD, so no iterate ever crosses a surface; after each iteration
+``end_iteration`` may raise the barrier stiffness (the objective is then re-evaluated);
+convergence is judged on the Newton direction ``||dx||_inf`` (a short CCD-bounded step is no
+sign of convergence); and the step is solved again while ``relag`` asks for another friction
+lagging iteration. ``keeps_contact = True`` declares it (the trait the other integrators lack).
+
 First order; unconditionally stable.
 """
 
