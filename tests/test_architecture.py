@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "femkit"
-LIBRARY = ("mesh", "fem", "solvers", "dynamics", "solids", "elements")
+LIBRARY = ("mesh", "fem", "solvers", "dynamics", "solids", "elements", "contact")
 APPLICATION = ("case", "study", "cli")
 #: What the library must never import: the application and the cost model (planned above it).
 ABOVE_THE_LIBRARY = APPLICATION + ("cost",)
@@ -120,13 +120,14 @@ def test_library_layers_do_not_write_femkit_files(layer):
 
 
 @pytest.mark.parametrize("layer, below", [
-    ("mesh", ("fem", "solvers", "dynamics", "solids", "elements")),
-    ("solvers", ("mesh", "fem", "dynamics", "solids", "elements")),
-    ("fem", ("dynamics", "solids")),
+    ("mesh", ("fem", "solvers", "dynamics", "solids", "elements", "contact")),
+    ("solvers", ("mesh", "fem", "dynamics", "solids", "elements", "contact")),
+    ("fem", ("dynamics", "solids", "contact")),
     ("solids", ("dynamics",)),
     ("dynamics", ("solids",)),
-    ("elements", ("mesh", "fem", "solvers", "dynamics", "solids"))],
-    ids=["mesh", "solvers", "fem", "solids", "dynamics", "elements"])
+    ("elements", ("mesh", "fem", "solvers", "dynamics", "solids", "contact")),
+    ("contact", ("fem", "solvers", "dynamics", "solids", "elements"))],
+    ids=["mesh", "solvers", "fem", "solids", "dynamics", "elements", "contact"])
 def test_lower_layers_do_not_import_higher_library_layers(layer, below):
     """Below means below: and dynamics and solids, side by side, import nothing of each other
     (what both need, the compiled element kernels, is femkit.elements)."""

@@ -194,12 +194,19 @@ class MassSpringSystem:
         self.last_shift = 0.0
 
         # each system binds its own shallow copies, so one force object may serve many systems
+        self.forces = ()
+        self.attach(*forces)
+
+    def attach(self, *forces: Force) -> None:
+        """Bind shallow copies of ``forces`` to this system and add them to :attr:`forces`
+        (a force that needs the built system, e.g. barrier contact on its triangles)."""
         for f in forces:
             if not isinstance(f, Force):
                 raise InputError(f"forces must be femkit force objects, got {f!r}")
-        self.forces = tuple(copy.copy(f) for f in forces)
-        for f in self.forces:
+        new = tuple(copy.copy(f) for f in forces)
+        for f in new:
             f.bind(self)
+        self.forces = self.forces + new
         self._rayleigh = tuple(f for f in self.forces if isinstance(f, RayleighDamping))
         self._conservative = tuple(f for f in self.forces if f.kind is not None)
 

@@ -94,7 +94,7 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
                  shrink: float = 0.5, max_backtracks: int = 40,
                  linear_solver: SolverSpec | str = "direct", x0=None,
                  on_step: Callable[[LoadStepRecord, np.ndarray], Any] | None = None,
-                 stop: Callable[[], bool] | None = None) -> StaticResult:
+                 stop: Callable[[], bool] | None = None, contact=None) -> StaticResult:
     """Static equilibrium of ``body`` under nodal ``forces`` ``(n, d)`` and ``dirichlet`` data.
 
     Parameters
@@ -126,6 +126,11 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
     stop : callable, optional
         Checked before each Newton iteration; once it returns true the solve ends, returning
         the load steps completed so far (the one under way is dropped).
+    contact : femkit.contact.barrier.BarrierModel, optional
+        Barrier contact (IPC, Li et al. 2020) of the body's surface: its potential joins the
+        total potential, every line search starts from the collision-free step size (CCD) of
+        the Newton step, the stiffness is initialised by IPC's rule at the first iteration and
+        updated after each; the start must be intersection-free. No friction in statics.
 
     Raises
     ------
@@ -150,6 +155,7 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
     newton = _Newton(body, dirichlet, f_ext, project, rtol, xtol, max_iterations, armijo, shrink,
                      max_backtracks, SolverSpec(linear_solver) if isinstance(linear_solver, str)
                      else linear_solver, stop)
+    newton.contact = contact
     x = body.rest_positions.reshape(-1).copy() if x0 is None else \
         np.array(x0, dtype=float).reshape(-1)
     records: list[LoadStepRecord] = []
@@ -186,6 +192,7 @@ class _Newton:
         self.armijo, self.shrink, self.max_backtracks = armijo, shrink, max_backtracks
         self.X = body.rest_positions.reshape(-1)
         self.fixed, self.u_fixed, self.free = dirichlet.dofs, dirichlet.values, dirichlet.free()
+        self.contact = None
         self.length = float(np.linalg.norm(np.ptp(body.rest_positions, axis=0)))
         # the size of the terms an energy density sums before they cancel near rest: (mu + lam) vol
         self.stored = float(sum((m.mu + abs(m.lam)) * body.rest.volumes[e].sum()
@@ -200,6 +207,8 @@ class _Newton:
             e = float(self.body.evaluate(xf, 0)[0].sum())
         except SolverError:
             return np.inf, 0.0
+        if self.contact is not None:
+            e += self.contact.energy(xf)
         work = float(f @ xf)
         return e - work, 64 * np.finfo(float).eps * (abs(e) + abs(work) + self.stored)
 
@@ -214,6 +223,12 @@ class _Newton:
         dc = self.X[fixed] + lf * self.u_fixed - x[fixed]
         out[fixed] += dc
         if not np.any(dc) or not len(free):
+            return out
+        if self.contact is not None:   # a linear spread could pass through a contact
+            if self.contact.max_step(x, out) < 1.0:
+                raise EquilibriumError("static Newton: the prescribed increment of this load "
+                                       "step would bring surfaces into contact; use more load "
+                                       "steps")
             return out
         try:
             H = self.body.evaluate(x, 2, project=True)[2].tocsr()
@@ -257,6 +272,8 @@ class _Newton:
             if self.stop is not None and self.stop():
                 raise _Stopped
             _, g, H, _ = body.evaluate(x, 2, project=self.project is True)
+            if self.contact is not None:
+                g, H = self._with_contact(x, g, H, f)
             r = g.reshape(-1) - f
             res = float(np.linalg.norm(r[free]))
             rec.residuals.append(res)
@@ -271,26 +288,43 @@ class _Newton:
             slope = float(r[free] @ sol.x)
             if self.project == "auto" and not (slope < 0.0 and np.all(np.isfinite(sol.x))):
                 H = body.evaluate(x, 2, project=True)[2]
+                if self.contact is not None:
+                    H = H + self.contact.hessian(x, project=True)
                 sol = spec.solve(H[free][:, free].tocsr(), -r[free])
                 slope = float(r[free] @ sol.x)
                 rec.projected += 1
             dx = np.zeros_like(x)
             dx[free] = sol.x
-            t, p_try, noise_try = self.line_search(x, dx, f, pot, noise, slope, res, rec)
+            t0 = 1.0 if self.contact is None else self.contact.max_step(x, x + dx)
+            t, p_try, noise_try = self.line_search(x, dx, f, pot, noise, slope, res, rec, t0)
             rec.step_lengths.append(t)
             x = x + t * dx
             pot, noise = p_try, noise_try
+            if self.contact is not None and self.contact.update_stiffness(x):
+                pot, noise = self.potential(x, f)
             step = float(np.abs(dx).max(initial=0.0))      # the Newton step, not t * dx
         raise EquilibriumError(
             f"static Newton: no convergence in {self.max_iterations} iterations in the load step "
             f"to load factor {rec.load_factor:g} (residual {rec.residuals[-1]:.3e}, start "
             f"{rec.residuals[0]:.3e})")
 
-    def line_search(self, x, dx, f, pot, noise, slope, res, rec) -> tuple[float, float, float]:
-        """Armijo backtracking (Nocedal & Wright, section 3.1) with the round-off slack; when it
-        finds no decrease, the full step if it lowers the residual norm; ``(t, potential, noise)``
-        of the accepted step; :class:`EquilibriumError` when there is none."""
-        t = 1.0
+    def _with_contact(self, x, g, H, f):
+        """The body's gradient and Hessian plus the barrier's (its stiffness set by IPC's rule
+        at the first call); the Hessian's contact blocks PSD-projected as the body's are."""
+        c = self.contact
+        if c.kappa is None:
+            mass = float(np.mean(self.body.lumped_masses()))
+            c.init_stiffness(g.reshape(-1) - f, mass, 1.0, x)
+        g = g + c.gradient(x).reshape(g.shape)
+        return g, H + c.hessian(x, project=self.project is not False)
+
+    def line_search(self, x, dx, f, pot, noise, slope, res, rec,
+                    t_max: float = 1.0) -> tuple[float, float, float]:
+        """Armijo backtracking (Nocedal & Wright, section 3.1) from ``t_max`` (with contact the
+        collision-free step size) with the round-off slack; when it finds no decrease, the
+        largest step if it lowers the residual norm; ``(t, potential, noise)`` of the accepted
+        step; :class:`EquilibriumError` when there is none."""
+        t = t_max
         if slope < 0.0:
             for _ in range(self.max_backtracks):
                 p_try, noise_try = self.potential(x + t * dx, f)
@@ -298,23 +332,25 @@ class _Newton:
                     return t, p_try, noise_try
                 t *= self.shrink
             # energy differences below rounding: accept a full step that lowers |r|
-            p_try, noise_try = self.potential(x + dx, f)
+            p_try, noise_try = self.potential(x + t_max * dx, f)
             lowers = False
             if np.isfinite(p_try):
-                g_try = self.body.evaluate(x + dx, 1)[1].reshape(-1) - f
+                g_try = self.body.evaluate(x + t_max * dx, 1)[1].reshape(-1) - f
+                if self.contact is not None:
+                    g_try = g_try + self.contact.gradient(x + t_max * dx).reshape(-1)
                 lowers = bool(np.linalg.norm(g_try[self.free]) < (1.0 - self.armijo) * res)
             if not lowers:
                 raise EquilibriumError(
                     f"static Newton: line search found no decrease in the load step to load "
                     f"factor {rec.load_factor:g} (iteration {rec.iterations}, residual {res:.3e}; "
                     f"residuals {', '.join(f'{v:.2e}' for v in rec.residuals[-6:])})")
-            return 1.0, p_try, noise_try
+            return t_max, p_try, noise_try
         # not a descent direction (projection off): the full Newton step
-        p_try, noise_try = self.potential(x + dx, f)
+        p_try, noise_try = self.potential(x + t_max * dx, f)
         if not np.isfinite(p_try):
             raise EquilibriumError(f"static Newton: energy not finite in the load step to load "
                                    f"factor {rec.load_factor:g}")
-        return 1.0, p_try, noise_try
+        return t_max, p_try, noise_try
 
 
 def _result(body: ElasticBody, x: np.ndarray, records) -> StaticResult:

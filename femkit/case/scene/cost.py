@@ -9,6 +9,7 @@ step are timed on a first batch (:func:`femkit.case.cost.measure_step_seconds`).
 from __future__ import annotations
 
 from ...cost import Plan, check_budget, plan_mesh, plan_scene
+from ..contact import contact_stage, obstacle_facets
 from ..cost import OVERRIDE, measure_step_seconds
 
 __all__ = ["plan_scene_case", "check_scene_fits"]
@@ -40,14 +41,23 @@ def plan_scene_case(case, size, *, build=None, measure: bool = True) -> Plan:
     common = dict(n_nodes=nodes, n_springs=springs, dim=dim, dt=spec.dt, t_end=spec.t_end,
                   every=spec.output.every, outputs=spec.output.files(), method=method,
                   implicit=implicit, name=case.name)
-    plan = _with_mesh(plan_scene(**common), mesh)
+    plan = _with_contact(_with_mesh(plan_scene(**common), mesh), spec, nodes)
     if not measure or build is None:
         return plan
     if system is None:
         check_budget(plan, force=case.options.force, override=OVERRIDE)
         system, integrator, ctx = build()
     per_step = measure_step_seconds(system, integrator, spec.dt, ctx=ctx)
-    return _with_mesh(plan_scene(**common, step_seconds=per_step), mesh)
+    return _with_contact(_with_mesh(plan_scene(**common, step_seconds=per_step), mesh), spec, nodes)
+
+
+def _with_contact(plan: Plan, spec, nodes: float) -> Plan:
+    """``plan`` with barrier contact's stage when the scene declares ``contact:`` (a surface of
+    ~2 triangles per node, a sphere obstacle's 20 * 4^level)."""
+    if getattr(spec, "contact", None) is None:
+        return plan
+    plan.stages.append(contact_stage(spec.steps, 2.0 * nodes + obstacle_facets(spec.contact)))
+    return plan
 
 
 def check_scene_fits(case, size) -> None:

@@ -86,16 +86,18 @@ class FrameStream:
         self.names: list[str] = []
         self.writer = BackgroundWriter(depth, "femkit frame writer", background)
 
-    def add(self, k: int, t: float, x: np.ndarray, v: np.ndarray) -> None:
-        """Queue frame ``k`` (state ``x``, ``v`` at time ``t``; not modified afterwards)."""
+    def add(self, k: int, t: float, x: np.ndarray, v: np.ndarray,
+            point_data: dict | None = None) -> None:
+        """Queue frame ``k`` (state ``x``, ``v`` at time ``t``; not modified afterwards), with
+        extra ``point_data`` (barrier contact's ``contact_force``)."""
         name = f"{self.subdir}/frame_{k:05d}.vtu"
-        self.writer.submit(self._write, self.directory / name, x, v)
+        self.writer.submit(self._write, self.directory / name, x, v, point_data)
         self.names.append(name)
 
-    def _write(self, path: Path, x: np.ndarray, v: np.ndarray) -> None:
+    def _write(self, path: Path, x: np.ndarray, v: np.ndarray, extra=None) -> None:
         stretch = _stretch(x, self._i, self._j, self._rest)
         self._vtu.write(path, x, cell_data={"stretch": [stretch, *self._zeros]},
-                        point_data={"velocity": pad3(v), "pinned": self._pinned})
+                        point_data={"velocity": pad3(v), "pinned": self._pinned, **(extra or {})})
 
     def close(self, stop=None) -> list[str]:
         """Wait for the queued frames; the relative names of those written, in order.

@@ -57,6 +57,7 @@ from ...timing import StageTimer
 from .cost import check_scene_fits
 from ..expressions import compile_expression
 from ..frozen import freeze
+from ..contact import ContactRecorder, build_contact, check_contact_integrator, resolve_obstacle_files
 from ..load import Case
 from ..name_checks import check_geometry_spec, resolve_file
 from ..result import RunResult
@@ -115,6 +116,12 @@ def prepare_scene(case: Case) -> None:
     except InputError as exc:
         raise CaseFileError(str(exc)) from None
 
+    contact = dict(d["contact"]) if d.get("contact") is not None else None
+    if contact is not None:
+        check_contact_integrator(integ.method)
+        contact["obstacles"] = [dict(o) for o in contact.get("obstacles") or []]
+        resolve_obstacle_files(contact, case.base_dir)
+
     # linear solver
     default = KINDS.get(case.problem, "problem").default_solver
     ls_spec = solver_spec(d["linear_solver"], "linear_solver", default_method=default)
@@ -171,7 +178,8 @@ def prepare_scene(case: Case) -> None:
                           bool(out["xdmf"]), bool(out["energy_csv"]), bool(out["png"]),
                           bool(out["gif"])),
         stability=StabilitySpec(bool(st["check"]), float(st["energy_growth_limit"]),
-                                int(st["check_every"])))
+                                int(st["check_every"])),
+        contact=None if contact is None else freeze(contact))
 
 
 def _repeatable() -> str:
@@ -220,6 +228,8 @@ def build_system(case: Case):
         raise with_prefix(exc, "system") from None
     known = case.notes
     known.extend(n for n in (notes[0] if notes else ()) if n not in known)
+    if case.spec.contact is not None:
+        attach_contact(case.spec.contact, system, triangles)
     vel = [case.functions[f"system.velocity[{i}]"]
            for i in range(len(case.spec.system.get("velocity") or []))]
     if vel:
@@ -232,6 +242,28 @@ def build_system(case: Case):
         v0[system.pinned] = 0.0
         system.v0 = np.ascontiguousarray(v0, dtype=float)
     return system, triangles
+
+
+def attach_contact(contact, system, triangles) -> None:
+    """Attach the barrier contact of a ``contact:`` mapping to ``system``, on its triangles (a
+    rope's or a spring mesh's springs without them); raises InputError (one line naming a pair
+    of elements) when the initial state intersects."""
+    cells = triangles if triangles is not None and len(triangles) else system.springs
+    if system.dim == 3 and np.asarray(cells).shape[1] == 2:
+        raise CaseFileError("contact: a 3-D system needs triangles for barrier contact "
+                            "(cloth or mesh systems)")
+    try:
+        system.attach(build_contact(contact, system.x0, cells))
+        system.forces[-1].model.check_intersection_free(system.x0)
+    except CaseFileError:
+        raise
+    except InputError as exc:
+        raise CaseFileError(str(exc)) from None
+
+
+def contact_force(system):
+    """The system's barrier contact force, or None."""
+    return next((f for f in system.forces if getattr(f, "requires_bounded_steps", False)), None)
 
 
 def build_integrator(case: Case):
@@ -274,6 +306,8 @@ def _declared(case: Case, system) -> list[str]:
     kinds = [f["type"] for f in case.spec.forces]
     if "dashpot" not in kinds and np.any(np.asarray(system.damping) != 0):
         kinds.append("dashpot")
+    if case.spec.contact is not None:
+        kinds.append("barrier contact")
     return kinds
 
 
@@ -293,6 +327,7 @@ class SceneResult(RunResult):
     timings: dict
     omega_max: float | None = None
     warnings: list = field(default_factory=list)
+    contact: Any = None                 # ContactRecorder of a run with barrier contact
     output_dir: Path | None = None
     files: list = field(default_factory=list)
     output_stop: str | None = None      # signal that stopped the frame writing, if one did
@@ -389,6 +424,7 @@ class SceneResult(RunResult):
             "warnings": list(self.warnings),
             "timings": dict(self.timings),
             "files": list(self.files),
+            **({} if self.contact is None else {"contact": self.contact.facts()}),
         }
 
     def summary_lines(self) -> list[str]:
@@ -426,6 +462,8 @@ class SceneResult(RunResult):
         if st["dt_exceeds_critical"] and self.instability is None:
             verdict += " (but dt exceeds the critical step: growth may not have shown yet)"
         lines.append(f"verdict   {verdict}" + (f" ({stab})" if stab else ""))
+        if self.contact is not None:
+            lines.append(self.contact.summary_line())
         if self.output_dir is not None:
             lines.append(self.output_line())
         return lines
@@ -482,6 +520,14 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
         frames = None
         if write and case.spec.output.vtu:
             frames = outputs.enter_context(FrameStream(tmp, system, triangles))
+        barrier = contact_force(system)
+        recorder = None if barrier is None else ContactRecorder(barrier)
+        on_record = None if frames is None else frames.add
+        if recorder is not None:  # every recorded frame: distances, pairs, the independent check
+            def on_record(k, t, x, v, _frames=frames):
+                data = recorder.record(t, x)
+                if _frames is not None:
+                    _frames.add(k, t, x, v, point_data=data)
         with timer("simulate"), warnings.catch_warnings(record=True) as wlist:
             warnings.simplefilter("always", StabilityWarning)
             try:
@@ -489,7 +535,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
                                 record_every=every, energy_growth_limit=st.energy_growth_limit,
                                 check_stability=st.check, check_every=st.check_every,
                                 progress=progress, stop=stop,
-                                on_record=None if frames is None else frames.add)
+                                on_record=on_record)
             except InstabilityError as exc:
                 instability = exc
                 traj = exc.partial
@@ -505,7 +551,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
         result = SceneResult(case=case, system=system, integrator=integrator, trajectory=traj,
                              triangles=triangles, instability=instability, every=every,
                              wall_time=time.perf_counter() - t0, timings=timer.times,
-                             omega_max=omega, warnings=caught)
+                             omega_max=omega, warnings=caught, contact=recorder)
         if not quiet:
             for w in caught:
                 print(f"femkit: warning: {w}", file=sys.stderr)

@@ -14,6 +14,7 @@ Every property named here appears in docs/scenes.md (a test checks it).
 
 from __future__ import annotations
 
+from ..contact import CONTACT_SCHEMA
 from ..specs import INTEGRATOR_SCHEMA, LIMITS_SCHEMA, SOLVER_SCHEMA
 from .forces import FORCES
 from ..fragments import POS
@@ -104,6 +105,7 @@ _SCENE: dict = {
         "integrator": INTEGRATOR_SCHEMA,
         "linear_solver": {**SOLVER_SCHEMA, "default": {}},
         "limits": LIMITS_SCHEMA,
+        "contact": CONTACT_SCHEMA,
         "dt": _TIME,
         "t_end": _TIME,
         "stability": {

@@ -70,6 +70,8 @@ class SceneSpec:
         ``round(t_end / dt)``.
     output : OutputSpec
     stability : StabilitySpec
+    contact : Mapping or None
+        The ``contact:`` mapping (barrier contact, obstacle files absolute), None without one.
     """
 
     system: Mapping
@@ -81,3 +83,4 @@ class SceneSpec:
     steps: int
     output: OutputSpec
     stability: StabilitySpec
+    contact: Mapping | None = None

@@ -26,6 +26,7 @@ from __future__ import annotations
 import functools
 import math
 
+from ..contact import contact_stage, obstacle_facets
 from ...cost import Plan, Stage, check_budget, load_constants
 from ...cost.plan import round_down, round_up
 from ..cost import OVERRIDE, geometry_domain
@@ -85,6 +86,8 @@ def plan_solid_case(case, *, measure: bool = True) -> Plan:
     p2 = spec.element == "P2"
     if p2:
         points = points + (points + cells)            # a node per edge
+    if spec.bodies is not None:     # bodies of the file's mesh size each
+        cells, points = cells * len(spec.bodies), points * len(spec.bodies)
     dofs = dim * points
     nnz = dim * dim * (P2_ROW_NODES if p2 else ROW_NODES)[dim] * points
     fill = max(1.0, dofs ** (1.0 / 3.0)) if dim == 3 else max(1.0, math.log(max(dofs, 2.0)))
@@ -113,6 +116,9 @@ def plan_solid_case(case, *, measure: bool = True) -> Plan:
         Stage("output", frames * frame_bytes / 2e7, frame_bytes * 4, out_bytes,
               f"{frames} frames"),
     ]
+    if spec.contact is not None:   # boundary triangles ~ 12 n^(2/3) of n nodes (segments 4 sqrt n)
+        surface = 12.0 * points ** (2.0 / 3.0) if dim == 3 else 4.0 * points ** 0.5
+        stages.append(contact_stage(steps, surface + obstacle_facets(spec.contact)))
     title = (f"{case.name}: {spec.mesh.get('geometry', spec.mesh.get('file'))} "
              f"{'static' if spec.static else spec.integrator.method}")
     sizes = {what: cells, "points": points, "unknowns": dofs, "nonzeros": nnz,

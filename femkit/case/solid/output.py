@@ -46,7 +46,9 @@ def write_solid_frames(directory: str | os.PathLike, result, stop=None) -> list[
         name = f"frames/frame_{k:05d}.vtu"
         write_cells(Path(directory) / name, body.rest_positions, cells,
                     point_data={"displacement": pad3(result.x[k] - body.rest_positions),
-                                "velocity": pad3(result.v[k])},
+                                "velocity": pad3(result.v[k]),
+                                **({"contact_force": result.contact_forces[k]}
+                                   if result.contact_forces else {})},
                     cell_data={"principal_stretches": [s], "von_mises": [f["von_mises"]],
                                "J": [f["J"]], "region": [region]})
         names.append(name)

@@ -45,6 +45,7 @@ from ...errors import (CaseFileError, DegenerateMeshError, EquilibriumError, Inp
 from ...io.atomic import EARLIER_RUN, check_output_dir
 from ...kinds import KINDS
 from ...timing import StageTimer
+from ..contact import ContactRecorder, build_contact, check_contact_integrator, resolve_obstacle_files
 from ..frozen import freeze
 from ..name_checks import check_geometry_spec, resolve_file
 from ..result import RunResult
@@ -100,6 +101,35 @@ def _check_geometry_tags(d, boundaries) -> int | None:
             raise CaseFileError(f"regions: unknown region {name!r} of geometry {entry.name!r}; "
                                 f"valid regions: {', '.join(entry.cell_tags) or '(none)'}")
     return entry.dim
+
+
+def _bodies(d, base, mesh: dict, material, dynamic: bool) -> tuple | None:
+    """``bodies:`` checked: each body's mesh (default the file's ``mesh``), material (default
+    ``material``), offset and velocity; only for a time integration without boundaries or
+    regions (their tags would be ambiguous among the bodies)."""
+    if not d.get("bodies"):
+        return None
+    from ...solids.materials import material_from_spec
+
+    if not dynamic or d["boundaries"] or d["regions"]:
+        raise CaseFileError("bodies: several bodies take a time integration with neither "
+                            "'boundaries' nor 'regions' (free bodies in contact)")
+    out = []
+    for i, b in enumerate(d["bodies"]):
+        where = f"bodies[{i}]"
+        m = dict(b.get("mesh") or mesh)
+        if "mesh" in b and "file" in m:
+            resolve_file(m, f"{where}.mesh", base)
+        elif "mesh" in b:
+            check_geometry_spec(m, f"{where}.mesh")
+        try:
+            mat = material_from_spec(b["material"]) if "material" in b else material
+        except InputError as exc:
+            raise with_prefix(exc, f"{where}.material") from None
+        vel = b.get("velocity", d.get("velocity"))
+        out.append(freeze({"mesh": m, "material": mat, "offset": tuple(b["offset"]),
+                           "velocity": None if vel is None else tuple(vel)}))
+    return tuple(out)
 
 
 def prepare_solid(case) -> None:
@@ -168,6 +198,16 @@ def prepare_solid(case) -> None:
         integ, dt, t_end = None, None, None
         static_spec = StaticSpec(**({} if static is True else dict(static)))
         steps, every = static_spec.load_steps, int(out.get("every", 1))
+    bodies = _bodies(d, case.base_dir, mesh, materials[None], dynamic)
+    contact = dict(d["contact"]) if d.get("contact") is not None else None
+    if contact is not None:
+        if dynamic:
+            check_contact_integrator(integ.method)
+        if not dynamic and contact.get("friction"):
+            raise CaseFileError("contact.friction: friction needs a time integration (it lives "
+                                "on the step's velocity); a static run is frictionless")
+        contact["obstacles"] = [dict(o) for o in contact.get("obstacles") or []]
+        resolve_obstacle_files(contact, case.base_dir)
     directory = str((case.base_dir / out.get("dir", os.path.join("runs", case.name))).resolve())
     out["dir"] = directory
     case.spec = SolidSpec(
@@ -176,7 +216,7 @@ def prepare_solid(case) -> None:
         integrator=integ, solver=solver, dt=dt, t_end=t_end, steps=steps,
         velocity=tuple(d["velocity"]) if "velocity" in d else None,
         output=SolidOutput(directory, every, bool(out["vtu"]), bool(out["png"]), bool(out["gif"])),
-        element=element)
+        element=element, contact=None if contact is None else freeze(contact), bodies=bodies)
 
 
 def _check_element(integ: IntegratorSpec, element: str) -> None:
@@ -235,9 +275,32 @@ def build_mesh(spec: SolidSpec):
     order re-oriented, saying how many); refused with
     :class:`~femkit.errors.DegenerateMeshError` naming the elements when some are inverted
     (cells folded over a neighbour: :func:`folded_cells`)."""
+    if spec.bodies is not None:
+        return _merged_bodies(spec.bodies)
+    return _one_mesh(spec.mesh)
+
+
+def _merged_bodies(bodies):
+    """One mesh of every body's mesh moved by its offset, cells tagged by body (1, 2, ...)."""
+    from ...mesh import Mesh
+
+    points, cells, tags, off = [], [], [], 0
+    for k, b in enumerate(bodies):
+        m = _one_mesh(b["mesh"])
+        offset = np.asarray(b["offset"], float)
+        if len(offset) != m.dim:
+            raise CaseFileError(f"bodies[{k}].offset: needs {m.dim} components, got {len(offset)}")
+        points.append(m.points + offset)
+        cells.append(m.cells + off)
+        tags.append(np.full(m.n_cells, k + 1))
+        off += m.n_points
+    return Mesh(np.concatenate(points), np.concatenate(cells), cell_tags=np.concatenate(tags))
+
+
+def _one_mesh(m):
+    """The validated mesh of one ``mesh:`` mapping (see :func:`build_mesh`)."""
     from ...mesh import generate, read_mesh, validate
 
-    m = spec.mesh
     where = f"mesh.file {m['file']}" if "file" in m else f"mesh.geometry {m['geometry']}"
     try:
         flipped = 0
@@ -304,7 +367,9 @@ def build_problem(case) -> SolidProblem:
             regions[mesh.tag(name)] = mat
         except InputError as exc:
             raise with_prefix(exc, f"regions.{name}") from None
-    if regions:
+    if spec.bodies is not None:   # cells tagged by body
+        material = {k + 1: b["material"] for k, b in enumerate(spec.bodies)}
+    elif regions:
         tags = np.unique(mesh.cell_tags)
         regions.update({int(t): default for t in tags if int(t) not in regions})
         material = regions
@@ -385,6 +450,8 @@ class SolidResult(RunResult):
     stats: dict = field(default_factory=dict)
     output_dir: Any = None
     files: list = field(default_factory=list)
+    contact: Any = None            # ContactRecorder of a run with barrier contact
+    contact_forces: list = field(default_factory=list)   # (n, 3) per frame
     steps: int = 0                   # time or load steps done
     stopped: str | None = None       # the signal that stopped the solve ("SIGINT" ...), if one did
     output_stop: str | None = None   # the signal that stopped the output, if one did
@@ -457,6 +524,7 @@ class SolidResult(RunResult):
             "stats": dict(self.stats),
             "wall_time": float(self.wall_time), "timings": dict(self.timings),
             "files": list(self.files),
+            **({} if self.contact is None else {"contact": self.contact.facts()}),
         }
 
     def summary_lines(self) -> list[str]:
@@ -489,6 +557,8 @@ class SolidResult(RunResult):
                  f"{d['frames']} frames",
                  f"verdict   {self.verdict}" + (f": {self.failure}" if self.failure else ""),
                  self.timings_line()]
+        if self.contact is not None:
+            lines.append(self.contact.summary_line())
         if self.output_dir is not None:
             lines.append(self.output_line())
         return lines
@@ -515,11 +585,15 @@ def _run_static(case, problem: SolidProblem, stop) -> dict:
         out["v"].append(np.zeros_like(x))
         out["energies"].append(frame_energies(problem, x, load_factor=rec.load_factor))
 
+    barrier = None
+    if spec.contact is not None:
+        out["contact"] = solid_contact(spec.contact, x, body)
+        barrier = out["contact"].model
     try:
         solve_static(body, problem.dirichlet(1.0), problem.traction + problem.weight,
                      load_steps=K, project=st.project, rtol=st.rtol,
                      max_iterations=st.max_iterations, linear_solver=spec.solver,
-                     on_step=keep, stop=stop)
+                     on_step=keep, stop=stop, contact=barrier)
     except SolverError as exc:   # Newton or a linear solve failed: the load steps before are kept
         k = len(out["records"]) + 1
         out["failure"] = (f"load step {k}/{K} (load factor {k / K:g}): " + " ".join(str(exc).split()))
@@ -530,6 +604,23 @@ def _run_static(case, problem: SolidProblem, stop) -> dict:
     out["stopped"] = "failure" not in out and len(out["records"]) < K
     out["steps"] = len(out["records"])
     return out
+
+
+def solid_contact(contact, x0, body):
+    """The barrier contact force of a solid's ``contact:`` mapping on its boundary surface; the
+    initial state checked (one line naming a pair of intersecting elements, CaseFileError)."""
+    from ...contact.barrier import BarrierModel
+
+    try:
+        force = build_contact(contact, x0, body.rest.cells)
+        force.model = BarrierModel(np.asarray(x0, float).reshape(body.n, body.dim), force.surface,
+                                   force.obstacles, **force.options)
+        force.model.check_intersection_free(x0)
+    except CaseFileError:
+        raise
+    except InputError as exc:
+        raise CaseFileError(str(exc)) from None
+    return force
 
 
 def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
@@ -547,6 +638,12 @@ def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
     v0 = None
     if spec.velocity is not None:
         v0 = np.broadcast_to(np.asarray(spec.velocity, float), (body.n, body.dim)).copy()
+    if spec.bodies is not None:   # each body's velocity on its nodes
+        v0 = np.zeros((body.n, body.dim))
+        cells, tags = np.asarray(problem.mesh.cells), np.asarray(problem.mesh.cell_tags)
+        for k, b in enumerate(spec.bodies):
+            if b["velocity"] is not None:
+                v0[np.unique(cells[tags == k + 1])] = np.asarray(b["velocity"], float)[:body.dim]
     # every fixed or roller component is held where its displacement puts it, from t = 0
     bc = problem.dirichlet(1.0)
     held = np.zeros(body.ndof, dtype=bool)
@@ -555,8 +652,13 @@ def _run_dynamic(case, problem: SolidProblem, stop, progress) -> dict:
     x0[bc.dofs] += bc.values
     system = elastic_system(body, x0=x0.reshape(body.n, body.dim), v0=v0,
                             pinned=held.reshape(body.n, body.dim), forces=forces)
+    if spec.contact is not None:
+        system.attach(solid_contact(spec.contact, system.x0, body))
+        out_contact = system.forces[-1]
+    else:
+        out_contact = None
     check_explicit_step(case, system)    # a step that can only blow up: refused, nothing written
-    out: dict = {}
+    out: dict = {} if out_contact is None else {"contact": out_contact}
     try:
         traj = simulate(system, spec.integrator.build(), spec.dt, spec.t_end,
                         ctx=StepContext(spec.solver), record_every=spec.output.every,
@@ -639,6 +741,10 @@ def run_solid(case, output_dir: str | os.PathLike | None = None, quiet: bool = F
                          verdict=_verdict(case, run, stop), wall_time=time.perf_counter() - t0,
                          timings=timer.times, stats=run.get("stats", {}),
                          steps=run["steps"], stopped=stop.name if run.get("stopped") else None, warnings=messages)
+    if run.get("contact") is not None:   # every frame: distances, pairs, the independent check
+        result.contact = ContactRecorder(run["contact"])
+        result.contact_forces = [result.contact.record(t, x)["contact_force"]
+                                 for t, x in zip(result.times, result.x)]
     for w in () if quiet else messages:
         print(f"femkit: warning: {w}", file=sys.stderr)
     if write:

@@ -12,6 +12,7 @@ messages name the constant. Every property is described in docs/solids.md.
 
 from __future__ import annotations
 
+from ..contact import CONTACT_SCHEMA
 from ..fragments import POS, closed
 from ..specs import LIMITS_SCHEMA, SOLVER_SCHEMA
 
@@ -119,6 +120,10 @@ def solid_schema() -> dict:
             "dt": _TIME,
             "t_end": _TIME,
             "velocity": _VEC,
+            "bodies": {"type": "array", "minItems": 1, "items": closed(
+                {"mesh": _mesh(), "material": material, "offset": _VEC, "velocity": _VEC},
+                ["offset"])},
+            "contact": CONTACT_SCHEMA,
             "linear_solver": {**SOLVER_SCHEMA, "default": {}},
             "limits": LIMITS_SCHEMA,
             "output": {

@@ -66,6 +66,11 @@ class SolidSpec:
     output : SolidOutput
     element : str
         ``"P1"`` or ``"P2"`` (:data:`femkit.elements.ELEMENTS`).
+    contact : Mapping or None
+        The ``contact:`` mapping (barrier contact, :mod:`femkit.case.contact`), None without.
+    bodies : tuple of Mapping or None
+        ``bodies:``: per body its ``mesh`` (absolute file), ``material`` (a Material),
+        ``offset`` and ``velocity`` (defaults: the file's ``mesh``, ``material``, ``velocity``).
     """
 
     mesh: Mapping
@@ -81,3 +86,5 @@ class SolidSpec:
     velocity: tuple | None
     output: SolidOutput
     element: str = "P1"
+    contact: Mapping | None = None
+    bodies: tuple | None = None

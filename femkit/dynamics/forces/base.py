@@ -5,6 +5,12 @@ calls :meth:`Force.bind` once at construction (precompute per-system arrays) and
 per evaluation, only the methods below. Every method has a "nothing" default, so a
 force implements only what it contributes.
 
+The step protocol of the minimising integrators (``newton``): :meth:`Force.begin_step`,
+:meth:`Force.step_bound` (a line search never steps past it), :meth:`Force.end_iteration`,
+:meth:`Force.relag` and :meth:`Force.end_step`, no-ops here; barrier contact
+(:mod:`.barrier`) uses them and declares ``requires_bounded_steps = True``, which every
+integrator without ``keeps_contact`` refuses.
+
 ``kind`` names the energy bucket (``"gravity"``, ``"contact"``) or ``None`` for
 non-conservative forces. ``constant = True`` declares a force independent of ``x``, ``v``
 and ``t`` (gravity): integrators may then evaluate it once per run
@@ -21,6 +27,9 @@ class Force:
 
     kind: str | None = None
     constant: bool = False
+    #: Only an integrator that bounds every step by :meth:`step_bound` keeps this force's
+    #: guarantee (``Integrator.keeps_contact``); the others refuse it.
+    requires_bounded_steps: bool = False
 
     def bind(self, system) -> None:
         """Precompute per-system data (called once by the system)."""
@@ -55,6 +64,26 @@ class Force:
     def damping(self, x: np.ndarray):
         """Contribution to ``D = -df/dv`` as a sparse matrix, or ``None``."""
         return None
+
+    def begin_step(self, x: np.ndarray, h: float, objective_gradient) -> None:
+        """A minimising step of length ``h`` starts from ``x`` (``objective_gradient(x_flat)``:
+        the step objective's gradient)."""
+
+    def step_bound(self, x: np.ndarray, x_try: np.ndarray) -> float:
+        """The largest admissible fraction of the move ``x -> x_try`` (1: all of it)."""
+        return 1.0
+
+    def end_iteration(self, x: np.ndarray) -> bool:
+        """After an iteration at ``x``; True when this force's energy changed (re-evaluate)."""
+        return False
+
+    def relag(self, x_start: np.ndarray, x: np.ndarray, h: float) -> bool:
+        """Whether the step from ``x_start``, solved to ``x``, is to be solved again with
+        lagged quantities renewed at ``x``."""
+        return False
+
+    def end_step(self) -> None:
+        """The step is over."""
 
 
 def as_vector(value, dim: int, name: str) -> np.ndarray:

@@ -46,6 +46,9 @@ __all__ = [
     "NonlinearConvergenceWarning",
     "NewtonStepError",
     "note_unconverged",
+    "check_contact",
+    "contact_integrators",
+    "contact_refusal",
 ]
 
 
@@ -131,6 +134,12 @@ class Integrator:
     #: or None: any (an integrator that sees only the system's forces and masses).
     elements = None
 
+    #: Whether every step minimises with line-search steps bounded by the forces'
+    #: ``step_bound`` (continuous collision detection), the condition under which barrier
+    #: contact never lets surfaces pass through each other (Li et al. 2020). An integrator
+    #: without it refuses a system with a force that ``requires_bounded_steps``.
+    keeps_contact = False
+
     def start(self, system, x, v, t: float, dt: float, ctx: StepContext) -> StepperState:
         """Initial state: copies of ``x``, ``v`` with pinned velocities zeroed."""
         x = np.array(x, dtype=float, copy=True)
@@ -141,6 +150,7 @@ class Integrator:
                 f"got {x.shape} and {v.shape}"
             )
         v[system.pinned_dofs] = 0.0
+        check_contact(self, system)
         if getattr(self, "matrix_free", False):  # refuse a solver that needs the matrix up front
             check_matrix_free(self.name, ctx)
         return StepperState(x, v, float(t))
@@ -168,6 +178,28 @@ class Integrator:
             "stability_bound": None if math.isinf(bound) else float(bound),
             "options": opts,
         }
+
+
+def contact_integrators() -> list[str]:
+    """The registered integrators that keep barrier contact (``keeps_contact``)."""
+    from .registry import INTEGRATORS
+
+    return [n for n in INTEGRATORS.names() if getattr(INTEGRATORS.get(n), "keeps_contact", False)]
+
+
+def contact_refusal(name: str) -> str:
+    """The one-line refusal of barrier contact under integrator ``name``."""
+    return (f"contact: integrator '{name}' cannot keep barrier contact intersection-free (its "
+            "steps are not minimisations bounded by continuous collision detection); use "
+            f"{' or '.join(contact_integrators())}")
+
+
+def check_contact(integrator, system) -> None:
+    """Refuse (one-line :class:`~femkit.errors.InputError`) a force that requires
+    CCD-bounded steps under an integrator that does not keep contact."""
+    needs = [f for f in system.forces if getattr(f, "requires_bounded_steps", False)]
+    if needs and not integrator.keeps_contact:
+        raise InputError(contact_refusal(integrator.name))
 
 
 # ----------------------------------------------------------------------------- iterative steps

@@ -46,6 +46,16 @@ into the free-dof pattern cached for the run (the clamp applied in the same pass
 once per step on the same pattern) and refactorised by CHOLMOD on the symbolic analysis of the
 first iteration (:meth:`femkit.solvers.session.LinearSession.solve_on_pattern`).
 
+Barrier contact (:class:`~femkit.dynamics.forces.BarrierContact`, IPC: Li et al. 2020): a
+system with a force that ``requires_bounded_steps`` is run the IPC way -- each step starts from
+``x_n`` (``y`` may lie past a contact) after the forces' ``begin_step`` (the barrier stiffness,
+lagged friction); every line search starts from ``t_max = min(1, step_bound)``, the
+collision-free step size of CCD, so no iterate ever crosses a surface; after each iteration
+``end_iteration`` may raise the barrier stiffness (the objective is then re-evaluated);
+convergence is judged on the Newton direction ``||dx||_inf`` (a short CCD-bounded step is no
+sign of convergence); and the step is solved again while ``relag`` asks for another friction
+lagging iteration. ``keeps_contact = True`` declares it (the trait the other integrators lack).
+
 First order; unconditionally stable.
 """
 
@@ -77,6 +87,7 @@ class NewtonImplicitEuler(Integrator):
     order = 1
     implicit = True
     symplectic = False
+    keeps_contact = True    # every line-search step bounded by the forces' step_bound (CCD)
     solves_per_step = 4.0   # ~4 Newton iterations measured on the springs_vs_elements scenes
     #: stopped by the iteration count, not the tolerance
     work_precision = {"newton": ("Newton", "max_iterations", {"tol": 1e-14})}
@@ -185,58 +196,60 @@ class NewtonImplicitEuler(Integrator):
 
         x = y.copy()
         x[~_free_mask(free, xn.size)] = xn[~_free_mask(free, xn.size)]
+        forces = system.forces
+        bounded = any(f.requires_bounded_steps for f in forces)
+        if bounded:  # start where the step began: y may lie past a contact
+            x = xn.copy()
+            for f in forces:
+                f.begin_step(state.x, h, gradient)
         gx, noise = g(x)
         residuals = []
         iterations = 0
-        for iterations in range(1, self.max_iterations + 1):
-            if compiled:  # the matrix first: an elastic body's element pass then serves the gradient
-                data = assemble_with_forces(pat, system, x.reshape(shape), zero_v, state.t,
-                                            diagonal=m, kcoef=h * h, dcoef=0.0, fix=self.fix)[0]
-                data += h * c_data
-            grad = gradient(x)
-            residuals.append(float(np.linalg.norm(grad[free])))
-            dx = np.zeros_like(x)
-            if self.matrix_free:
-                op, diag = self.newton_operator(system, x.reshape(shape), h, C)
-                dx[free] = ctx.session.solve(op, -grad[free], diagonal=diag)
-            elif compiled:
-                dx[free] = ctx.session.solve_on_pattern(
-                    pat.matrix(data), -grad[free], pat,
-                    "newton_factor" if self.reuse_factorization else None)
+        while True:  # once, or once per friction lagging iteration
+            for it in range(1, self.max_iterations + 1):
+                iterations += 1
+                if compiled:  # the matrix first: an elastic body's element pass then serves the gradient
+                    data = assemble_with_forces(pat, system, x.reshape(shape), zero_v, state.t,
+                                                diagonal=m, kcoef=h * h, dcoef=0.0, fix=self.fix)[0]
+                    data += h * c_data
+                grad = gradient(x)
+                residuals.append(float(np.linalg.norm(grad[free])))
+                dx = np.zeros_like(x)
+                if self.matrix_free:
+                    op, diag = self.newton_operator(system, x.reshape(shape), h, C)
+                    dx[free] = ctx.session.solve(op, -grad[free], diagonal=diag)
+                elif compiled:
+                    dx[free] = ctx.session.solve_on_pattern(
+                        pat.matrix(data), -grad[free], pat,
+                        "newton_factor" if self.reuse_factorization else None)
+                else:
+                    H = M + (h * h) * system.stiffness_matrix(x.reshape(shape), fix=self.fix) + h * C
+                    dx[free] = ctx.session.solve(
+                        restrict(H, free), -grad[free], refactor=True,
+                        keep="newton_factor" if self.reuse_factorization else None)
+                t_max = min([1.0] + [f.step_bound(x.reshape(shape), (x + dx).reshape(shape))
+                                     for f in forces]) if bounded else 1.0
+                t, x_try, g_try, noise_try = self._line_search(
+                    g, gradient, x, dx, grad, gx, noise, t_max, free, residuals, state, h,
+                    iterations)
+                # with contact the Newton direction decides (IPC): a CCD-bounded t is no sign
+                # of convergence
+                step_size = (1.0 if bounded else t) * np.abs(dx).max(initial=0.0)
+                x, gx, noise = x_try, g_try, noise_try
+                if bounded and any([f.end_iteration(x.reshape(shape)) for f in forces]):
+                    gx, noise = g(x)   # the barrier stiffness changed: a new objective
+                if step_size <= self.tol * length:
+                    converged = True
+                    break
             else:
-                H = M + (h * h) * system.stiffness_matrix(x.reshape(shape), fix=self.fix) + h * C
-                dx[free] = ctx.session.solve(
-                    restrict(H, free), -grad[free], refactor=True,
-                    keep="newton_factor" if self.reuse_factorization else None)
-            slope = grad[free] @ dx[free]
-            t = 1.0
-            if slope < 0.0:
-                for _ in range(self.max_backtracks):
-                    x_try = x + t * dx
-                    g_try, noise_try = g(x_try)
-                    if g_try <= gx + self.armijo * t * slope + max(noise, noise_try):
-                        break
-                    t *= self.shrink
-                else:  # no decrease above round-off: a full step must lower the residual
-                    t, x_try = 1.0, x + dx
-                    g_try, noise_try = g(x_try)
-                    lower = np.isfinite(g_try) and np.linalg.norm(
-                        gradient(x_try)[free]) < (1.0 - self.armijo) * residuals[-1]
-                    if not lower:
-                        self._fail(state, h, iterations, residuals,
-                                   "the line search found no decrease")
-            else:  # not a descent direction (no definiteness fix): take the full Newton step
-                x_try = x + dx
-                g_try, noise_try = g(x_try)
-            if not np.isfinite(g_try):
-                self._fail(state, h, iterations, residuals, "the objective is not finite")
-            step_size = t * np.abs(dx).max(initial=0.0)
-            x, gx, noise = x_try, g_try, noise_try
-            if step_size <= self.tol * length:
-                converged = True
+                converged = False
+            if not (bounded and converged and any(
+                    [f.relag(state.x, x.reshape(shape), h) for f in forces])):
                 break
-        else:
-            converged = False
+            gx, noise = g(x)
+        if bounded:
+            for f in forces:
+                f.end_step()
         ctx.record("newton_iterations", iterations)
         if not converged:
             note_unconverged(self.name, ctx, state.t + h, self.max_iterations,
@@ -244,6 +257,34 @@ class NewtonImplicitEuler(Integrator):
         x_new = x.reshape(shape)
         v_new = ((x - xn) / h).reshape(shape)
         return StepperState(x_new, v_new, state.t + h)
+
+    def _line_search(self, g, gradient, x, dx, grad, gx, noise, t_max, free, residuals, state,
+                     h, iterations):
+        """Armijo backtracking from ``t_max`` (the forces' step bound, 1 without contact):
+        ``(t, x_try, g_try, noise_try)``; :class:`~.base.NewtonStepError` when it fails."""
+        slope = grad[free] @ dx[free]
+        t = t_max
+        if slope < 0.0:
+            for _ in range(self.max_backtracks):
+                x_try = x + t * dx
+                g_try, noise_try = g(x_try)
+                if g_try <= gx + self.armijo * t * slope + max(noise, noise_try):
+                    break
+                t *= self.shrink
+            else:  # no decrease above round-off: a full step must lower the residual
+                t, x_try = t_max, x + t_max * dx
+                g_try, noise_try = g(x_try)
+                lower = np.isfinite(g_try) and np.linalg.norm(
+                    gradient(x_try)[free]) < (1.0 - self.armijo) * residuals[-1]
+                if not lower:
+                    self._fail(state, h, iterations, residuals,
+                               "the line search found no decrease")
+        else:  # not a descent direction (no definiteness fix): take the full Newton step
+            x_try = x + t_max * dx
+            g_try, noise_try = g(x_try)
+        if not np.isfinite(g_try):
+            self._fail(state, h, iterations, residuals, "the objective is not finite")
+        return t, x_try, g_try, noise_try
 
     def _fail(self, state: StepperState, h: float, iterations: int, residuals: list,
               why: str) -> None:

@@ -1,0 +1,88 @@
+"""Barrier contact benchmark (run by hand): ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_contact.py [--n 41] [--steps 25]``.
+
+The ``cloth_on_sphere`` scene (``cases/scenes/cloth_on_sphere.yaml``: a cloth dropped on a sphere
+resting on the ground, self-contact, friction 0.2) at ``n x n`` vertices, run twice in one
+process with the same ``newton`` integrator, dt and tolerance:
+
+* **contact**: barrier contact on (IPC through ipctk);
+* **free**: the same cloth without ``contact:`` (it falls through the sphere; the contact-free
+  Newton step, the peer of the ratio).
+
+For each: the seconds per step over the steps after the first contact (the steps before it are
+cheap in both), Newton iterations per step, and for the contact run the split of its time among
+the collision broad phase (``NormalCollisions.build``), CCD (``compute_collision_free_stepsize``)
+and the barrier/friction Hessian (``BarrierModel.seconds``); the rest is the Newton step itself
+(springs, the linear solves). The issue's bar is a contact step at most 3x the contact-free one.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+SCENE = Path(__file__).resolve().parents[1] / "cases" / "scenes" / "cloth_on_sphere.yaml"
+
+
+def run(n: int, steps: int, contact: bool, tmp: Path) -> dict:
+    """Seconds per step after the first contact, Newton iterations and (contact) the split."""
+    import yaml
+
+    from femkit import load_case
+    from femkit.case.scene.run import build_context, build_integrator, build_system, contact_force
+
+    data = yaml.safe_load(SCENE.read_text())
+    data["system"].update(nx=n, ny=n)
+    if not contact:
+        data.pop("contact")
+    path = tmp / f"scene_{int(contact)}.yaml"
+    path.write_text(yaml.safe_dump(data))
+    case = load_case(path)
+    system, _ = build_system(case)
+    integ, ctx = build_integrator(case), build_context(case)
+    f = contact_force(system)
+    st = integ.start(system, system.x0, system.v0, 0.0, case.spec.dt, ctx)
+    times, split0, first = [], None, None
+    for k in range(steps):
+        t0 = time.perf_counter()
+        st = integ.step(system, st, case.spec.dt, ctx)
+        times.append(time.perf_counter() - t0)
+        touching = st.x[:, 2].min() < 0.51 if f is None else f.model.active(st.x) > 0
+        if first is None and touching:
+            first = k
+            split0 = None if f is None else dict(f.model.seconds)
+    first = steps if first is None else first
+    after = np.array(times[first:]) if first < steps else np.array(times)
+    its = ctx.stats["newton_iterations"][first:]
+    out = {"per_step": float(after.mean()), "iterations": float(np.mean(its)) if its else 0.0,
+           "steps_measured": len(after), "first_contact_step": first}
+    if f is not None:
+        sec = f.model.seconds
+        out["split"] = {k: (sec[k] - split0[k]) / max(len(after), 1) for k in sec}
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, default=41, help="cloth vertices per side (81: the scene)")
+    ap.add_argument("--steps", type=int, default=25)
+    args = ap.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        free = run(args.n, args.steps, False, Path(tmp))
+        con = run(args.n, args.steps, True, Path(tmp))
+    print(f"cloth {args.n} x {args.n}, {args.steps} steps, measured from the first contact")
+    for name, r in (("contact-free", free), ("barrier contact", con)):
+        print(f"  {name:16s} {1e3 * r['per_step']:9.1f} ms/step, {r['iterations']:5.1f} Newton "
+              f"iterations/step ({r['steps_measured']} steps)")
+    print(f"  ratio contact / free: {con['per_step'] / free['per_step']:.2f} (bar: <= 3)")
+    rest = con["per_step"] - sum(con["split"].values())
+    print("  split of a contact step: " + ", ".join(
+        f"{k} {1e3 * v:.1f} ms" for k, v in con["split"].items()) + f", Newton rest {1e3 * rest:.1f} ms")
+
+
+if __name__ == "__main__":
+    main()

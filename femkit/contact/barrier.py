@@ -1,0 +1,387 @@
+"""The IPC log barrier, its continuous collision detection and smooth lagged friction, by ipctk.
+
+Li et al. 2020 ("Incremental Potential Contact: intersection- and inversion-free,
+large-deformation dynamics", ACM TOG 39(4)): the contact potential is
+``kappa * sum_k b(d_k)`` over the pairs of surface primitives closer than ``dhat``, with the
+clamped log barrier ``b(d) = -(d - dhat)^2 log(d / dhat)`` (ipctk's ``BarrierPotential``), which
+grows without bound as a distance goes to 0. A minimiser that starts intersection-free and
+never steps past the collision-free step size of continuous collision detection (ipctk's
+``compute_collision_free_stepsize``, Tight-Inclusion CCD) therefore never lets two surfaces
+touch: the guarantee of :class:`BarrierModel`'s users, the ``newton`` integrator and the static
+solver. ``kappa`` adapts (IPC's rules, ipctk's ``initial_barrier_stiffness`` and
+``update_barrier_stiffness``) unless given. Friction is IPC's smooth lagged Coulomb friction
+(ipctk's ``TangentialCollisions`` and ``FrictionPotential``): the normal forces and tangent bases
+are frozen ("lagged") at the start of a step, the friction force is ``-grad_v D(v)`` with
+``v = (x - x_n) / h`` and ``D`` mollified below the slip speed ``eps_v``; as a potential of
+``x`` it is ``h D((x - x_n) / h)``, whose gradient is that force (IPC's dissipative potential).
+
+femkit's conventions: positions are node-major ``(n, d)``, the flat dof ``i*d + c``; the
+potential's gradient is ``(n, d)`` on every node of the body (zero off its surface), its Hessian a
+CSR matrix ``n d x n d``. Obstacles are static: their vertices are part of the collision mesh but
+carry no dofs.
+
+ipctk is the optional extra ``femkit[contact]`` (``pip install femkit[contact]``): importing this
+module never needs it; building a :class:`BarrierModel` without it is a one-line
+:class:`~femkit.errors.InputError`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import InputError
+from .surfaces import Obstacle
+
+__all__ = ["BarrierModel", "require_ipctk", "DHAT_SCALE", "REPORT_SCALE"]
+
+#: ``dhat`` by default: this fraction of the bodies' bounding-box diagonal (IPC's 1e-3).
+DHAT_SCALE = 1e-3
+#: Minimum distances are reported up to this many ``dhat`` (farther: ``None``).
+REPORT_SCALE = 10.0
+#: Tight-Inclusion CCD's iteration cap per primitive pair (ipctk's default, 1e7, let one nearly
+#: parallel face pair at a tiny gap -- a cube resting on a cube -- cost tens of seconds; at the
+#: cap the root finder returns its conservative lower bound, so the guarantee stands).
+CCD_MAX_ITERATIONS = 10_000
+
+
+def require_ipctk():
+    """The ipctk module, or a one-line InputError naming the extra to install."""
+    try:
+        import ipctk
+    except ImportError:
+        raise InputError("barrier contact needs ipctk: pip install femkit[contact] "
+                         "(or pip install 'ipctk>=1.6')") from None
+    return ipctk
+
+
+def _positive(value, name: str) -> float:
+    v = float(value)
+    if not (np.isfinite(v) and v > 0.0):
+        raise InputError(f"contact.{name} must be > 0, got {value!r}")
+    return v
+
+
+class BarrierModel:
+    """Barrier contact of one set of bodies (their surfaces) and static obstacles.
+
+    Parameters
+    ----------
+    x0 : (n, d) array
+        The nodes of the bodies (all of them; only the surface's take part).
+    surface : (k, 3) triangles or (k, 2) segments
+        The bodies' contact surface in node numbering (:func:`~.surfaces.body_surface`).
+    obstacles : sequence of Obstacle
+    dhat : float, optional
+        Activation distance; default :data:`DHAT_SCALE` times the bounding-box diagonal of ``x0``.
+    stiffness : float, optional
+        A fixed barrier stiffness ``kappa`` (energy units); default adaptive (IPC).
+    self_contact : bool
+        Whether a connected piece of the surface may touch itself (cloth folding, a bent bar);
+        pieces always touch each other and the obstacles.
+    mu : float
+        Coulomb friction coefficient (0: frictionless).
+    eps_v : float
+        Friction's slip-speed mollifier (velocity units); below it friction is a stiff
+        viscous law.
+    lagging : int
+        Friction lagging iterations per step (normal forces and tangent bases re-frozen at the
+        step's solution and the step solved again, ``lagging - 1`` times).
+
+    Raises
+    ------
+    InputError
+        ``dhat``, ``stiffness`` or ``eps_v`` not > 0, ``mu < 0``, ``lagging < 1``, ipctk missing.
+    """
+
+    def __init__(self, x0, surface, obstacles=(), *, dhat=None, stiffness=None,
+                 self_contact: bool = True, mu: float = 0.0, eps_v: float = 1e-3,
+                 lagging: int = 1):
+        ipctk = require_ipctk()
+        self._ipc = ipctk
+        x0 = np.asarray(x0, dtype=float)
+        self.n, self.dim = x0.shape
+        self.length = float(np.linalg.norm(np.ptp(x0, axis=0))) or 1.0
+        self.dhat = DHAT_SCALE * self.length if dhat is None else _positive(dhat, "dhat")
+        self.fixed_stiffness = None if stiffness is None else _positive(stiffness, "stiffness")
+        if not (np.isfinite(float(mu)) and float(mu) >= 0.0):
+            raise InputError(f"contact.friction must be >= 0, got {mu!r}")
+        self.mu, self.eps_v = float(mu), _positive(eps_v, "eps_v")
+        if int(lagging) < 1:
+            raise InputError(f"contact.lagging must be >= 1, got {lagging!r}")
+        self.lagging = int(lagging)
+        self.self_contact = bool(self_contact)
+        surface = np.asarray(surface, dtype=np.int64)
+        self.surface_nodes, local = np.unique(surface, return_inverse=True)
+        self.nb = len(self.surface_nodes)
+        faces = [local.reshape(surface.shape)]
+        verts, offset = [np.zeros((0, self.dim))], self.nb
+        for ob in obstacles:
+            if ob.dim != self.dim:
+                raise InputError(f"contact.obstacles: {ob.name} is {ob.dim}-D, the bodies "
+                                 f"{self.dim}-D")
+            verts.append(np.asarray(ob.vertices, float))
+            faces.append(np.asarray(ob.faces, np.int64) + offset)
+            offset += len(ob.vertices)
+        self.static = np.concatenate(verts)
+        self.faces = np.ascontiguousarray(np.concatenate(faces), dtype=np.int32)
+        self.n_obstacle_faces = len(self.faces) - len(surface)
+        self.component = self._components()
+        self.mesh = self._collision_mesh(x0)
+        self.barrier = ipctk.BarrierPotential(self.dhat, 1.0)
+        self.ccd = ipctk.TightInclusionCCD(1e-6, CCD_MAX_ITERATIONS)
+        self.kappa = self.fixed_stiffness
+        self.kappa_max = np.inf
+        self.friction = ipctk.FrictionPotential(self.eps_v) if self.mu > 0 else None
+        self._lag = None            # (x_n flat, h, TangentialCollisions) inside a step
+        self._kept = (None, None)   # (collision vertices, NormalCollisions)
+        self.stats = {"collision_builds": 0, "ccd_calls": 0, "hessians": 0}
+        self.seconds = {"broad_phase": 0.0, "ccd": 0.0, "hessian": 0.0}
+
+    # ------------------------------------------------------------------ the collision mesh
+    def _components(self) -> np.ndarray:
+        """Connected piece of every collision vertex (obstacles included)."""
+        from scipy.sparse.csgraph import connected_components
+
+        m = self.nb + len(self.static)
+        f = self.faces.astype(np.int64)
+        rows = np.repeat(f[:, 0], f.shape[1] - 1)
+        cols = f[:, 1:].ravel()
+        graph = sp.coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(m, m))
+        return connected_components(graph, directed=False)[1]
+
+    def _collision_mesh(self, x0):
+        ipc = self._ipc
+        V = self.vertices(x0)
+        if self.dim == 3:
+            mesh = ipc.CollisionMesh(V, ipc.edges(self.faces), self.faces)
+        else:
+            mesh = ipc.CollisionMesh(V, self.faces)
+        allowed = ipc.make_static_obstacle_filter(self.nb)
+        if not self.self_contact:
+            if self.dim == 3:
+                allowed = allowed & ipc.make_connected_components_filter(self.faces)
+            else:
+                comp = self.component
+                allowed = allowed & ipc.CollisionFilter(lambda i, j: bool(comp[i] != comp[j]))
+        mesh.can_collide = allowed
+        return mesh
+
+    def vertices(self, x) -> np.ndarray:
+        """The collision mesh's vertices: the surface nodes of ``x`` then the obstacles'."""
+        x = np.asarray(x, dtype=float).reshape(self.n, self.dim)
+        return np.asfortranarray(np.concatenate([x[self.surface_nodes], self.static]))
+
+    def _collisions(self, x, dhat=None):
+        import time
+
+        V = self.vertices(x)
+        if dhat is None and self._kept[0] is not None and np.array_equal(self._kept[0], V):
+            return V, self._kept[1]
+        t0 = time.perf_counter()
+        c = self._ipc.NormalCollisions()
+        c.build(self.mesh, V, self.dhat if dhat is None else dhat)
+        self.seconds["broad_phase"] += time.perf_counter() - t0
+        self.stats["collision_builds"] += 1
+        if dhat is None:
+            self._kept = (V, c)
+        return V, c
+
+    # ------------------------------------------------------------------ dofs
+    def _to_nodes(self, g_flat) -> np.ndarray:
+        out = np.zeros((self.n, self.dim))
+        out[self.surface_nodes] = np.asarray(g_flat).reshape(-1, self.dim)[:self.nb]
+        return out
+
+    def _to_dofs(self, H) -> sp.csr_matrix:
+        d, nbd = self.dim, self.nb * self.dim
+        H = sp.coo_matrix(H)
+        keep = (H.row < nbd) & (H.col < nbd)
+        dof = (self.surface_nodes[:, None] * d + np.arange(d)).ravel()
+        return sp.csr_matrix((H.data[keep], (dof[H.row[keep]], dof[H.col[keep]])),
+                             shape=(self.n * d, self.n * d))
+
+    # ------------------------------------------------------------------ the barrier
+    @property
+    def kappa_value(self) -> float:
+        """The barrier stiffness now (0 before it is initialised)."""
+        return 0.0 if self.kappa is None else float(self.kappa)
+
+    def energy(self, x) -> float:
+        """``kappa * sum b(d_k)`` (+ the lagged friction potential inside a step)."""
+        V, c = self._collisions(x)
+        e = self.kappa_value * float(self.barrier(c, self.mesh, V)) if len(c) else 0.0
+        return e + self._friction_energy(x)
+
+    def barrier_gradient(self, x) -> np.ndarray:
+        """Gradient ``(n, d)`` of the unit-stiffness barrier ``sum b(d_k)``."""
+        V, c = self._collisions(x)
+        if not len(c):
+            return np.zeros((self.n, self.dim))
+        return self._to_nodes(self.barrier.gradient(c, self.mesh, V))
+
+    def gradient(self, x) -> np.ndarray:
+        """Gradient ``(n, d)`` of :meth:`energy` (minus the contact force)."""
+        g = self.kappa_value * self.barrier_gradient(x) if self.kappa else \
+            np.zeros((self.n, self.dim))
+        return g + self._friction_gradient(x)
+
+    def hessian(self, x, project: bool = True) -> sp.csr_matrix:
+        """Hessian of :meth:`energy`, CSR ``n d x n d``; ``project``: each collision's block
+        projected onto its positive semi-definite part (ipctk's clamp)."""
+        import time
+
+        t0 = time.perf_counter()
+        V, c = self._collisions(x)
+        how = self._ipc.PSDProjectionMethod.CLAMP if project else \
+            self._ipc.PSDProjectionMethod.NONE
+        H = None
+        if len(c) and self.kappa:
+            H = self.kappa_value * self._to_dofs(self.barrier.hessian(c, self.mesh, V, how))
+        F = self._friction_hessian(x, how)
+        if F is not None:
+            H = F if H is None else H + F
+        self.stats["hessians"] += 1
+        self.seconds["hessian"] += time.perf_counter() - t0
+        return H if H is not None else sp.csr_matrix((self.n * self.dim,) * 2)
+
+    def max_step(self, x0, x1) -> float:
+        """The collision-free fraction of the straight move ``x0 -> x1`` (CCD), in ``[0, 1]``."""
+        import time
+
+        t0 = time.perf_counter()
+        t = float(self._ipc.compute_collision_free_stepsize(
+            self.mesh, self.vertices(x0), self.vertices(x1), narrow_phase_ccd=self.ccd))
+        self.stats["ccd_calls"] += 1
+        self.seconds["ccd"] += time.perf_counter() - t0
+        return t
+
+    def active(self, x) -> int:
+        """The number of primitive pairs closer than ``dhat``."""
+        return len(self._collisions(x)[1])
+
+    def min_distance(self, x) -> float | None:
+        """The smallest distance between surface primitives that may touch, when below
+        :data:`REPORT_SCALE` ``* dhat`` (``None``: all farther)."""
+        V, c = self._collisions(x, REPORT_SCALE * self.dhat)
+        if not len(c):
+            return None
+        return float(np.sqrt(c.compute_minimum_distance(self.mesh, V)))
+
+    # ------------------------------------------------------------------ stiffness
+    def init_stiffness(self, grad_energy, average_mass: float, scale: float = 1.0, x=None) -> None:
+        """IPC's initial stiffness (once, unless fixed): ``kappa`` minimising the gradient of the
+        objective ``grad_energy + scale * kappa * grad b`` at ``x``, clamped to IPC's range from
+        ``average_mass``; ``scale`` is the objective's weight of a potential (``h^2`` in implicit
+        Euler, 1 in statics)."""
+        if self.kappa is not None:
+            return
+        gb = scale * self.barrier_gradient(x).reshape(-1)
+        k, kmax = self._ipc.initial_barrier_stiffness(
+            self.length, self.barrier.barrier, self.dhat, float(average_mass),
+            np.asarray(grad_energy, float).reshape(-1), gb)
+        self.kappa, self.kappa_max = k / scale, kmax / scale
+        self._prev_d = self._squared_min(x)
+
+    def _squared_min(self, x) -> float:
+        V, c = self._collisions(x)
+        return float(c.compute_minimum_distance(self.mesh, V)) if len(c) else np.inf
+
+    def update_stiffness(self, x) -> bool:
+        """IPC's update after a Newton iteration: ``kappa`` doubles (up to its maximum) while the
+        minimum distance keeps shrinking below ``1e-9`` of the scene; True when it changed."""
+        if self.fixed_stiffness is not None or self.kappa is None:
+            return False
+        d = self._squared_min(x)
+        new = self._ipc.update_barrier_stiffness(self._prev_d, d, self.kappa_max, self.kappa,
+                                                 self.length)
+        self._prev_d = d
+        changed = new != self.kappa
+        self.kappa = float(new)
+        return bool(changed)
+
+    # ------------------------------------------------------------------ friction
+    def lag_friction(self, x_start, x_basis, h: float) -> None:
+        """Freeze the friction of a step from ``x_start`` of length ``h``: normal forces and
+        tangent bases at ``x_basis`` (``x_start`` first, the step's solution at a lagging
+        iteration)."""
+        if self.friction is None:
+            return
+        V, c = self._collisions(x_basis)
+        tc = self._ipc.TangentialCollisions()
+        if len(c):
+            tc.build(self.mesh, V, c, self._ipc.BarrierPotential(self.dhat, self.kappa_value),
+                     self.mu)
+        self._lag = (np.asarray(x_start, float).reshape(self.n, self.dim).copy(), float(h), tc)
+
+    def end_step(self) -> None:
+        """Friction is off outside a step (it lives on the step's velocity)."""
+        self._lag = None
+
+    def _velocities(self, x):
+        xs, h, tc = self._lag
+        return self.vertices((np.asarray(x, float).reshape(self.n, self.dim) - xs) / h), h, tc
+
+    def _friction_active(self) -> bool:
+        return self._lag is not None and len(self._lag[2]) > 0
+
+    def _friction_energy(self, x) -> float:
+        if not self._friction_active():
+            return 0.0
+        W, h, tc = self._velocities(x)
+        W[self.nb:] = 0.0
+        return h * float(self.friction(tc, self.mesh, W))
+
+    def _friction_gradient(self, x) -> np.ndarray:
+        if not self._friction_active():
+            return np.zeros((self.n, self.dim))
+        W, h, tc = self._velocities(x)
+        W[self.nb:] = 0.0
+        return self._to_nodes(self.friction.gradient(tc, self.mesh, W))
+
+    def _friction_hessian(self, x, how):
+        if not self._friction_active():
+            return None
+        W, h, tc = self._velocities(x)
+        W[self.nb:] = 0.0
+        return self._to_dofs(self.friction.hessian(tc, self.mesh, W, how)) / h
+
+    # ------------------------------------------------------------------ checks
+    def check_intersection_free(self, x, where: str = "initial state") -> None:
+        """Raise a one-line InputError naming a pair of intersecting surface elements of ``x``
+        (the independent test :func:`~.check.intersecting_pairs`), or a pair at distance 0."""
+        from .check import intersecting_pairs
+
+        V = self.vertices(x)
+        pairs = intersecting_pairs(V, self.faces, self._allowed_faces)
+        if len(pairs):
+            i, j = pairs[0]
+            raise InputError(f"contact: the {where} intersects: {self.describe_face(i)} "
+                             f"crosses {self.describe_face(j)} ({len(pairs)} intersecting "
+                             "pair(s)); move the bodies apart")
+        d = self.min_distance(x)
+        if d is not None and d <= 0.0:
+            raise InputError(f"contact: the {where} has surfaces touching (distance 0); move "
+                             "the bodies apart")
+
+    def _allowed_faces(self, i, j) -> np.ndarray:
+        fi, fj = self.faces[i, 0], self.faces[j, 0]
+        dynamic = (fi < self.nb) | (fj < self.nb)
+        if self.self_contact:
+            return dynamic
+        return dynamic & (self.component[fi] != self.component[fj])
+
+    def describe_face(self, k: int) -> str:
+        """``'surface triangle 12 (nodes 3, 4, 9)'`` or ``'obstacle triangle 2'``."""
+        kind = "triangle" if self.faces.shape[1] == 3 else "segment"
+        body = len(self.faces) - self.n_obstacle_faces
+        if k < body:
+            nodes = ", ".join(str(int(self.surface_nodes[v])) for v in self.faces[k])
+            return f"surface {kind} {k} (nodes {nodes})"
+        return f"obstacle {kind} {k - body}"
+
+    def intersections(self, x) -> int:
+        """How many pairs of surface elements of ``x`` intersect (the independent test)."""
+        from .check import intersecting_pairs
+
+        return len(intersecting_pairs(self.vertices(x), self.faces, self._allowed_faces))
