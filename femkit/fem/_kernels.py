@@ -373,9 +373,6 @@ def warm_up() -> None:
     for cells, pts, slots, nnz_ in ((tri, pts, slots, nnz), (tet, p3, slots3, nnz3)):
         w = cells.shape[1]
         _element_stiffness(cells, pts, np.ones(1), True, np.ones((w * w, w * w)), slots, nnz_)
-    from ._element_kernels import warm_up as element_kernels
-
-    element_kernels()  # P2's pattern, stiffness and load passes
 
 
 @numba.njit(cache=True)

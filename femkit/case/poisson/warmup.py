@@ -159,6 +159,9 @@ def warm_up(echo: Callable[[str], object] | None = None, multigrid: bool = True,
         one_off_kernels(dims)  # the incidence rows of a mesh read (the tiny case's are refined)
 
         assembly_kernels()  # the cached-pattern assembly, which a one-off run does not call
+        from ...fem._element_kernels import warm_up as element_kernels
+
+        element_kernels()  # P2's pattern, stiffness and load passes
         from ...mesh._refine_kernel import warm_up as refinement_kernels
 
         refinement_kernels(dims=dims)  # a renumbered (large) hierarchy's, which the tiny cases skip
