@@ -348,13 +348,15 @@ class SolidProblem:
         return bc
 
 
-def build_problem(case) -> SolidProblem:
-    """Mesh, body (a material per region), boundary conditions and loads of a prepared case."""
+def build_problem(case, mesh=None) -> SolidProblem:
+    """Mesh, body (a material per region), boundary conditions and loads of a prepared case;
+    ``mesh`` (optional) replaces the case's own (a refinement of it, with its tags: a study's
+    levels)."""
     from ...solids import ElasticBody, body_forces, traction_forces
     from ...solids.boundary import tagged_facets
 
     spec = case.spec
-    mesh = build_mesh(spec)
+    mesh = build_mesh(spec) if mesh is None else mesh
     d = mesh.dim
     for key, v in (("gravity", spec.gravity), ("velocity", spec.velocity)):
         if v is not None and len(v) != d:
