@@ -4,7 +4,7 @@ from __future__ import annotations
 
 __all__ = ["build", "summary", "crossover_line"]
 
-_NAMES = {"L2": "L2", "H1_semi": "H1 seminorm", "corner": "relative displacement error"}
+_NAMES = {"L2": "L2", "H1_semi": "H1 seminorm", "corner": "relative displacement"}
 _COLUMNS = {"corner": ["displacement", "corner"], None: ["nnz", "iterations", "L2", "H1_semi"]}
 
 

@@ -125,7 +125,7 @@ def _adaptive_records(study, quiet: bool) -> list[dict]:
         nodes_per_dof = get_element(element, mesh0.dim).degree ** mesh0.dim   # P2: ~4 (2D), ~8 (3D)
         loop = adaptive_solve(solve_on, mesh0, theta=a["theta"], estimator=a["estimator"],
                               max_dofs=max(a["max_dofs"] // nodes_per_dof, mesh0.n_points + 1),
-                              grad_exact=exact_gradient(case))
+                              max_levels=None, grad_exact=exact_gradient(case))   # max_dofs bounds it
         for lv in loop.levels:
             records.append({"element": f"{element} adaptive", "refinement": "adaptive",
                             "level": lv.level, "cells": lv.n_elements, "h": None, "dofs": lv.dofs,
