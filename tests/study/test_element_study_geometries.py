@@ -125,3 +125,15 @@ def test_bad_input_is_one_line(base, change, error, says):
     with pytest.raises(error) as err:
         study_from_dict(data, name="bad")
     assert says in str(err.value) and "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("reference, says", [
+    ({"point": [47.0, 60.0], "component": 1, "value": 1.0}, "reference.point [47.0, 60.0] is not a node"),
+    ({"point": [48.0, 60.0], "component": 2, "value": 1.0}, "valid: 0 (x), 1 (y)"),
+])
+def test_a_bad_reference_is_refused_before_any_solve(reference, says, tmp_path):
+    study = study_from_dict({**COOK, "reference": reference}, name="bad")
+    with pytest.raises(CaseFileError) as err:
+        run_study(study, tmp_path / "out")
+    assert says in str(err.value) and "\n" not in str(err.value)
+    assert not (tmp_path / "out").exists()

@@ -57,7 +57,9 @@ def solid_records(study, *, quiet: bool = False) -> list[dict]:
     meshes = [build_mesh(cases[d.elements[0]].spec)]
     comp, value = int(ref["component"]), float(ref["value"])
     if comp >= meshes[0].dim:
-        raise CaseFileError(f"reference.component: {comp} for a {meshes[0].dim}D mesh")
+        raise CaseFileError(f"reference.component: {comp} for a {meshes[0].dim}D mesh; valid: "
+                            + ", ".join(f"{i} ({'xyz'[i]})" for i in range(meshes[0].dim)))
+    _node(meshes[0].points, ref["point"])      # refused before any solve
     jobs = [(e, k) for e, count in zip(d.elements, d.counts) for k in range(count)]
     if d.warmup:                                # untimed: compiled kernels, factorisation set-up
         for e in d.elements:

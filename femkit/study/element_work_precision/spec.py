@@ -87,7 +87,7 @@ class ElementStudySpec(StudySpec, PoissonSource):
     error_order: int
     adaptive: Mapping | None = None      # {elements, theta, max_dofs, estimator}: extra series
     reference: Mapping | None = None     # a solid base case: {point, component, value}
-    case_overrides: Mapping = None
+    case_overrides: Mapping | None = None  # solid base case only: merged into it
 
     @classmethod
     def from_data(cls, d: Mapping) -> "ElementStudySpec":
