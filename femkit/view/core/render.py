@@ -277,9 +277,15 @@ def movie(picture: Picture, path: str | os.PathLike, size: tuple[int, int] = (80
     with atomic_path(path) as tmp:
         if path.suffix.lower() == ".gif":
             imageio.mimsave(tmp, images, format="GIF", duration=1000.0 / fps, loop=0)
-        else:
-            imageio.mimsave(tmp, images, fps=fps)
+        else:  # H.264 in yuv420p: even sides, kept as drawn (no resize, no warning)
+            imageio.mimsave(tmp, [_even(img) for img in images], fps=fps, macro_block_size=2)
     return path
+
+
+def _even(img: np.ndarray) -> np.ndarray:
+    """``img`` with a white row and column appended where its height or width is odd."""
+    h, w = img.shape[:2]
+    return np.pad(img, ((0, h % 2), (0, w % 2), (0, 0)), constant_values=255)
 
 
 def show(picture: Picture, frame: int = -1, size: tuple[int, int] = (1024, 768)) -> None:
