@@ -25,7 +25,7 @@ from ...errors import InputError, ViewUnavailableError
 from .picture import Picture
 
 __all__ = ["pyvista", "display_available", "offscreen_available", "plotter", "draw", "image",
-           "png_bytes", "screenshot", "movie", "show", "check_movie_path", "frame_index",
+           "series_camera", "encode_png", "png_bytes", "screenshot", "movie", "show", "check_movie_path", "frame_index",
            "frame_slider", "plane_bounds", "colour_range", "MOVIE_SUFFIXES",
            "INSTALL_VIEW", "INSTALL_OFFSCREEN"]
 
@@ -206,25 +206,46 @@ def frame_index(picture: Picture, frame: int) -> int:
     return frame
 
 
-def image(picture: Picture, frame: int = -1, size: tuple[int, int] = (1280, 960)) -> np.ndarray:
-    """Frame ``frame`` rendered off screen: an ``(height, width, 3)`` array of RGB bytes."""
+def image(picture: Picture, frame: int = -1, size: tuple[int, int] = (1280, 960), *,
+          camera: tuple | None = None) -> np.ndarray:
+    """Frame ``frame`` rendered off screen: an ``(height, width, 3)`` array of RGB bytes, in the
+    colour range of every frame; ``camera`` (a pyvista camera position) replaces the frame's
+    own view (a time series drawn with one camera: :func:`series_camera`)."""
     p = plotter(size, off_screen=True)
     try:
         draw(p, picture, frame_index(picture, frame))
+        if camera is not None:
+            p.camera_position = camera
         return np.asarray(p.screenshot(None, return_img=True))
     finally:
         p.close()
 
 
-def png_bytes(picture: Picture, frame: int = -1, size: tuple[int, int] = (1280, 960)) -> bytes:
-    """Frame ``frame`` as PNG bytes (what a notebook shows inline)."""
+def series_camera(picture: Picture, size: tuple[int, int]) -> tuple:
+    """The camera position of the first frame of ``picture`` drawn at ``size``: the one view of
+    every frame of a movie and of the notebook's slider."""
+    p = plotter(size, off_screen=True)
+    try:
+        draw(p, picture, 0)
+        return tuple(p.camera_position)
+    finally:
+        p.close()
+
+
+def encode_png(img: np.ndarray) -> bytes:
+    """An RGB array as PNG bytes."""
     import io
 
     from PIL import Image
 
     buf = io.BytesIO()
-    Image.fromarray(image(picture, frame, size)).save(buf, format="PNG", optimize=True)
+    Image.fromarray(img).save(buf, format="PNG", optimize=True)
     return buf.getvalue()
+
+
+def png_bytes(picture: Picture, frame: int = -1, size: tuple[int, int] = (1280, 960)) -> bytes:
+    """Frame ``frame`` as PNG bytes (what a notebook shows inline)."""
+    return encode_png(image(picture, frame, size))
 
 
 def screenshot(picture: Picture, path: str | os.PathLike, frame: int = -1,
