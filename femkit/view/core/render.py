@@ -239,7 +239,7 @@ def encode_png(img: np.ndarray) -> bytes:
     from PIL import Image
 
     buf = io.BytesIO()
-    Image.fromarray(img).save(buf, format="PNG", optimize=True)
+    Image.fromarray(img).save(buf, format="PNG")  # optimize=True: 5x the time for 5 % fewer bytes
     return buf.getvalue()
 
 
