@@ -1,6 +1,7 @@
 """Every kind's picture rendered off screen and judged by its pixels; ``femkit view`` writes
-valid files; the refusals (no pyvista, no off-screen OpenGL, a bad field) are one line, exit 2,
-nothing written.
+valid files (PNG, GIF, MP4; a Poisson run directory's indicators ``eta``); the notebook's frame
+slider shows the frame it points at; the refusals (no pyvista, no off-screen OpenGL, no
+imageio-ffmpeg for an MP4, a bad field) are one line, exit 2, nothing written.
 
 One small run per kind and shape (module-scoped): Poisson 2D (in memory, with its estimator's
 indicators) and 3D (the adaptive Fichera corner, from its run directory), a 2D scene with its
