@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import MeshError
 from .mesh import Mesh
-from .vtk import write_cells
+from .vtk import Later, write_cells
 
 _SIDECAR = ".tags.json"
 
@@ -306,7 +306,8 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = No
         ``.vtu``, ``.xdmf`` or any other meshio format
     point_data : ``{name: (n,) or (n, k) array}``
     cell_data : ``{name: (m,) or (m, k) array}`` on the cells (tagged boundary facets get
-        zeros in the written file)
+        zeros in the written file), or a :class:`~femkit.mesh.vtk.Later` whose values come
+        while the file is written
     compression : ``.vtu`` only: ``none``, ``zlib`` or ``lzma``
         (:data:`femkit.mesh.vtk.COMPRESSIONS`; default :data:`~femkit.mesh.vtk.DEFAULT_COMPRESSION`)
 
@@ -332,7 +333,7 @@ def write_mesh(path: str | os.PathLike, mesh: Mesh, point_data: dict | None = No
     cdata = {"gmsh:physical": per_block(cell_tags, facet_tags),
              "gmsh:geometrical": per_block(cell_tags, facet_tags)}
     for name, arr in (cell_data or {}).items():
-        a = np.asarray(arr)
+        a = arr if isinstance(arr, Later) else np.asarray(arr)  # Later: values still to come
         if a.shape[0] != m:
             raise MeshError(f"cell_data {name!r} has {a.shape[0]} rows, mesh has {m} "
                             f"{'triangles' if mesh.dim == 2 else 'tetrahedra'}")

@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import MeshError
 
 __all__ = ["write_cells", "write_collection", "write_parallel_index", "pad3", "vtu_header",
-           "reappended", "COMPRESSIONS", "DEFAULT_COMPRESSION"]
+           "reappended", "Later", "COMPRESSIONS", "DEFAULT_COMPRESSION"]
 
 #: Compression of the binary arrays of a ``.vtu`` file (VTK's ``compressor`` attribute):
 #: ``none`` writes at disk speed (about 2x the bytes of ``zlib``), ``zlib`` is VTK's usual
@@ -48,6 +48,65 @@ def pad3(points: np.ndarray) -> np.ndarray:
     if a.shape[1] == 3:
         return a
     return np.concatenate([a, np.zeros((a.shape[0], 3 - a.shape[1]))], axis=1)
+
+
+class Later:
+    """A data array whose values another thread hands over while its file is being written
+    (a Poisson run's error indicators, known after the solution file was begun).
+
+    Its rows and type are known at once, so the ``.vtu`` declares it and its bytes are a hole
+    that is filled when :meth:`get` returns (the raw appended writer: everything else is
+    written first; other formats and compressions wait for it before writing anything).
+    :meth:`set` hands the values over; :meth:`abandon` makes a waiting :meth:`get` fail (the
+    run failed, nothing is to be written).
+
+    Parameters
+    ----------
+    rows : int
+        The array's length.
+    dtype : numpy dtype
+        Its type (one of VTK's; float64 by default).
+    """
+
+    _POLL = 0.05  # seconds between looks, so a cancelled writer is never stuck here
+
+    def __init__(self, rows: int, dtype=np.float64):
+        import threading
+
+        self.shape = (int(rows),)
+        self.dtype = np.dtype(dtype)
+        self.nbytes = self.shape[0] * self.dtype.itemsize
+        self.ndim = 1
+        self._ready = threading.Event()
+        self._value: np.ndarray | None = None
+
+    def set(self, values) -> None:
+        """Hand the values over (``rows`` of them, cast to the declared type)."""
+        a = np.asarray(values, dtype=self.dtype)
+        if a.shape != self.shape:
+            raise MeshError(f"a data array declared with {self.shape[0]} rows was given "
+                            f"{a.shape[0] if a.ndim else 0}")
+        self._value = a
+        self._ready.set()
+
+    def abandon(self) -> None:
+        """Make :meth:`get` fail: the values will never come."""
+        self._ready.set()
+
+    def get(self) -> np.ndarray:
+        """The values, once :meth:`set` gave them (waiting until then)."""
+        while not self._ready.wait(self._POLL):
+            pass
+        if self._value is None:
+            raise MeshError("the file was abandoned before its last array was given")
+        return self._value
+
+
+def _resolved(data: dict | None) -> dict:
+    """``data`` with every :class:`Later` replaced by its values (waiting for them)."""
+    return {name: ([p.get() if isinstance(p, Later) else p for p in v] if isinstance(v, list)
+                   else v.get() if isinstance(v, Later) else v)
+            for name, v in (data or {}).items()}
 
 
 def write_cells(path: str | os.PathLike, points: np.ndarray, cells: Sequence[tuple[str, np.ndarray]],
@@ -90,8 +149,8 @@ def write_cells(path: str | os.PathLike, points: np.ndarray, cells: Sequence[tup
         return Path(p)
     import meshio
 
-    out = meshio.Mesh(pts, blocks, point_data=point_data or {}, cell_data=cell_data or {},
-                      field_data=field_data or {})
+    out = meshio.Mesh(pts, blocks, point_data=_resolved(point_data),
+                      cell_data=_resolved(cell_data), field_data=field_data or {})
     kwargs = {} if binary is None else {"binary": binary}
     if (file_format or Path(p).suffix.lower().lstrip(".")) == "vtu":
         kwargs["compression"] = COMPRESSIONS[compression]
@@ -116,6 +175,8 @@ def _native(a: np.ndarray, contiguous: bool = True) -> np.ndarray:
     """``a`` as a native-order array of one of VTK's types (booleans as UInt8, other types as
     Int64 or Float64), C-contiguous unless ``contiguous`` is false (a broadcast constant stays
     a view: :func:`_write_appended` writes it a block of rows at a time)."""
+    if isinstance(a, Later):
+        return a  # written when its values come (:func:`_write_appended`)
     a = np.asarray(a)
     if a.dtype == bool:
         a = a.astype(np.uint8)
@@ -137,6 +198,8 @@ def _write_vtu_raw(path: str, points: np.ndarray, blocks: list, point_data: dict
         pieces = [_native(a, contiguous=False) for a in pieces]
         dtypes = {a.dtype for a in pieces}
         if len(dtypes) > 1:
+            if any(isinstance(a, Later) for a in pieces):
+                raise MeshError(f"{section} array {name!r}: its pieces' types differ")
             common = np.result_type(*dtypes)
             pieces = [a.astype(common) for a in pieces]
         dtype = pieces[0].dtype
@@ -170,10 +233,10 @@ def _write_vtu_raw(path: str, points: np.ndarray, blocks: list, point_data: dict
     add("Cells", "types", [np.full(len(c), _vtk_cell_type(kind), np.uint8)
                            for (kind, _), c in zip(blocks, conn)])
     for name, a in point_data.items():
-        a = np.asarray(a)
+        a = a if isinstance(a, Later) else np.asarray(a)
         add("PointData", name, [a], a.shape[1] if a.ndim == 2 else None)
     for name, per_block in cell_data.items():
-        a0 = np.asarray(per_block[0])
+        a0 = per_block[0] if isinstance(per_block[0], Later) else np.asarray(per_block[0])
         add("CellData", name, list(per_block), a0.shape[1] if a0.ndim == 2 else None)
 
     pts = np.asarray(points, dtype=np.float64)
@@ -248,16 +311,23 @@ def _write_appended(f, header: bytes, arrays: list) -> None:
     (given in the order declared, written in reverse: see :func:`_appended_header`): its
     UInt64 size, then the pieces' memory as it is (no copy, no encoding; a piece that is
     not contiguous, e.g. a broadcast constant, a block of rows at a time)."""
+    holes = []  # (file position, Later): filled last, when their values have come
     f.write(header)
     for nbytes, pieces in reversed(arrays):
         f.write(np.uint64(nbytes).tobytes())
         for a in pieces:
-            if a.flags.c_contiguous:
+            if isinstance(a, Later):
+                holes.append((f.tell(), a))
+                f.seek(a.nbytes, os.SEEK_CUR)
+            elif a.flags.c_contiguous:
                 f.write(memoryview(a).cast("B"))
-                continue
-            for lo in range(0, len(a), _ROWS):
-                f.write(memoryview(np.ascontiguousarray(a[lo:lo + _ROWS])).cast("B"))
+            else:
+                for lo in range(0, len(a), _ROWS):
+                    f.write(memoryview(np.ascontiguousarray(a[lo:lo + _ROWS])).cast("B"))
     f.write(b"\n</AppendedData>\n</VTKFile>\n")
+    for at, later in holes:
+        f.seek(at)
+        f.write(memoryview(_native(later.get().astype(later.dtype, copy=False))).cast("B"))
 
 
 #: VTK's cell type numbers of the cells femkit writes (others: meshio's table).

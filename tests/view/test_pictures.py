@@ -1,6 +1,7 @@
 """Every kind's picture rendered off screen and judged by its pixels; ``femkit view`` writes
-valid files; the refusals (no pyvista, no off-screen OpenGL, a bad field) are one line, exit 2,
-nothing written.
+valid files (PNG, GIF, MP4; a Poisson run directory's indicators ``eta``); the notebook's frame
+slider shows the frame it points at; the refusals (no pyvista, no off-screen OpenGL, no
+imageio-ffmpeg for an MP4, a bad field) are one line, exit 2, nothing written.
 
 One small run per kind and shape (module-scoped): Poisson 2D (in memory, with its estimator's
 indicators) and 3D (the adaptive Fichera corner, from its run directory), a 2D scene with its
@@ -171,11 +172,6 @@ def test_a_bad_field_is_one_line_naming_the_valid_ones_nothing_written(runs, tmp
              ".gif")
     _refused(capsys, ["view", str(tmp_path), "--screenshot", str(png)], "result.json")
     _refused(capsys, ["view", str(runs["solid"].output_dir), "--size", "big"], "WIDTHxHEIGHT")
-    import importlib.util
-
-    if importlib.util.find_spec("imageio_ffmpeg") is None:  # MP4 needs it: said in one line
-        _refused(capsys, ["view", str(runs["solid"].output_dir), "--movie",
-                          str(tmp_path / "x.mp4")], "pip install imageio-ffmpeg")
     assert not list(tmp_path.iterdir())
 
 
@@ -232,8 +228,9 @@ def test_a_3d_study_report_embeds_the_solution_and_works_without_pyvista(tmp_pat
     assert (tmp_path / "without" / "figures" / "error_vs_h.png").is_file()
 
 
-#: Every bundled case and scene file with FEMKIT_VIEW_ALL=1 (a few minutes: cube.yaml alone is a
-#: minute); the default run draws two cheap ones this way, beside the runs above.
+#: Every bundled case and scene file with FEMKIT_VIEW_ALL=1 (.ci/run runs it as a step of its
+#: own after the suite: about a minute on 2 cores with the kernels compiled); the default run
+#: draws two cheap ones this way, beside the runs of every kind above.
 BUNDLED = sorted((ROOT / "cases").glob("*.yaml")) + \
     sorted((ROOT / "cases" / "scenes").glob("*.yaml"))
 if os.environ.get("FEMKIT_VIEW_ALL") != "1":
@@ -241,17 +238,27 @@ if os.environ.get("FEMKIT_VIEW_ALL") != "1":
 
 
 def _small(path: Path) -> dict:
-    """Overrides that make a bundled file's run short, by its kind."""
+    """Overrides that make a bundled file's run short, by its kind: a coarser mesh, fewer
+    adaptive levels, steps or load steps; what is drawn is still the file's own problem."""
     import yaml
 
     data = yaml.safe_load(path.read_text())
+    mesh = data.get("mesh", {})
+    small = {"mesh__refine": 1} if mesh.get("refine", 0) > 1 else {}  # fmg needs one level
     if data["problem"] == "poisson":
-        return {"output__vtu": True, "output__plot": False}
+        if data.get("adaptive"):
+            small["adaptive__max_dofs"] = 500
+        return dict(small, output__vtu=True, output__plot=False)
     if data["problem"] == "mass_spring":
-        return {"t_end": 0.05, "output__png": False}
+        system = data.get("system", {})
+        if system.get("nx", 0) > 21:  # a large cloth: 21 x 21 nodes show it as well
+            small.update(system__nx=21, system__ny=21)
+        return dict(small, t_end=0.05, output__png=False)
+    if "h" in mesh:
+        small["mesh__h"] = 2 * mesh["h"]
     if "static" in data:
-        return {"static__load_steps": 2, "output__png": False, "output__gif": False}
-    return {"t_end": 0.02, "output__png": False, "output__gif": False}
+        return dict(small, static__load_steps=2, output__png=False, output__gif=False)
+    return dict(small, t_end=0.02, output__png=False, output__gif=False)
 
 
 @pytest.mark.parametrize("path", BUNDLED, ids=[p.stem for p in BUNDLED])
@@ -278,3 +285,85 @@ def test_the_window_slider_redraws_the_chosen_frame(runs):
         p.close()
     assert np.abs(images[0].astype(int) - images[1].astype(int)).max() > 50
     assert all(judge(img)["bar_colours"] >= 15 for img in images)
+
+
+@pytest.mark.parametrize("name", ["disk", "cloth"])
+def test_the_notebook_slider_shows_the_frame_it_points_at(runs, name):
+    """The ipywidgets slider (femkit.view.slider), built and moved without a browser: the image
+    changes with the value, each frame is rendered once, and a 2D frame is pixel for pixel the
+    frame's own picture (View.frame(k)); a 3D frame is drawn with the first frame's camera."""
+    from PIL import Image
+
+    from femkit.view import slider
+
+    def pixels(png: bytes) -> np.ndarray:
+        import io
+
+        return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
+
+    box = slider(runs[name].output_dir, size=SIZE)
+    img, row = box.children
+    bar, label = row.children
+    n = len(box.frames)
+    assert n > 2 and (bar.min, bar.max, bar.value) == (0, n - 1, n - 1)
+    last = pixels(img.value)
+    bar.value = 0
+    first = pixels(img.value)
+    assert np.abs(first.astype(int) - last.astype(int)).max() > 50, "the image did not change"
+    assert label.value.startswith("t = ") and label.value != box.frames.label(n - 1)
+    assert_picture(first, min_cover=0.005)
+    view = open_view(runs[name].output_dir, size=SIZE)
+    if name == "disk":
+        np.testing.assert_array_equal(first, view.frame(0).image())
+    else:
+        camera = render.series_camera(view.picture, SIZE)
+        np.testing.assert_array_equal(first, render.image(view.picture, 0, SIZE, camera=camera))
+    bar.value = n - 1
+    assert np.array_equal(pixels(img.value), last) and box.frames.rendered == 2  # kept, not redrawn
+
+
+def test_an_mp4_is_written_and_read_back_frame_by_frame(runs, tmp_path, capsys):
+    pytest.importorskip("imageio_ffmpeg", reason="femkit[view] installs imageio-ffmpeg")
+    import imageio.v2 as imageio
+
+    mp4 = tmp_path / "cloth.mp4"
+    code = main(["view", str(runs["cloth"].output_dir), "--movie", str(mp4), "--size", "400x300"])
+    assert code == 0, capsys.readouterr().err
+    reader = imageio.get_reader(mp4)
+    frames = [np.asarray(f) for f in reader]
+    reader.close()
+    assert len(frames) == len(open_view(runs["cloth"].output_dir).picture.frames)
+    assert frames[0].shape == (300, 400, 3)  # as drawn: not resized
+    assert np.abs(frames[0].astype(int) - frames[-1].astype(int)).max() > 50
+    assert judge(frames[-1])["bar_colours"] >= 15
+    assert not list(tmp_path.glob(".*"))
+
+
+def test_without_imageio_ffmpeg_an_mp4_is_one_line_naming_it(runs, tmp_path, capsys, monkeypatch):
+    import importlib.util
+
+    find_spec = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name == "imageio_ffmpeg" else find_spec(name, *a))
+    _refused(capsys, ["view", str(runs["solid"].output_dir), "--movie", str(tmp_path / "x.mp4")],
+             "pip install imageio-ffmpeg", ".gif")
+    assert not list(tmp_path.iterdir())
+
+
+def test_a_poisson_run_directory_draws_its_indicators(runs, tmp_path, capsys):
+    """solution.vtu holds eta: `femkit view RUN --field eta` draws it (log scale) from the
+    file, the values those of the run; an unknown field lists the valid ones."""
+    run = runs["poisson2d"].output_dir
+    png = tmp_path / "eta.png"
+    code = main(["view", str(run), "--field", "eta", "--screenshot", str(png), "--size", "400x300"])
+    assert code == 0, capsys.readouterr().err
+    from PIL import Image
+
+    assert_picture(np.asarray(Image.open(png).convert("RGB")))
+    picture = open_view(run, field="eta").picture
+    layer = picture.frames[0].layers[0]
+    assert layer.log and picture.field == "eta"
+    np.testing.assert_array_equal(np.asarray(layer.mesh.cell_data["eta"]), runs["poisson2d"].indicators)
+    _refused(capsys, ["view", str(run), "--field", "nope", "--screenshot", str(tmp_path / "x.png")],
+             "'nope'", "eta", "kappa", "tag", "u")
+    assert not (tmp_path / "x.png").exists()

@@ -15,6 +15,7 @@ import numpy as np
 
 from ...errors import InputError, with_prefix
 from ...io.figures import new_figure, save_figure
+from ...mesh.vtk import Later
 
 __all__ = ["write_solution", "write_plot", "write_outputs", "output_location",
            "SolutionFile", "solution_file", "RESULT_KEYS"]
@@ -27,8 +28,13 @@ RESULT_KEYS = ("case", "problem", "case_file", "femkit_version", "mesh", "dofs",
 
 def write_solution(path: str | os.PathLike, mesh, u: np.ndarray,
                    kappa: np.ndarray | float | None = None, extra_point_data: dict | None = None,
-                   compression: str | None = None, element: str = "P1") -> Path:
-    """Write the mesh with point data ``u`` and cell data ``kappa`` and ``tag`` (vtu/xdmf by extension).
+                   compression: str | None = None, element: str = "P1", eta=None) -> Path:
+    """Write the mesh with point data ``u`` and cell data ``kappa``, ``tag`` and, when given,
+    ``eta`` (vtu/xdmf by extension).
+
+    ``eta``: the error estimator's indicator of each cell (``(n_cells,)``, the run's
+    ``result.indicators``), or a :class:`~femkit.mesh.vtk.Later` whose values are handed over
+    while the file is written (:class:`SolutionFile`).
 
     ``element="P2"``: quadratic cells (VTK_QUADRATIC_TRIANGLE 22 / VTK_QUADRATIC_TETRA 24, meshio's
     ``triangle6`` / ``tetra10``) whose nodes are the mesh's points followed by the edge midpoints,
@@ -39,7 +45,7 @@ def write_solution(path: str | os.PathLike, mesh, u: np.ndarray,
     from ...mesh import write_mesh
 
     if element != "P1":
-        return _write_quadratic(Path(path), mesh, u, kappa, compression, element)
+        return _write_quadratic(Path(path), mesh, u, kappa, compression, element, eta)
 
     point_data = {"u": np.asarray(u, dtype=np.float64)}
     point_data.update(extra_point_data or {})
@@ -48,6 +54,8 @@ def write_solution(path: str | os.PathLike, mesh, u: np.ndarray,
         kappa = np.asarray(kappa, dtype=np.float64)
         # a constant: a broadcast view, written a block at a time (no array of m copies)
         cell_data["kappa"] = np.broadcast_to(kappa, (mesh.n_cells,)) if kappa.ndim == 0 else kappa
+    if eta is not None:
+        cell_data["eta"] = eta
     # Written in place: sibling files (XDMF's .h5, a tag-name sidecar) are named after the
     # file, so a temporary name would orphan them. Callers write into an atomic directory.
     target = Path(path)
@@ -55,7 +63,8 @@ def write_solution(path: str | os.PathLike, mesh, u: np.ndarray,
     return target
 
 
-def _write_quadratic(target: Path, mesh, u, kappa, compression, element: str) -> Path:
+def _write_quadratic(target: Path, mesh, u, kappa, compression, element: str,
+                     eta=None) -> Path:
     """:func:`write_solution` of a P2 field: quadratic cells, ``u`` at every node."""
     from ...fem.dofs import dof_map
     from ...mesh.vtk import write_cells
@@ -66,6 +75,8 @@ def _write_quadratic(target: Path, mesh, u, kappa, compression, element: str) ->
     if kappa is not None:
         kappa = np.asarray(kappa, dtype=np.float64)
         cell_data["kappa"] = [np.full(mesh.n_cells, float(kappa)) if kappa.ndim == 0 else kappa]
+    if eta is not None:
+        cell_data["eta"] = [eta]
     write_cells(target, dofs.points(mesh), [(kind, dofs.cells)],
                 point_data={"u": np.asarray(u, dtype=np.float64)}, cell_data=cell_data,
                 **({} if compression is None else {"compression": compression}))
@@ -180,7 +191,9 @@ class SolutionFile:
 
     ``u`` and ``kappa`` must not be modified until then (the run hands over its final arrays).
     On one core the write costs what it cost in the output stage; with two, the output stage
-    only waits for what is left of it.
+    only waits for what is left of it. The estimator's indicators (cell data ``eta``) come
+    last: the file declares them at once and the writer fills their bytes when
+    :meth:`move_into` hands them over (:class:`~femkit.mesh.vtk.Later`).
     """
 
     NAME = "solution.vtu"
@@ -194,12 +207,15 @@ class SolutionFile:
         directory.parent.mkdir(parents=True, exist_ok=True)
         self.staging: Path | None = Path(tempfile.mkdtemp(prefix=f"{directory.name}.tmp-",
                                                           dir=directory.parent))
+        self.eta = Later(mesh.n_cells)
         self._writer = BackgroundWriter(depth=1, name="femkit solution writer")
         self._writer.submit(write_solution, self.staging / self.NAME, mesh, u, kappa, None,
-                            compression, element)
+                            compression, element, self.eta)
 
-    def move_into(self, directory: Path) -> None:
-        """Wait for the file, then move it and its sidecars into ``directory`` (renames)."""
+    def move_into(self, directory: Path, eta: np.ndarray | None = None) -> None:
+        """Hand over the indicators ``eta`` (NaN when the run has none), wait for the file,
+        then move it and its sidecars into ``directory`` (renames)."""
+        self.eta.set(np.full(self.eta.shape, np.nan) if eta is None else eta)
         self._writer.close()
         for path in sorted(self.staging.iterdir()):
             os.replace(path, directory / path.name)
@@ -213,6 +229,7 @@ class SolutionFile:
 
     def discard(self) -> None:
         """Wait for the writer (bounded) and remove what was not moved."""
+        self.eta.abandon()  # a writer waiting for the indicators stops at once
         self._writer.cancel()
         if self.staging is not None:
             import shutil
@@ -250,15 +267,17 @@ def write_outputs(result, directory: str | os.PathLike, *, write_pieces=None,
         if opts.vtu and write_pieces is not None:
             write_pieces(tmp)
         elif opts.vtu and solution is not None:
-            solution.move_into(tmp)
+            solution.move_into(tmp, result.indicators)
         elif opts.vtu:
             write_solution(tmp / "solution.vtu", result.mesh, result.u, result.kappa,
-                           compression=opts.compression, element=result.case.spec.element)
+                           compression=opts.compression, element=result.case.spec.element,
+                           eta=result.indicators)
         if result.u is None:
             result.parallel["not_written"] = [f"solution.{e}" for e, k in
                                               (("xdmf", "xdmf"), ("png", "plot")) if getattr(opts, k)]
         elif opts.xdmf:
-            write_solution(tmp / "solution.xdmf", result.mesh, result.u, result.kappa)
+            write_solution(tmp / "solution.xdmf", result.mesh, result.u, result.kappa,
+                           eta=result.indicators)
         if opts.plot and result.u is not None:
             from ...mesh.mesh import CELLS_NAME
 

@@ -45,12 +45,19 @@ def _grid(mesh, u, kappa=None, indicators=None):
 
 
 def _grid_from_file(run: Run):
-    """``solution.vtu``'s triangles (2D) or tetrahedra (3D), without the boundary facets."""
+    """``solution.vtu``'s triangles (2D) or tetrahedra (3D), linear (P1) or quadratic (P2),
+    without the boundary facets."""
     pv = pyvista()
-    grid = pv.read(run.file("solution.vtu"))
-    dim = int(run.facts.get("mesh", {}).get("dim", 3 if pv.CellType.TETRA in grid.celltypes else 2))
-    kind = pv.CellType.TRIANGLE if dim == 2 else pv.CellType.TETRA
-    return grid.extract_cells_by_type(kind), dim
+    path = run.file("solution.vtu")
+    grid = pv.read(path)
+    c = pv.CellType
+    solids = (c.TETRA, c.QUADRATIC_TETRA)
+    dim = int(run.facts.get("mesh", {}).get("dim", 3 if set(solids) & set(grid.celltypes) else 2))
+    kinds = solids if dim == 3 else (c.TRIANGLE, c.QUADRATIC_TRIANGLE)
+    cells = grid.extract_cells_by_type(list(kinds))
+    if cells.n_cells == 0:
+        raise InputError(f"{path}: no {'tetrahedra' if dim == 3 else 'triangles'} in the file")
+    return cells, dim
 
 
 def _layers_3d(grid, scalars: str, title: str, log: bool, edges: bool, section: str) -> list:

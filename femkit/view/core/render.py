@@ -25,7 +25,7 @@ from ...errors import InputError, ViewUnavailableError
 from .picture import Picture
 
 __all__ = ["pyvista", "display_available", "offscreen_available", "plotter", "draw", "image",
-           "png_bytes", "screenshot", "movie", "show", "check_movie_path", "frame_index",
+           "series_camera", "encode_png", "png_bytes", "screenshot", "movie", "show", "check_movie_path", "frame_index",
            "frame_slider", "plane_bounds", "colour_range", "MOVIE_SUFFIXES",
            "INSTALL_VIEW", "INSTALL_OFFSCREEN"]
 
@@ -206,25 +206,46 @@ def frame_index(picture: Picture, frame: int) -> int:
     return frame
 
 
-def image(picture: Picture, frame: int = -1, size: tuple[int, int] = (1280, 960)) -> np.ndarray:
-    """Frame ``frame`` rendered off screen: an ``(height, width, 3)`` array of RGB bytes."""
+def image(picture: Picture, frame: int = -1, size: tuple[int, int] = (1280, 960), *,
+          camera: tuple | None = None) -> np.ndarray:
+    """Frame ``frame`` rendered off screen: an ``(height, width, 3)`` array of RGB bytes, in the
+    colour range of every frame; ``camera`` (a pyvista camera position) replaces the frame's
+    own view (a time series drawn with one camera: :func:`series_camera`)."""
     p = plotter(size, off_screen=True)
     try:
         draw(p, picture, frame_index(picture, frame))
+        if camera is not None:
+            p.camera_position = camera
         return np.asarray(p.screenshot(None, return_img=True))
     finally:
         p.close()
 
 
-def png_bytes(picture: Picture, frame: int = -1, size: tuple[int, int] = (1280, 960)) -> bytes:
-    """Frame ``frame`` as PNG bytes (what a notebook shows inline)."""
+def series_camera(picture: Picture, size: tuple[int, int]) -> tuple:
+    """The camera position of the first frame of ``picture`` drawn at ``size``: the one view of
+    every frame of a movie and of the notebook's slider."""
+    p = plotter(size, off_screen=True)
+    try:
+        draw(p, picture, 0)
+        return tuple(p.camera_position)
+    finally:
+        p.close()
+
+
+def encode_png(img: np.ndarray) -> bytes:
+    """An RGB array as PNG bytes."""
     import io
 
     from PIL import Image
 
     buf = io.BytesIO()
-    Image.fromarray(image(picture, frame, size)).save(buf, format="PNG", optimize=True)
+    Image.fromarray(img).save(buf, format="PNG")  # optimize=True: 5x the time for 5 % fewer bytes
     return buf.getvalue()
+
+
+def png_bytes(picture: Picture, frame: int = -1, size: tuple[int, int] = (1280, 960)) -> bytes:
+    """Frame ``frame`` as PNG bytes (what a notebook shows inline)."""
+    return encode_png(image(picture, frame, size))
 
 
 def screenshot(picture: Picture, path: str | os.PathLike, frame: int = -1,
@@ -277,9 +298,15 @@ def movie(picture: Picture, path: str | os.PathLike, size: tuple[int, int] = (80
     with atomic_path(path) as tmp:
         if path.suffix.lower() == ".gif":
             imageio.mimsave(tmp, images, format="GIF", duration=1000.0 / fps, loop=0)
-        else:
-            imageio.mimsave(tmp, images, fps=fps)
+        else:  # H.264 in yuv420p: even sides, kept as drawn (no resize, no warning)
+            imageio.mimsave(tmp, [_even(img) for img in images], fps=fps, macro_block_size=2)
     return path
+
+
+def _even(img: np.ndarray) -> np.ndarray:
+    """``img`` with a white row and column appended where its height or width is odd."""
+    h, w = img.shape[:2]
+    return np.pad(img, ((0, h % 2), (0, w % 2), (0, 0)), constant_values=255)
 
 
 def show(picture: Picture, frame: int = -1, size: tuple[int, int] = (1024, 768)) -> None:

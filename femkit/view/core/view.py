@@ -1,6 +1,7 @@
 """:class:`View`: a picture a notebook shows inline (a PNG, or an animated GIF for a time series,
 rendered off screen: no server, no widget), saved with :meth:`View.screenshot` and
-:meth:`View.movie`, or opened in a window with :meth:`View.show`."""
+:meth:`View.movie`, opened in a window with :meth:`View.show`, or a time series with a frame
+slider in the notebook (:meth:`View.slider`, ipywidgets)."""
 
 from __future__ import annotations
 
@@ -64,6 +65,13 @@ class View:
         from .render import movie
 
         return movie(self.picture, path, size or self.size, fps)
+
+    def slider(self, size: tuple[int, int] | None = None):
+        """A notebook widget: the frames with a slider (``ipywidgets``; each frame rendered off
+        screen when first shown; :func:`femkit.view.core.widget.slider_widget`)."""
+        from .widget import slider_widget
+
+        return slider_widget(self.picture, size or self.size)
 
     def show(self) -> None:
         """Open an interactive window (a frame slider for a time series)."""
