@@ -25,7 +25,8 @@ from ..frozen import freeze
 from ..name_checks import check_geometry_spec, lookup, resolve_file, with_prefix
 
 __all__ = ["VARIABLES", "TransientSpec", "TransientOutput", "transient_schema",
-           "prepare_transient", "at_time", "element_values", "build_system", "check_step",
+           "prepare_transient", "at_time", "element_values", "build_system", "system_parts",
+           "check_step",
            "frame_errors", "initial_values", "plan_transient", "dof_points"]
 
 #: Variables of the expressions of a time-dependent case (``z`` on tetrahedra only).
@@ -314,6 +315,22 @@ def build_system(case, mesh, capacity: str):
     or lumped, ``capacity`` per cell), ``K`` (``kappa`` per cell), the Dirichlet nodes and the
     time-dependent load and boundary values (evaluated once when they do not use ``t``)."""
     from ...dynamics.mol import LinearSystem, step_solver, stiffness_ratio
+
+    parts = system_parts(case, mesh, capacity)
+    spec = case.spec
+    if spec.solver_default:   # the size rule; the step matrix M + b K: b = dt (heat), dt^2 / 4
+        M, K, fixed = parts["M"], parts["K"], parts["fixed"]
+        free = np.setdiff1d(np.arange(K.shape[0]), fixed)
+        b = spec.dt if capacity == "rho_c" else spec.dt ** 2 / 4.0
+        parts["solver"] = step_solver(mesh.dim, free.size, parts["solver"],
+                                      stiffness_ratio(M, K, free, b))
+    return LinearSystem(**parts)
+
+
+def system_parts(case, mesh, capacity: str, elements=None) -> dict:
+    """The keyword arguments of :class:`femkit.dynamics.mol.LinearSystem` for the case on
+    ``mesh`` (:func:`build_system`); ``elements``: ``M`` and ``K`` of these cells only (a
+    partition's part, global shape), the load and boundary data always whole."""
     from ...fem import assemble_load, assemble_neumann, assemble_stiffness
     from ...fem.forms import assemble_matrix
     from ...fem.lagrange import element_load, element_neumann
@@ -324,9 +341,10 @@ def build_system(case, mesh, capacity: str):
     kappa = element_values(case, mesh, spec.coefficient, "coefficient")
     density = element_values(case, mesh, spec.capacity, capacity)
     p1 = spec.element == "P1"
-    K = assemble_stiffness(mesh, kappa) if p1 else \
-        assemble_matrix(mesh, "stiffness", kappa, element=spec.element)
-    M = mass_matrix(mesh, element=spec.element, lumped=lumped, density=density)
+    K = assemble_stiffness(mesh, kappa, elements=elements) if p1 else \
+        assemble_matrix(mesh, "stiffness", kappa, element=spec.element, elements=elements)
+    M = mass_matrix(mesh, element=spec.element, lumped=lumped, density=density,
+                    elements=elements)
     n = K.shape[0]
     fixed, groups = _dirichlet(case, mesh)
     pts = dof_points(case, mesh)[fixed].T
@@ -360,15 +378,10 @@ def build_system(case, mesh, capacity: str):
         return F
 
     uses_t = [fn for fn in [source, *(h for _, h in neumann)] if "t" in fn.used]
-    solver = spec.solver
-    if spec.solver_default:   # the size rule; the step matrix M + b K: b = dt (heat), dt^2 / 4
-        free = np.setdiff1d(np.arange(n), fixed)
-        b = spec.dt if capacity == "rho_c" else spec.dt ** 2 / 4.0
-        solver = step_solver(dim, free.size, solver, stiffness_ratio(M, K, free, b))
-    return LinearSystem(M, K, fixed, load=load if has_load else None,
-                        boundary=boundary if groups else None, load_constant=not uses_t,
-                        boundary_constant=not any("t" in fn.used for _, fn in groups),
-                        lumped=lumped, solver=solver)
+    return dict(M=M, K=K, fixed=fixed, load=load if has_load else None,
+                boundary=boundary if groups else None, load_constant=not uses_t,
+                boundary_constant=not any("t" in fn.used for _, fn in groups),
+                lumped=lumped, solver=spec.solver)
 
 
 def initial_values(case, mesh, key: str) -> np.ndarray:

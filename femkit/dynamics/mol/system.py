@@ -12,9 +12,11 @@ Cholesky engines) when the linear solver is ``direct`` or ``cholesky``; with an 
 its preconditioner (AMG hierarchy, IC(0) factor) is built once and kept the same way
 (:meth:`LinearSession.solve_kept`, ``stats["preconditioner_setups"]``), and each step's solve
 starts from the linear extrapolation ``2 x_n - x_{n-1}`` of that matrix's last two solutions. A
-new ``dt`` (adaptive steps) is a new ``A``: factorised or set up afresh. Another backend
-(``petsc``: :data:`femkit.solvers.registry.BACKENDS`, one process) solves every step by its own
-KSP, warm-started, nothing kept. A lumped (diagonal) ``M`` alone is inverted by a division.
+new ``dt`` (adaptive steps) is a new ``A``: factorised or set up afresh. Another backend named in the solver spec
+(``petsc``: :data:`femkit.solvers.registry.BACKENDS`) solves every step by its own KSP,
+warm-started, nothing kept; the heat and wave kinds run PETSc through their distributed
+system instead (``femkit.case.transient.distributed``: one KSP kept per matrix, any number of
+ranks). A lumped (diagonal) ``M`` alone is inverted by a division.
 """
 
 from __future__ import annotations
