@@ -94,6 +94,18 @@ class ConstrainedOperator:
     key: object = None
     keep_preconditioner: bool = True
     history: list = field(default_factory=list)
+    perm: np.ndarray | None = None
+    A_solve: sp.csr_matrix | None = None
+
+    def reorder(self) -> None:
+        """Solve in reverse Cuthill-McKee order (an ``ic0`` preconditioner asking for ``rcm``):
+        ``A_ff`` permuted once here, so each solve permutes its right-hand side and solution
+        once instead of the preconditioner permuting at every iteration; the matrix-vector
+        products gain the band's locality too."""
+        from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+        self.perm = reverse_cuthill_mckee(self.A_ff, symmetric_mode=True)
+        self.A_solve = self.A_ff[self.perm][:, self.perm].tocsr()
 
     def initial_guess(self) -> np.ndarray | None:
         """The warm start: ``2 x_n - x_{n-1}`` of the last two solutions, the last one alone
@@ -111,13 +123,22 @@ class ConstrainedOperator:
             return rhs / self.diagonal
         if self.factor is not None:
             return self.factor.solve(rhs)
-        x0 = self.initial_guess()
-        if self.keep_preconditioner:
-            x = self.session.solve_kept(self.A_ff, rhs, x0, key=self.key)
+        x0 = self.initial_guess()   # kept in the solve's order
+        perm = self.perm
+        A = self.A_ff if perm is None else self.A_solve
+        if perm is not None:
+            rhs = rhs[perm]
+        if self.keep_preconditioner:   # already in RCM order: the preconditioner's own is off
+            x = self.session.solve_kept(A, rhs, x0, key=self.key, preconditioner_options=None
+                                        if perm is None else {"ordering": "natural"})
         else:
-            x = self.session.solve(self.A_ff, rhs, x0)
+            x = self.session.solve(A, rhs, x0)
         self.history = (self.history + [x])[-2:]
-        return x
+        if perm is None:
+            return x
+        out = np.empty_like(x)
+        out[perm] = x
+        return out
 
 
 @dataclass
@@ -225,6 +246,9 @@ class LinearSystem:
         else:
             op.session, op.key = self.session, key
             op.keep_preconditioner = self.keep_preconditioner
+            if (self.keep_preconditioner and self.solver.preconditioner == "ic0"
+                    and self.solver.preconditioner_options.get("ordering") == "rcm"):
+                op.reorder()
         self._ops[key] = op
         return op
 
