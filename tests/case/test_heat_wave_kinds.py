@@ -165,6 +165,39 @@ def test_the_kinds_are_listed_schema_checked_and_planned(tmp_path, capsys):
     assert "steps" in out and "crank_nicolson" in out and not (tmp_path / "out").exists()
 
 
+def test_the_plan_prices_a_step_by_the_kept_factors_fill_not_by_a_factorisation(tmp_path):
+    """Plan structure (no timing): a kept-factor step costs one substitution pair priced from
+    the factor's fill (``nnz(L + U) ~ n^1.21``) plus one SpMV, whatever the factorisation costs
+    (``~ n^2.9``): the step's share of the factorisation falls with the size, doubling the
+    steps doubles the steps stage alone; above the size rule's limit the plan prices the
+    iterative step solver the run will use, not a factorisation."""
+    from femkit.cost import load_constants
+    from femkit.case.transient.setup import SUBSTITUTION_PER_FILL, plan_transient
+
+    c = load_constants()
+    share = []
+    for h in (0.05, 0.005):
+        plans = []
+        for t_end in (0.5, 1.0):
+            data = {**MANUFACTURED, "mesh": {"geometry": "unit_square", "h": h}, "t_end": t_end,
+                    "solver": {"method": "direct"}}
+            plans.append(plan_transient(load_case(_write(tmp_path, data)), measure=False))
+        st = [{s.name: s.seconds for s in p.stages} for p in plans]
+        n, nnz = plans[0].sizes["unknowns"], plans[0].sizes["nonzeros"]
+        fill = c["fill"]["direct_coefficient"] * n ** c["fill"]["direct_exponent"]
+        per_step = st[0]["steps"] / plans[0].sizes["steps"]
+        assert per_step == pytest.approx(SUBSTITUTION_PER_FILL * fill
+                                         + c["seconds"]["iteration_per_nonzero"]["cg"] * nnz)
+        assert st[1]["steps"] == pytest.approx(2 * st[0]["steps"])
+        assert st[1]["factor"] == st[0]["factor"] > 0
+        share.append(per_step / st[0]["factor"])
+    assert share[1] < share[0] / 10   # 100x the unknowns: a step is no fixed share of a factor
+    big = {**MANUFACTURED, "mesh": {"geometry": "unit_square", "h": 0.002}}   # ~290k unknowns
+    plan = plan_transient(load_case(_write(tmp_path, big)), measure=False)
+    factor = next(s for s in plan.stages if s.name == "factor")
+    assert "preconditioner kept" in factor.detail and "pcg" in factor.detail
+
+
 @pytest.mark.parametrize("name", sorted(p.name for p in (ROOT / "cases").glob("*.yaml")
                                         if p.name.startswith(("heat_", "wave_"))))
 def test_bundled_heat_and_wave_cases_run(name, tmp_path):
