@@ -216,14 +216,17 @@ def test_theta_one_is_implicit_euler_and_bad_options_are_refused():
     assert get_scheme(WAVE_INTEGRATORS, "newmark", beta=0.0 + 1e-3, gamma=0.5).stability_bound < 100
 
 
-@pytest.mark.parametrize("pc", ["amg", "ic0"])
-def test_iterative_steps_keep_one_preconditioner_and_match_the_rebuild_path(pc):
+@pytest.mark.parametrize("pc,options", [("amg", {}), ("ic0", {}), ("ic0", {"ordering": "rcm"})],
+                         ids=["amg", "ic0", "ic0-rcm"])
+def test_iterative_steps_keep_one_preconditioner_and_match_the_rebuild_path(pc, options):
     """With a fixed dt the step matrix is constant: its preconditioner is set up once over all
     steps (as the direct solver's factor is kept), and the states equal those of the path that
-    rebuilds it every step, and the kept factor's, to the solver's tolerance."""
+    rebuilds it every step, and the kept factor's, to the solver's tolerance (``rcm``: the
+    kept path solves in the permuted order, the rebuild path lets IC(0) permute)."""
     from femkit.solvers import SolverSpec
 
-    spec = SolverSpec.from_mapping({"method": "pcg", "preconditioner": pc, "rtol": 1e-10})
+    spec = SolverSpec.from_mapping({"method": "pcg", "preconditioner": pc, "rtol": 1e-10,
+                                    "preconditioner_options": options})
     mesh, kept = _system(16, solver=spec)
     _, rebuilt = _system(16, solver=spec, keep_preconditioner=False)
     _, direct = _system(16)
