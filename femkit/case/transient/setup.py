@@ -469,10 +469,11 @@ class _Frozen:
 
 # ----------------------------------------------------------------------------- the plan
 
-#: PCG iterations of one warm-started heat step (IC(0), ``rtol`` 1e-10): 15.4 measured at 251,809
-#: unknowns, ``dt kappa / h^2 ~ 1`` (docs/benchmarks.md, ``benchmarks/bench_heat.py``); a step
+#: PCG iterations of one warm-started heat step (IC(0), ``rtol`` 1e-10, the quadratic warm start
+#: of :class:`femkit.dynamics.mol.system.ConstrainedOperator`): 7.8 measured at 251,809
+#: unknowns, ``dt kappa / h^2 ~ 20`` (docs/benchmarks.md, ``benchmarks/bench_heat.py``); a step
 #: is priced at this many iterations of the stationary solve, never more than that solve's.
-STEP_ITERATIONS = 15.0
+STEP_ITERATIONS = 8.0
 
 
 #: Seconds per entry of ``L + U`` for the pair of triangular solves of a kept SuperLU factor of a
