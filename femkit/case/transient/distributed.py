@@ -61,7 +61,7 @@ class _Summed:
 class DistributedLinearSystem(LinearSystem):
     """:class:`~femkit.dynamics.mol.LinearSystem` with ``M`` and ``K`` this rank's part.
 
-    Extra parameters
+    Other Parameters
     ----------------
     dof : (n,) int
         Global (PETSc) unknown of each dof, ``-1`` on the Dirichlet dofs.
@@ -178,18 +178,11 @@ class DistributedLinearSystem(LinearSystem):
         self.mpi.Allgatherv(np.ascontiguousarray(xv.getArray()), [by_dof, self.counts, displs, _double()])
         return by_dof[self.dof[self.free]]
 
-    def energy(self, u: np.ndarray, v: np.ndarray | None = None) -> dict:
-        """:meth:`LinearSystem.energy`, each rank's part summed."""
-        parts = [float(u @ (self.K @ u)), float(u @ (self.M @ u)) if v is None else float(v @ (self.M @ v))]
+    def quadratic_forms(self, u: np.ndarray, v: np.ndarray | None = None) -> tuple[float, float]:
+        """:meth:`LinearSystem.quadratic_forms`, each rank's part summed."""
         total = np.empty(2)
-        self.mpi.Allreduce(np.array(parts), total)
-        out = {"potential": 0.5 * float(total[0])}
-        if v is None:
-            out["thermal"] = 0.5 * float(total[1])
-            return out
-        out["kinetic"] = 0.5 * float(total[1])
-        out["total"] = out["potential"] + out["kinetic"]
-        return out
+        self.mpi.Allreduce(np.array(LinearSystem.quadratic_forms(self, u, v)), total)
+        return float(total[0]), float(total[1])
 
 
 def _double():

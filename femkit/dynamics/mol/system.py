@@ -283,10 +283,16 @@ class LinearSystem:
     def energy(self, u: np.ndarray, v: np.ndarray | None = None) -> dict:
         """``1/2 u^T K u`` (``potential``), ``1/2 v^T M v`` (``kinetic``, with ``v``) and their
         ``total``; for the heat equation ``1/2 u^T M u`` is its ``thermal`` energy."""
-        out = {"potential": 0.5 * float(u @ (self.K @ u))}
+        stiff, mass = self.quadratic_forms(u, v)
+        out = {"potential": 0.5 * stiff}
         if v is None:
-            out["thermal"] = 0.5 * float(u @ (self.M @ u))
+            out["thermal"] = 0.5 * mass
             return out
-        out["kinetic"] = 0.5 * float(v @ (self.M @ v))
+        out["kinetic"] = 0.5 * mass
         out["total"] = out["potential"] + out["kinetic"]
         return out
+
+    def quadratic_forms(self, u: np.ndarray, v: np.ndarray | None = None) -> tuple[float, float]:
+        """``(u^T K u, w^T M w)`` with ``w = v``, or ``u`` without ``v``."""
+        w = u if v is None else v
+        return float(u @ (self.K @ u)), float(w @ (self.M @ w))
