@@ -26,7 +26,7 @@ path's mesh); the matrices and the solver's memory are split.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -73,7 +73,6 @@ class DistributedLinearSystem(LinearSystem):
     dof: np.ndarray = None
     dof_offsets: np.ndarray = None
     comm: object = None
-    _ksps: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
         from ...solvers.registry import petsc_names
