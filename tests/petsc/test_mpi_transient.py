@@ -61,3 +61,17 @@ def test_transient_on_two_ranks_equals_serial(name, changes, kept, tmp_path):
     for a, b in zip(serial["energies"], petsc["energies"]):   # summed over ranks
         for key in a:
             assert b[key] == pytest.approx(a[key], rel=1e-8, abs=1e-14)
+
+
+@pytest.mark.usefixtures("needs_mpi")
+def test_a_step_above_the_critical_one_is_refused_on_two_ranks_in_one_line(tmp_path):
+    """Every rank finds it (replicated data): each exits 2 by itself, rank 0 says it once, no
+    MPI_Abort, nothing written."""
+    path = _case(tmp_path, "heat_explicit_lumped", dt=0.01)
+    proc = femkit(["solve", path, "--backend", "petsc", "--output", tmp_path / "out"], ranks=2,
+                  check=False)
+    assert proc.returncode == 2, proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if ln.startswith("femkit")]
+    assert len(lines) == 1 and "exceeds the critical step" in lines[0], lines
+    assert "MPI_ABORT" not in proc.stderr
+    assert not (tmp_path / "out").exists()

@@ -162,7 +162,7 @@ def _run(case, capacity, registry, second_order, output_dir, quiet, write, echo,
 
     spec = case.spec
     root = comm is None or comm.getRank() == 0
-    on_root = _on_root(comm)
+    on_root, on_all = _on_root(comm), _on_all(comm)
     if write:
         on_root(check_output_dir, output_dir or spec.output.dir, EARLIER_RUN)
     timer = StageTimer()
@@ -179,19 +179,20 @@ def _run(case, capacity, registry, second_order, output_dir, quiet, write, echo,
     with timer("stability"):   # distributed: the eigenvalue on the serial matrices, when needed
         serial = system if comm is None or scheme.stability_bound == float("inf") else \
             build_system(case, mesh, capacity)
-        stability = check_step(case, serial, scheme)
+        stability = on_all(check_step, case, serial, scheme)
     u0 = initial_values(case, mesh, "initial")
     v0 = initial_values(case, mesh, "initial_velocity") if second_order else None
     stop = case.options.stop
     every = max(1, spec.steps // spec.output.frames)
     with timer("steps"):
         if spec.rtol_t is not None:
-            run = march_adaptive(system, scheme, u0, 0.0, spec.t_end, spec.dt, spec.rtol_t, stop=stop)
+            run = on_all(march_adaptive, system, scheme, u0, 0.0, spec.t_end, spec.dt,
+                         spec.rtol_t, stop=stop)
         else:
             progress = Progress(spec.steps, f"{case.problem} {case.name}", unit="step",
                                 quiet=quiet or not root)
-            run = march(system, scheme, u0, 0.0, spec.dt, spec.steps, v0=v0, every=every,
-                        stop=stop, progress=progress)
+            run = on_all(march, system, scheme, u0, 0.0, spec.dt, spec.steps, v0=v0,
+                         every=every, stop=stop, progress=progress)
     with timer("errors"):
         errors = frame_errors(case, mesh, run.frames) if run.failure is None and root else None
     energies = [{"t": float(t), **system.energy(u, v)} for t, u, v in run.frames]
@@ -220,6 +221,17 @@ def _on_root(comm):
     from ...solvers.petsc.failure import from_root
 
     return lambda fn, *args: from_root(comm.tompi4py(), fn, *args)
+
+
+def _on_all(comm):
+    """``fn(*args, **kwargs)`` on every rank, an error raised on all of them (a step of
+    replicated data fails alike everywhere: each rank exits 2 by itself, rank 0 says it,
+    no ``MPI_Abort``); serial: a plain call."""
+    if comm is None:
+        return lambda fn, *args, **kwargs: fn(*args, **kwargs)
+    from ...solvers.petsc.failure import collective
+
+    return lambda fn, *args, **kwargs: collective(comm.tompi4py(), fn, *args, **kwargs)
 
 
 def _broadcast_mesh(case, build_mesh, comm):
