@@ -51,9 +51,39 @@ def msh_triangle_count(path: str | os.PathLike, max_scan: int = 1 << 26) -> tupl
                     nums = fh.readline().split()
                     count = int(nums[1] if fmt and fmt.startswith("4") else nums[0])
                     return (max(count, 1), "the $Elements header")
+                if fmt is not None and line == b"$Nodes":
+                    nums = _line_after(fh, b"$Elements", max_scan - scanned)
+                    if nums is None:
+                        return estimate
+                    count = int(nums[1] if fmt.startswith("4") else nums[0])
+                    return (max(count, 1), "the $Elements header")
     except (OSError, ValueError, IndexError):
         return estimate
     return estimate
+
+
+def _line_after(fh, header: bytes, budget: int) -> list | None:
+    """The fields of the line after the line ``header`` (``$Elements``, not ``$ElementData``),
+    found by reading blocks of a MiB (the node section is skipped without splitting it into
+    lines); None past ``budget`` bytes or at the end of the file."""
+    key = b"\n" + header
+    buf, read = b"", 0
+    while read <= budget:
+        chunk = fh.read(1 << 20)
+        read += len(chunk)
+        buf += chunk
+        at = buf.find(key)
+        while at >= 0:
+            lines = buf[at + 1:].split(b"\n", 2)
+            if len(lines) < 3 and chunk:
+                break                      # the next line is in the next block
+            if lines[0].strip() == header and len(lines) > 1:
+                return lines[1].split()
+            at = buf.find(key, at + 1)
+        if not chunk:
+            return None
+        buf = buf[max(0, len(buf) - 256):] if at < 0 else buf[at:]
+    return None
 
 
 def msh_has_volume(path: str | os.PathLike, max_scan: int = 1 << 26) -> bool:

@@ -165,6 +165,39 @@ def test_the_kinds_are_listed_schema_checked_and_planned(tmp_path, capsys):
     assert "steps" in out and "crank_nicolson" in out and not (tmp_path / "out").exists()
 
 
+def test_the_plan_prices_a_step_by_the_kept_factors_fill_not_by_a_factorisation(tmp_path):
+    """Plan structure (no timing): a kept-factor step costs one substitution pair priced from
+    the factor's fill (``nnz(L + U) ~ n^1.21``) plus one SpMV, whatever the factorisation costs
+    (``~ n^2.9``): the step's share of the factorisation falls with the size, doubling the
+    steps doubles the steps stage alone; above the size rule's limit the plan prices the
+    iterative step solver the run will use, not a factorisation."""
+    from femkit.cost import load_constants
+    from femkit.case.transient.setup import SUBSTITUTION_PER_FILL, plan_transient
+
+    c = load_constants()
+    share = []
+    for h in (0.05, 0.005):
+        plans = []
+        for t_end in (0.5, 1.0):
+            data = {**MANUFACTURED, "mesh": {"geometry": "unit_square", "h": h}, "t_end": t_end,
+                    "solver": {"method": "direct"}}
+            plans.append(plan_transient(load_case(_write(tmp_path, data)), measure=False))
+        st = [{s.name: s.seconds for s in p.stages} for p in plans]
+        n, nnz = plans[0].sizes["unknowns"], plans[0].sizes["nonzeros"]
+        fill = c["fill"]["direct_coefficient"] * n ** c["fill"]["direct_exponent"]
+        per_step = st[0]["steps"] / plans[0].sizes["steps"]
+        assert per_step == pytest.approx(SUBSTITUTION_PER_FILL * fill
+                                         + c["seconds"]["iteration_per_nonzero"]["cg"] * nnz)
+        assert st[1]["steps"] == pytest.approx(2 * st[0]["steps"])
+        assert st[1]["factor"] == st[0]["factor"] > 0
+        share.append(per_step / st[0]["factor"])
+    assert share[1] < share[0] / 10   # 100x the unknowns: a step is no fixed share of a factor
+    big = {**MANUFACTURED, "mesh": {"geometry": "unit_square", "h": 0.002}}   # ~290k unknowns
+    plan = plan_transient(load_case(_write(tmp_path, big)), measure=False)
+    factor = next(s for s in plan.stages if s.name == "factor")
+    assert "preconditioner kept" in factor.detail and "pcg" in factor.detail
+
+
 @pytest.mark.parametrize("name", sorted(p.name for p in (ROOT / "cases").glob("*.yaml")
                                         if p.name.startswith(("heat_", "wave_"))))
 def test_bundled_heat_and_wave_cases_run(name, tmp_path):
@@ -219,7 +252,16 @@ def test_adaptive_steps_through_the_heat_kind(tmp_path, capsys):
     assert r.converged and r.march.t_reached == pytest.approx(0.5)
     assert ad["accepted"] == len(ad["steps"]) > 5 and len({s["dt"] for s in ad["steps"]}) > 2
     assert all(s["error_estimate"] <= 1.0 for s in ad["steps"])
-    _refused(tmp_path, capsys, {**data, "integrator": "bdf2"}, "rtol_t", "implicit_euler")
+    for name in ("crank_nicolson", "bdf2"):   # Milne's device (femkit.dynamics.mol.estimate)
+        r2 = load_case(_write(tmp_path, {**data, "integrator": name})).run(write=False, quiet=True)
+        steps = r2.to_dict()["adaptive"]["steps"]
+        assert r2.converged and r2.march.t_reached == pytest.approx(0.5)
+        assert all(s["error_estimate"] <= 1.0 for s in steps) and len(steps) < ad["accepted"]
+    _refused(tmp_path, capsys, {**data, "integrator": "explicit_euler"}, "rtol_t",
+             "bdf2, crank_nicolson, implicit_euler")
+    _refused(tmp_path, capsys, {**data, "integrator": {"method": "crank_nicolson",
+                                                       "options": {"theta": 0.75}}},
+             "rtol_t", "bdf2, crank_nicolson, implicit_euler")
 
 
 def test_p2_heat_converges_at_order_three_and_writes_quadratic_frames(tmp_path):
@@ -268,7 +310,7 @@ def test_default_step_solver_follows_the_size_rule_and_a_named_one_is_kept(tmp_p
 
 
 def test_heat_on_the_petsc_backend_equals_femkit_step_by_step(tmp_path):
-    """``solver.backend: petsc`` (one process, every step a PETSc KSP solve, warm-started):
+    """``solver.backend: petsc`` (one process, one KSP kept for every step, warm-started):
     the states equal femkit's kept factor's to 1e-8 (the PETSc solve's tolerance 1e-12)."""
     pytest.importorskip("petsc4py")
     base = {**MANUFACTURED, "integrator": "implicit_euler", "mesh": {"geometry": "unit_square", "h": 0.1}}
@@ -277,6 +319,7 @@ def test_heat_on_the_petsc_backend_equals_femkit_step_by_step(tmp_path):
                                 "rtol": 1e-12}}
     r = load_case(_write(tmp_path, petsc, "petsc.yaml")).run(write=False, quiet=True)
     assert r.linear["method"] == "pcg" and r.linear["factorizations"] == 0
+    assert r.linear["preconditioner_setups"] == 1 and r.linear["backend"] == "petsc"
     for (t, u, _), (s, v, _) in zip(r.march.frames, ref.march.frames):
         assert t == s and np.abs(u - v).max() < 1e-8 * np.abs(v).max()
 

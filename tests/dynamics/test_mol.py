@@ -216,14 +216,17 @@ def test_theta_one_is_implicit_euler_and_bad_options_are_refused():
     assert get_scheme(WAVE_INTEGRATORS, "newmark", beta=0.0 + 1e-3, gamma=0.5).stability_bound < 100
 
 
-@pytest.mark.parametrize("pc", ["amg", "ic0"])
-def test_iterative_steps_keep_one_preconditioner_and_match_the_rebuild_path(pc):
+@pytest.mark.parametrize("pc,options", [("amg", {}), ("ic0", {}), ("ic0", {"ordering": "rcm"})],
+                         ids=["amg", "ic0", "ic0-rcm"])
+def test_iterative_steps_keep_one_preconditioner_and_match_the_rebuild_path(pc, options):
     """With a fixed dt the step matrix is constant: its preconditioner is set up once over all
     steps (as the direct solver's factor is kept), and the states equal those of the path that
-    rebuilds it every step, and the kept factor's, to the solver's tolerance."""
+    rebuilds it every step, and the kept factor's, to the solver's tolerance (``rcm``: the
+    kept path solves in the permuted order, the rebuild path lets IC(0) permute)."""
     from femkit.solvers import SolverSpec
 
-    spec = SolverSpec.from_mapping({"method": "pcg", "preconditioner": pc, "rtol": 1e-10})
+    spec = SolverSpec.from_mapping({"method": "pcg", "preconditioner": pc, "rtol": 1e-10,
+                                    "preconditioner_options": options})
     mesh, kept = _system(16, solver=spec)
     _, rebuilt = _system(16, solver=spec, keep_preconditioner=False)
     _, direct = _system(16)
@@ -262,3 +265,58 @@ def test_iterative_error_history_equals_direct_below_the_time_error():
         ea, eb = np.abs(ua - _mode(mesh, t)).max(), np.abs(ub - _mode(mesh, t)).max()
         assert eb > 1e-4 * np.abs(ub).max()              # the time error is there to see
         assert abs(ea - eb) < 1e-6 * eb, (t, ea, eb)
+
+
+def _two_rates():
+    """``u' = -diag(1, 200) u``: a slow mode and a fast transient, exact ``exp(-lambda t)``."""
+    import scipy.sparse as sp
+
+    lam = np.array([1.0, 200.0])
+    s = LinearSystem(sp.identity(2, format="csr"), sp.diags(lam, format="csr"), fixed=[],
+                     lumped=True)
+    return s, (lambda t: np.exp(-lam * t))
+
+
+@pytest.mark.parametrize("name", ["crank_nicolson", "bdf2"])
+def test_adaptive_second_order_schemes_need_fewer_steps_than_fixed_on_a_fast_transient(name):
+    """Adaptive Crank-Nicolson and BDF2 (Milne's device) resolve the fast transient with small
+    steps and then grow them; a fixed step taking even twice as many steps misses the
+    adaptive run's accuracy (max error over time against the exact solution)."""
+    from femkit.dynamics.mol import march_adaptive
+
+    s, exact = _two_rates()
+    scheme = get_scheme(HEAT_INTEGRATORS, name)
+    T = 2.0
+    r = march_adaptive(s, scheme, np.ones(2), 0.0, T, 1e-3, 1e-4)
+    assert r.failure is None and r.t_reached == pytest.approx(T, abs=1e-12)
+    assert all(e <= 1.0 for e in r.errors) and max(r.dts) >= 64 * min(r.dts)
+
+    def worst(frames):
+        return max(np.abs(u - exact(t)).max() for t, u, _ in frames)
+
+    target = worst(r.frames)
+    assert target < 1e-3
+    for n in (r.steps, 2 * r.steps):
+        assert worst(march(s, scheme, np.ones(2), 0.0, T / n, n).frames) > 10 * target
+
+
+@pytest.mark.parametrize("name", ["crank_nicolson", "bdf2"])
+@pytest.mark.parametrize("ratio", [1.0, 2.0], ids=["constant-step", "step-doubled"])
+def test_the_embedded_estimate_is_within_a_factor_two_of_the_true_local_error(name, ratio):
+    """One step from the exact past (the local error): the estimate against the true error on
+    both modes (``lambda h`` = 0.002 and 0.4), for a constant step and a doubled one (BDF2's
+    variable-step coefficients and error constant)."""
+    from femkit.dynamics.mol import MolState
+
+    s, exact = _two_rates()
+    scheme = get_scheme(HEAT_INTEGRATORS, name)
+    h = 0.002
+    hp = h / ratio
+    tn = 0.01
+    past = [(tn - 2 * hp, exact(tn - 2 * hp)), (tn - hp, exact(tn - hp)), (tn, exact(tn))]
+    state = MolState(tn, exact(tn), aux={"estimate": True, "history": past,
+                                         "previous": exact(tn - hp), "dt": hp})
+    new = scheme.step(s, state, h)
+    true = new.u - exact(tn + h)
+    q = new.aux["error"] / true
+    assert np.all((q > 0.5) & (q < 2.0)), q

@@ -29,8 +29,10 @@ def prepare_heat(case) -> None:
 
     spec = prepare_transient(case, "rho_c", HEAT_INTEGRATORS)
     if spec.rtol_t is not None:
-        embedded = [n for n in HEAT_INTEGRATORS.names() if HEAT_INTEGRATORS.get(n).embedded]
-        if not HEAT_INTEGRATORS.get(spec.integrator[0]).embedded:
+        from ...dynamics.mol import get_scheme
+
+        embedded = [n for n in HEAT_INTEGRATORS.names() if get_scheme(HEAT_INTEGRATORS, n).embedded]
+        if not get_scheme(HEAT_INTEGRATORS, spec.integrator[0], **dict(spec.integrator[1])).embedded:
             raise CaseFileError(f"rtol_t: adaptive steps need an integrator with an embedded error "
                                 f"estimate; valid: {', '.join(embedded)}")
     case.spec = HeatSpec(**{f.name: getattr(spec, f.name) for f in dataclasses.fields(spec)})

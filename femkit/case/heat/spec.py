@@ -13,4 +13,5 @@ __all__ = ["HeatSpec"]
 @dataclass(frozen=True)
 class HeatSpec(TransientSpec):
     """A :class:`~femkit.case.transient.setup.TransientSpec` whose ``capacity`` is ``rho_c`` and whose
-    ``rtol_t``, when set, makes the steps adaptive (implicit Euler's embedded estimate)."""
+    ``rtol_t``, when set, makes the steps adaptive (the integrator's embedded estimate: implicit
+    Euler, Crank-Nicolson, BDF2)."""

@@ -98,7 +98,9 @@ class TransientResult(RunResult):
             lines.append(f"stability dt_critical {st['dt_critical']:.4g} (lambda_max "
                          f"{st['lambda_max']:.4g}): dt / dt_critical = {spec.dt / st['dt_critical']:.3f}")
         lin = self.linear
-        lines.append(f"linear    {lin['method']}: {lin['factorizations']} factorisations, "
+        where = f" on petsc, {lin['ranks']} rank{'s' if lin['ranks'] > 1 else ''}" \
+            if lin.get("backend") == "petsc" else ""
+        lines.append(f"linear    {lin['method']}{where}: {lin['factorizations']} factorisations, "
                      f"{lin['solves']} solves, {lin['seconds_per_step'] * 1e3:.3g} ms per step")
         if self.errors is not None:
             top, fin = self.errors["max_over_time"], self.errors["final"]
@@ -128,24 +130,28 @@ def _linear_facts(system, march) -> dict:
             "iterations": int(st.get("linear_iterations", 0))}
 
 
-def _one_petsc_process(problem: str) -> None:
-    """The time-dependent kinds solve their steps on PETSc in one process: ``mpirun -n N``
-    with ``N > 1`` is refused in one line (the distributed path, femkit/fem/distributed,
-    assembles and solves a stationary Poisson problem; it has no mass matrix or time loop)."""
-    from ...errors import InputError
-    from ...solvers.petsc.env import world
-
-    size = world().getSize()
-    if size > 1:
-        raise InputError(f"problem: {problem} with solver.backend petsc runs on one process; "
-                         f"got {size} MPI ranks (the distributed path solves Poisson only)")
-
-
 def run_transient(case, capacity: str, registry, *, second_order: bool,
                   output_dir: str | os.PathLike | None = None, quiet: bool = False,
                   write: bool = True, echo: Callable[[str], Any] | None = None,
                   result_type=TransientResult) -> TransientResult:
-    """Run a prepared heat (``second_order=False``) or wave case; see the module docstring."""
+    """Run a prepared heat (``second_order=False``) or wave case; see the module docstring.
+
+    With ``solver.backend: petsc`` the run is on every rank of ``PETSc.COMM_WORLD`` (one
+    process, or ``mpirun -n N``): :mod:`femkit.case.transient.distributed`; rank 0 writes the
+    outputs and prints, every rank returns the result."""
+    args = (case, capacity, registry, second_order, output_dir, quiet, write, echo, result_type)
+    if case.spec.solver.backend != "petsc":
+        return _run(*args, None)
+    from ...solvers.petsc import require_petsc
+    from ...solvers.petsc.failure import abort_on_error
+
+    comm = require_petsc().COMM_WORLD
+    with abort_on_error(comm.tompi4py()):
+        return _run(*args, comm)
+
+
+def _run(case, capacity, registry, second_order, output_dir, quiet, write, echo, result_type,
+         comm) -> TransientResult:
     from ...dynamics.mol import get_scheme, march, march_adaptive
     from ...interrupt import raising
     from ...io.atomic import EARLIER_RUN, check_output_dir
@@ -155,43 +161,83 @@ def run_transient(case, capacity: str, registry, *, second_order: bool,
     from .setup import build_system, check_step, frame_errors, initial_values
 
     spec = case.spec
-    if spec.solver.backend == "petsc":
-        _one_petsc_process(case.problem)
+    root = comm is None or comm.getRank() == 0
+    on_root, on_all = _on_root(comm), _on_all(comm)
     if write:
-        check_output_dir(output_dir or spec.output.dir, EARLIER_RUN)
+        on_root(check_output_dir, output_dir or spec.output.dir, EARLIER_RUN)
     timer = StageTimer()
     with raising("meshing"), timer("mesh"):
-        mesh = build_mesh(case)
-    with raising("assembly"), timer("assembly"):
-        system = build_system(case, mesh, capacity)
+        mesh = build_mesh(case) if comm is None else _broadcast_mesh(case, build_mesh, comm)
     scheme = get_scheme(registry, spec.integrator[0], **dict(spec.integrator[1]))
-    with timer("stability"):
-        stability = check_step(case, system, scheme)
+    with raising("assembly"), timer("assembly"):
+        if comm is None:
+            system = build_system(case, mesh, capacity)
+        else:
+            from .distributed import build_distributed_system
+
+            system = build_distributed_system(case, mesh, capacity, comm)
+    with timer("stability"):   # distributed: the eigenvalue on the serial matrices, when needed
+        serial = system if comm is None or scheme.stability_bound == float("inf") else \
+            build_system(case, mesh, capacity)
+        stability = on_all(check_step, case, serial, scheme)
     u0 = initial_values(case, mesh, "initial")
     v0 = initial_values(case, mesh, "initial_velocity") if second_order else None
     stop = case.options.stop
     every = max(1, spec.steps // spec.output.frames)
     with timer("steps"):
         if spec.rtol_t is not None:
-            run = march_adaptive(system, scheme, u0, 0.0, spec.t_end, spec.dt, spec.rtol_t, stop=stop)
+            run = on_all(march_adaptive, system, scheme, u0, 0.0, spec.t_end, spec.dt,
+                         spec.rtol_t, stop=stop)
         else:
-            progress = Progress(spec.steps, f"{case.problem} {case.name}", unit="step", quiet=quiet)
-            run = march(system, scheme, u0, 0.0, spec.dt, spec.steps, v0=v0, every=every,
-                        stop=stop, progress=progress)
+            progress = Progress(spec.steps, f"{case.problem} {case.name}", unit="step",
+                                quiet=quiet or not root)
+            run = on_all(march, system, scheme, u0, 0.0, spec.dt, spec.steps, v0=v0,
+                         every=every, stop=stop, progress=progress)
     with timer("errors"):
-        errors = frame_errors(case, mesh, run.frames) if run.failure is None else None
+        errors = frame_errors(case, mesh, run.frames) if run.failure is None and root else None
     energies = [{"t": float(t), **system.energy(u, v)} for t, u, v in run.frames]
+    linear = _linear_facts(system, run)
+    if comm is not None:
+        linear.update(backend="petsc", ranks=comm.getSize())
     result = result_type(case=case, mesh=mesh, frames=run.frames, march=run, scheme=scheme,
                          stability=stability, errors=errors, energies=energies,
-                         linear=_linear_facts(system, run), timings=timer.times,
+                         linear=linear, timings=timer.times,
                          stopped=stop.name if run.interrupted else None)
     if write:
         with timer("output"):
-            write_transient_outputs(result, output_dir or spec.output.dir)
-    if not quiet:
+            final = on_root(write_transient_outputs, result, output_dir or spec.output.dir)
+        result.output_dir = final
+    if not quiet and root:
         for line in result.summary_lines():
             (echo or print)(line)
     return result
+
+
+def _on_root(comm):
+    """``fn(*args)`` on rank 0, its result broadcast (errors raised on every rank); serial:
+    a plain call."""
+    if comm is None:
+        return lambda fn, *args: fn(*args)
+    from ...solvers.petsc.failure import from_root
+
+    return lambda fn, *args: from_root(comm.tompi4py(), fn, *args)
+
+
+def _on_all(comm):
+    """``fn(*args, **kwargs)`` on every rank, an error raised on all of them (a step of
+    replicated data fails alike everywhere: each rank exits 2 by itself, rank 0 says it,
+    no ``MPI_Abort``); serial: a plain call."""
+    if comm is None:
+        return lambda fn, *args, **kwargs: fn(*args, **kwargs)
+    from ...solvers.petsc.failure import collective
+
+    return lambda fn, *args, **kwargs: collective(comm.tompi4py(), fn, *args, **kwargs)
+
+
+def _broadcast_mesh(case, build_mesh, comm):
+    from ...fem.distributed.poisson import broadcast_mesh
+
+    return broadcast_mesh(lambda: build_mesh(case), comm)
 
 
 def write_transient_outputs(result: TransientResult, directory: str | os.PathLike) -> Path:

@@ -25,7 +25,8 @@ from ..frozen import freeze
 from ..name_checks import check_geometry_spec, lookup, resolve_file, with_prefix
 
 __all__ = ["VARIABLES", "TransientSpec", "TransientOutput", "transient_schema",
-           "prepare_transient", "at_time", "element_values", "build_system", "check_step",
+           "prepare_transient", "at_time", "element_values", "build_system", "system_parts",
+           "check_step",
            "frame_errors", "initial_values", "plan_transient", "dof_points"]
 
 #: Variables of the expressions of a time-dependent case (``z`` on tetrahedra only).
@@ -314,6 +315,22 @@ def build_system(case, mesh, capacity: str):
     or lumped, ``capacity`` per cell), ``K`` (``kappa`` per cell), the Dirichlet nodes and the
     time-dependent load and boundary values (evaluated once when they do not use ``t``)."""
     from ...dynamics.mol import LinearSystem, step_solver, stiffness_ratio
+
+    parts = system_parts(case, mesh, capacity)
+    spec = case.spec
+    if spec.solver_default:   # the size rule; the step matrix M + b K: b = dt (heat), dt^2 / 4
+        M, K, fixed = parts["M"], parts["K"], parts["fixed"]
+        free = np.setdiff1d(np.arange(K.shape[0]), fixed)
+        b = spec.dt if capacity == "rho_c" else spec.dt ** 2 / 4.0
+        parts["solver"] = step_solver(mesh.dim, free.size, parts["solver"],
+                                      stiffness_ratio(M, K, free, b))
+    return LinearSystem(**parts)
+
+
+def system_parts(case, mesh, capacity: str, elements=None) -> dict:
+    """The keyword arguments of :class:`femkit.dynamics.mol.LinearSystem` for the case on
+    ``mesh`` (:func:`build_system`); ``elements``: ``M`` and ``K`` of these cells only (a
+    partition's part, global shape), the load and boundary data always whole."""
     from ...fem import assemble_load, assemble_neumann, assemble_stiffness
     from ...fem.forms import assemble_matrix
     from ...fem.lagrange import element_load, element_neumann
@@ -324,9 +341,10 @@ def build_system(case, mesh, capacity: str):
     kappa = element_values(case, mesh, spec.coefficient, "coefficient")
     density = element_values(case, mesh, spec.capacity, capacity)
     p1 = spec.element == "P1"
-    K = assemble_stiffness(mesh, kappa) if p1 else \
-        assemble_matrix(mesh, "stiffness", kappa, element=spec.element)
-    M = mass_matrix(mesh, element=spec.element, lumped=lumped, density=density)
+    K = assemble_stiffness(mesh, kappa, elements=elements) if p1 else \
+        assemble_matrix(mesh, "stiffness", kappa, element=spec.element, elements=elements)
+    M = mass_matrix(mesh, element=spec.element, lumped=lumped, density=density,
+                    elements=elements)
     n = K.shape[0]
     fixed, groups = _dirichlet(case, mesh)
     pts = dof_points(case, mesh)[fixed].T
@@ -360,15 +378,10 @@ def build_system(case, mesh, capacity: str):
         return F
 
     uses_t = [fn for fn in [source, *(h for _, h in neumann)] if "t" in fn.used]
-    solver = spec.solver
-    if spec.solver_default:   # the size rule; the step matrix M + b K: b = dt (heat), dt^2 / 4
-        free = np.setdiff1d(np.arange(n), fixed)
-        b = spec.dt if capacity == "rho_c" else spec.dt ** 2 / 4.0
-        solver = step_solver(dim, free.size, solver, stiffness_ratio(M, K, free, b))
-    return LinearSystem(M, K, fixed, load=load if has_load else None,
-                        boundary=boundary if groups else None, load_constant=not uses_t,
-                        boundary_constant=not any("t" in fn.used for _, fn in groups),
-                        lumped=lumped, solver=solver)
+    return dict(M=M, K=K, fixed=fixed, load=load if has_load else None,
+                boundary=boundary if groups else None, load_constant=not uses_t,
+                boundary_constant=not any("t" in fn.used for _, fn in groups),
+                lumped=lumped, solver=spec.solver)
 
 
 def initial_values(case, mesh, key: str) -> np.ndarray:
@@ -456,38 +469,99 @@ class _Frozen:
 
 # ----------------------------------------------------------------------------- the plan
 
+#: PCG iterations of one warm-started heat step (IC(0), ``rtol`` 1e-10, the quadratic warm start
+#: of :class:`femkit.dynamics.mol.system.ConstrainedOperator`): 7.8 measured at 251,809
+#: unknowns, ``dt kappa / h^2 ~ 20`` (docs/benchmarks.md, ``benchmarks/bench_heat.py``); a step
+#: is priced at this many iterations of the stationary solve, never more than that solve's.
+STEP_ITERATIONS = 8.0
+
+
+#: Seconds per entry of ``L + U`` for the pair of triangular solves of a kept SuperLU factor of a
+#: heat step matrix, at the cost model's reference speed (``cost/constants.json``): measured
+#: 2.5e-9 (18,727 unknowns, 1.43M entries, 25 ms) and 1.6e-9 (75,349 unknowns, 7.8M entries,
+#: 114 ms) at speed x7-9, the fill law of the Poisson model within 3% of the factors' own. The
+#: Poisson model's ``direct_solve_per_fill`` (3.2e-8) prices the first solve after a
+#: factorisation, 13-20 times a kept factor's substitution: priced with it, implicit steps cost
+#: a tenth of a factorisation each and a 410-step run came out at 102 s instead of ~6.
+SUBSTITUTION_PER_FILL = 2.0e-9
+
+
+def _step_prices(base, solver) -> tuple[float, float, float]:
+    """``(factor, substitution, spmv)`` seconds of a plan's solver, from the Poisson plan
+    ``base`` on the same mesh: the ``setup`` stage paid once (the kept factor or
+    preconditioner); per step the kept factor's two triangular solves
+    (:data:`SUBSTITUTION_PER_FILL` times the factor's fill ``nnz(L + U)``), or :data:`STEP_ITERATIONS`
+    iterations of the stationary solve; one SpMV priced as a CG iteration on the plan's
+    nonzeros, at the plan's machine speed (the ratio of its ``solve`` stage to that stage's
+    unscaled price)."""
+    from ...cost import load_constants
+    from ...cost.poisson import solver_key
+    from ...solvers.registry import priced_names
+
+    c = load_constants()
+    sec = c["seconds"]
+    stages = {st.name: st.seconds for st in base.stages}
+    setup, solve = stages.get("setup", 0.0), stages.get("solve", 0.0)
+    nnz, unknowns = float(base.sizes["nonzeros"]), float(base.sizes["unknowns"])
+    per_nnz = sec["iteration_per_nonzero"]
+    if solver.method in ("direct", "cholesky"):
+        fill = c["fill"]["direct_coefficient"] * unknowns ** c["fill"]["direct_exponent"]
+        unscaled = sec["direct_solve_per_fill"] * fill
+        substitution = SUBSTITUTION_PER_FILL * fill * (solve / unscaled if unscaled > 0 else 1.0)
+    else:
+        key = solver_key(*priced_names(solver.method, solver.preconditioner))
+        its = max(float(base.sizes.get("iterations", 1.0)), 1.0)
+        unscaled = per_nnz.get(key, per_nnz["cg"]) * nnz * its
+        substitution = solve * min(1.0, STEP_ITERATIONS / its)
+    speed = solve / unscaled if unscaled > 0 else 1.0
+    return setup, substitution, per_nnz["cg"] * nnz * speed
+
+
 def plan_transient(case, *, measure: bool = True):
     """The plan of a heat or wave case: the mesh and assembly stages of the Poisson model on
-    the same mesh (:func:`femkit.case.poisson.cost.plan_poisson_case`), its solve priced as
-    the one factorisation, then ``steps`` steps of one SpMV and one pair of triangular solves
-    each (about a tenth of a factorisation at these sizes; an explicit scheme on a lumped mass:
-    no factorisation, one SpMV per step), and the frames written."""
+    the same mesh (:func:`femkit.case.poisson.cost.plan_poisson_case`) with the step solver the
+    run will use (the size rule :func:`femkit.dynamics.mol.step_solver` when the case names
+    none), its ``setup`` priced as the one factorisation (or preconditioner) kept, then
+    ``steps`` steps of one SpMV and the kept factor's pair of triangular solves each, priced
+    from the factor's fill (:func:`_step_prices`; an explicit scheme on a lumped mass: no
+    factorisation, one SpMV per step), and the frames written."""
     from types import SimpleNamespace
 
     from ...cost import Plan, Stage
     from ..poisson.cost import plan_poisson_case
 
     spec = case.spec
-    proxy = SimpleNamespace(
-        name=case.name, functions={}, solver=spec.solver,
-        spec=SimpleNamespace(mesh=spec.mesh, adaptive=None, element=spec.element,
-                             output=SimpleNamespace(vtu=False, xdmf=False, plot=False)))
-    base = plan_poisson_case(proxy, measure=measure)
+
+    def poisson_plan(solver):
+        proxy = SimpleNamespace(
+            name=case.name, functions={}, solver=solver,
+            spec=SimpleNamespace(mesh=spec.mesh, adaptive=None, element=spec.element,
+                                 output=SimpleNamespace(vtu=False, xdmf=False, plot=False)))
+        return plan_poisson_case(proxy, measure=measure)
+
+    solver = spec.solver
+    base = poisson_plan(solver)
+    if spec.solver_default:   # the run's size rule (its stiffness unknown here: IC(0))
+        from ...dynamics.mol import step_solver
+
+        dim = 3 if "tetrahedra" in base.sizes else 2
+        solver = step_solver(dim, int(base.sizes.get("unknowns", 0.0)), solver)
+        if solver.method != spec.solver.method:
+            base = poisson_plan(solver)
     keep = [st for st in base.stages if st.name in ("mesh", "quality", "assembly", "boundary")]
-    solve = sum(st.seconds for st in base.stages if st.name in ("setup", "solve"))
+    factor, substitution, spmv = _step_prices(base, solver)
     peak = max(st.peak_bytes for st in base.stages)
     points = float(base.sizes.get("points", 0.0))
-    nnz = float(base.sizes.get("nonzeros", 0.0))
     steps = spec.steps
     frames = min(steps, spec.output.frames) + 1
-    per_step = 0.1 * solve + 2e-8 * nnz
+    per_step = substitution + spmv
     if spec.mass == "lumped" and spec.integrator[0] in ("explicit_euler", "central_difference"):
-        solve, per_step = 0.0, 2e-8 * nnz   # no matrix to factorise: an SpMV and a division
+        factor, per_step = 0.0, spmv   # no matrix to factorise: an SpMV and a division
     frame_bytes = 16.0 * points + 200.0
     stages = keep + [
-        Stage("factor", solve, peak, 0.0,
-              f"{spec.solver.method}: one factor kept" if spec.solver.method in ("direct", "cholesky")
-              else f"{spec.solver.method}: one preconditioner kept, warm-started solves per step"),
+        Stage("factor", factor, peak, 0.0,
+              f"{solver.method}: one factor kept" if solver.method in ("direct", "cholesky")
+              else f"{solver.method}: one preconditioner kept, warm-started solves per step"),
         Stage("steps", steps * per_step, peak + frames * 8.0 * points, 0.0,
               f"{steps:,} steps of {spec.integrator[0]}"),
         Stage("output", frames * frame_bytes / 2e7, frame_bytes, frames * frame_bytes,
@@ -498,7 +572,8 @@ def plan_transient(case, *, measure: bool = True):
                 stages, base.baseline_bytes,
                 assumptions=base.assumptions[:2] + [
                     "each step: one SpMV and one pair of triangular solves of the kept factor "
-                    "(~0.1 x its factorisation); adaptive runs are priced at their first dt"])
+                    f"(priced from its fill; {STEP_ITERATIONS:g} warm-started iterations with a "
+                    "kept preconditioner); adaptive runs are priced at their first dt"])
 
     def suggest(kind: str, limit: float) -> str:
         if kind not in ("time", "steps"):

@@ -89,14 +89,18 @@ def march_adaptive(system, scheme, u0, t0: float, t_end: float, dt0: float, rtol
 
     A step is accepted when ``||error||_inf <= rtol_t * max(||u||_inf, floor)``, ``floor`` being
     ``1e-3`` of the largest ``|u0|`` (a decaying solution is not chased to round-off). Step sizes
-    are ``dt0 * 2^k`` (halved on a rejection, doubled when the estimate is below a quarter of
-    its bound, the local error being ``O(dt^2)``), so a few kept factors serve the whole run; the
-    last step ends on ``t_end``. Every accepted step is kept as a frame with its size and error.
+    are ``dt0 * 2^k`` (halved on a rejection, doubled when the estimate is below
+    ``2^-(order + 1)`` of its bound, the local error being ``O(dt^(order + 1))``), so a few kept
+    factors serve the whole run; the last step ends on ``t_end``. Every accepted step is kept as
+    a frame with its size and error. The march asks the scheme for its estimate
+    (``aux["estimate"]``) and hands it the initial rate ``u'(t0)`` (``aux["rate"]``).
     """
     out = MarchResult()
     scale = 1e-3 * max(float(np.abs(u0).max()) if np.size(u0) else 0.0, 1e-300)
     state = scheme.start(system, u0, t0, dt0)
     state.aux["rate"] = rate(system, state.u, t0, dt0)
+    state.aux["estimate"] = True
+    grow = 2.0 ** -(scheme.order + 1)
     _keep(out, state)
     dt = dt0
     clock = time.perf_counter()
@@ -120,7 +124,7 @@ def march_adaptive(system, scheme, u0, t0: float, t_end: float, dt0: float, rtol
         out.dts.append(h)
         out.errors.append(err)
         _keep(out, state)
-        if err < 0.25 and h == dt:
+        if err < grow and h == dt:
             dt = 2.0 * dt
     out.step_seconds = time.perf_counter() - clock
     if out.steps + out.rejected >= max_steps and state.t < t_end - eps:

@@ -8,7 +8,10 @@ side matrix is kept too: one SpMV and one pair of triangular solves per step, as
 scikit-fem's heat example ex19). Second order at ``theta = 1/2``, first otherwise;
 unconditionally stable for ``theta >= 1/2``, else for ``dt lambda_max <= 2 / (1 - 2 theta)``.
 
-Implicit Euler carries an embedded error estimate (``embedded``): the trapezoidal rule with the
+Crank-Nicolson carries an embedded error estimate too (``embedded`` at ``theta = 1/2``): Milne's
+device against the quadratic extrapolation of the last three states
+(:mod:`femkit.dynamics.mol.estimate`, the trapezoidal rule's ``E = h^3 / 12 u'''``), no extra
+solve. Implicit Euler carries an embedded error estimate (``embedded``): the trapezoidal rule with the
 same two derivatives, ``u0 + dt/2 (u0' + u1')``, is second order, and its difference from the
 implicit Euler value, ``dt/2 (u1' - u0')`` with ``u1' = (u1 - u0) / dt``, estimates the step's
 local error at no extra solve (``state.aux["error"]``).
@@ -21,6 +24,7 @@ from dataclasses import dataclass
 
 from ...errors import InputError
 from .base import HeatScheme, MolState
+from .estimate import attach_estimate, trapezoid_constant
 from .registry import register_heat
 
 
@@ -43,7 +47,9 @@ class ThetaMethod(HeatScheme):
 
     theta: float = 0.5
 
-    embedded = False
+    @property
+    def embedded(self) -> bool:  # type: ignore[override]
+        return self.theta == 0.5
 
     @property
     def order(self) -> int:  # type: ignore[override]
@@ -62,7 +68,8 @@ class ThetaMethod(HeatScheme):
             raise InputError(f"integrator {self.name!r}: theta must lie in [0, 1], got {self.theta!r}")
 
     def step(self, system, state: MolState, dt: float) -> MolState:
-        return theta_step(system, state, dt, self.theta)
+        new = theta_step(system, state, dt, self.theta)
+        return attach_estimate(state, new, trapezoid_constant(dt)) if self.theta == 0.5 else new
 
 
 @register_heat("implicit_euler")

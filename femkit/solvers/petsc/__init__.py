@@ -11,10 +11,13 @@ when it cannot. Modules:
 - ``options``: ``petsc_options`` pass-through (PETSc's options database, per solve prefix);
 - ``coo``: ``MatSetPreallocationCOO`` / ``MatSetValuesCOO`` (pattern once, values many);
 - ``backend``: :class:`PetscBackend`, the :class:`~femkit.solvers.backend.LinearSolverBackend`;
+- ``kept``: :class:`~.kept.KeptKsp`, one KSP set up once and solved for many right-hand sides
+  (the time steps of a fixed ``dt``);
 - ``failure``: collective error handling (a failing rank never leaves the others hanging).
 
 The distributed Poisson problem (partition, assembly, solve, output) sits one layer up, in
-:mod:`femkit.fem.distributed`, since the solver layer knows nothing of meshes.
+:mod:`femkit.fem.distributed`, and the distributed heat and wave kinds in
+``femkit.case.transient.distributed``, since the solver layer knows nothing of meshes.
 """
 
 from .env import INSTALL_HINT, petsc_available, require_petsc
