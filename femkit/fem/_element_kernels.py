@@ -10,6 +10,12 @@ random, read twice); here an incidence is only ``w e + a`` (cell ``e``, local do
 cell's dofs are read from the dof map when its row is built and the slots written (``w m``
 incidence entries instead of ``w^2 m``: P2 has 6 or 10 dofs per cell). The same rows and slots,
 entry for entry (tests/fem/test_p2_compiled_passes.py).
+
+A mesh's first stiffness (:func:`first_stiffness`, no pattern cached yet) is summed in that row
+pass itself, from each cell's P1 products computed once before it (:func:`_cell_products`): each
+incidence adds its cell's local row into the row being built, so no slot map is written or read
+(72 MB on a 1M-dof square) and the matrix owns the new index arrays (no copy of a cached
+pattern's); the values are the separate pass's bit for bit.
 """
 
 from __future__ import annotations
@@ -22,10 +28,32 @@ from .cells.kernels import _tetrahedron, _triangle
 
 
 @numba.njit(cache=True)
-def _element_pattern(cells, n, indices, slots):  # pragma: no cover - compiled
+def _element_pattern(cells, n, indices, slots, k1, table, data):  # pragma: no cover - compiled
     """CSR pattern of the dof map ``cells`` (m, w) among ``n`` dofs into ``indices`` (a buffer of
-    at least ``n + w (w - 1) m`` entries) and ``slots`` (m, w * w). Returns ``(indptr, nnz)``."""
-    m, w = cells.shape
+    at least ``n + w (w - 1) m`` entries) and ``slots`` (m, w * w; nothing written when it has no
+    rows). Returns ``(indptr, nnz)``, ``indptr`` of the slots' integer type.
+
+    With a non-empty ``k1`` (m, P) (the cells' symmetric P1 products, :func:`_cell_products`) and
+    ``table`` (w, P, w) (``table[a, p, b]``: the folded reference tensor's entry ``(a, b)`` of
+    pair ``p``, :func:`symmetric_table`), the stiffness is summed into ``data`` (a buffer as long
+    as ``indices``) while each row is built: entry ``(a, b)`` of cell ``e`` is
+    ``sum_p k1[e, p] table[a, p, b]`` (p in order, as :func:`_element_stiffness` sums it), added
+    to the row's entry in increasing ``e`` (the incidences' order): the separate pass's values
+    bit for bit, without a slot map written and walked again at random. The body is compiled with
+    ``w`` a constant for P2 (6 and 10 dofs: the loops over a cell's dofs unrolled)."""
+    if cells.shape[1] == 6:
+        return _pattern_rows(cells, n, indices, slots, k1, table, data, 6)
+    if cells.shape[1] == 10:
+        return _pattern_rows(cells, n, indices, slots, k1, table, data, 10)
+    return _pattern_rows(cells, n, indices, slots, k1, table, data, cells.shape[1])
+
+
+@numba.njit(cache=True, inline="always")
+def _pattern_rows(cells, n, indices, slots, k1, table, data, w):  # pragma: no cover - compiled
+    """The body of :func:`_element_pattern` for ``w`` dofs per cell."""
+    m = cells.shape[0]
+    values = k1.shape[0] > 0
+    with_slots = slots.shape[0] > 0
     start = _vertex_starts(cells, n)
     inc = np.empty(w * m, slots.dtype)               # dof -> incidences w e + a, e increasing
     fill = start[:-1].copy()
@@ -34,9 +62,10 @@ def _element_pattern(cells, n, indices, slots):  # pragma: no cover - compiled
             i = cells[e, a]
             inc[fill[i]] = w * e + a
             fill[i] += 1
-    indptr = np.zeros(n + 1, np.int64)
-    stamp = np.full(n, -1, np.int64)
+    indptr = np.zeros(n + 1, slots.dtype)
+    stamp = np.full(n, -1, slots.dtype)
     pos = np.empty(n, slots.dtype)
+    row = np.zeros(w)
     nnz = 0
     for i in range(n):
         s = nnz
@@ -49,28 +78,100 @@ def _element_pattern(cells, n, indices, slots):  # pragma: no cover - compiled
                     nnz = _insert_sorted(indices, s, nnz, j)
         for q in range(s, nnz):
             pos[indices[q]] = q
+            if values:
+                data[q] = 0.0
         for k in range(start[i], start[i + 1]):
             e = inc[k] // w
             a = inc[k] - w * e
+            if values:
+                _local_row(k1, table, e, a, row, w)
             for b in range(w):
-                slots[e, w * a + b] = pos[cells[e, b]]
+                q = pos[cells[e, b]]
+                if with_slots:
+                    slots[e, w * a + b] = q
+                if values:
+                    data[q] += row[b]
         indptr[i + 1] = nnz
     return indptr, nnz
+
+
+@numba.njit(cache=True, inline="always")
+def _local_row(k1, table, e, a, row, w):  # pragma: no cover - compiled
+    """Row ``a`` of cell ``e``'s stiffness into ``row``: ``sum_p k1[e, p] table[a, p, :]``."""
+    for b in range(w):
+        row[b] = 0.0
+    for p in range(k1.shape[1]):
+        c = k1[e, p]
+        for b in range(w):
+            row[b] += c * table[a, p, b]
+
+
+@numba.njit(cache=True)
+def _cell_products(cells, points, kappa, scalar_kappa):  # pragma: no cover - compiled
+    """The symmetric P1 products ``k1_ab = kappa |T| grad lambda_a . grad lambda_b`` (``a <= b``,
+    row by row) of every cell, (m, P), and the number of degenerate cells (their rows zero)."""
+    m = cells.shape[0]
+    nv = 3 if points.shape[1] == 2 else 4
+    k1 = np.zeros((m, (nv * (nv + 1)) // 2))
+    g = np.zeros((4, 3))
+    bad = 0
+    for e in range(m):
+        ok, s = _cell_gradients(cells, points, e, nv, kappa, scalar_kappa, g)
+        if not ok:
+            bad += 1
+            continue
+        p = 0
+        for a in range(nv):
+            for b in range(a, nv):
+                k1[e, p] = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
+                p += 1
+    return k1, bad
+
+
+def _pattern_buffers(cells: np.ndarray, n: int, *, with_slots: bool = True):
+    """``cells`` as int64, the ``indices`` buffer and the ``slots`` of :func:`_element_pattern`
+    (int32 when the entry count allows it; ``slots`` without rows unless ``with_slots``)."""
+    cells = np.ascontiguousarray(cells, dtype=np.int64)
+    m, w = cells.shape
+    bound = int(n) + w * (w - 1) * m
+    dtype = np.int32 if max(bound, w * m) < np.iinfo(np.int32).max else np.int64
+    return cells, np.empty(bound, dtype), np.empty((m if with_slots else 0, w * w), dtype)
 
 
 def element_pattern_kernel(cells: np.ndarray, n: int):
     """``(indptr, indices, slots)`` of the dof map ``cells`` among ``n`` dofs (compiled,
     :func:`_element_pattern`); ``indices`` and ``slots`` int32 when the entry count allows it."""
-    cells = np.ascontiguousarray(cells, dtype=np.int64)
-    n = int(n)
-    m, w = cells.shape
-    bound = n + w * (w - 1) * m
-    dtype = np.int32 if max(bound, w * m) < np.iinfo(np.int32).max else np.int64
-    indices = np.empty(bound, dtype)
-    slots = np.empty((m, w * w), dtype)
-    indptr, nnz = _element_pattern(cells, n, indices, slots)
+    cells, indices, slots = _pattern_buffers(cells, n)
+    indptr, nnz = _element_pattern(cells, int(n), indices, slots, np.zeros((0, 1)),
+                                   np.zeros((0, 1, 1)), np.zeros(0))
     indices.resize(nnz, refcheck=False)   # shrink in place: the untouched tail was never paged in
     return indptr, indices, slots
+
+
+def first_stiffness(mesh, dofs, kappa, table: np.ndarray):
+    """The stiffness matrix (CSR, sorted rows) of the dof map ``dofs`` on ``mesh`` for the
+    reference tensor ``table`` ((d+1)^2, n^2), pattern and values in one pass and no slot map
+    (:func:`_element_pattern`): the first assembly on a large mesh. ``kappa``: a float or one per
+    cell. None if a cell is degenerate (the caller's numpy path then names it)."""
+    import scipy.sparse as sp
+
+    from ._kernels import _values
+
+    k1, bad = _cell_products(np.ascontiguousarray(mesh.cells, dtype=np.int64),
+                             np.ascontiguousarray(mesh.points, dtype=np.float64), *_values(kappa))
+    if bad:
+        return None
+    cells, indices, slots = _pattern_buffers(dofs.cells, dofs.n_dofs, with_slots=False)
+    data = np.empty(len(indices))
+    w = cells.shape[1]
+    folded = symmetric_table(table, mesh.dim + 1).reshape(-1, w, w)        # (P, a, b)
+    folded = np.ascontiguousarray(folded.transpose(1, 0, 2))                # (a, P, b)
+    indptr, nnz = _element_pattern(cells, int(dofs.n_dofs), indices, slots, k1, folded, data)
+    indices.resize(nnz, refcheck=False)   # shrink in place: the untouched tails were never paged in
+    data.resize(nnz, refcheck=False)
+    K = sp.csr_matrix((data, indices, indptr), shape=(dofs.n_dofs, dofs.n_dofs), copy=False)
+    K.has_sorted_indices = True
+    return K
 
 
 @numba.njit(cache=True)
@@ -92,12 +193,11 @@ def _quadrature_coordinates(cells, points, bary):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _element_load(cells, points, fq, wphi, n_dofs):  # pragma: no cover - compiled
-    """``F_i = sum_cells |T| sum_q fq[e, q] wphi[q, a]`` over the dof map ``cells`` (m, w);
-    returns ``(F, number of degenerate cells)``."""
+def _element_load(cells, points, fq, wphi, F):  # pragma: no cover - compiled
+    """``F_i += sum_cells |T| sum_q fq[e, q] wphi[q, a]`` over the dof map ``cells`` (m, w) (a
+    block of cells); returns the number of degenerate cells."""
     m, w = cells.shape
     nq = wphi.shape[0]
-    F = np.zeros(n_dofs)
     g = np.zeros((4, 3))
     bad = 0
     for e in range(m):
@@ -113,7 +213,7 @@ def _element_load(cells, points, fq, wphi, n_dofs):  # pragma: no cover - compil
             for p in range(nq):
                 acc += fq[e, p] * wphi[p, a]
             F[cells[e, a]] += measure * acc
-    return F, bad
+    return bad
 
 
 def quadrature_coordinates(cells: np.ndarray, points: np.ndarray, bary: np.ndarray) -> tuple:
@@ -124,14 +224,15 @@ def quadrature_coordinates(cells: np.ndarray, points: np.ndarray, bary: np.ndarr
 
 
 def element_load_kernel(cells: np.ndarray, points: np.ndarray, fq: np.ndarray, wphi: np.ndarray,
-                        n_dofs: int):
-    """The load vector of the dof map ``cells`` from ``f`` at the quadrature points ``fq`` (m, q)
-    and ``wphi[q, a] = w_q phi_a(x_q)``; None if a cell is degenerate."""
-    F, bad = _element_load(np.ascontiguousarray(cells, dtype=np.int64),
-                           np.ascontiguousarray(points, dtype=np.float64),
-                           np.ascontiguousarray(fq, dtype=np.float64),
-                           np.ascontiguousarray(wphi, dtype=np.float64), int(n_dofs))
-    return None if bad else F
+                        F: np.ndarray) -> bool:
+    """Add the load of the cells ``cells`` (rows of a dof map) from ``f`` at their quadrature
+    points ``fq`` (m, q) and ``wphi[q, a] = w_q phi_a(x_q)`` into ``F`` (n_dofs,); False (``F``
+    partly summed) if a cell is degenerate."""
+    bad = _element_load(np.ascontiguousarray(cells, dtype=np.int64),
+                        np.ascontiguousarray(points, dtype=np.float64),
+                        np.ascontiguousarray(fq, dtype=np.float64),
+                        np.ascontiguousarray(wphi, dtype=np.float64), F)
+    return not bad
 
 
 def warm_up() -> None:
@@ -146,10 +247,13 @@ def warm_up() -> None:
         w = elem.n_dofs
         cells = np.arange(w, dtype=np.int64)[None, :]   # one cell; only its vertices are read as points
         element_pattern_kernel(cells, w)
+        _cell_products(cells, pts, np.ones(1), True)
         _element_stiffness(cells, pts, np.ones(1), True, np.ones(((nv * (nv + 1)) // 2, w * w)),
                            np.arange(w * w, dtype=np.int32).reshape(1, -1), w * w)
         quadrature_coordinates(cells, pts, np.full((1, nv), 1.0 / nv))
-        element_load_kernel(cells, pts, np.ones((1, 1)), np.ones((1, w)), w)
+        fq = np.ones((1, 1))
+        element_load_kernel(cells, pts, fq, np.ones((1, w)), np.zeros(w))          # a compiled source's values
+        element_load_kernel(cells, pts, np.broadcast_to(fq, (1, 1)), np.ones((1, w)), np.zeros(w))  # NumPy's (read-only)
 
 
 @numba.njit(cache=True)

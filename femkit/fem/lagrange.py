@@ -88,18 +88,25 @@ def element_load(mesh, f, element="P2", *, rule: str | None = None) -> np.ndarra
 
 def _load_compiled(mesh, dofs: DofMap, f, quad, phi: np.ndarray) -> np.ndarray | None:
     """:func:`element_load` of a callable ``f`` by the compiled passes
-    (:mod:`femkit.fem._element_kernels`: the points' coordinates, then measures, products and sums
-    in one pass over the cells); None when ``f`` is not finite somewhere or a cell is degenerate
-    (the NumPy path then raises naming them)."""
+    (:mod:`femkit.fem._element_kernels`), block by block of :func:`~femkit.fem.quadrature.blocks`
+    (the rule's points' coordinates, ``f`` on them, then measures, products and sums: the block's
+    arrays stay in cache, none is ever the whole mesh's); None when ``f`` is not finite somewhere
+    or a cell is degenerate (the NumPy path then raises naming them)."""
     from ._element_kernels import element_load_kernel, quadrature_coordinates
     from .fused import source_values
 
+    wphi = quad.weights[:, None] * phi
+    F = np.zeros(dofs.n_dofs)
     fq = source_values(mesh, f, quad)
-    if fq is None:
-        fq = evaluate_callable(f, *quadrature_coordinates(dofs.cells, mesh.points, quad.points), name="f")
-    if not np.isfinite(fq).all():
-        return None
-    return element_load_kernel(dofs.cells, mesh.points, fq, quad.weights[:, None] * phi, dofs.n_dofs)
+    if fq is not None:
+        ok = bool(np.isfinite(fq).all()) and element_load_kernel(dofs.cells, mesh.points, fq, wphi, F)
+        return F if ok else None
+    for part in blocks(mesh.n_cells):
+        cells = dofs.cells[part]
+        fq = evaluate_callable(f, *quadrature_coordinates(cells, mesh.points, quad.points), name="f")
+        if not (np.isfinite(fq).all() and element_load_kernel(cells, mesh.points, fq, wphi, F)):
+            return None
+    return F
 
 
 def _facet_dofs(mesh, dofs: DofMap, facets: np.ndarray) -> np.ndarray:
