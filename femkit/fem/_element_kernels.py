@@ -128,6 +128,16 @@ def _cell_products(cells, points, kappa, scalar_kappa):  # pragma: no cover - co
     return k1, bad
 
 
+def cell_products(mesh, kappa) -> np.ndarray | None:
+    """The cells' symmetric P1 products (m, P) (:func:`_cell_products`) for ``kappa`` (a float or
+    one per cell); None if a cell is degenerate."""
+    from ._kernels import _values
+
+    k1, bad = _cell_products(np.ascontiguousarray(mesh.cells, dtype=np.int64),
+                             np.ascontiguousarray(mesh.points, dtype=np.float64), *_values(kappa))
+    return None if bad else k1
+
+
 def _pattern_buffers(cells: np.ndarray, n: int, *, with_slots: bool = True):
     """``cells`` as int64, the ``indices`` buffer and the ``slots`` of :func:`_element_pattern`
     (int32 when the entry count allows it; ``slots`` without rows unless ``with_slots``)."""
@@ -155,11 +165,8 @@ def first_stiffness(mesh, dofs, kappa, table: np.ndarray):
     cell. None if a cell is degenerate (the caller's numpy path then names it)."""
     import scipy.sparse as sp
 
-    from ._kernels import _values
-
-    k1, bad = _cell_products(np.ascontiguousarray(mesh.cells, dtype=np.int64),
-                             np.ascontiguousarray(mesh.points, dtype=np.float64), *_values(kappa))
-    if bad:
+    k1 = cell_products(mesh, kappa)
+    if k1 is None:
         return None
     cells, indices, slots = _pattern_buffers(dofs.cells, dofs.n_dofs, with_slots=False)
     data = np.empty(len(indices))
@@ -247,9 +254,9 @@ def warm_up() -> None:
         w = elem.n_dofs
         cells = np.arange(w, dtype=np.int64)[None, :]   # one cell; only its vertices are read as points
         element_pattern_kernel(cells, w)
-        _cell_products(cells, pts, np.ones(1), True)
-        _element_stiffness(cells, pts, np.ones(1), True, np.ones(((nv * (nv + 1)) // 2, w * w)),
-                           np.arange(w * w, dtype=np.int32).reshape(1, -1), w * w)
+        k1, _ = _cell_products(cells, pts, np.ones(1), True)
+        _element_stiffness(k1, np.ones((k1.shape[1], w * w)), np.arange(w * w, dtype=np.int32).reshape(1, -1),
+                           w * w)
         quadrature_coordinates(cells, pts, np.full((1, nv), 1.0 / nv))
         fq = np.ones((1, 1))
         element_load_kernel(cells, pts, fq, np.ones((1, w)), np.zeros(w))          # a compiled source's values
@@ -257,37 +264,27 @@ def warm_up() -> None:
 
 
 @numba.njit(cache=True)
-def _element_stiffness(cells, points, kappa, scalar_kappa, table, slots, nnz):  # pragma: no cover - compiled
-    """Stiffness of an element other than P1 on affine cells into CSR data: per cell the P1
-    products ``k1_ab`` (symmetric: the ``a <= b`` ones, ``table`` row ``p`` for pair ``p`` holding
-    ``S_ab + S_ba``, or ``S_aa``), then ``local += k1_ab table[p]`` row by row (independent sums
-    over the ``w^2`` entries, which the compiler vectorises; the P1 kernel's order,
-    :func:`femkit.fem._kernels._element_stiffness`, sums each entry's products in one chain), then
-    scattered through ``slots``. Returns (data, number of degenerate cells)."""
-    m = cells.shape[0]
-    nv = 3 if points.shape[1] == 2 else 4
+def _element_stiffness(k1, table, slots, nnz):  # pragma: no cover - compiled
+    """Stiffness of an element other than P1 on affine cells into CSR data: per cell its P1
+    products ``k1`` (symmetric: the ``a <= b`` ones, :func:`_cell_products`; ``table`` row ``p``
+    for pair ``p`` holding ``S_ab + S_ba``, or ``S_aa``), then ``local += k1_ab table[p]`` row by
+    row (independent sums over the ``w^2`` entries, which the compiler vectorises; the P1
+    kernel's order, :func:`femkit.fem._kernels._element_stiffness`, sums each entry's products in
+    one chain), then scattered through ``slots``."""
+    m, npair = k1.shape
     n2 = table.shape[1]
     data = np.zeros(nnz)
-    g = np.zeros((4, 3))
     local = np.empty(n2)
-    bad = 0
     for e in range(m):
-        ok, s = _cell_gradients(cells, points, e, nv, kappa, scalar_kappa, g)
-        if not ok:
-            bad += 1
-            continue
         for j in range(n2):
             local[j] = 0.0
-        p = 0
-        for a in range(nv):
-            for b in range(a, nv):
-                k = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
-                for j in range(n2):
-                    local[j] += k * table[p, j]
-                p += 1
+        for p in range(npair):
+            k = k1[e, p]
+            for j in range(n2):
+                local[j] += k * table[p, j]
         for j in range(n2):
             data[slots[e, j]] += local[j]
-    return data, bad
+    return data
 
 
 def symmetric_table(table: np.ndarray, nv: int) -> np.ndarray:
@@ -302,10 +299,7 @@ def element_stiffness_kernel(mesh, kappa, table: np.ndarray, pattern):
     """CSR data of the stiffness of every cell of ``mesh`` for the reference tensor ``table``
     ((d+1)^2, n^2) into ``pattern``, or None if a cell is degenerate (the caller's numpy path
     then names it). ``kappa``: a float or one per cell."""
-    from ._kernels import _values
-
-    nv = mesh.dim + 1
-    data, bad = _element_stiffness(np.ascontiguousarray(mesh.cells, dtype=np.int64),
-                                   np.ascontiguousarray(mesh.points, dtype=np.float64),
-                                   *_values(kappa), symmetric_table(table, nv), pattern.slots, pattern.nnz)
-    return None if bad else data
+    k1 = cell_products(mesh, kappa)
+    if k1 is None:
+        return None
+    return _element_stiffness(k1, symmetric_table(table, mesh.dim + 1), pattern.slots, pattern.nnz)
