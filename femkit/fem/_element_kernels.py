@@ -11,11 +11,12 @@ cell's dofs are read from the dof map when its row is built and the slots writte
 incidence entries instead of ``w^2 m``: P2 has 6 or 10 dofs per cell). The same rows and slots,
 entry for entry (tests/fem/test_p2_compiled_passes.py).
 
-A mesh's first stiffness (:func:`first_stiffness`, no pattern cached yet) is summed in that row
-pass itself, from each cell's P1 products computed once before it (:func:`_cell_products`): each
-incidence adds its cell's local row into the row being built, so no slot map is written or read
-(72 MB on a 1M-dof square) and the matrix owns the new index arrays (no copy of a cached
-pattern's); the values are the separate pass's bit for bit.
+A mesh's first stiffness (:func:`first_stiffness`, no pattern cached yet) is summed in such a row
+pass (:func:`_stiffness_rows`), from each cell's P1 products computed once before it
+(:func:`_cell_products`): each incidence adds its cell's local row into the row being built, which
+is sorted at its end, so no slot map is written or read (72 MB on a 1M-dof square) and the matrix
+owns the new index arrays (no copy of a cached pattern's); the values are the separate pass's bit
+for bit.
 """
 
 from __future__ import annotations
@@ -28,44 +29,42 @@ from .cells.kernels import _tetrahedron, _triangle
 
 
 @numba.njit(cache=True)
-def _element_pattern(cells, n, indices, slots, k1, table, data):  # pragma: no cover - compiled
+def _element_pattern(cells, n, indices, slots):  # pragma: no cover - compiled
     """CSR pattern of the dof map ``cells`` (m, w) among ``n`` dofs into ``indices`` (a buffer of
-    at least ``n + w (w - 1) m`` entries) and ``slots`` (m, w * w; nothing written when it has no
-    rows). Returns ``(indptr, nnz)``, ``indptr`` of the slots' integer type.
-
-    With a non-empty ``k1`` (m, P) (the cells' symmetric P1 products, :func:`_cell_products`) and
-    ``table`` (w, P, w) (``table[a, p, b]``: the folded reference tensor's entry ``(a, b)`` of
-    pair ``p``, :func:`symmetric_table`), the stiffness is summed into ``data`` (a buffer as long
-    as ``indices``) while each row is built: entry ``(a, b)`` of cell ``e`` is
-    ``sum_p k1[e, p] table[a, p, b]`` (p in order, as :func:`_element_stiffness` sums it), added
-    to the row's entry in increasing ``e`` (the incidences' order): the separate pass's values
-    bit for bit, without a slot map written and walked again at random. The body is compiled with
-    ``w`` a constant for P2 (6 and 10 dofs: the loops over a cell's dofs unrolled)."""
+    at least ``n + w (w - 1) m`` entries) and ``slots`` (m, w * w). Returns ``(indptr, nnz)``,
+    ``indptr`` of the slots' integer type. Compiled with ``w`` a constant for P2 (6 and 10 dofs:
+    the loops over a cell's dofs unrolled)."""
     if cells.shape[1] == 6:
-        return _pattern_rows(cells, n, indices, slots, k1, table, data, 6)
+        return _pattern_rows(cells, n, indices, slots, 6)
     if cells.shape[1] == 10:
-        return _pattern_rows(cells, n, indices, slots, k1, table, data, 10)
-    return _pattern_rows(cells, n, indices, slots, k1, table, data, cells.shape[1])
+        return _pattern_rows(cells, n, indices, slots, 10)
+    return _pattern_rows(cells, n, indices, slots, cells.shape[1])
 
 
 @numba.njit(cache=True, inline="always")
-def _pattern_rows(cells, n, indices, slots, k1, table, data, w):  # pragma: no cover - compiled
-    """The body of :func:`_element_pattern` for ``w`` dofs per cell."""
+def _incidence_lists(cells, n, w, like):  # pragma: no cover - compiled
+    """The dof -> incidence lists of ``cells`` (a counting sort): ``inc[start[i]:start[i + 1]]``
+    holds ``w e + a`` for each cell ``e`` whose local dof ``a`` is ``i``, ``e`` increasing
+    (``inc`` of ``like``'s integer type)."""
     m = cells.shape[0]
-    values = k1.shape[0] > 0
-    with_slots = slots.shape[0] > 0
     start = _vertex_starts(cells, n)
-    inc = np.empty(w * m, slots.dtype)               # dof -> incidences w e + a, e increasing
+    inc = np.empty(w * m, like.dtype)
     fill = start[:-1].copy()
     for e in range(m):
         for a in range(w):
             i = cells[e, a]
             inc[fill[i]] = w * e + a
             fill[i] += 1
+    return start, inc
+
+
+@numba.njit(cache=True, inline="always")
+def _pattern_rows(cells, n, indices, slots, w):  # pragma: no cover - compiled
+    """The body of :func:`_element_pattern` for ``w`` dofs per cell."""
+    start, inc = _incidence_lists(cells, n, w, slots)
     indptr = np.zeros(n + 1, slots.dtype)
     stamp = np.full(n, -1, slots.dtype)
     pos = np.empty(n, slots.dtype)
-    row = np.zeros(w)
     nnz = 0
     for i in range(n):
         s = nnz
@@ -78,19 +77,65 @@ def _pattern_rows(cells, n, indices, slots, k1, table, data, w):  # pragma: no c
                     nnz = _insert_sorted(indices, s, nnz, j)
         for q in range(s, nnz):
             pos[indices[q]] = q
-            if values:
-                data[q] = 0.0
         for k in range(start[i], start[i + 1]):
             e = inc[k] // w
             a = inc[k] - w * e
-            if values:
-                _local_row(k1, table, e, a, row, w)
             for b in range(w):
-                q = pos[cells[e, b]]
-                if with_slots:
-                    slots[e, w * a + b] = q
-                if values:
-                    data[q] += row[b]
+                slots[e, w * a + b] = pos[cells[e, b]]
+        indptr[i + 1] = nnz
+    return indptr, nnz
+
+
+@numba.njit(cache=True)
+def _stiffness_rows(cells, n, indices, k1, table, data):  # pragma: no cover - compiled
+    """The CSR pattern (as :func:`_element_pattern`, no slots) and the stiffness values of the dof
+    map ``cells`` into ``indices`` and ``data`` (buffers of ``n + w (w - 1) m`` entries), row by
+    row: each incidence (cell ``e``, local dof ``a``) of the row adds the cell's local row
+    ``sum_p k1[e, p] table[a, p, :]`` (``k1`` (m, P): the cells' symmetric P1 products,
+    :func:`_cell_products`; ``table`` (w, P, w): the folded reference tensor, :func:`symmetric_table`;
+    p in order, as :func:`_element_stiffness` sums it) at its columns, appended when new; the row
+    is then sorted with its values. Each entry sums its cells in increasing ``e`` (the
+    incidences' order), as the separate pass does: the same bits. Returns ``(indptr, nnz)``."""
+    if cells.shape[1] == 6:
+        return _value_rows(cells, n, indices, k1, table, data, 6)
+    if cells.shape[1] == 10:
+        return _value_rows(cells, n, indices, k1, table, data, 10)
+    return _value_rows(cells, n, indices, k1, table, data, cells.shape[1])
+
+
+@numba.njit(cache=True, inline="always")
+def _value_rows(cells, n, indices, k1, table, data, w):  # pragma: no cover - compiled
+    """The body of :func:`_stiffness_rows` for ``w`` dofs per cell."""
+    start, inc = _incidence_lists(cells, n, w, indices)
+    indptr = np.zeros(n + 1, indices.dtype)
+    stamp = np.full(n, -1, indices.dtype)
+    pos = np.empty(n, indices.dtype)
+    row = np.zeros(w)
+    nnz = 0
+    for i in range(n):
+        s = nnz
+        for k in range(start[i], start[i + 1]):
+            e = inc[k] // w
+            _local_row(k1, table, e, inc[k] - w * e, row, w)
+            for b in range(w):
+                j = cells[e, b]
+                if stamp[j] != i:
+                    stamp[j] = i
+                    pos[j] = nnz
+                    indices[nnz] = j
+                    data[nnz] = 0.0
+                    nnz += 1
+                data[pos[j]] += row[b]
+        for q in range(s + 1, nnz):       # insertion sort of the row, its values along
+            j = indices[q]
+            v = data[q]
+            r = q
+            while r > s and indices[r - 1] > j:
+                indices[r] = indices[r - 1]
+                data[r] = data[r - 1]
+                r -= 1
+            indices[r] = j
+            data[r] = v
         indptr[i + 1] = nnz
     return indptr, nnz
 
@@ -152,8 +197,7 @@ def element_pattern_kernel(cells: np.ndarray, n: int):
     """``(indptr, indices, slots)`` of the dof map ``cells`` among ``n`` dofs (compiled,
     :func:`_element_pattern`); ``indices`` and ``slots`` int32 when the entry count allows it."""
     cells, indices, slots = _pattern_buffers(cells, n)
-    indptr, nnz = _element_pattern(cells, int(n), indices, slots, np.zeros((0, 1)),
-                                   np.zeros((0, 1, 1)), np.zeros(0))
+    indptr, nnz = _element_pattern(cells, int(n), indices, slots)
     indices.resize(nnz, refcheck=False)   # shrink in place: the untouched tail was never paged in
     return indptr, indices, slots
 
@@ -161,19 +205,19 @@ def element_pattern_kernel(cells: np.ndarray, n: int):
 def first_stiffness(mesh, dofs, kappa, table: np.ndarray):
     """The stiffness matrix (CSR, sorted rows) of the dof map ``dofs`` on ``mesh`` for the
     reference tensor ``table`` ((d+1)^2, n^2), pattern and values in one pass and no slot map
-    (:func:`_element_pattern`): the first assembly on a large mesh. ``kappa``: a float or one per
+    (:func:`_stiffness_rows`): the first assembly on a large mesh. ``kappa``: a float or one per
     cell. None if a cell is degenerate (the caller's numpy path then names it)."""
     import scipy.sparse as sp
 
     k1 = cell_products(mesh, kappa)
     if k1 is None:
         return None
-    cells, indices, slots = _pattern_buffers(dofs.cells, dofs.n_dofs, with_slots=False)
+    cells, indices, _ = _pattern_buffers(dofs.cells, dofs.n_dofs, with_slots=False)
     data = np.empty(len(indices))
     w = cells.shape[1]
     folded = symmetric_table(table, mesh.dim + 1).reshape(-1, w, w)        # (P, a, b)
     folded = np.ascontiguousarray(folded.transpose(1, 0, 2))                # (a, P, b)
-    indptr, nnz = _element_pattern(cells, int(dofs.n_dofs), indices, slots, k1, folded, data)
+    indptr, nnz = _stiffness_rows(cells, int(dofs.n_dofs), indices, k1, folded, data)
     indices.resize(nnz, refcheck=False)   # shrink in place: the untouched tails were never paged in
     data.resize(nnz, refcheck=False)
     K = sp.csr_matrix((data, indices, indptr), shape=(dofs.n_dofs, dofs.n_dofs), copy=False)
@@ -245,6 +289,8 @@ def element_load_kernel(cells: np.ndarray, points: np.ndarray, fq: np.ndarray, w
 def warm_up() -> None:
     """Compile (or load from the on-disk cache) these kernels with a large run's argument types
     (a P2 triangle and a P2 tetrahedron)."""
+    from types import SimpleNamespace
+
     from ..elements import get_element
 
     for dim in (2, 3):
@@ -254,6 +300,8 @@ def warm_up() -> None:
         w = elem.n_dofs
         cells = np.arange(w, dtype=np.int64)[None, :]   # one cell; only its vertices are read as points
         element_pattern_kernel(cells, w)
+        first_stiffness(SimpleNamespace(cells=cells[:, :nv], points=pts, dim=dim),
+                        SimpleNamespace(cells=cells, n_dofs=w), 1.0, np.ones(((dim + 1) ** 2, w * w)))
         k1, _ = _cell_products(cells, pts, np.ones(1), True)
         _element_stiffness(k1, np.ones((k1.shape[1], w * w)), np.arange(w * w, dtype=np.int32).reshape(1, -1),
                            w * w)

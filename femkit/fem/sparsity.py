@@ -46,8 +46,8 @@ register_kernels("P1 assembly", "femkit.fem._kernels", "_incidences", "_pattern"
 # the element-generic assembly's (femkit.fem.forms, not imported by the P1 pipeline; its kernels are
 # declared with the stack's pattern so that the warm-up, which compiles them, knows them)
 register_kernels("P1 assembly", "femkit.fem._kernels", "_scatter", "_element_stiffness", rank=1)
-register_kernels("P1 assembly", "femkit.fem._element_kernels", "_element_pattern", "_cell_products",
-                 "_element_stiffness", "_quadrature_coordinates", "_element_load", rank=1)
+register_kernels("P1 assembly", "femkit.fem._element_kernels", "_element_pattern", "_stiffness_rows",
+                 "_cell_products", "_element_stiffness", "_quadrature_coordinates", "_element_load", rank=1)
 
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 _ELEMENT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
