@@ -10,6 +10,13 @@ random, read twice); here an incidence is only ``w e + a`` (cell ``e``, local do
 cell's dofs are read from the dof map when its row is built and the slots written (``w m``
 incidence entries instead of ``w^2 m``: P2 has 6 or 10 dofs per cell). The same rows and slots,
 entry for entry (tests/fem/test_p2_compiled_passes.py).
+
+A mesh's first stiffness (:func:`first_stiffness`, no pattern cached yet) is summed in such a row
+pass (:func:`_stiffness_rows`), from each cell's P1 products computed once before it
+(:func:`_cell_products`): each incidence adds its cell's local row into the row being built, which
+is sorted at its end, so no slot map is written or read (72 MB on a 1M-dof square) and the matrix
+owns the new index arrays (no copy of a cached pattern's); the values are the separate pass's bit
+for bit.
 """
 
 from __future__ import annotations
@@ -24,18 +31,39 @@ from .cells.kernels import _tetrahedron, _triangle
 @numba.njit(cache=True)
 def _element_pattern(cells, n, indices, slots):  # pragma: no cover - compiled
     """CSR pattern of the dof map ``cells`` (m, w) among ``n`` dofs into ``indices`` (a buffer of
-    at least ``n + w (w - 1) m`` entries) and ``slots`` (m, w * w). Returns ``(indptr, nnz)``."""
-    m, w = cells.shape
+    at least ``n + w (w - 1) m`` entries) and ``slots`` (m, w * w). Returns ``(indptr, nnz)``,
+    ``indptr`` of the slots' integer type. Compiled with ``w`` a constant for P2 (6 and 10 dofs:
+    the loops over a cell's dofs unrolled)."""
+    if cells.shape[1] == 6:
+        return _pattern_rows(cells, n, indices, slots, 6)
+    if cells.shape[1] == 10:
+        return _pattern_rows(cells, n, indices, slots, 10)
+    return _pattern_rows(cells, n, indices, slots, cells.shape[1])
+
+
+@numba.njit(cache=True, inline="always")
+def _incidence_lists(cells, n, w, like):  # pragma: no cover - compiled
+    """The dof -> incidence lists of ``cells`` (a counting sort): ``inc[start[i]:start[i + 1]]``
+    holds ``w e + a`` for each cell ``e`` whose local dof ``a`` is ``i``, ``e`` increasing
+    (``inc`` of ``like``'s integer type)."""
+    m = cells.shape[0]
     start = _vertex_starts(cells, n)
-    inc = np.empty(w * m, slots.dtype)               # dof -> incidences w e + a, e increasing
+    inc = np.empty(w * m, like.dtype)
     fill = start[:-1].copy()
     for e in range(m):
         for a in range(w):
             i = cells[e, a]
             inc[fill[i]] = w * e + a
             fill[i] += 1
-    indptr = np.zeros(n + 1, np.int64)
-    stamp = np.full(n, -1, np.int64)
+    return start, inc
+
+
+@numba.njit(cache=True, inline="always")
+def _pattern_rows(cells, n, indices, slots, w):  # pragma: no cover - compiled
+    """The body of :func:`_element_pattern` for ``w`` dofs per cell."""
+    start, inc = _incidence_lists(cells, n, w, slots)
+    indptr = np.zeros(n + 1, slots.dtype)
+    stamp = np.full(n, -1, slots.dtype)
     pos = np.empty(n, slots.dtype)
     nnz = 0
     for i in range(n):
@@ -58,19 +86,143 @@ def _element_pattern(cells, n, indices, slots):  # pragma: no cover - compiled
     return indptr, nnz
 
 
+@numba.njit(cache=True)
+def _stiffness_rows(cells, n, indices, k1, table, data):  # pragma: no cover - compiled
+    """The CSR pattern (as :func:`_element_pattern`, no slots) and the stiffness values of the dof
+    map ``cells`` into ``indices`` and ``data`` (buffers of ``n + w (w - 1) m`` entries), row by
+    row: each incidence (cell ``e``, local dof ``a``) of the row adds the cell's local row
+    ``sum_p k1[e, p] table[a, p, :]`` (``k1`` (m, P): the cells' symmetric P1 products,
+    :func:`_cell_products`; ``table`` (w, P, w): the folded reference tensor, :func:`symmetric_table`;
+    p in order, as :func:`_element_stiffness` sums it) at its columns, appended when new; the row
+    is then sorted with its values. Each entry sums its cells in increasing ``e`` (the
+    incidences' order), as the separate pass does: the same bits. Returns ``(indptr, nnz)``."""
+    if cells.shape[1] == 6:
+        return _value_rows(cells, n, indices, k1, table, data, 6)
+    if cells.shape[1] == 10:
+        return _value_rows(cells, n, indices, k1, table, data, 10)
+    return _value_rows(cells, n, indices, k1, table, data, cells.shape[1])
+
+
+@numba.njit(cache=True, inline="always")
+def _value_rows(cells, n, indices, k1, table, data, w):  # pragma: no cover - compiled
+    """The body of :func:`_stiffness_rows` for ``w`` dofs per cell."""
+    start, inc = _incidence_lists(cells, n, w, indices)
+    indptr = np.zeros(n + 1, indices.dtype)
+    stamp = np.full(n, -1, indices.dtype)
+    pos = np.empty(n, indices.dtype)
+    row = np.zeros(w)
+    nnz = 0
+    for i in range(n):
+        s = nnz
+        for k in range(start[i], start[i + 1]):
+            e = inc[k] // w
+            _local_row(k1, table, e, inc[k] - w * e, row, w)
+            for b in range(w):
+                j = cells[e, b]
+                if stamp[j] != i:
+                    stamp[j] = i
+                    pos[j] = nnz
+                    indices[nnz] = j
+                    data[nnz] = 0.0
+                    nnz += 1
+                data[pos[j]] += row[b]
+        for q in range(s + 1, nnz):       # insertion sort of the row, its values along
+            j = indices[q]
+            v = data[q]
+            r = q
+            while r > s and indices[r - 1] > j:
+                indices[r] = indices[r - 1]
+                data[r] = data[r - 1]
+                r -= 1
+            indices[r] = j
+            data[r] = v
+        indptr[i + 1] = nnz
+    return indptr, nnz
+
+
+@numba.njit(cache=True, inline="always")
+def _local_row(k1, table, e, a, row, w):  # pragma: no cover - compiled
+    """Row ``a`` of cell ``e``'s stiffness into ``row``: ``sum_p k1[e, p] table[a, p, :]``."""
+    for b in range(w):
+        row[b] = 0.0
+    for p in range(k1.shape[1]):
+        c = k1[e, p]
+        for b in range(w):
+            row[b] += c * table[a, p, b]
+
+
+@numba.njit(cache=True)
+def _cell_products(cells, points, kappa, scalar_kappa):  # pragma: no cover - compiled
+    """The symmetric P1 products ``k1_ab = kappa |T| grad lambda_a . grad lambda_b`` (``a <= b``,
+    row by row) of every cell, (m, P), and the number of degenerate cells (their rows zero)."""
+    m = cells.shape[0]
+    nv = 3 if points.shape[1] == 2 else 4
+    k1 = np.zeros((m, (nv * (nv + 1)) // 2))
+    g = np.zeros((4, 3))
+    bad = 0
+    for e in range(m):
+        ok, s = _cell_gradients(cells, points, e, nv, kappa, scalar_kappa, g)
+        if not ok:
+            bad += 1
+            continue
+        p = 0
+        for a in range(nv):
+            for b in range(a, nv):
+                k1[e, p] = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
+                p += 1
+    return k1, bad
+
+
+def cell_products(mesh, kappa) -> np.ndarray | None:
+    """The cells' symmetric P1 products (m, P) (:func:`_cell_products`) for ``kappa`` (a float or
+    one per cell); None if a cell is degenerate."""
+    from ._kernels import _values
+
+    k1, bad = _cell_products(np.ascontiguousarray(mesh.cells, dtype=np.int64),
+                             np.ascontiguousarray(mesh.points, dtype=np.float64), *_values(kappa))
+    return None if bad else k1
+
+
+def _pattern_buffers(cells: np.ndarray, n: int, *, with_slots: bool = True):
+    """``cells`` as int64, the ``indices`` buffer and the ``slots`` of :func:`_element_pattern`
+    (int32 when the entry count allows it; ``slots`` without rows unless ``with_slots``)."""
+    cells = np.ascontiguousarray(cells, dtype=np.int64)
+    m, w = cells.shape
+    bound = int(n) + w * (w - 1) * m
+    dtype = np.int32 if max(bound, w * m) < np.iinfo(np.int32).max else np.int64
+    return cells, np.empty(bound, dtype), np.empty((m if with_slots else 0, w * w), dtype)
+
+
 def element_pattern_kernel(cells: np.ndarray, n: int):
     """``(indptr, indices, slots)`` of the dof map ``cells`` among ``n`` dofs (compiled,
     :func:`_element_pattern`); ``indices`` and ``slots`` int32 when the entry count allows it."""
-    cells = np.ascontiguousarray(cells, dtype=np.int64)
-    n = int(n)
-    m, w = cells.shape
-    bound = n + w * (w - 1) * m
-    dtype = np.int32 if max(bound, w * m) < np.iinfo(np.int32).max else np.int64
-    indices = np.empty(bound, dtype)
-    slots = np.empty((m, w * w), dtype)
-    indptr, nnz = _element_pattern(cells, n, indices, slots)
+    cells, indices, slots = _pattern_buffers(cells, n)
+    indptr, nnz = _element_pattern(cells, int(n), indices, slots)
     indices.resize(nnz, refcheck=False)   # shrink in place: the untouched tail was never paged in
     return indptr, indices, slots
+
+
+def first_stiffness(mesh, dofs, kappa, table: np.ndarray):
+    """The stiffness matrix (CSR, sorted rows) of the dof map ``dofs`` on ``mesh`` for the
+    reference tensor ``table`` ((d+1)^2, n^2), pattern and values in one pass and no slot map
+    (:func:`_stiffness_rows`): the first assembly on a large mesh. ``kappa``: a float or one per
+    cell. None if a cell is degenerate (the caller's numpy path then names it)."""
+    import scipy.sparse as sp
+
+    k1 = cell_products(mesh, kappa)
+    if k1 is None:
+        return None
+    cells, indices, _ = _pattern_buffers(dofs.cells, dofs.n_dofs, with_slots=False)
+    data = np.empty(len(indices))
+    w = cells.shape[1]
+    folded = symmetric_table(table, mesh.dim + 1).reshape(-1, w, w)        # (P, a, b)
+    folded = np.ascontiguousarray(folded.transpose(1, 0, 2))                # (a, P, b)
+    indptr, nnz = _stiffness_rows(cells, int(dofs.n_dofs), indices, k1, folded, data)
+    indices.resize(nnz, refcheck=False)   # shrink in place: the untouched tails were never paged in
+    data.resize(nnz, refcheck=False)
+    K = sp.csr_matrix((data, indices, indptr), shape=(dofs.n_dofs, dofs.n_dofs), copy=False)
+    K.has_sorted_indices = True
+    return K
 
 
 @numba.njit(cache=True)
@@ -92,12 +244,11 @@ def _quadrature_coordinates(cells, points, bary):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _element_load(cells, points, fq, wphi, n_dofs):  # pragma: no cover - compiled
-    """``F_i = sum_cells |T| sum_q fq[e, q] wphi[q, a]`` over the dof map ``cells`` (m, w);
-    returns ``(F, number of degenerate cells)``."""
+def _element_load(cells, points, fq, wphi, F):  # pragma: no cover - compiled
+    """``F_i += sum_cells |T| sum_q fq[e, q] wphi[q, a]`` over the dof map ``cells`` (m, w) (a
+    block of cells); returns the number of degenerate cells."""
     m, w = cells.shape
     nq = wphi.shape[0]
-    F = np.zeros(n_dofs)
     g = np.zeros((4, 3))
     bad = 0
     for e in range(m):
@@ -113,7 +264,7 @@ def _element_load(cells, points, fq, wphi, n_dofs):  # pragma: no cover - compil
             for p in range(nq):
                 acc += fq[e, p] * wphi[p, a]
             F[cells[e, a]] += measure * acc
-    return F, bad
+    return bad
 
 
 def quadrature_coordinates(cells: np.ndarray, points: np.ndarray, bary: np.ndarray) -> tuple:
@@ -124,19 +275,22 @@ def quadrature_coordinates(cells: np.ndarray, points: np.ndarray, bary: np.ndarr
 
 
 def element_load_kernel(cells: np.ndarray, points: np.ndarray, fq: np.ndarray, wphi: np.ndarray,
-                        n_dofs: int):
-    """The load vector of the dof map ``cells`` from ``f`` at the quadrature points ``fq`` (m, q)
-    and ``wphi[q, a] = w_q phi_a(x_q)``; None if a cell is degenerate."""
-    F, bad = _element_load(np.ascontiguousarray(cells, dtype=np.int64),
-                           np.ascontiguousarray(points, dtype=np.float64),
-                           np.ascontiguousarray(fq, dtype=np.float64),
-                           np.ascontiguousarray(wphi, dtype=np.float64), int(n_dofs))
-    return None if bad else F
+                        F: np.ndarray) -> bool:
+    """Add the load of the cells ``cells`` (rows of a dof map) from ``f`` at their quadrature
+    points ``fq`` (m, q) and ``wphi[q, a] = w_q phi_a(x_q)`` into ``F`` (n_dofs,); False (``F``
+    partly summed) if a cell is degenerate."""
+    bad = _element_load(np.ascontiguousarray(cells, dtype=np.int64),
+                        np.ascontiguousarray(points, dtype=np.float64),
+                        np.ascontiguousarray(fq, dtype=np.float64),
+                        np.ascontiguousarray(wphi, dtype=np.float64), F)
+    return not bad
 
 
 def warm_up() -> None:
     """Compile (or load from the on-disk cache) these kernels with a large run's argument types
     (a P2 triangle and a P2 tetrahedron)."""
+    from types import SimpleNamespace
+
     from ..elements import get_element
 
     for dim in (2, 3):
@@ -146,44 +300,39 @@ def warm_up() -> None:
         w = elem.n_dofs
         cells = np.arange(w, dtype=np.int64)[None, :]   # one cell; only its vertices are read as points
         element_pattern_kernel(cells, w)
-        _element_stiffness(cells, pts, np.ones(1), True, np.ones(((nv * (nv + 1)) // 2, w * w)),
-                           np.arange(w * w, dtype=np.int32).reshape(1, -1), w * w)
+        first_stiffness(SimpleNamespace(cells=cells[:, :nv], points=pts, dim=dim),
+                        SimpleNamespace(cells=cells, n_dofs=w), 1.0, np.ones(((dim + 1) ** 2, w * w)))
+        k1, _ = _cell_products(cells, pts, np.ones(1), True)
+        _element_stiffness(k1, np.ones((k1.shape[1], w * w)), np.arange(w * w, dtype=np.int32).reshape(1, -1),
+                           w * w)
         quadrature_coordinates(cells, pts, np.full((1, nv), 1.0 / nv))
-        element_load_kernel(cells, pts, np.ones((1, 1)), np.ones((1, w)), w)
+        fq = np.ones((1, 1))
+        element_load_kernel(cells, pts, fq, np.ones((1, w)), np.zeros(w))          # a compiled source's values
+        element_load_kernel(cells, pts, np.broadcast_to(fq, (1, 1)), np.ones((1, w)), np.zeros(w))  # NumPy's (read-only)
 
 
 @numba.njit(cache=True)
-def _element_stiffness(cells, points, kappa, scalar_kappa, table, slots, nnz):  # pragma: no cover - compiled
-    """Stiffness of an element other than P1 on affine cells into CSR data: per cell the P1
-    products ``k1_ab`` (symmetric: the ``a <= b`` ones, ``table`` row ``p`` for pair ``p`` holding
-    ``S_ab + S_ba``, or ``S_aa``), then ``local += k1_ab table[p]`` row by row (independent sums
-    over the ``w^2`` entries, which the compiler vectorises; the P1 kernel's order,
-    :func:`femkit.fem._kernels._element_stiffness`, sums each entry's products in one chain), then
-    scattered through ``slots``. Returns (data, number of degenerate cells)."""
-    m = cells.shape[0]
-    nv = 3 if points.shape[1] == 2 else 4
+def _element_stiffness(k1, table, slots, nnz):  # pragma: no cover - compiled
+    """Stiffness of an element other than P1 on affine cells into CSR data: per cell its P1
+    products ``k1`` (symmetric: the ``a <= b`` ones, :func:`_cell_products`; ``table`` row ``p``
+    for pair ``p`` holding ``S_ab + S_ba``, or ``S_aa``), then ``local += k1_ab table[p]`` row by
+    row (independent sums over the ``w^2`` entries, which the compiler vectorises; the P1
+    kernel's order, :func:`femkit.fem._kernels._element_stiffness`, sums each entry's products in
+    one chain), then scattered through ``slots``."""
+    m, npair = k1.shape
     n2 = table.shape[1]
     data = np.zeros(nnz)
-    g = np.zeros((4, 3))
     local = np.empty(n2)
-    bad = 0
     for e in range(m):
-        ok, s = _cell_gradients(cells, points, e, nv, kappa, scalar_kappa, g)
-        if not ok:
-            bad += 1
-            continue
         for j in range(n2):
             local[j] = 0.0
-        p = 0
-        for a in range(nv):
-            for b in range(a, nv):
-                k = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
-                for j in range(n2):
-                    local[j] += k * table[p, j]
-                p += 1
+        for p in range(npair):
+            k = k1[e, p]
+            for j in range(n2):
+                local[j] += k * table[p, j]
         for j in range(n2):
             data[slots[e, j]] += local[j]
-    return data, bad
+    return data
 
 
 def symmetric_table(table: np.ndarray, nv: int) -> np.ndarray:
@@ -198,10 +347,7 @@ def element_stiffness_kernel(mesh, kappa, table: np.ndarray, pattern):
     """CSR data of the stiffness of every cell of ``mesh`` for the reference tensor ``table``
     ((d+1)^2, n^2) into ``pattern``, or None if a cell is degenerate (the caller's numpy path
     then names it). ``kappa``: a float or one per cell."""
-    from ._kernels import _values
-
-    nv = mesh.dim + 1
-    data, bad = _element_stiffness(np.ascontiguousarray(mesh.cells, dtype=np.int64),
-                                   np.ascontiguousarray(mesh.points, dtype=np.float64),
-                                   *_values(kappa), symmetric_table(table, nv), pattern.slots, pattern.nnz)
-    return None if bad else data
+    k1 = cell_products(mesh, kappa)
+    if k1 is None:
+        return None
+    return _element_stiffness(k1, symmetric_table(table, mesh.dim + 1), pattern.slots, pattern.nnz)

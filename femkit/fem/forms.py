@@ -13,7 +13,10 @@ CSR pattern of the dof map (:func:`femkit.fem.sparsity.pattern_for`) by ``np.bin
 from :data:`~femkit.fem.sparsity.NUMBA_THRESHOLD` cells on, block by block through one compiled
 scatter (:func:`femkit.fem._kernels.scatter_kernel`), so no (m, n^2) array is ever whole; the
 whole mesh's stiffness there is one compiled pass (geometry, local matrix, scatter:
-:func:`femkit.fem._kernels.element_stiffness_kernel`).
+:func:`femkit.fem._kernels.element_stiffness_kernel`). A P2 stiffness on a large mesh whose
+pattern is not cached yet (a run's one assembly) is built with its pattern in one pass and
+caches none (:func:`femkit.fem._element_kernels.first_stiffness`); a later matrix of that mesh
+builds and caches the pattern then.
 
 Coefficients (``kappa``, ``rho``) are constant per cell, as in the P1 assembly: a float, one
 value per cell, a ``{tag or name: value}`` table or a callable evaluated at the cell centroids
@@ -135,8 +138,15 @@ def assemble_matrix(mesh, form: str, coefficient=1.0, *, element="P1", elements=
     dofs = dof_map(mesh, elem)
     idx = select_elements(mesh, elements)
     scale = element_coefficient(mesh, coefficient, idx)
-    pattern = sparsity.pattern_for(mesh, dofs)
     count = mesh.n_cells if idx is None else len(idx)
+    if (form == "stiffness" and idx is None and elem.name != "P1" and count >= sparsity.NUMBA_THRESHOLD
+            and sparsity.cached_pattern(mesh, dofs) is None):
+        from ._element_kernels import first_stiffness   # pattern and values in one pass, none cached
+
+        K = first_stiffness(mesh, dofs, scale, reference_stiffness(elem))
+        if K is not None:
+            return K
+    pattern = sparsity.pattern_for(mesh, dofs)
     if count < sparsity.NUMBA_THRESHOLD or pattern.slots.dtype != np.int32:
         return pattern.assemble(_local(mesh, elem, form, scale, idx), elements=idx)
     from ._kernels import element_stiffness_kernel, scatter_kernel

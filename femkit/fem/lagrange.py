@@ -31,7 +31,7 @@ import numpy as np
 
 from ..elements import Element, get_element
 from ..errors import InputError
-from ._elements import cell_measures, simplex_gradients
+from ._elements import cell_measures, select_elements, simplex_gradients
 from .coefficients import evaluate_callable
 from .dofs import DofMap, dof_map
 from .quadrature import blocks, get_rule, rule_for_degree
@@ -45,15 +45,17 @@ _G3 = np.array([0.5 - 0.5 * np.sqrt(0.6), 0.5, 0.5 + 0.5 * np.sqrt(0.6)])
 _W3 = np.array([5.0, 8.0, 5.0]) / 18.0
 
 
-def dof_weights(mesh, element="P2") -> np.ndarray:
-    """``w_i = int phi_i dx`` (n_dofs,): ``sum w = |Omega|`` (P2 vertex weights are 0 on
-    triangles and negative on tetrahedra)."""
+def dof_weights(mesh, element="P2", *, elements=None) -> np.ndarray:
+    """``w_i = int phi_i dx`` (n_dofs,) over the cells ``elements`` (None: all, and then
+    ``sum w = |Omega|``; P2 vertex weights are 0 on triangles and negative on tetrahedra)."""
     elem = get_element(element, mesh.dim)
     dofs = dof_map(mesh, elem)
-    vol, _ = cell_measures(mesh, None)
+    idx = select_elements(mesh, elements)
+    vol, _ = cell_measures(mesh, idx)
     rule = rule_for_degree(elem.degree, mesh.dim)
     ref = rule.weights @ elem.basis(rule.points)                     # (n,) int phi / |T|
-    return np.bincount(dofs.cells.ravel(), weights=np.outer(vol, ref).ravel(), minlength=dofs.n_dofs)
+    cells = dofs.cells if idx is None else dofs.cells[idx]
+    return np.bincount(cells.ravel(), weights=np.outer(vol, ref).ravel(), minlength=dofs.n_dofs)
 
 
 def load_rule(element: Element):
@@ -62,18 +64,20 @@ def load_rule(element: Element):
     return rule_for_degree(element.load_degree, element.dim, every=True)
 
 
-def element_load(mesh, f, element="P2", *, rule: str | None = None) -> np.ndarray:
-    """Load vector ``int f phi_i`` (n_dofs,) of ``element``; ``rule`` a quadrature rule name
-    (default: the cheapest registered rule of degree :attr:`Element.load_degree`)."""
+def element_load(mesh, f, element="P2", *, rule: str | None = None, elements=None) -> np.ndarray:
+    """Load vector ``int f phi_i`` (n_dofs,) of ``element`` over the cells ``elements`` (None:
+    all; a distributed run's own cells); ``rule`` a quadrature rule name (default: the cheapest
+    registered rule of degree :attr:`Element.load_degree`)."""
     elem = get_element(element, mesh.dim)
     dofs = dof_map(mesh, elem)
+    idx = select_elements(mesh, elements)
     quad = get_rule(rule, mesh.dim) if rule else load_rule(elem)
     phi = elem.basis(quad.points)                                    # (q, n)
-    if callable(f) and mesh.n_cells >= sparsity.NUMBA_THRESHOLD:  # the assembly's threshold
+    if callable(f) and idx is None and mesh.n_cells >= sparsity.NUMBA_THRESHOLD:  # the assembly's threshold
         F = _load_compiled(mesh, dofs, f, quad, phi)
         if F is not None:
             return F
-    vol, cells = cell_measures(mesh, None)
+    vol, cells = cell_measures(mesh, idx)
     if not callable(f):
         from .load import _scalar
 
@@ -81,25 +85,33 @@ def element_load(mesh, f, element="P2", *, rule: str | None = None) -> np.ndarra
     else:
         from .load import _source_values
 
-        fq = _source_values(mesh, f, quad, cells, None)              # (m, q)
+        fq = _source_values(mesh, f, quad, cells, idx)               # (m, q)
         local = ((fq * quad.weights) @ phi) * vol[:, None]
-    return np.bincount(dofs.cells.ravel(), weights=local.ravel(), minlength=dofs.n_dofs)
+    cells = dofs.cells if idx is None else dofs.cells[idx]
+    return np.bincount(cells.ravel(), weights=local.ravel(), minlength=dofs.n_dofs)
 
 
 def _load_compiled(mesh, dofs: DofMap, f, quad, phi: np.ndarray) -> np.ndarray | None:
     """:func:`element_load` of a callable ``f`` by the compiled passes
-    (:mod:`femkit.fem._element_kernels`: the points' coordinates, then measures, products and sums
-    in one pass over the cells); None when ``f`` is not finite somewhere or a cell is degenerate
-    (the NumPy path then raises naming them)."""
+    (:mod:`femkit.fem._element_kernels`), block by block of :func:`~femkit.fem.quadrature.blocks`
+    (the rule's points' coordinates, ``f`` on them, then measures, products and sums: the block's
+    arrays stay in cache, none is ever the whole mesh's); None when ``f`` is not finite somewhere
+    or a cell is degenerate (the NumPy path then raises naming them)."""
     from ._element_kernels import element_load_kernel, quadrature_coordinates
     from .fused import source_values
 
+    wphi = quad.weights[:, None] * phi
+    F = np.zeros(dofs.n_dofs)
     fq = source_values(mesh, f, quad)
-    if fq is None:
-        fq = evaluate_callable(f, *quadrature_coordinates(dofs.cells, mesh.points, quad.points), name="f")
-    if not np.isfinite(fq).all():
-        return None
-    return element_load_kernel(dofs.cells, mesh.points, fq, quad.weights[:, None] * phi, dofs.n_dofs)
+    if fq is not None:
+        ok = bool(np.isfinite(fq).all()) and element_load_kernel(dofs.cells, mesh.points, fq, wphi, F)
+        return F if ok else None
+    for part in blocks(mesh.n_cells):
+        cells = dofs.cells[part]
+        fq = evaluate_callable(f, *quadrature_coordinates(cells, mesh.points, quad.points), name="f")
+        if not (np.isfinite(fq).all() and element_load_kernel(cells, mesh.points, fq, wphi, F)):
+            return None
+    return F
 
 
 def _facet_dofs(mesh, dofs: DofMap, facets: np.ndarray) -> np.ndarray:
@@ -187,14 +199,21 @@ def element_energy_error(mesh, u: np.ndarray, grad_exact: Callable, kappa=1.0, *
 
 
 def element_error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callable | None = None, *,
-                        element="P2", order: int = 5) -> dict:
+                        element="P2", order: int = 5, elements=None, squared: bool = False) -> dict:
     """``L2``, ``H1_semi`` (None without ``grad_exact``) and ``max_nodal`` (over every dof:
     vertices and edge midpoints) errors of the finite-element function ``u`` (n_dofs,), as
-    :func:`femkit.fem.norms.error_norms` for P1; the rule is exact to degree ``order``."""
-    l2, h1 = _squares(mesh, u, exact, grad_exact, element, order, None)
+    :func:`femkit.fem.norms.error_norms` for P1; the rule is exact to degree ``order``.
+
+    ``elements``: over these cells only (their dofs for ``max_nodal``; ``u`` is read there
+    only), ``squared``: the integrals not square-rooted -- what a distributed run sums over
+    ranks (as :func:`~femkit.fem.norms.error_norms` takes them)."""
+    idx = select_elements(mesh, elements)
+    l2, h1 = _squares(mesh, u, exact, grad_exact, element, order, None, idx)
     dofs = dof_map(mesh, element)
-    nodal = u - evaluate_callable(exact, *dofs.points(mesh).T, name="exact")
-    out = {"L2": float(np.sqrt(l2)), "H1_semi": None if grad_exact is None else float(np.sqrt(h1)),
+    at = np.arange(dofs.n_dofs) if idx is None else np.unique(dofs.cells[idx])
+    nodal = np.asarray(u)[at] - evaluate_callable(exact, *dofs.points(mesh)[at].T, name="exact")
+    root = (lambda v: v) if squared else np.sqrt
+    out = {"L2": float(root(l2)), "H1_semi": None if grad_exact is None else float(root(h1)),
            "max_nodal": float(np.abs(nodal).max()) if nodal.size else 0.0}
     for k, v in out.items():
         if v is not None and not np.isfinite(v):
@@ -202,9 +221,9 @@ def element_error_norms(mesh, u: np.ndarray, exact: Callable, grad_exact: Callab
     return out
 
 
-def _squares(mesh, u, exact, grad_exact, element, order: int, weight) -> tuple[float, float]:
-    """``(int (u - u_h)^2, int w |grad(u - u_h)|^2)`` block by block (``exact`` None: 0;
-    ``weight`` None: 1, else one value per cell)."""
+def _squares(mesh, u, exact, grad_exact, element, order: int, weight, cells=None) -> tuple[float, float]:
+    """``(int (u - u_h)^2, int w |grad(u - u_h)|^2)`` block by block over ``cells`` (None: all;
+    ``exact`` None: 0; ``weight`` None: 1, else one value per cell)."""
     elem = get_element(element, mesh.dim)
     dofs = dof_map(mesh, elem)
     u = np.asarray(u, dtype=np.float64)
@@ -212,8 +231,9 @@ def _squares(mesh, u, exact, grad_exact, element, order: int, weight) -> tuple[f
         raise InputError(f"u must have one value per {elem.name} dof, shape ({dofs.n_dofs},), got {u.shape}")
     rule = rule_for_degree(order, mesh.dim)
     l2 = h1 = 0.0
-    for part in blocks(mesh.n_cells):
-        idx = np.arange(part.start, part.stop)
+    every = np.arange(mesh.n_cells) if cells is None else np.asarray(cells, dtype=np.int64)
+    for part in blocks(len(every)):
+        idx = every[part]
         val, grad, vol = evaluate(mesh, u, rule.points, elem, idx)
         coords = rule.physical_points(mesh, mesh.cells[idx])
         if exact is not None:
@@ -226,6 +246,6 @@ def _squares(mesh, u, exact, grad_exact, element, order: int, weight) -> tuple[f
                          for d in range(mesh.dim))
             except (TypeError, IndexError, ValueError) as exc:
                 raise InputError(f"grad_exact must return {mesh.dim} components: {exc}") from None
-            w = vol if weight is None else vol * weight[part]
+            w = vol if weight is None else vol * weight[idx]
             h1 += float(w @ (sq @ rule.weights))
     return l2, h1

@@ -370,12 +370,9 @@ class PoissonProblem:
         :mod:`femkit.fem.lagrange`)."""
         from .forms import assemble_matrix
         from .lagrange import element_load
-        from .sparsity import pattern_for
 
         t = self._timer
-        with t("pattern"):
-            pattern_for(self.mesh, self.dofs)
-        with t("stiffness"):
+        with t("stiffness"):   # with its pattern (one pass on a large mesh, forms.assemble_matrix)
             K = assemble_matrix(self.mesh, "stiffness", self.kappa, element=self.element)
         with t("load"):
             rule = None if self.load_rule == "barycentric" else self.load_rule

@@ -46,8 +46,8 @@ register_kernels("P1 assembly", "femkit.fem._kernels", "_incidences", "_pattern"
 # the element-generic assembly's (femkit.fem.forms, not imported by the P1 pipeline; its kernels are
 # declared with the stack's pattern so that the warm-up, which compiles them, knows them)
 register_kernels("P1 assembly", "femkit.fem._kernels", "_scatter", "_element_stiffness", rank=1)
-register_kernels("P1 assembly", "femkit.fem._element_kernels", "_element_pattern", "_element_stiffness",
-                 "_quadrature_coordinates", "_element_load", rank=1)
+register_kernels("P1 assembly", "femkit.fem._element_kernels", "_element_pattern", "_stiffness_rows",
+                 "_cell_products", "_element_stiffness", "_quadrature_coordinates", "_element_load", rank=1)
 
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 _ELEMENT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -219,6 +219,13 @@ def pattern_for(mesh, dofs, block: int = 1) -> SparsityPattern:
             pat = SparsityPattern.from_cells(dofs.cells, dofs.n_dofs, block=block)
         per_mesh[key] = pat
     return pat
+
+
+def cached_pattern(mesh, dofs, block: int = 1) -> "SparsityPattern | None":
+    """The pattern :func:`pattern_for` would return if it is built already, else None."""
+    if dofs.element.name == "P1" and block == 1:
+        return SparsityPattern.cached(mesh)
+    return _ELEMENT_CACHE.get(mesh, {}).get((dofs.element.name, int(block)))
 
 
 def _normalise(pattern: SparsityPattern, elements):

@@ -1,6 +1,7 @@
 """The compiled P2 passes of large meshes (:mod:`femkit.fem._element_kernels`), forced on small
 meshes: the row-by-row pattern gives the numpy builder's rows and slots entry for entry, the
-stiffness on it the numpy assembly's values, the compiled load the numpy load's; a degenerate
+first stiffness (summed in the pattern's row pass) the later one's (through the slots) bit for bit
+and the numpy assembly's values, the compiled load (block by block) the numpy load's; a degenerate
 cell or a non-finite source still raises the numpy path's one-line error."""
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ import numpy as np
 import pytest
 
 from femkit.errors import DegenerateMeshError, InputError
-from femkit.fem import forms, lagrange, sparsity
+from femkit.fem import forms, lagrange, quadrature, sparsity
 from femkit.fem.dofs import dof_map
 from femkit.mesh import Mesh, structured_box, structured_mesh
 
@@ -29,12 +30,17 @@ def compiled(monkeypatch):
 
 @pytest.mark.parametrize("mesh", [structured_mesh(5, 4), structured_box(2, 3, 2)], ids=["tri", "tet"])
 def test_p2_compiled_pattern_stiffness_and_load_equal_the_numpy_paths(mesh, compiled, monkeypatch):
+    monkeypatch.setattr(quadrature, "BLOCK", 7)   # the compiled load over several blocks of cells
     mesh = _wobbly(mesh)
     kappa = np.linspace(1.0, 3.0, mesh.n_cells)
-    K = forms.assemble_matrix(mesh, "stiffness", kappa, element="P2")
-    F = lagrange.element_load(mesh, _source(mesh.dim), "P2")
     dofs = dof_map(mesh, "P2")
+    K = forms.assemble_matrix(mesh, "stiffness", kappa, element="P2")   # the first: pattern and values in one pass
+    assert sparsity.cached_pattern(mesh, dofs) is None                  # ... which caches no pattern
+    F = lagrange.element_load(mesh, _source(mesh.dim), "P2")
     pat = sparsity.pattern_for(mesh, dofs)
+    K2 = forms.assemble_matrix(mesh, "stiffness", kappa, element="P2")  # a later one: through the slots
+    assert np.array_equal(K.indptr, K2.indptr) and np.array_equal(K.indices, K2.indices)
+    assert np.array_equal(K.data, K2.data)                              # the same sums, bit for bit
     ref = sparsity.SparsityPattern.from_cells(dofs.cells, dofs.n_dofs, backend="numpy")
     assert np.array_equal(pat.indptr, ref.indptr) and np.array_equal(pat.indices, ref.indices)
     assert np.array_equal(pat.slots, ref.slots)

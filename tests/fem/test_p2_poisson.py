@@ -127,3 +127,39 @@ def test_pure_neumann_p2(mode, method):
             assert abs(prob.weights() @ u) < 1e-12
         l2.append(prob.errors(u, ex, gr)["L2"])
     assert 7.0 < l2[0] / l2[1] < 9.0
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_p2_pieces_over_a_partition_of_the_cells_sum_to_the_whole(dim):
+    """What a distributed run computes per rank (tests/petsc): the load, the dof weights and the
+    squared error integrals of P2 over the parts of a partition of the cells add up to the whole
+    mesh's; each edge dof is owned by its lower node's owner (femkit.fem.distributed.partition)."""
+    from femkit.fem.distributed.partition import dof_owners
+    from femkit.fem.dofs import dof_map
+    from femkit.fem.lagrange import dof_weights, element_error_norms, element_load
+    from femkit.mesh import structured_mesh
+
+    from femkit.mesh import Mesh
+
+    base = structured_mesh(5, 4) if dim == 2 else structured_box(2, 3, 2)
+    mesh = Mesh(base.points + 0.02 * np.sin(7.0 * base.points[:, ::-1]), base.cells)
+    f = (lambda x, y: np.sin(3 * x) + y) if dim == 2 else (lambda x, y, z: np.sin(3 * x) + y * z)
+    ex = (lambda x, y: np.cos(x) * y) if dim == 2 else (lambda x, y, z: np.cos(x) * y + z)
+    gr = ((lambda x, y: (-np.sin(x) * y, np.cos(x))) if dim == 2
+          else (lambda x, y, z: (-np.sin(x) * y, np.cos(x), 1.0 + 0 * z)))
+    dofs = dof_map(mesh, "P2")
+    u = np.cos(np.arange(dofs.n_dofs))
+    parts = np.array_split(np.random.default_rng(0).permutation(mesh.n_cells), 3)
+    whole = element_error_norms(mesh, u, ex, gr, element="P2", squared=True)
+    pieces = [element_error_norms(mesh, u, ex, gr, element="P2", elements=p, squared=True) for p in parts]
+    for key in ("L2", "H1_semi"):
+        assert sum(p[key] for p in pieces) == pytest.approx(whole[key], rel=1e-12)
+    assert max(p["max_nodal"] for p in pieces) == whole["max_nodal"]
+    np.testing.assert_allclose(sum(element_load(mesh, f, "P2", elements=p) for p in parts),
+                               element_load(mesh, f, "P2"), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(sum(dof_weights(mesh, "P2", elements=p) for p in parts),
+                               dof_weights(mesh, "P2"), rtol=0, atol=1e-15)
+    owner = np.arange(mesh.n_points) % 2
+    owners = dof_owners(owner, dofs)
+    assert np.array_equal(owners[:mesh.n_points], owner)
+    assert np.array_equal(owners[mesh.n_points:], owner[np.minimum(*dofs.edge_nodes.T)])

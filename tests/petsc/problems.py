@@ -53,7 +53,32 @@ def poisson_neumann(mesh):
     return prob, (lambda x, y: np.cos(pi * x) * np.cos(pi * y), None)
 
 
-#: name -> (mesh recipe, problem builder); mesh recipe: ("generate", geometry, h, params) or ("file", path)
+def unit_square_p2(mesh):
+    prob, exact = unit_square(mesh)
+    return PoissonProblem(mesh, prob.kappa, prob.f, dirichlet=prob.dirichlet, element="P2"), exact
+
+
+def plate_p2(mesh):
+    prob, exact = plate_mesh_file(mesh)
+    return PoissonProblem(mesh, 1.0, 0.0, dirichlet=prob.dirichlet, neumann=prob.neumann,
+                          element="P2"), exact
+
+
+def neumann_p2(mesh):
+    prob, exact = poisson_neumann(mesh)
+    return PoissonProblem(mesh, 1.0, prob.f, dirichlet=[], neumann=prob.neumann,
+                          nullspace="mean_zero", element="P2"), exact
+
+
+def cube_p2(mesh):
+    """3D P2, Dirichlet on the whole (topological) boundary: u = sin(x) e^y + z^2 (-lap u = -2)."""
+    u = lambda x, y, z: np.sin(x) * np.exp(y) + z * z  # noqa: E731
+    prob = PoissonProblem(mesh, 1.0, -2.0, dirichlet=[(None, u)], element="P2")
+    return prob, (u, lambda x, y, z: (np.cos(x) * np.exp(y), np.sin(x) * np.exp(y), 2 * z))
+
+
+#: name -> (mesh recipe, problem builder); mesh recipe: ("generate", geometry, h, params),
+#: ("file", path) or ("box", n) (femkit's structured n^3 Kuhn cube)
 CASES = {
     "unit_square": (("generate", "unit_square", 0.1, {}), unit_square),
     "annulus": (("generate", "annulus", 0.12, {"r_inner": 0.5, "r_outer": 1.0}), annulus),
@@ -61,11 +86,19 @@ CASES = {
     "high_contrast": (("generate", "square_with_inclusion", 0.08, {"radius": 0.25}), high_contrast),
     "plate_mesh_file": (("file", str(ROOT / "meshes" / "plate_with_hole.msh")), plate_mesh_file),
     "poisson_neumann": (("generate", "unit_square", 0.1, {}), poisson_neumann),
+    "unit_square_p2": (("generate", "unit_square", 0.1, {}), unit_square_p2),
+    "plate_p2": (("file", str(ROOT / "meshes" / "plate_with_hole.msh")), plate_p2),
+    "neumann_p2": (("generate", "unit_square", 0.15, {}), neumann_p2),
+    "cube_p2": (("box", 3), cube_p2),
 }
 
 
 def make_mesh(name: str):
     recipe = CASES[name][0]
+    if recipe[0] == "box":
+        from femkit.mesh import structured_box
+
+        return structured_box(recipe[1], recipe[1], recipe[1])
     if recipe[0] == "file":
         from femkit.mesh import read_mesh
 
@@ -79,8 +112,8 @@ def mesh_arrays(mesh) -> dict:
     """The mesh as plain arrays (saved by the driver, rebuilt by the test)."""
     import json
 
-    return {"points": mesh.points, "triangles": mesh.triangles, "cell_tags": mesh.cell_tags,
-            "boundary_edges": mesh.boundary_edges, "boundary_tags": mesh.boundary_tags,
+    return {"points": mesh.points, "cells": mesh.cells, "cell_tags": mesh.cell_tags,
+            "boundary_facets": mesh.boundary_facets, "boundary_tags": mesh.boundary_tags,
             "tag_names": json.dumps(mesh.tag_names)}
 
 
@@ -89,5 +122,5 @@ def mesh_from_arrays(d):
 
     from femkit.mesh import Mesh
 
-    return Mesh(d["points"], d["triangles"], d["cell_tags"], d["boundary_edges"],
+    return Mesh(d["points"], d["cells"], d["cell_tags"], d["boundary_facets"],
                 d["boundary_tags"], json.loads(str(d["tag_names"])))

@@ -151,11 +151,16 @@ def test_adaptive_case_refuses_the_petsc_backend(tmp_path):
 
 
 @pytest.mark.usefixtures("needs_mpi")
-def test_solve_backend_petsc_on_tetrahedra_matches_serial(tmp_path):
-    """The bundled cube case (its mesh refined once, PCG + AMG to 1e-10) on 2 ranks: the
-    partition, the assembly and the pieces take tetrahedra; u equals the serial one to 1e-8."""
+@pytest.mark.parametrize("element,refine", [("P1", 1), ("P2", 0)])
+def test_solve_backend_petsc_on_tetrahedra_matches_serial(element, refine, tmp_path):
+    """The bundled cube case (its mesh refined once for P1, PCG + AMG to 1e-10) on 2 ranks: the
+    partition, the assembly and the pieces take tetrahedra, P2's dofs (edges owned by a rank of
+    their own); u (P2: on every node of the quadratic cells) equals the serial one to 1e-8."""
     case = yaml.safe_load((ROOT / "cases" / "cube.yaml").read_text())
-    case["mesh"]["refine"] = 1
+    case["mesh"]["refine"] = refine
+    case["element"] = element
+    if element == "P2":
+        del case["quadrature"]     # P2's load rule: the cheapest exact for its products
     case["solver"] = {"method": "pcg", "preconditioner": "amg", "rtol": 1e-10}
     case["output"] = {"vtu": True}
     path = tmp_path / "cube.yaml"
@@ -166,6 +171,7 @@ def test_solve_backend_petsc_on_tetrahedra_matches_serial(tmp_path):
     serial = json.loads((tmp_path / "serial" / "result.json").read_text())
     petsc = json.loads((tmp_path / "petsc" / "result.json").read_text())
     assert petsc["mesh"] == serial["mesh"] and serial["mesh"]["dim"] == 3
+    assert serial["mesh"]["element"] == element
     assert petsc["parallel"]["ranks"] == 2 and petsc["converged"]
     assert (petsc["dofs"], petsc["nnz"]) == (serial["dofs"], serial["nnz"])
     import meshio

@@ -151,7 +151,6 @@ def _prepare_element(d: dict, solver) -> None:
         return
     name = d["element"]
     unsupported = [
-        (solver.backend == "petsc", "solver.backend 'petsc'", "the default backend"),
         (d["estimator"] != "residual", f"estimator {d['estimator']!r}", "estimator 'residual'"),
         (bool(d["output"].get("xdmf")), "output.xdmf", "output.vtu (quadratic cells)"),
     ]

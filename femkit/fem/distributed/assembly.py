@@ -1,9 +1,11 @@
-"""Partitioned assembly of a P1 Poisson problem into PETSc objects.
+"""Partitioned assembly of a P1 or P2 Poisson problem into PETSc objects.
 
 Every rank holds the whole mesh (read or generated once on rank 0 and broadcast; see
 :mod:`.poisson`), assembles only its own elements with femkit's kernels
-(:func:`femkit.fem.local_stiffness`, :func:`femkit.fem.assemble_load` with ``elements=``)
-and hands the ``(rows, cols, values)`` triplets to an MPIAIJ matrix through
+(:func:`femkit.fem.local_stiffness`, :func:`femkit.fem.assemble_load` with ``elements=``; P2:
+:func:`femkit.fem.forms.local_matrices`, :func:`femkit.fem.lagrange.element_load`, over the dof
+map's cells, the unknowns being its dofs: :func:`.partition.dof_owners`) and hands the
+``(rows, cols, values)`` triplets to an MPIAIJ matrix through
 ``MatSetPreallocationCOO``/``MatSetValuesCOO`` (:mod:`.coo`); PETSc sends entries owned by
 other ranks to them and sums repeated entries. Dirichlet nodes are eliminated (their rows and
 columns get index ``-1``, which PETSc drops; their values are lifted to the right-hand side),
@@ -65,15 +67,15 @@ def add_nodal(vec, layout: Layout, nodes: np.ndarray, values: np.ndarray) -> Non
 
 
 def assemble_matrix(problem, layout: Layout, comm, local: np.ndarray, *, timer=None):
-    """The MPIAIJ matrix ``K[free, free]`` from this rank's local matrices ``local`` (k, 3, 3)
-    on triangles, (k, 4, 4) on tetrahedra;
+    """The MPIAIJ matrix ``K[free, free]`` from this rank's local matrices ``local`` (k, w, w):
+    w = 3 on triangles, 4 on tetrahedra (P1), 6 and 10 (P2, the dof map's cells);
     ``timer("pattern")`` times the one-off pattern analysis (MatSetPreallocationCOO),
     ``timer("stiffness")`` the values (MatSetValuesCOO)."""
     import contextlib
 
     PETSc = require_petsc()
     timer = timer or (lambda stage: contextlib.nullcontext())
-    tri = problem.mesh.cells[layout.elements]
+    tri = problem.dofs.cells[layout.elements]
     d = layout.dof[tri].astype(PETSc.IntType)  # (k, 3 or 4), -1 on eliminated nodes
     nv = tri.shape[1]
     N = int(layout.dof_offsets[-1])
@@ -101,27 +103,27 @@ def assemble_poisson(problem, layout: Layout, comm, fixed: np.ndarray, values: n
     timer = timer or (lambda stage: contextlib.nullcontext())
     mesh = problem.mesh
     own = layout.elements
-    tri = mesh.cells[own]
+    tri = problem.dofs.cells[own]
     with timer("stiffness"):
-        local = local_stiffness(mesh, problem.kappa, elements=own)
+        local = _local_stiffness(problem, own)
     A = assemble_matrix(problem, layout, comm, local, timer=timer)
     with timer("load"):
         touched = np.unique(tri)
-        F_src = assemble_load(mesh, problem.f, rule=problem.load_rule, elements=own)[touched]
+        F_src = _load(problem, own)[touched]
         mine = layout.owned
         F_flux = problem.neumann_vector()[mine] if problem.neumann else np.zeros(len(mine))
         F = node_vector(layout, comm)
         add_nodal(F, layout, touched, F_src)
         add_nodal(F, layout, mine, F_flux)
         F.assemble()
-    g = np.zeros(mesh.n_points)
+    g = np.zeros(problem.n_dofs)
     g[fixed] = values
     mode, w, facts = problem.nullspace, None, {}
     with timer("dirichlet"):
         if mode is not None:
             mpi = comm.tompi4py()
             w = node_vector(layout, comm)
-            add_nodal(w, layout, touched, node_weights(mesh, elements=own)[touched])
+            add_nodal(w, layout, touched, _weights(problem, own)[touched])
             w.assemble()
             # sum |F_source| needs the assembled source alone: F - flux on owned nodes
             F_arr = F.getArray()
@@ -142,6 +144,36 @@ def assemble_poisson(problem, layout: Layout, comm, fixed: np.ndarray, values: n
     F.destroy()
     return DistributedSystem(A=A, b=b, layout=layout, g=g, mode=mode, weights=w,
                              compatibility=facts)
+
+
+def _local_stiffness(problem, own: np.ndarray) -> np.ndarray:
+    """Local stiffness matrices (k, w, w) of the cells ``own``: P1's own kernel, else the
+    element-generic one (:func:`femkit.fem.forms.local_matrices`)."""
+    if problem.element.name == "P1":
+        return local_stiffness(problem.mesh, problem.kappa, elements=own)
+    from ..forms import local_matrices
+
+    return local_matrices(problem.mesh, "stiffness", problem.kappa, element=problem.element, elements=own)
+
+
+def _load(problem, own: np.ndarray) -> np.ndarray:
+    """The source's load vector (n_dofs,) of the cells ``own`` (P1's rule, or the element's
+    default rule unless the problem names another, as :meth:`PoissonProblem.assemble_matrices`)."""
+    if problem.element.name == "P1":
+        return assemble_load(problem.mesh, problem.f, rule=problem.load_rule, elements=own)
+    from ..lagrange import element_load
+
+    rule = None if problem.load_rule == "barycentric" else problem.load_rule
+    return element_load(problem.mesh, problem.f, problem.element, rule=rule, elements=own)
+
+
+def _weights(problem, own: np.ndarray) -> np.ndarray:
+    """``int phi_i`` (n_dofs,) over the cells ``own``."""
+    if problem.element.name == "P1":
+        return node_weights(problem.mesh, elements=own)
+    from ..lagrange import dof_weights
+
+    return dof_weights(problem.mesh, problem.element, elements=own)
 
 
 def nodal_solution(system: DistributedSystem, x, comm):

@@ -7,7 +7,9 @@ needs, and it minimises the edge cut, i.e. the off-rank couplings of the matrix.
 ``MatPartitioning`` type can be chosen (``method=``; ``average``/``square`` are the trivial
 ones). Nodes are then renumbered so each rank owns one contiguous block (PETSc's MPIAIJ row
 distribution), keeping the original order inside a block; each element goes to the rank that
-owns most of its vertices (the middle of its three owners).
+owns most of its vertices (the middle of its three owners). With P2 the unknowns are the dofs of
+the dof map (:func:`femkit.fem.dofs.dof_map`: the nodes, then one per edge), renumbered the same
+way; an edge's dof belongs to the owner of its lower-numbered node (:func:`dof_owners`).
 """
 
 from __future__ import annotations
@@ -88,7 +90,8 @@ def partition_nodes(mesh, comm, *, method: str = DEFAULT_PARTITIONER) -> np.ndar
 
 @dataclass
 class Layout:
-    """Node and unknown (dof) numbering of a partitioned mesh on one rank.
+    """Node and unknown (dof) numbering of a partitioned mesh on one rank. With P2 a "node"
+    here is a dof of the dof map (the mesh's nodes, then its edges: :func:`dof_owners`).
 
     Attributes
     ----------
@@ -139,9 +142,21 @@ def element_owners(cells: np.ndarray, owner: np.ndarray) -> np.ndarray:
     return np.sort(owner[cells], axis=1)[:, 1]
 
 
+def dof_owners(owner: np.ndarray, dofs) -> np.ndarray:
+    """Owner rank of every dof of the dof map ``dofs`` (:func:`femkit.fem.dofs.dof_map`) from the
+    owners of the mesh's nodes: a vertex dof is its node's; an edge dof (P2) is owned by the
+    owner of its edge's lower-numbered node (``edge_nodes[k, 0]``, original numbering), so a rank
+    owns the edges it reaches first, and every rank computes the same owners."""
+    if not len(dofs.edge_nodes):
+        return owner
+    return np.concatenate([owner, owner[dofs.edge_nodes[:, 0]]])
+
+
 def build_layout(mesh, owner: np.ndarray, fixed: np.ndarray, rank: int, size: int) -> Layout:
-    """Contiguous renumbering for the partition ``owner``; ``fixed`` are the eliminated nodes."""
-    n = mesh.n_points
+    """Contiguous renumbering for the partition ``owner`` of the dofs (the nodes for P1, then the
+    edges for P2: :func:`dof_owners`); ``fixed`` are the eliminated dofs. Elements go to ranks by
+    their vertices' owners (:func:`element_owners`; the vertex dofs are the nodes)."""
+    n = len(owner)
     order = np.lexsort((np.arange(n), owner))  # by owner, original order inside a rank
     node_id = np.empty(n, dtype=np.int64)
     node_id[order] = np.arange(n)
@@ -153,6 +168,6 @@ def build_layout(mesh, owner: np.ndarray, fixed: np.ndarray, rank: int, size: in
     dof[order[free_in_order]] = np.arange(int(free_in_order.sum()))
     dof_offsets = np.concatenate([[0], np.cumsum(np.bincount(owner[is_free], minlength=size))])
     owned = order[node_offsets[rank]:node_offsets[rank + 1]]
-    elements = np.flatnonzero(element_owners(mesh.cells, owner) == rank)
+    elements = np.flatnonzero(element_owners(mesh.cells, owner[:mesh.n_points]) == rank)
     return Layout(rank=rank, size=size, owner=owner, node_id=node_id, node_offsets=node_offsets,
                   owned=owned, dof=dof, dof_offsets=dof_offsets, elements=elements)

@@ -30,7 +30,7 @@ from ..norms import error_norms
 from ..poisson import mean_shift_parts
 from .assembly import (DistributedSystem, assemble_poisson, gather_nodal, nodal_solution,
                        values_at)
-from .partition import DEFAULT_PARTITIONER, build_layout, partition_nodes
+from .partition import DEFAULT_PARTITIONER, build_layout, dof_owners, partition_nodes
 
 
 def broadcast_mesh(make_mesh, comm=None):
@@ -116,7 +116,7 @@ def solve_poisson(problem, *, method: str = "pcg", preconditioner: str | None = 
             fixed = np.array([problem.pin_node], dtype=np.int64)
             values = np.array([problem.pin_value if problem.nullspace == "pin" else 0.0])
     with timer("partition"):
-        owner = partition_nodes(mesh, comm, method=partitioner)
+        owner = dof_owners(partition_nodes(mesh, comm, method=partitioner), problem.dofs)
         layout = build_layout(mesh, owner, fixed, rank, size)
     system = collective(mpi, assemble_poisson, problem, layout, comm, fixed, values, timer=timer)
     result, x = ksp_solve(system.A, system.b, table=petsc_names(), method=method,
@@ -130,7 +130,8 @@ def solve_poisson(problem, *, method: str = "pcg", preconditioner: str | None = 
     if exact is not None:
         with timer("errors"):
             errors = parallel_errors(mesh, u_vec, layout, comm, exact, grad_exact, error_order,
-                                     modulo_constant=problem.nullspace is not None)
+                                     modulo_constant=problem.nullspace is not None,
+                                     element=problem.element.name)
     u = None
     if gather:
         with timer("gather"):
@@ -155,27 +156,48 @@ def _max_op():
 
 
 def parallel_errors(mesh, u_vec, layout, comm, exact, grad_exact=None, order: int = 5, *,
-                    modulo_constant: bool = False) -> dict:
-    """:func:`femkit.fem.error_norms` on each rank's elements, reduced over ranks (squared
-    integrals summed, nodal maxima maximised); the nodes of own elements that other ranks
-    own are fetched with a VecScatter. ``modulo_constant`` (pure Neumann): errors of
-    ``u - c`` with ``int (u - c - exact) = 0``, the integrals summed over ranks
-    (:func:`femkit.fem.poisson.mean_shift_parts`), as :meth:`PoissonProblem.errors` does."""
+                    modulo_constant: bool = False, element: str = "P1") -> dict:
+    """:func:`femkit.fem.error_norms` (P2: :func:`femkit.fem.lagrange.element_error_norms`) on
+    each rank's elements, reduced over ranks (squared integrals summed, nodal maxima maximised);
+    the dofs of own elements that other ranks own are fetched with a VecScatter.
+    ``modulo_constant`` (pure Neumann): errors of ``u - c`` with ``int (u - c - exact) = 0``, the
+    integrals summed over ranks (:func:`femkit.fem.poisson.mean_shift_parts`), as
+    :meth:`PoissonProblem.errors` does."""
     from mpi4py import MPI  # femkit[petsc]: reached only after require_petsc() succeeded
 
+    from ..dofs import dof_map
+
     mpi = comm.tompi4py()
-    nodes = np.unique(mesh.cells[layout.elements])
-    u = np.zeros(mesh.n_points)
+    own = layout.elements
+    dofs = dof_map(mesh, element)
+    nodes = np.unique(dofs.cells[own])
+    u = np.zeros(dofs.n_dofs)
     u[nodes] = values_at(u_vec, layout, nodes, comm)
     if modulo_constant:
-        parts = np.array(collective(mpi, mean_shift_parts, mesh, u, exact, order=order,
-                                    elements=layout.elements))
+        parts = np.array(collective(mpi, _shift_parts, mesh, u, exact, order, own, element))
         mpi.Allreduce(parts.copy(), parts, op=MPI.SUM)
         u[nodes] -= (parts[0] - parts[1]) / parts[2]
-    local = collective(mpi, error_norms, mesh, u, exact, grad_exact, order=order,
-                       elements=layout.elements, squared=True)
+    if element == "P1":
+        local = collective(mpi, error_norms, mesh, u, exact, grad_exact, order=order,
+                           elements=own, squared=True)
+    else:
+        from ..lagrange import element_error_norms
+
+        local = collective(mpi, element_error_norms, mesh, u, exact, grad_exact, element=element,
+                           order=order, elements=own, squared=True)
     sums = mpi.allreduce(np.array([local["L2"], local["H1_semi"] or 0.0]), op=MPI.SUM)
     worst = mpi.allreduce(local["max_nodal"], op=MPI.MAX)
     return {"L2": float(np.sqrt(sums[0])),
             "H1_semi": float(np.sqrt(sums[1])) if grad_exact is not None else None,
             "max_nodal": float(worst)}
+
+
+def _shift_parts(mesh, u, exact, order: int, own, element: str) -> tuple:
+    """``(int u_h, int u, measure)`` over the cells ``own`` (:func:`mean_shift_parts`; P2:
+    ``int u_h`` by the dof weights of those cells, as :meth:`PoissonProblem.errors`)."""
+    if element == "P1":
+        return mean_shift_parts(mesh, u, exact, order=order, elements=own)
+    from ..lagrange import dof_weights
+
+    _, ue, area = mean_shift_parts(mesh, np.zeros(mesh.n_points), exact, order=order, elements=own)
+    return float(dof_weights(mesh, element, elements=own) @ u), ue, area
