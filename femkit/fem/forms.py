@@ -139,7 +139,8 @@ def assemble_matrix(mesh, form: str, coefficient=1.0, *, element="P1", elements=
     idx = select_elements(mesh, elements)
     scale = element_coefficient(mesh, coefficient, idx)
     count = mesh.n_cells if idx is None else len(idx)
-    if (form == "stiffness" and idx is None and elem.name != "P1" and count >= sparsity.NUMBA_THRESHOLD
+    compiled = sparsity.compiled_from(count, elem)
+    if (form == "stiffness" and idx is None and elem.name != "P1" and compiled
             and sparsity.cached_pattern(mesh, dofs) is None):
         from ._element_kernels import first_stiffness   # pattern and values in one pass, none cached
 
@@ -147,7 +148,7 @@ def assemble_matrix(mesh, form: str, coefficient=1.0, *, element="P1", elements=
         if K is not None:
             return K
     pattern = sparsity.pattern_for(mesh, dofs)
-    if count < sparsity.NUMBA_THRESHOLD or pattern.slots.dtype != np.int32:
+    if not compiled or pattern.slots.dtype != np.int32:
         return pattern.assemble(_local(mesh, elem, form, scale, idx), elements=idx)
     from ._kernels import element_stiffness_kernel, scatter_kernel
 

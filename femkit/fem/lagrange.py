@@ -73,7 +73,7 @@ def element_load(mesh, f, element="P2", *, rule: str | None = None, elements=Non
     idx = select_elements(mesh, elements)
     quad = get_rule(rule, mesh.dim) if rule else load_rule(elem)
     phi = elem.basis(quad.points)                                    # (q, n)
-    if callable(f) and idx is None and mesh.n_cells >= sparsity.NUMBA_THRESHOLD:  # the assembly's threshold
+    if callable(f) and idx is None and sparsity.compiled_from(mesh.n_cells, elem):  # the assembly's threshold
         F = _load_compiled(mesh, dofs, f, quad, phi)
         if F is not None:
             return F

@@ -60,3 +60,30 @@ def test_p2_compiled_load_refuses_degenerate_cells_and_nonfinite_sources(compile
         lagrange.element_load(flat, _source(2), "P2")
     with pytest.raises(InputError, match="not finite"):
         lagrange.element_load(mesh, lambda x, y: np.where(x > 0.5, np.inf, x), "P2")
+
+
+@pytest.mark.parametrize("dim, p2_cells", [(2, 50_000), (3, 32_000)], ids=["tri", "tet"])
+def test_p2_takes_the_compiled_passes_from_as_many_local_entries_as_p1(dim, p2_cells):
+    """P2 goes compiled from NUMBA_THRESHOLD * (P1 local entries) / (P2 local entries) cells (a
+    quarter of P1's cells in 2D, 16 % in 3D); P1 keeps its own threshold exactly."""
+    from femkit.elements import get_element
+
+    p1, p2 = get_element("P1", dim), get_element("P2", dim)
+    assert sparsity.compiled_from(sparsity.NUMBA_THRESHOLD, p1)
+    assert not sparsity.compiled_from(sparsity.NUMBA_THRESHOLD - 1, p1)
+    assert sparsity.compiled_from(p2_cells, p2) and not sparsity.compiled_from(p2_cells - 1, p2)
+
+
+def test_a_p2_mesh_between_the_two_thresholds_is_assembled_compiled(monkeypatch):
+    monkeypatch.setattr(sparsity, "NUMBA_THRESHOLD", 100)   # P2 triangles compiled from 25 on
+    mesh = _wobbly(structured_mesh(4, 4))                    # 32 cells: P1 would stay on numpy
+    from femkit.fem import _element_kernels
+
+    calls = []
+    real = _element_kernels.first_stiffness
+    monkeypatch.setattr(_element_kernels, "first_stiffness", lambda *a: calls.append(1) or real(*a))
+    K = forms.assemble_matrix(mesh, "stiffness", 1.0, element="P2")
+    assert calls == [1]
+    monkeypatch.setattr(sparsity, "NUMBA_THRESHOLD", 10 ** 9)
+    K_np = forms.assemble_matrix(Mesh(mesh.points.copy(), mesh.cells.copy()), "stiffness", 1.0, element="P2")
+    assert abs(K - K_np).max() <= 1e-13 * abs(K_np).max()

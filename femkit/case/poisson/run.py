@@ -314,10 +314,11 @@ def _compile_stage(case: Case, mesh, stage, echo) -> None:
     from .warmup import dimensions, must_compile, needs_kernels, start_numba, warm_up
 
     multigrid = case.solver.needs_hierarchy
-    if needs_kernels(mesh, multigrid):
+    element = case.spec.element
+    if needs_kernels(mesh, multigrid, element):
         start_numba(stage)  # numba's own start-up, once, in its own stage
     dims = dimensions(mesh.dim if mesh is not None else case_dimension(case))
-    if must_compile(mesh, multigrid, dims):
+    if must_compile(mesh, multigrid, dims, element):
         with stage("compile"):
             seconds = warm_up(echo, multigrid, dims)
         if echo is not None:

@@ -91,17 +91,20 @@ __all__ += ["compile_expressions", "expressions_cached", "EXPRESSIONS_MESSAGE"]
 EXPRESSIONS_MESSAGE = "compiling the case's expressions (first run, cached afterwards)..."
 
 
-def needs_kernels(mesh, multigrid: bool) -> bool:
-    """True when a run on ``mesh`` (None: not built yet) calls compiled kernels: a mesh above the
-    smallest size threshold, or geometric multigrid (``multigrid``: fmg, or pcg + gmg)."""
+def needs_kernels(mesh, multigrid: bool, element: str = "P1") -> bool:
+    """True when a run on ``mesh`` (None: not built yet) with ``element`` calls compiled kernels:
+    a mesh above the smallest size threshold (the assembly's is the element's,
+    :func:`femkit.fem.sparsity.compiled_from`), or geometric multigrid (``multigrid``: fmg, or
+    pcg + gmg)."""
     if multigrid:
         return True
     if mesh is None:
         return False
-    from ...fem.sparsity import NUMBA_THRESHOLD
+    from ...elements import get_element
+    from ...fem.sparsity import compiled_from
     from ...mesh.edges import NUMBA_THRESHOLD as EDGES
 
-    return mesh.n_cells >= min(NUMBA_THRESHOLD, EDGES)
+    return mesh.n_cells >= EDGES or compiled_from(mesh.n_cells, get_element(element, mesh.dim))
 
 
 def dimensions(dim: int | None) -> tuple[int, ...]:
@@ -230,11 +233,11 @@ def start_numba(stage) -> None:
             pass
 
 
-def must_compile(mesh, multigrid: bool, dims: tuple[int, ...] = (2, 3)) -> bool:
+def must_compile(mesh, multigrid: bool, dims: tuple[int, ...] = (2, 3), element: str = "P1") -> bool:
     """True before the first run after an install whose ``mesh`` (with geometric multigrid when
-    ``multigrid``; in the dimensions ``dims``) will call kernels that are not compiled yet (not
-    inside a warm-up)."""
-    return (not _ACTIVE and needs_kernels(mesh, multigrid)
+    ``multigrid``; in the dimensions ``dims``; with ``element``) will call kernels that are not
+    compiled yet (not inside a warm-up)."""
+    return (not _ACTIVE and needs_kernels(mesh, multigrid, element)
             and not kernels_cached(families(multigrid), dims))
 
 
