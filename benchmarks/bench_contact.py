@@ -9,7 +9,9 @@ process with the same ``newton`` integrator, dt and tolerance:
   Newton step, the peer of the ratio).
 
 For each: the seconds per step over the steps after the first contact (the steps before it are
-cheap in both), Newton iterations per step, and for the contact run the split of its time among
+cheap in both) -- process CPU seconds, with ipctk held to one thread as femkit's contact-free
+step is (on a shared machine wall time follows the load; the wall seconds are printed too) --,
+Newton iterations per step, and for the contact run the split of its time among
 the collision broad phase (``NormalCollisions.build``), CCD (``compute_collision_free_stepsize``)
 and the barrier/friction Hessian (``BarrierModel.seconds``); the rest is the Newton step itself
 (springs, the linear solves). The issue's bar is a contact step at most 3x the contact-free one.
@@ -46,11 +48,12 @@ def run(n: int, steps: int, contact: bool, tmp: Path) -> dict:
     integ, ctx = build_integrator(case), build_context(case)
     f = contact_force(system)
     st = integ.start(system, system.x0, system.v0, 0.0, case.spec.dt, ctx)
-    times, split0, first = [], None, None
+    times, walls, split0, first = [], [], None, None
     for k in range(steps):
-        t0 = time.perf_counter()
+        t0, w0 = time.process_time(), time.perf_counter()
         st = integ.step(system, st, case.spec.dt, ctx)
-        times.append(time.perf_counter() - t0)
+        times.append(time.process_time() - t0)
+        walls.append(time.perf_counter() - w0)
         touching = st.x[:, 2].min() < 0.51 if f is None else f.model.active(st.x) > 0
         if first is None and touching:
             first = k
@@ -58,7 +61,7 @@ def run(n: int, steps: int, contact: bool, tmp: Path) -> dict:
     first = steps if first is None else first
     after = np.array(times[first:]) if first < steps else np.array(times)
     its = ctx.stats["newton_iterations"][first:]
-    out = {"per_step": float(after.mean()), "iterations": float(np.mean(its)) if its else 0.0,
+    out = {"per_step": float(after.mean()), "wall": float(np.mean(walls[first:] or walls)), "iterations": float(np.mean(its)) if its else 0.0,
            "steps_measured": len(after), "first_contact_step": first}
     if f is not None:
         sec = f.model.seconds
@@ -71,13 +74,19 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=41, help="cloth vertices per side (81: the scene)")
     ap.add_argument("--steps", type=int, default=25)
     args = ap.parse_args()
+    import ipctk
+
+    from femkit.contact.barrier import BarrierModel
+
+    ipctk.set_num_threads(1)   # CPU seconds of one thread, as the contact-free step
+    BarrierModel.clock = staticmethod(time.process_time)
     with tempfile.TemporaryDirectory() as tmp:
         free = run(args.n, args.steps, False, Path(tmp))
         con = run(args.n, args.steps, True, Path(tmp))
     print(f"cloth {args.n} x {args.n}, {args.steps} steps, measured from the first contact")
     for name, r in (("contact-free", free), ("barrier contact", con)):
         print(f"  {name:16s} {1e3 * r['per_step']:9.1f} ms/step, {r['iterations']:5.1f} Newton "
-              f"iterations/step ({r['steps_measured']} steps)")
+              f"iterations/step ({r['steps_measured']} steps; wall {1e3 * r['wall']:.1f} ms/step)")
     print(f"  ratio contact / free: {con['per_step'] / free['per_step']:.2f} (bar: <= 3)")
     rest = con["per_step"] - sum(con["split"].values())
     print("  split of a contact step: " + ", ".join(

@@ -27,6 +27,8 @@ module never needs it; building a :class:`BarrierModel` without it is a one-line
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -65,6 +67,9 @@ def _positive(value, name: str) -> float:
 class BarrierModel:
     """Barrier contact of one set of bodies (their surfaces) and static obstacles.
 
+    ``seconds`` sums the time of the broad phase, CCD and the Hessians by :attr:`clock`
+    (wall time; a benchmark may set CPU time).
+
     Parameters
     ----------
     x0 : (n, d) array
@@ -93,6 +98,8 @@ class BarrierModel:
     InputError
         ``dhat``, ``stiffness`` or ``eps_v`` not > 0, ``mu < 0``, ``lagging < 1``, ipctk missing.
     """
+
+    clock = staticmethod(time.perf_counter)
 
     def __init__(self, x0, surface, obstacles=(), *, dhat=None, stiffness=None,
                  self_contact: bool = True, mu: float = 0.0, eps_v: float = 1e-3,
@@ -135,6 +142,7 @@ class BarrierModel:
         self.friction = ipctk.FrictionPotential(self.eps_v) if self.mu > 0 else None
         self._lag = None            # (x_n flat, h, TangentialCollisions) inside a step
         self._kept = (None, None)   # (collision vertices, NormalCollisions)
+        self._sweep = None          # (lower, upper swept boxes, Candidates) of the last CCD move
         self.stats = {"collision_builds": 0, "ccd_calls": 0, "hessians": 0}
         self.seconds = {"broad_phase": 0.0, "ccd": 0.0, "hessian": 0.0}
 
@@ -173,15 +181,18 @@ class BarrierModel:
         return np.asfortranarray(np.concatenate([x[self.surface_nodes], self.static]))
 
     def _collisions(self, x, dhat=None):
-        import time
-
         V = self.vertices(x)
         if dhat is None and self._kept[0] is not None and np.array_equal(self._kept[0], V):
             return V, self._kept[1]
-        t0 = time.perf_counter()
+        t0 = self.clock()
         c = self._ipc.NormalCollisions()
-        c.build(self.mesh, V, self.dhat if dhat is None else dhat)
-        self.seconds["broad_phase"] += time.perf_counter() - t0
+        if dhat is None and self._within_sweep(V):
+            cand = self._sweep[2]
+        else:  # the same kind of broad phase at V: one collision set whichever way it is built
+            cand = self._ipc.Candidates()
+            cand.build(self.mesh, V, self.dhat if dhat is None else dhat)
+        c.build(cand, self.mesh, V, self.dhat if dhat is None else dhat)
+        self.seconds["broad_phase"] += self.clock() - t0
         self.stats["collision_builds"] += 1
         if dhat is None:
             self._kept = (V, c)
@@ -229,9 +240,7 @@ class BarrierModel:
     def hessian(self, x, project: bool = True) -> sp.csr_matrix:
         """Hessian of :meth:`energy`, CSR ``n d x n d``; ``project``: each collision's block
         projected onto its positive semi-definite part (ipctk's clamp)."""
-        import time
-
-        t0 = time.perf_counter()
+        t0 = self.clock()
         V, c = self._collisions(x)
         how = self._ipc.PSDProjectionMethod.CLAMP if project else \
             self._ipc.PSDProjectionMethod.NONE
@@ -242,19 +251,39 @@ class BarrierModel:
         if F is not None:
             H = F if H is None else H + F
         self.stats["hessians"] += 1
-        self.seconds["hessian"] += time.perf_counter() - t0
+        self.seconds["hessian"] += self.clock() - t0
         return H if H is not None else sp.csr_matrix((self.n * self.dim,) * 2)
 
     def max_step(self, x0, x1) -> float:
-        """The collision-free fraction of the straight move ``x0 -> x1`` (CCD), in ``[0, 1]``."""
-        import time
+        """The collision-free fraction of the straight move ``x0 -> x1`` (CCD), in ``[0, 1]``.
 
-        t0 = time.perf_counter()
-        t = float(self._ipc.compute_collision_free_stepsize(
-            self.mesh, self.vertices(x0), self.vertices(x1), narrow_phase_ccd=self.ccd))
+        The move's broad phase (candidate pairs whose boxes, swept over the move and inflated by
+        ``dhat``, overlap) serves the CCD and is kept: the collision set of any configuration
+        whose vertices all lie in their boxes swept by this move -- every line-search trial on
+        it, the accepted iterate -- is built from it (:meth:`_within_sweep`) instead of from a
+        broad phase of its own.
+        """
+        t0 = self.clock()
+        V0, V1 = self.vertices(x0), self.vertices(x1)
+        cand = self._ipc.Candidates()
+        cand.build(self.mesh, V0, V1, self.dhat)
+        self._sweep = (np.minimum(V0, V1), np.maximum(V0, V1), cand)
+        t1 = self.clock()
+        t = float(cand.compute_collision_free_stepsize(self.mesh, V0, V1, 0.0, self.ccd))
         self.stats["ccd_calls"] += 1
-        self.seconds["ccd"] += time.perf_counter() - t0
+        self.seconds["broad_phase"] += t1 - t0
+        self.seconds["ccd"] += self.clock() - t1
         return t
+
+    def _within_sweep(self, V) -> bool:
+        """Whether every collision vertex of ``V`` lies in its box swept by the last
+        :meth:`max_step` move; then every pair closer than ``dhat`` at ``V`` is among that
+        move's candidates (each primitive lies in its swept box, and the boxes are inflated by
+        ``dhat``)."""
+        if self._sweep is None:
+            return False
+        lo, hi, _ = self._sweep
+        return bool(np.all(V >= lo) and np.all(V <= hi))
 
     def active(self, x) -> int:
         """The number of primitive pairs closer than ``dhat``."""
