@@ -58,8 +58,9 @@ def run(n: int, steps: int, contact: bool, tmp: Path) -> dict:
         if first is None and touching:
             first = k
             split0 = None if f is None else dict(f.model.seconds)
-    first = steps if first is None else first
-    after = np.array(times[first:]) if first < steps else np.array(times)
+    if first is None:   # no contact in these steps: all of them measured
+        first, split0 = 0, None if f is None else {k: 0.0 for k in f.model.seconds}
+    after = np.array(times[first:])
     its = ctx.stats["newton_iterations"][first:]
     out = {"per_step": float(after.mean()), "wall": float(np.mean(walls[first:] or walls)), "iterations": float(np.mean(its)) if its else 0.0,
            "steps_measured": len(after), "first_contact_step": first}
