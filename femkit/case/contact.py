@@ -32,13 +32,13 @@ __all__ = ["CONTACT_SCHEMA", "check_contact_integrator", "build_contact", "Conta
            "contact_stage", "obstacle_facets", "CONTACT_ITERATIONS", "CONTACT_SECONDS_PER_FACET"]
 
 _OBSTACLES = {
-    "plane": closed({"type": {"const": "plane"}, "point": VEC, "normal": VEC, "size": POS},
-                    ["type"]),
+    "plane": closed({"type": {"const": "plane"}, "point": VEC, "normal": VEC, "size": POS,
+                     "velocity": VEC}, ["type"]),
     "sphere": closed({"type": {"const": "sphere"}, "centre": VEC, "radius": POS,
-                      "level": {"type": "integer", "minimum": 0, "maximum": 6}},
+                      "level": {"type": "integer", "minimum": 0, "maximum": 6}, "velocity": VEC},
                      ["type", "centre", "radius"]),
-    "file": closed({"type": {"const": "file"}, "file": {"type": "string", "minLength": 1}},
-                   ["type", "file"]),
+    "file": closed({"type": {"const": "file"}, "file": {"type": "string", "minLength": 1},
+                    "velocity": VEC}, ["type", "file"]),
 }
 
 #: The ``contact:`` mapping (closed; obstacles by ``type``).
@@ -93,10 +93,22 @@ def _obstacles(contact, x0: np.ndarray) -> list:
                 out.append(sphere_obstacle(ob["centre"], ob["radius"], dim, ob.get("level", 3)))
             else:
                 out.append(file_obstacle(ob["file"], dim))
+            if "velocity" in ob:
+                out[-1] = _moving(out[-1], ob["velocity"], dim)
         except (InputError, ValueError) as exc:
             raise with_prefix(InputError(str(exc).removeprefix("contact.obstacles: ")),
                               f"contact.obstacles[{i}]") from None
     return out
+
+
+def _moving(obstacle, velocity, dim: int):
+    """``obstacle`` moving at ``velocity`` (a vector of the scene's dimension)."""
+    from dataclasses import replace
+
+    v = np.asarray(velocity, float)
+    if v.shape != (dim,) or not np.all(np.isfinite(v)):
+        raise InputError(f"velocity must be {dim} finite numbers, got {list(velocity)!r}")
+    return replace(obstacle, velocity=v)
 
 
 def build_contact(contact, x0, cells):

@@ -17,8 +17,11 @@ are frozen ("lagged") at the start of a step, the friction force is ``-grad_v D(
 
 femkit's conventions: positions are node-major ``(n, d)``, the flat dof ``i*d + c``; the
 potential's gradient is ``(n, d)`` on every node of the body (zero off its surface), its Hessian a
-CSR matrix ``n d x n d``. Obstacles are static: their vertices are part of the collision mesh but
-carry no dofs.
+CSR matrix ``n d x n d``. Obstacles are part of the collision mesh but carry no dofs; a moving one
+(a prescribed constant velocity) is moved within each step towards its place at the step's end
+in moves each bounded by CCD against the bodies where the last solve left them
+(:meth:`BarrierModel.advance`; the step is solved again after every move), so it never passes
+through a body; friction sees its velocity.
 
 ipctk is the optional extra ``femkit[contact]`` (``pip install femkit[contact]``): importing this
 module never needs it; building a :class:`BarrierModel` without it is a one-line
@@ -41,6 +44,9 @@ __all__ = ["BarrierModel", "require_ipctk", "DHAT_SCALE", "REPORT_SCALE"]
 DHAT_SCALE = 1e-3
 #: Minimum distances are reported up to this many ``dhat`` (farther: ``None``).
 REPORT_SCALE = 10.0
+#: Moves of a moving obstacle within one step, each bounded by CCD with the bodies where the
+#: last solve left them (:meth:`BarrierModel.advance`).
+MAX_ADVANCES = 200
 #: Tight-Inclusion CCD's iteration cap per primitive pair (ipctk's default, 1e7, let one nearly
 #: parallel face pair at a tiny gap -- a cube resting on a cube -- cost tens of seconds; at the
 #: cap the root finder returns its conservative lower bound, so the guarantee stands).
@@ -122,15 +128,22 @@ class BarrierModel:
         self.surface_nodes, local = np.unique(surface, return_inverse=True)
         self.nb = len(self.surface_nodes)
         faces = [local.reshape(surface.shape)]
-        verts, offset = [np.zeros((0, self.dim))], self.nb
+        verts, vels, offset = [np.zeros((0, self.dim))], [np.zeros((0, self.dim))], self.nb
         for ob in obstacles:
             if ob.dim != self.dim:
                 raise InputError(f"contact.obstacles: {ob.name} is {ob.dim}-D, the bodies "
                                  f"{self.dim}-D")
             verts.append(np.asarray(ob.vertices, float))
+            v = np.zeros(self.dim) if ob.velocity is None else np.asarray(ob.velocity, float)
+            vels.append(np.tile(v, (len(ob.vertices), 1)))
             faces.append(np.asarray(ob.faces, np.int64) + offset)
             offset += len(ob.vertices)
-        self.static = np.concatenate(verts)
+        self.static = np.concatenate(verts)      # the obstacles' vertices now
+        self.static0 = self.static.copy()        # ... at time 0
+        self.static_velocity = np.concatenate(vels)
+        self.moving = bool(np.any(self.static_velocity))
+        self._target = None                      # the obstacles' vertices at the step's end
+        self.advances = 0                        # obstacle moves of the step
         self.faces = np.ascontiguousarray(np.concatenate(faces), dtype=np.int32)
         self.n_obstacle_faces = len(self.faces) - len(surface)
         self.component = self._components()
@@ -329,6 +342,48 @@ class BarrierModel:
         self.kappa = float(new)
         return bool(changed)
 
+    # ------------------------------------------------------------------ moving obstacles
+    def start_motion(self, t: float, h: float) -> None:
+        """A step from ``t`` to ``t + h``: the obstacles' place at ``t + h`` the target of
+        :meth:`advance` (they start where the last step left them, at ``t`` on the first)."""
+        if not self.moving:
+            return
+        if self._target is None:
+            self.static = self.static0 + t * self.static_velocity
+        self._target = self.static0 + (t + h) * self.static_velocity
+        self.advances = 0
+
+    def advance(self, x) -> bool:
+        """Move the obstacles towards their step's end place as far as CCD allows with the
+        bodies at ``x`` (they never pass through a body); True when they moved (the objective
+        changed: solve again), False when they are there already.
+
+        Raises
+        ------
+        SolverError
+            After :data:`MAX_ADVANCES` moves in one step without reaching the place (the bodies
+            cannot get out of the way: a smaller step is needed).
+        """
+        from ..errors import SolverError
+
+        if self._target is None or np.array_equal(self.static, self._target):
+            return False
+        if self.advances >= MAX_ADVANCES:
+            raise SolverError(f"contact: a moving obstacle did not reach its place in "
+                              f"{MAX_ADVANCES} moves within one step; use a smaller dt")
+        x = np.asarray(x, float).reshape(self.n, self.dim)
+        V0 = self.vertices(x)
+        V1 = V0.copy()
+        V1[self.nb:] = self._target
+        t0 = self.clock()
+        t = float(self._ipc.compute_collision_free_stepsize(self.mesh, V0, V1,
+                                                            narrow_phase_ccd=self.ccd))
+        self.seconds["ccd"] += self.clock() - t0
+        self.stats["ccd_calls"] += 1
+        self.static = self._target.copy() if t >= 1.0 else self.static + t * (self._target - self.static)
+        self.advances += 1
+        return True
+
     # ------------------------------------------------------------------ friction
     def lag_friction(self, x_start, x_basis, h: float) -> None:
         """Freeze the friction of a step from ``x_start`` of length ``h``: normal forces and
@@ -358,21 +413,21 @@ class BarrierModel:
         if not self._friction_active():
             return 0.0
         W, h, tc = self._velocities(x)
-        W[self.nb:] = 0.0
+        W[self.nb:] = self.static_velocity
         return h * float(self.friction(tc, self.mesh, W))
 
     def _friction_gradient(self, x) -> np.ndarray:
         if not self._friction_active():
             return np.zeros((self.n, self.dim))
         W, h, tc = self._velocities(x)
-        W[self.nb:] = 0.0
+        W[self.nb:] = self.static_velocity
         return self._to_nodes(self.friction.gradient(tc, self.mesh, W))
 
     def _friction_hessian(self, x, how):
         if not self._friction_active():
             return None
         W, h, tc = self._velocities(x)
-        W[self.nb:] = 0.0
+        W[self.nb:] = self.static_velocity
         return self._to_dofs(self.friction.hessian(tc, self.mesh, W, how)) / h
 
     # ------------------------------------------------------------------ checks

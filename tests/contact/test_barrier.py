@@ -205,3 +205,25 @@ def test_a_2d_body_on_its_boundary_segments_lands_on_a_line_without_crossing_it(
     frames, f = _run(s, 25, 2e-3)
     assert max(f.model.active(fr.x) for fr in frames) > 0
     assert min(fr.x[:, 1].min() for fr in frames) > 0.0
+
+
+def test_a_moving_plane_pushes_a_block_and_never_passes_through_it():
+    from dataclasses import replace
+
+    P, T = cube(1, 0.2, (0.0, 0.0, 0.0))
+    dhat = 1e-3 * np.linalg.norm(np.ptp(P, axis=0))
+    speed = 0.5   # 5 mm per step: about 15 dhat, many CCD-bounded moves within each step
+    wall = replace(plane_obstacle([-0.5 * dhat, 0.1, 0.1], [1, 0, 0], 1.0, 3),
+                   velocity=np.array([speed, 0.0, 0.0]))
+    s = elastic_system(_body(P, T, E=1e5), forces=[BarrierContact(body_surface(T, 3), [wall])])
+    frames, f = _run(s, 5, 0.01, tol=1e-6)
+    t = frames[-1].t
+    # the wall is where its motion puts it, and the block ahead of it (pushed, not crossed)
+    assert np.allclose(f.model.static, f.model.static0 + t * np.array([speed, 0.0, 0.0]))
+    wall_x = f.model.static[0, 0]
+    assert wall_x == pytest.approx(speed * t - 0.5 * dhat)
+    assert frames[-1].x[:, 0].min() > wall_x
+    assert frames[-1].v[:, 0].mean() > 0.5 * speed
+    with pytest.raises(InputError, match="moving obstacle"):
+        from femkit.solids import solve_static
+        solve_static(_body(P, T), contact=f.model)
