@@ -3,10 +3,10 @@
 Every surface is plain arrays: ``vertices`` ``(m, d)`` and ``faces`` ``(k, 3)`` triangles in 3D or
 ``(k, 2)`` segments in 2D. A body's contact surface is made from its cells
 (:func:`body_surface`): the boundary triangles of tetrahedra, the boundary segments of triangles
-in the plane, or the triangles themselves of a surface (cloth) in 3D. Obstacles are static
-surfaces, static or moving at a prescribed velocity: a plane (a square, or a segment in 2D, large
-enough for the scene), a sphere (a
-subdivided icosahedron, or a polygon in 2D) and a surface mesh read from a file by meshio
+in the plane, or the triangles themselves of a surface (cloth) in 3D. Obstacles are surfaces,
+static or moving at a prescribed velocity: a plane (a square, or a segment in 2D, large enough
+for the scene), a sphere (a subdivided icosahedron, or a polygon in 2D) and a surface mesh read
+from a file by meshio
 (``.msh``, ``.stl``, ``.obj``; triangles, or lines in 2D).
 """
 
