@@ -34,7 +34,8 @@ import numpy as np
 SCENE = Path(__file__).resolve().parents[1] / "cases" / "scenes" / "cloth_on_sphere.yaml"
 
 
-def run(n: int, steps: int, contact: bool, tmp: Path, penalty: float = 0.0) -> dict:
+def run(n: int, steps: int, contact: bool, tmp: Path, penalty: float = 0.0,
+        ccd: str = "tight_inclusion") -> dict:
     """Seconds per step after the first contact, Newton iterations and (contact) the split;
     ``penalty > 0`` (with ``contact=False``): the sphere and the ground as penalty forces of
     that stiffness instead (the same draping without barrier or CCD)."""
@@ -47,6 +48,8 @@ def run(n: int, steps: int, contact: bool, tmp: Path, penalty: float = 0.0) -> d
     data["system"].update(nx=n, ny=n)
     if not contact:
         data.pop("contact")
+    else:
+        data["contact"]["ccd"] = ccd
     if penalty:
         data["forces"] = {"gravity": data["forces"]["gravity"],
                           "ground": {"height": 0.0, "stiffness": penalty},
@@ -87,6 +90,8 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=25)
     ap.add_argument("--penalty", type=float, default=1e3,
                     help="stiffness of the penalty run's sphere and ground")
+    ap.add_argument("--ccd", default="tight_inclusion", choices=["tight_inclusion", "additive"],
+                    help="the contact run's narrow-phase CCD (contact.ccd)")
     args = ap.parse_args()
     import ipctk
 
@@ -97,8 +102,9 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         free = run(args.n, args.steps, False, Path(tmp))
         pen = run(args.n, args.steps, False, Path(tmp), penalty=args.penalty)
-        con = run(args.n, args.steps, True, Path(tmp))
-    print(f"cloth {args.n} x {args.n}, {args.steps} steps, measured from the first contact")
+        con = run(args.n, args.steps, True, Path(tmp), ccd=args.ccd)
+    print(f"cloth {args.n} x {args.n}, {args.steps} steps, measured from the first contact; "
+          f"CCD {args.ccd}")
     for name, r in (("contact-free", free), ("penalty contact", pen), ("barrier contact", con)):
         print(f"  {name:16s} {1e3 * r['per_step']:9.1f} ms/step, {r['iterations']:5.1f} Newton "
               f"iterations/step ({r['steps_measured']} steps; wall {1e3 * r['wall']:.1f} ms/step)")

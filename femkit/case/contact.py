@@ -9,6 +9,7 @@ Shared by the ``mass_spring`` and ``solid`` kinds (docs/scenes.md, docs/solids.m
       friction: 0.3         # Coulomb mu (default 0)
       eps_v: 1.0e-3         # friction's slip-speed mollifier
       lagging: 1            # friction lagging iterations per step
+      ccd: tight_inclusion  # or additive (cheaper, not certified against rounding)
       self: true            # a body may touch itself (default true)
       obstacles:
         - {type: plane, point: [0, 0, 0], normal: [0, 0, 1]}
@@ -45,6 +46,7 @@ _OBSTACLES = {
 CONTACT_SCHEMA = closed({
     "dhat": POS, "stiffness": POS, "friction": NONNEG, "eps_v": POS,
     "lagging": {"type": "integer", "minimum": 1}, "self": {"type": "boolean"},
+    "ccd": {"enum": ["tight_inclusion", "additive"]},
     "obstacles": {"type": "array", "items": {
         "type": "object", "required": ["type"],
         "properties": {"type": {"enum": sorted(_OBSTACLES)}},
@@ -125,7 +127,8 @@ def build_contact(contact, x0, cells):
                            self_contact=bool(contact.get("self", True)),
                            mu=float(contact.get("friction", 0.0)),
                            eps_v=float(contact.get("eps_v", 1e-3)),
-                           lagging=int(contact.get("lagging", 1)))
+                           lagging=int(contact.get("lagging", 1)),
+                           ccd=contact.get("ccd", "tight_inclusion"))
     return force
 
 
@@ -179,7 +182,7 @@ class ContactRecorder:
         dists = [f["min_distance"] for f in self.frames if f["min_distance"] is not None]
         return {"dhat": m.dhat, "stiffness": m.kappa_value,
                 "stiffness_adaptive": m.fixed_stiffness is None, "friction": m.mu,
-                "eps_v": m.eps_v, "self": m.self_contact,
+                "eps_v": m.eps_v, "self": m.self_contact, "ccd": m.ccd_method,
                 "obstacles": [o.name for o in self.force.obstacles],
                 "min_distance": min(dists) if dists else None,
                 "intersections": int(sum(f["intersections"] for f in self.frames)),

@@ -44,6 +44,8 @@ __all__ = ["BarrierModel", "require_ipctk", "DHAT_SCALE", "REPORT_SCALE"]
 DHAT_SCALE = 1e-3
 #: Minimum distances are reported up to this many ``dhat`` (farther: ``None``).
 REPORT_SCALE = 10.0
+#: The narrow-phase CCD methods (``BarrierModel(ccd=...)``, ``contact.ccd``).
+CCD_METHODS = ("tight_inclusion", "additive")
 #: Moves of a moving obstacle within one step, each bounded by CCD with the bodies where the
 #: last solve left them (:meth:`BarrierModel.advance`).
 MAX_ADVANCES = 200
@@ -98,18 +100,25 @@ class BarrierModel:
     lagging : int
         Friction lagging iterations per step (normal forces and tangent bases re-frozen at the
         step's solution and the step solved again, ``lagging - 1`` times).
+    ccd : {"tight_inclusion", "additive"}
+        The narrow-phase CCD: Tight-Inclusion (Wang et al. 2021, "A large-scale benchmark and an
+        inclusion-based algorithm for continuous collision detection", ACM TOG 40(5):
+        conservative including floating-point rounding; the default) or additive CCD (Li et al.
+        2021, "Codimensional incremental potential contact", ACM TOG 40(4): conservative by
+        construction, cheaper, not certified against rounding).
 
     Raises
     ------
     InputError
-        ``dhat``, ``stiffness`` or ``eps_v`` not > 0, ``mu < 0``, ``lagging < 1``, ipctk missing.
+        ``dhat``, ``stiffness`` or ``eps_v`` not > 0, ``mu < 0``, ``lagging < 1``, an unknown
+        ``ccd``, ipctk missing.
     """
 
     clock = staticmethod(time.perf_counter)
 
     def __init__(self, x0, surface, obstacles=(), *, dhat=None, stiffness=None,
                  self_contact: bool = True, mu: float = 0.0, eps_v: float = 1e-3,
-                 lagging: int = 1):
+                 lagging: int = 1, ccd: str = "tight_inclusion"):
         ipctk = require_ipctk()
         self._ipc = ipctk
         x0 = np.asarray(x0, dtype=float)
@@ -149,7 +158,11 @@ class BarrierModel:
         self.component = self._components()
         self.mesh = self._collision_mesh(x0)
         self.barrier = ipctk.BarrierPotential(self.dhat, 1.0)
-        self.ccd = ipctk.TightInclusionCCD(1e-6, CCD_MAX_ITERATIONS)
+        self.ccd_method = ccd
+        if ccd not in CCD_METHODS:
+            raise InputError(f"contact.ccd must be one of {', '.join(CCD_METHODS)}, got {ccd!r}")
+        self.ccd = ipctk.TightInclusionCCD(1e-6, CCD_MAX_ITERATIONS) \
+            if ccd == "tight_inclusion" else ipctk.AdditiveCCD()
         self.kappa = self.fixed_stiffness
         self.kappa_max = np.inf
         self.friction = ipctk.FrictionPotential(self.eps_v) if self.mu > 0 else None

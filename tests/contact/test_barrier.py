@@ -110,7 +110,8 @@ def test_an_integrator_refuses_barrier_contact_unless_it_keeps_it(name):
 
 
 @pytest.mark.parametrize("kw, word", [({"dhat": 0.0}, "dhat"), ({"mu": -0.1}, "friction"),
-                                      ({"eps_v": -1.0}, "eps_v"), ({"lagging": 0}, "lagging")])
+                                      ({"eps_v": -1.0}, "eps_v"), ({"lagging": 0}, "lagging"),
+                                      ({"ccd": "exact"}, "tight_inclusion, additive")])
 def test_bad_contact_parameters_are_one_line_errors(kw, word):
     with pytest.raises(InputError, match=word):
         BarrierModel(np.eye(3, 3), [[0, 1, 2]], **kw)
@@ -227,3 +228,16 @@ def test_a_moving_plane_pushes_a_block_and_never_passes_through_it():
     with pytest.raises(InputError, match="moving obstacle"):
         from femkit.solids import solve_static
         solve_static(_body(P, T), contact=f.model)
+
+
+def test_additive_ccd_keeps_a_fast_cube_off_the_plane():
+    # 2 m/s onto the plane at dt 0.01: the first step would pass 10 cube widths through it
+    P, T = cube(1, 0.2, (0.0, 0.0, 0.02))
+    force = BarrierContact(body_surface(T, 3), [plane_obstacle([0.13, 0.1, 0], [0, 0, 1], 1.0, 3)],
+                           ccd="additive")
+    s = elastic_system(_body(P, T, E=1e5), forces=[Gravity(9.81), force],
+                       v0=np.tile([0.0, 0.0, -2.0], (len(P), 1)))
+    frames, f = _run(s, 6, 1e-2, tol=1e-6)
+    assert f.model.ccd_method == "additive"
+    assert min(fr.x[:, 2].min() for fr in frames) > 0.0
+    assert frames[-1].v[:, 2].mean() > -1.0          # stopped (or thrown back) by the plane
