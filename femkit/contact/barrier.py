@@ -73,7 +73,8 @@ def _positive(value, name: str) -> float:
 
 
 class BarrierModel:
-    """Barrier contact of one set of bodies (their surfaces) and static obstacles.
+    """Barrier contact of one set of bodies (their surfaces) and obstacles, static or moving at
+    a prescribed velocity.
 
     ``seconds`` sums the time of the broad phase, CCD and the Hessians by :attr:`clock`
     (wall time; a benchmark may set CPU time).

@@ -37,7 +37,7 @@ class BarrierContact(Force):
     obstacles : sequence of :class:`femkit.contact.Obstacle`
     **options
         :class:`~femkit.contact.barrier.BarrierModel`'s keywords: ``dhat``, ``stiffness``,
-        ``self_contact``, ``mu``, ``eps_v``, ``lagging``.
+        ``self_contact``, ``mu``, ``eps_v``, ``lagging``, ``ccd``.
     """
 
     kind = "contact"
