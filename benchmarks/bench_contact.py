@@ -6,10 +6,16 @@ process with the same ``newton`` integrator, dt and tolerance:
 
 * **contact**: barrier contact on (IPC through ipctk);
 * **free**: the same cloth without ``contact:`` (it falls through the sphere; the contact-free
-  Newton step, the peer of the ratio).
+  Newton step, the peer of the ratio);
+* **penalty**: the sphere and the ground as penalty forces (``--penalty`` stiffness, 1e3 by
+  default) instead of barrier contact, no self-contact: the same draping and folding with
+  neither barrier nor CCD, to tell the Newton iterations the deformation needs from those the
+  barrier adds.
 
 For each: the seconds per step over the steps after the first contact (the steps before it are
-cheap in both), Newton iterations per step, and for the contact run the split of its time among
+cheap in both) -- process CPU seconds, with ipctk held to one thread as femkit's contact-free
+step is (on a shared machine wall time follows the load; the wall seconds are printed too) --,
+Newton iterations per step, and for the contact run the split of its time among
 the collision broad phase (``NormalCollisions.build``), CCD (``compute_collision_free_stepsize``)
 and the barrier/friction Hessian (``BarrierModel.seconds``); the rest is the Newton step itself
 (springs, the linear solves). The issue's bar is a contact step at most 3x the contact-free one.
@@ -28,8 +34,11 @@ import numpy as np
 SCENE = Path(__file__).resolve().parents[1] / "cases" / "scenes" / "cloth_on_sphere.yaml"
 
 
-def run(n: int, steps: int, contact: bool, tmp: Path) -> dict:
-    """Seconds per step after the first contact, Newton iterations and (contact) the split."""
+def run(n: int, steps: int, contact: bool, tmp: Path, penalty: float = 0.0,
+        ccd: str = "tight_inclusion") -> dict:
+    """Seconds per step after the first contact, Newton iterations and (contact) the split;
+    ``penalty > 0`` (with ``contact=False``): the sphere and the ground as penalty forces of
+    that stiffness instead (the same draping without barrier or CCD)."""
     import yaml
 
     from femkit import load_case
@@ -39,26 +48,35 @@ def run(n: int, steps: int, contact: bool, tmp: Path) -> dict:
     data["system"].update(nx=n, ny=n)
     if not contact:
         data.pop("contact")
-    path = tmp / f"scene_{int(contact)}.yaml"
+    else:
+        data["contact"]["ccd"] = ccd
+    if penalty:
+        data["forces"] = {"gravity": data["forces"]["gravity"],
+                          "ground": {"height": 0.0, "stiffness": penalty},
+                          "sphere": {"centre": [0.5, 0.5, 0.25], "radius": 0.25,
+                                     "stiffness": penalty}}
+    path = tmp / f"scene_{int(contact)}_{int(penalty > 0)}.yaml"
     path.write_text(yaml.safe_dump(data))
     case = load_case(path)
     system, _ = build_system(case)
     integ, ctx = build_integrator(case), build_context(case)
     f = contact_force(system)
     st = integ.start(system, system.x0, system.v0, 0.0, case.spec.dt, ctx)
-    times, split0, first = [], None, None
+    times, walls, split0, first = [], [], None, None
     for k in range(steps):
-        t0 = time.perf_counter()
+        t0, w0 = time.process_time(), time.perf_counter()
         st = integ.step(system, st, case.spec.dt, ctx)
-        times.append(time.perf_counter() - t0)
+        times.append(time.process_time() - t0)
+        walls.append(time.perf_counter() - w0)
         touching = st.x[:, 2].min() < 0.51 if f is None else f.model.active(st.x) > 0
         if first is None and touching:
             first = k
             split0 = None if f is None else dict(f.model.seconds)
-    first = steps if first is None else first
-    after = np.array(times[first:]) if first < steps else np.array(times)
+    if first is None:   # no contact in these steps: all of them measured
+        first, split0 = 0, None if f is None else {k: 0.0 for k in f.model.seconds}
+    after = np.array(times[first:])
     its = ctx.stats["newton_iterations"][first:]
-    out = {"per_step": float(after.mean()), "iterations": float(np.mean(its)) if its else 0.0,
+    out = {"per_step": float(after.mean()), "wall": float(np.mean(walls[first:] or walls)), "iterations": float(np.mean(its)) if its else 0.0,
            "steps_measured": len(after), "first_contact_step": first}
     if f is not None:
         sec = f.model.seconds
@@ -70,15 +88,28 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=41, help="cloth vertices per side (81: the scene)")
     ap.add_argument("--steps", type=int, default=25)
+    ap.add_argument("--penalty", type=float, default=1e3,
+                    help="stiffness of the penalty run's sphere and ground")
+    ap.add_argument("--ccd", default="tight_inclusion", choices=["tight_inclusion", "additive"],
+                    help="the contact run's narrow-phase CCD (contact.ccd)")
     args = ap.parse_args()
+    import ipctk
+
+    from femkit.contact.barrier import BarrierModel
+
+    ipctk.set_num_threads(1)   # CPU seconds of one thread, as the contact-free step
+    BarrierModel.clock = staticmethod(time.process_time)
     with tempfile.TemporaryDirectory() as tmp:
         free = run(args.n, args.steps, False, Path(tmp))
-        con = run(args.n, args.steps, True, Path(tmp))
-    print(f"cloth {args.n} x {args.n}, {args.steps} steps, measured from the first contact")
-    for name, r in (("contact-free", free), ("barrier contact", con)):
+        pen = run(args.n, args.steps, False, Path(tmp), penalty=args.penalty)
+        con = run(args.n, args.steps, True, Path(tmp), ccd=args.ccd)
+    print(f"cloth {args.n} x {args.n}, {args.steps} steps, measured from the first contact; "
+          f"CCD {args.ccd}")
+    for name, r in (("contact-free", free), ("penalty contact", pen), ("barrier contact", con)):
         print(f"  {name:16s} {1e3 * r['per_step']:9.1f} ms/step, {r['iterations']:5.1f} Newton "
-              f"iterations/step ({r['steps_measured']} steps)")
-    print(f"  ratio contact / free: {con['per_step'] / free['per_step']:.2f} (bar: <= 3)")
+              f"iterations/step ({r['steps_measured']} steps; wall {1e3 * r['wall']:.1f} ms/step)")
+    print(f"  ratio contact / free: {con['per_step'] / free['per_step']:.2f} (bar: <= 3); "
+          f"contact / penalty: {con['per_step'] / pen['per_step']:.2f}")
     rest = con["per_step"] - sum(con["split"].values())
     print("  split of a contact step: " + ", ".join(
         f"{k} {1e3 * v:.1f} ms" for k, v in con["split"].items()) + f", Newton rest {1e3 * rest:.1f} ms")

@@ -9,6 +9,7 @@ Shared by the ``mass_spring`` and ``solid`` kinds (docs/scenes.md, docs/solids.m
       friction: 0.3         # Coulomb mu (default 0)
       eps_v: 1.0e-3         # friction's slip-speed mollifier
       lagging: 1            # friction lagging iterations per step
+      ccd: tight_inclusion  # or additive (cheaper, not certified against rounding)
       self: true            # a body may touch itself (default true)
       obstacles:
         - {type: plane, point: [0, 0, 0], normal: [0, 0, 1]}
@@ -32,19 +33,20 @@ __all__ = ["CONTACT_SCHEMA", "check_contact_integrator", "build_contact", "Conta
            "contact_stage", "obstacle_facets", "CONTACT_ITERATIONS", "CONTACT_SECONDS_PER_FACET"]
 
 _OBSTACLES = {
-    "plane": closed({"type": {"const": "plane"}, "point": VEC, "normal": VEC, "size": POS},
-                    ["type"]),
+    "plane": closed({"type": {"const": "plane"}, "point": VEC, "normal": VEC, "size": POS,
+                     "velocity": VEC}, ["type"]),
     "sphere": closed({"type": {"const": "sphere"}, "centre": VEC, "radius": POS,
-                      "level": {"type": "integer", "minimum": 0, "maximum": 6}},
+                      "level": {"type": "integer", "minimum": 0, "maximum": 6}, "velocity": VEC},
                      ["type", "centre", "radius"]),
-    "file": closed({"type": {"const": "file"}, "file": {"type": "string", "minLength": 1}},
-                   ["type", "file"]),
+    "file": closed({"type": {"const": "file"}, "file": {"type": "string", "minLength": 1},
+                    "velocity": VEC}, ["type", "file"]),
 }
 
 #: The ``contact:`` mapping (closed; obstacles by ``type``).
 CONTACT_SCHEMA = closed({
     "dhat": POS, "stiffness": POS, "friction": NONNEG, "eps_v": POS,
     "lagging": {"type": "integer", "minimum": 1}, "self": {"type": "boolean"},
+    "ccd": {"enum": ["tight_inclusion", "additive"]},
     "obstacles": {"type": "array", "items": {
         "type": "object", "required": ["type"],
         "properties": {"type": {"enum": sorted(_OBSTACLES)}},
@@ -93,10 +95,22 @@ def _obstacles(contact, x0: np.ndarray) -> list:
                 out.append(sphere_obstacle(ob["centre"], ob["radius"], dim, ob.get("level", 3)))
             else:
                 out.append(file_obstacle(ob["file"], dim))
+            if "velocity" in ob:
+                out[-1] = _moving(out[-1], ob["velocity"], dim)
         except (InputError, ValueError) as exc:
             raise with_prefix(InputError(str(exc).removeprefix("contact.obstacles: ")),
                               f"contact.obstacles[{i}]") from None
     return out
+
+
+def _moving(obstacle, velocity, dim: int):
+    """``obstacle`` moving at ``velocity`` (a vector of the scene's dimension)."""
+    from dataclasses import replace
+
+    v = np.asarray(velocity, float)
+    if v.shape != (dim,) or not np.all(np.isfinite(v)):
+        raise InputError(f"velocity must be {dim} finite numbers, got {list(velocity)!r}")
+    return replace(obstacle, velocity=v)
 
 
 def build_contact(contact, x0, cells):
@@ -113,15 +127,16 @@ def build_contact(contact, x0, cells):
                            self_contact=bool(contact.get("self", True)),
                            mu=float(contact.get("friction", 0.0)),
                            eps_v=float(contact.get("eps_v", 1e-3)),
-                           lagging=int(contact.get("lagging", 1)))
+                           lagging=int(contact.get("lagging", 1)),
+                           ccd=contact.get("ccd", "tight_inclusion"))
     return force
 
 
 #: Barrier contact's price: Newton iterations of a step in contact (IPC's line search bounded by
-#: CCD; 7 on the small cloth_on_sphere, benchmarks/bench_contact.py) and seconds per surface
-#: facet per iteration of the broad phase, CCD and barrier Hessian together (2.5e-5 s measured
-#: there on the shared 2-core machine).
-CONTACT_ITERATIONS = 8.0
+#: CCD; 9.2 a contact step of the cloth_on_sphere at 21 x 21, 12.8 at 41 x 41 over 30 steps,
+#: benchmarks/bench_contact.py) and seconds per surface facet per iteration of the broad phase,
+#: CCD and barrier Hessian together (2.5e-5 s measured there on the shared 2-core machine).
+CONTACT_ITERATIONS = 12.0
 CONTACT_SECONDS_PER_FACET = 2.5e-5
 
 
@@ -167,7 +182,7 @@ class ContactRecorder:
         dists = [f["min_distance"] for f in self.frames if f["min_distance"] is not None]
         return {"dhat": m.dhat, "stiffness": m.kappa_value,
                 "stiffness_adaptive": m.fixed_stiffness is None, "friction": m.mu,
-                "eps_v": m.eps_v, "self": m.self_contact,
+                "eps_v": m.eps_v, "self": m.self_contact, "ccd": m.ccd_method,
                 "obstacles": [o.name for o in self.force.obstacles],
                 "min_distance": min(dists) if dists else None,
                 "intersections": int(sum(f["intersections"] for f in self.frames)),

@@ -17,8 +17,11 @@ are frozen ("lagged") at the start of a step, the friction force is ``-grad_v D(
 
 femkit's conventions: positions are node-major ``(n, d)``, the flat dof ``i*d + c``; the
 potential's gradient is ``(n, d)`` on every node of the body (zero off its surface), its Hessian a
-CSR matrix ``n d x n d``. Obstacles are static: their vertices are part of the collision mesh but
-carry no dofs.
+CSR matrix ``n d x n d``. Obstacles are part of the collision mesh but carry no dofs; a moving one
+(a prescribed constant velocity) is moved within each step towards its place at the step's end
+in moves each bounded by CCD against the bodies where the last solve left them
+(:meth:`BarrierModel.advance`; the step is solved again after every move), so it never passes
+through a body; friction sees its velocity.
 
 ipctk is the optional extra ``femkit[contact]`` (``pip install femkit[contact]``): importing this
 module never needs it; building a :class:`BarrierModel` without it is a one-line
@@ -26,6 +29,8 @@ module never needs it; building a :class:`BarrierModel` without it is a one-line
 """
 
 from __future__ import annotations
+
+import time
 
 import numpy as np
 import scipy.sparse as sp
@@ -39,6 +44,11 @@ __all__ = ["BarrierModel", "require_ipctk", "DHAT_SCALE", "REPORT_SCALE"]
 DHAT_SCALE = 1e-3
 #: Minimum distances are reported up to this many ``dhat`` (farther: ``None``).
 REPORT_SCALE = 10.0
+#: The narrow-phase CCD methods (``BarrierModel(ccd=...)``, ``contact.ccd``).
+CCD_METHODS = ("tight_inclusion", "additive")
+#: Moves of a moving obstacle within one step, each bounded by CCD with the bodies where the
+#: last solve left them (:meth:`BarrierModel.advance`).
+MAX_ADVANCES = 200
 #: Tight-Inclusion CCD's iteration cap per primitive pair (ipctk's default, 1e7, let one nearly
 #: parallel face pair at a tiny gap -- a cube resting on a cube -- cost tens of seconds; at the
 #: cap the root finder returns its conservative lower bound, so the guarantee stands).
@@ -63,7 +73,11 @@ def _positive(value, name: str) -> float:
 
 
 class BarrierModel:
-    """Barrier contact of one set of bodies (their surfaces) and static obstacles.
+    """Barrier contact of one set of bodies (their surfaces) and obstacles, static or moving at
+    a prescribed velocity.
+
+    ``seconds`` sums the time of the broad phase, CCD and the Hessians by :attr:`clock`
+    (wall time; a benchmark may set CPU time).
 
     Parameters
     ----------
@@ -87,16 +101,25 @@ class BarrierModel:
     lagging : int
         Friction lagging iterations per step (normal forces and tangent bases re-frozen at the
         step's solution and the step solved again, ``lagging - 1`` times).
+    ccd : {"tight_inclusion", "additive"}
+        The narrow-phase CCD: Tight-Inclusion (Wang et al. 2021, "A large-scale benchmark and an
+        inclusion-based algorithm for continuous collision detection", ACM TOG 40(5):
+        conservative including floating-point rounding; the default) or additive CCD (Li et al.
+        2021, "Codimensional incremental potential contact", ACM TOG 40(4): conservative by
+        construction, cheaper, not certified against rounding).
 
     Raises
     ------
     InputError
-        ``dhat``, ``stiffness`` or ``eps_v`` not > 0, ``mu < 0``, ``lagging < 1``, ipctk missing.
+        ``dhat``, ``stiffness`` or ``eps_v`` not > 0, ``mu < 0``, ``lagging < 1``, an unknown
+        ``ccd``, ipctk missing.
     """
+
+    clock = staticmethod(time.perf_counter)
 
     def __init__(self, x0, surface, obstacles=(), *, dhat=None, stiffness=None,
                  self_contact: bool = True, mu: float = 0.0, eps_v: float = 1e-3,
-                 lagging: int = 1):
+                 lagging: int = 1, ccd: str = "tight_inclusion"):
         ipctk = require_ipctk()
         self._ipc = ipctk
         x0 = np.asarray(x0, dtype=float)
@@ -115,26 +138,38 @@ class BarrierModel:
         self.surface_nodes, local = np.unique(surface, return_inverse=True)
         self.nb = len(self.surface_nodes)
         faces = [local.reshape(surface.shape)]
-        verts, offset = [np.zeros((0, self.dim))], self.nb
+        verts, vels, offset = [np.zeros((0, self.dim))], [np.zeros((0, self.dim))], self.nb
         for ob in obstacles:
             if ob.dim != self.dim:
                 raise InputError(f"contact.obstacles: {ob.name} is {ob.dim}-D, the bodies "
                                  f"{self.dim}-D")
             verts.append(np.asarray(ob.vertices, float))
+            v = np.zeros(self.dim) if ob.velocity is None else np.asarray(ob.velocity, float)
+            vels.append(np.tile(v, (len(ob.vertices), 1)))
             faces.append(np.asarray(ob.faces, np.int64) + offset)
             offset += len(ob.vertices)
-        self.static = np.concatenate(verts)
+        self.static = np.concatenate(verts)      # the obstacles' vertices now
+        self.static0 = self.static.copy()        # ... at time 0
+        self.static_velocity = np.concatenate(vels)
+        self.moving = bool(np.any(self.static_velocity))
+        self._target = None                      # the obstacles' vertices at the step's end
+        self.advances = 0                        # obstacle moves of the step
         self.faces = np.ascontiguousarray(np.concatenate(faces), dtype=np.int32)
         self.n_obstacle_faces = len(self.faces) - len(surface)
         self.component = self._components()
         self.mesh = self._collision_mesh(x0)
         self.barrier = ipctk.BarrierPotential(self.dhat, 1.0)
-        self.ccd = ipctk.TightInclusionCCD(1e-6, CCD_MAX_ITERATIONS)
+        self.ccd_method = ccd
+        if ccd not in CCD_METHODS:
+            raise InputError(f"contact.ccd must be one of {', '.join(CCD_METHODS)}, got {ccd!r}")
+        self.ccd = ipctk.TightInclusionCCD(1e-6, CCD_MAX_ITERATIONS) \
+            if ccd == "tight_inclusion" else ipctk.AdditiveCCD()
         self.kappa = self.fixed_stiffness
         self.kappa_max = np.inf
         self.friction = ipctk.FrictionPotential(self.eps_v) if self.mu > 0 else None
         self._lag = None            # (x_n flat, h, TangentialCollisions) inside a step
         self._kept = (None, None)   # (collision vertices, NormalCollisions)
+        self._sweep = None          # (lower, upper swept boxes, Candidates) of the last CCD move
         self.stats = {"collision_builds": 0, "ccd_calls": 0, "hessians": 0}
         self.seconds = {"broad_phase": 0.0, "ccd": 0.0, "hessian": 0.0}
 
@@ -173,15 +208,18 @@ class BarrierModel:
         return np.asfortranarray(np.concatenate([x[self.surface_nodes], self.static]))
 
     def _collisions(self, x, dhat=None):
-        import time
-
         V = self.vertices(x)
         if dhat is None and self._kept[0] is not None and np.array_equal(self._kept[0], V):
             return V, self._kept[1]
-        t0 = time.perf_counter()
+        t0 = self.clock()
         c = self._ipc.NormalCollisions()
-        c.build(self.mesh, V, self.dhat if dhat is None else dhat)
-        self.seconds["broad_phase"] += time.perf_counter() - t0
+        if dhat is None and self._within_sweep(V):
+            cand = self._sweep[2]
+        else:  # the same kind of broad phase at V: one collision set whichever way it is built
+            cand = self._ipc.Candidates()
+            cand.build(self.mesh, V, self.dhat if dhat is None else dhat)
+        c.build(cand, self.mesh, V, self.dhat if dhat is None else dhat)
+        self.seconds["broad_phase"] += self.clock() - t0
         self.stats["collision_builds"] += 1
         if dhat is None:
             self._kept = (V, c)
@@ -229,9 +267,7 @@ class BarrierModel:
     def hessian(self, x, project: bool = True) -> sp.csr_matrix:
         """Hessian of :meth:`energy`, CSR ``n d x n d``; ``project``: each collision's block
         projected onto its positive semi-definite part (ipctk's clamp)."""
-        import time
-
-        t0 = time.perf_counter()
+        t0 = self.clock()
         V, c = self._collisions(x)
         how = self._ipc.PSDProjectionMethod.CLAMP if project else \
             self._ipc.PSDProjectionMethod.NONE
@@ -242,19 +278,39 @@ class BarrierModel:
         if F is not None:
             H = F if H is None else H + F
         self.stats["hessians"] += 1
-        self.seconds["hessian"] += time.perf_counter() - t0
+        self.seconds["hessian"] += self.clock() - t0
         return H if H is not None else sp.csr_matrix((self.n * self.dim,) * 2)
 
     def max_step(self, x0, x1) -> float:
-        """The collision-free fraction of the straight move ``x0 -> x1`` (CCD), in ``[0, 1]``."""
-        import time
+        """The collision-free fraction of the straight move ``x0 -> x1`` (CCD), in ``[0, 1]``.
 
-        t0 = time.perf_counter()
-        t = float(self._ipc.compute_collision_free_stepsize(
-            self.mesh, self.vertices(x0), self.vertices(x1), narrow_phase_ccd=self.ccd))
+        The move's broad phase (candidate pairs whose boxes, swept over the move and inflated by
+        ``dhat``, overlap) serves the CCD and is kept: the collision set of any configuration
+        whose vertices all lie in their boxes swept by this move -- every line-search trial on
+        it, the accepted iterate -- is built from it (:meth:`_within_sweep`) instead of from a
+        broad phase of its own.
+        """
+        t0 = self.clock()
+        V0, V1 = self.vertices(x0), self.vertices(x1)
+        cand = self._ipc.Candidates()
+        cand.build(self.mesh, V0, V1, self.dhat)
+        self._sweep = (np.minimum(V0, V1), np.maximum(V0, V1), cand)
+        t1 = self.clock()
+        t = float(cand.compute_collision_free_stepsize(self.mesh, V0, V1, 0.0, self.ccd))
         self.stats["ccd_calls"] += 1
-        self.seconds["ccd"] += time.perf_counter() - t0
+        self.seconds["broad_phase"] += t1 - t0
+        self.seconds["ccd"] += self.clock() - t1
         return t
+
+    def _within_sweep(self, V) -> bool:
+        """Whether every collision vertex of ``V`` lies in its box swept by the last
+        :meth:`max_step` move; then every pair closer than ``dhat`` at ``V`` is among that
+        move's candidates (each primitive lies in its swept box, and the boxes are inflated by
+        ``dhat``)."""
+        if self._sweep is None:
+            return False
+        lo, hi, _ = self._sweep
+        return bool(np.all(V >= lo) and np.all(V <= hi))
 
     def active(self, x) -> int:
         """The number of primitive pairs closer than ``dhat``."""
@@ -300,6 +356,48 @@ class BarrierModel:
         self.kappa = float(new)
         return bool(changed)
 
+    # ------------------------------------------------------------------ moving obstacles
+    def start_motion(self, t: float, h: float) -> None:
+        """A step from ``t`` to ``t + h``: the obstacles' place at ``t + h`` the target of
+        :meth:`advance` (they start where the last step left them, at ``t`` on the first)."""
+        if not self.moving:
+            return
+        if self._target is None:
+            self.static = self.static0 + t * self.static_velocity
+        self._target = self.static0 + (t + h) * self.static_velocity
+        self.advances = 0
+
+    def advance(self, x) -> bool:
+        """Move the obstacles towards their step's end place as far as CCD allows with the
+        bodies at ``x`` (they never pass through a body); True when they moved (the objective
+        changed: solve again), False when they are there already.
+
+        Raises
+        ------
+        SolverError
+            After :data:`MAX_ADVANCES` moves in one step without reaching the place (the bodies
+            cannot get out of the way: a smaller step is needed).
+        """
+        from ..errors import SolverError
+
+        if self._target is None or np.array_equal(self.static, self._target):
+            return False
+        if self.advances >= MAX_ADVANCES:
+            raise SolverError(f"contact: a moving obstacle did not reach its place in "
+                              f"{MAX_ADVANCES} moves within one step; use a smaller dt")
+        x = np.asarray(x, float).reshape(self.n, self.dim)
+        V0 = self.vertices(x)
+        V1 = V0.copy()
+        V1[self.nb:] = self._target
+        t0 = self.clock()
+        t = float(self._ipc.compute_collision_free_stepsize(self.mesh, V0, V1,
+                                                            narrow_phase_ccd=self.ccd))
+        self.seconds["ccd"] += self.clock() - t0
+        self.stats["ccd_calls"] += 1
+        self.static = self._target.copy() if t >= 1.0 else self.static + t * (self._target - self.static)
+        self.advances += 1
+        return True
+
     # ------------------------------------------------------------------ friction
     def lag_friction(self, x_start, x_basis, h: float) -> None:
         """Freeze the friction of a step from ``x_start`` of length ``h``: normal forces and
@@ -329,21 +427,21 @@ class BarrierModel:
         if not self._friction_active():
             return 0.0
         W, h, tc = self._velocities(x)
-        W[self.nb:] = 0.0
+        W[self.nb:] = self.static_velocity
         return h * float(self.friction(tc, self.mesh, W))
 
     def _friction_gradient(self, x) -> np.ndarray:
         if not self._friction_active():
             return np.zeros((self.n, self.dim))
         W, h, tc = self._velocities(x)
-        W[self.nb:] = 0.0
+        W[self.nb:] = self.static_velocity
         return self._to_nodes(self.friction.gradient(tc, self.mesh, W))
 
     def _friction_hessian(self, x, how):
         if not self._friction_active():
             return None
         W, h, tc = self._velocities(x)
-        W[self.nb:] = 0.0
+        W[self.nb:] = self.static_velocity
         return self._to_dofs(self.friction.hessian(tc, self.mesh, W, how)) / h
 
     # ------------------------------------------------------------------ checks

@@ -3,9 +3,10 @@
 Every surface is plain arrays: ``vertices`` ``(m, d)`` and ``faces`` ``(k, 3)`` triangles in 3D or
 ``(k, 2)`` segments in 2D. A body's contact surface is made from its cells
 (:func:`body_surface`): the boundary triangles of tetrahedra, the boundary segments of triangles
-in the plane, or the triangles themselves of a surface (cloth) in 3D. Obstacles are static
-surfaces: a plane (a square, or a segment in 2D, large enough for the scene), a sphere (a
-subdivided icosahedron, or a polygon in 2D) and a surface mesh read from a file by meshio
+in the plane, or the triangles themselves of a surface (cloth) in 3D. Obstacles are surfaces,
+static or moving at a prescribed velocity: a plane (a square, or a segment in 2D, large enough
+for the scene), a sphere (a subdivided icosahedron, or a polygon in 2D) and a surface mesh read
+from a file by meshio
 (``.msh``, ``.stl``, ``.obj``; triangles, or lines in 2D).
 """
 
@@ -23,19 +24,24 @@ __all__ = ["Obstacle", "body_surface", "plane_obstacle", "sphere_obstacle", "fil
 
 @dataclass(frozen=True)
 class Obstacle:
-    """A static contact surface.
+    """A contact surface: static, or moving rigidly at a prescribed constant velocity.
 
     Attributes
     ----------
     name : str
         What it is, for messages (``"plane"``, ``"sphere"``, the file's name).
     vertices : (m, d) float array
+        Its vertices at time 0.
     faces : (k, 3) triangles (3D) or (k, 2) segments (2D), int array
+    velocity : (d,) float array, optional
+        Its prescribed velocity (the vertices at time ``t`` are ``vertices + t velocity``);
+        ``None``: static.
     """
 
     name: str
     vertices: np.ndarray
     faces: np.ndarray
+    velocity: np.ndarray | None = None
 
     @property
     def dim(self) -> int:

@@ -142,6 +142,9 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
         raise InputError(f"solve_static: project must be True, False or 'auto', got {project!r}")
     if load_steps < 1 or max_iterations < 1:
         raise InputError("solve_static: load_steps and max_iterations must be >= 1")
+    if contact is not None and contact.moving:
+        raise InputError("contact.obstacles: a moving obstacle (velocity) needs dynamics; the "
+                         "static solver has no time to move it")
     if dirichlet is None or len(dirichlet.dofs) == 0:
         raise InputError("solve_static: prescribe some displacements (a free body has "
                          "rigid-body motions and no unique equilibrium)")

@@ -123,6 +123,8 @@ def test_a_stack_of_three_solids_rests_with_each_contact_carrying_the_weight_abo
     ("newton", "{dhat: 0, obstacles: [{type: plane}]}", ["dhat"]),
     ("newton", "{friction: -0.1}", ["friction"]),
     ("newton", "{obstacles: [{type: file, file: vol.msh}]}", ["not a surface", "tetra"]),
+    ("newton", "{obstacles: [{type: plane, velocity: [0, 1]}]}", ["obstacles[0]", "velocity",
+                                                                 "3 finite numbers"]),
 ])
 def test_bad_contact_input_is_one_line_and_writes_nothing(tmp_path, capsys, integrator, contact,
                                                         words):

@@ -206,6 +206,9 @@ def prepare_solid(case) -> None:
         if not dynamic and contact.get("friction"):
             raise CaseFileError("contact.friction: friction needs a time integration (it lives "
                                 "on the step's velocity); a static run is frictionless")
+        if not dynamic and any("velocity" in o for o in contact.get("obstacles") or []):
+            raise CaseFileError("contact.obstacles: a moving obstacle (velocity) needs a time "
+                                "integration; a static run keeps obstacles where they are")
         contact["obstacles"] = [dict(o) for o in contact.get("obstacles") or []]
         resolve_obstacle_files(contact, case.base_dir)
     directory = str((case.base_dir / out.get("dir", os.path.join("runs", case.name))).resolve())

@@ -12,8 +12,9 @@ with this force when the run starts (:attr:`requires_bounded_steps`).
 
 The step protocol the ``newton`` integrator calls (no-ops on every other force,
 :class:`~.base.Force`): :meth:`begin_step` (the stiffness initialised on the first step, IPC's
-rule; friction lagged at ``x_n``), :meth:`step_bound`, :meth:`end_iteration` (IPC's stiffness
-update), :meth:`relag` (another friction lagging iteration) and :meth:`end_step`.
+rule; friction lagged at ``x_n``; moving obstacles started), :meth:`step_bound`,
+:meth:`end_iteration` (IPC's stiffness update), :meth:`advance` (moving obstacles moved on:
+solve again), :meth:`relag` (another friction lagging iteration) and :meth:`end_step`.
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ class BarrierContact(Force):
     obstacles : sequence of :class:`femkit.contact.Obstacle`
     **options
         :class:`~femkit.contact.barrier.BarrierModel`'s keywords: ``dhat``, ``stiffness``,
-        ``self_contact``, ``mu``, ``eps_v``, ``lagging``.
+        ``self_contact``, ``mu``, ``eps_v``, ``lagging``, ``ccd``.
     """
 
     kind = "contact"
@@ -70,11 +71,14 @@ class BarrierContact(Force):
         return (K @ np.asarray(d, float).reshape(-1)).reshape(x.shape)
 
     # ------------------------------------------------------------------ the step protocol
-    def begin_step(self, x, h: float, objective_gradient) -> None:
-        """Start a step from ``x`` of length ``h``: on the first step IPC's initial stiffness
-        from ``objective_gradient(x)`` (the step objective's gradient without contact, flat),
-        then friction frozen at ``x``."""
+    def begin_step(self, x, h: float, objective_gradient, t: float = 0.0) -> None:
+        """Start a step from ``x`` at time ``t`` of length ``h``: moving obstacles at their
+        time-``t`` place and moved towards their step's end place as far as CCD allows; on the
+        first step IPC's initial stiffness from ``objective_gradient(x)`` (the step objective's
+        gradient without contact, flat), then friction frozen at ``x``."""
         m = self.model
+        m.start_motion(t, h)
+        m.advance(x)
         if m.kappa is None:
             m.init_stiffness(objective_gradient(x.reshape(-1)), float(np.mean(self._system.mass)),
                              h * h, x)
@@ -88,6 +92,11 @@ class BarrierContact(Force):
     def end_iteration(self, x) -> bool:
         """IPC's stiffness update after an iteration; True when the objective changed."""
         return self.model.update_stiffness(x)
+
+    def advance(self, x) -> bool:
+        """Moving obstacles moved on towards their step's end place (CCD-bounded, the bodies at
+        ``x``); True when they moved."""
+        return self.model.advance(x)
 
     def relag(self, x_start, x, h: float) -> bool:
         """Another lagging iteration: friction re-frozen at the step's solution ``x``; False

@@ -65,9 +65,14 @@ class Force:
         """Contribution to ``D = -df/dv`` as a sparse matrix, or ``None``."""
         return None
 
-    def begin_step(self, x: np.ndarray, h: float, objective_gradient) -> None:
-        """A minimising step of length ``h`` starts from ``x`` (``objective_gradient(x_flat)``:
-        the step objective's gradient)."""
+    def begin_step(self, x: np.ndarray, h: float, objective_gradient, t: float = 0.0) -> None:
+        """A minimising step from time ``t`` of length ``h`` starts from ``x``
+        (``objective_gradient(x_flat)``: the step objective's gradient)."""
+
+    def advance(self, x: np.ndarray) -> bool:
+        """After a step's solve at ``x``: True when this force's prescribed motion moved on
+        (a new objective: solve again), False when it is where the step ends."""
+        return False
 
     def step_bound(self, x: np.ndarray, x_try: np.ndarray) -> float:
         """The largest admissible fraction of the move ``x -> x_try`` (1: all of it)."""

@@ -49,11 +49,13 @@ first iteration (:meth:`femkit.solvers.session.LinearSession.solve_on_pattern`).
 Barrier contact (:class:`~femkit.dynamics.forces.BarrierContact`, IPC: Li et al. 2020): a
 system with a force that ``requires_bounded_steps`` is run the IPC way -- each step starts from
 ``x_n`` (``y`` may lie past a contact) after the forces' ``begin_step`` (the barrier stiffness,
-lagged friction); every line search starts from ``t_max = min(1, step_bound)``, the
+lagged friction, moving obstacles moved as far as CCD allows); every line search starts from
+``t_max = min(1, step_bound)``, the
 collision-free step size of CCD, so no iterate ever crosses a surface; after each iteration
 ``end_iteration`` may raise the barrier stiffness (the objective is then re-evaluated);
 convergence is judged on the Newton direction ``||dx||_inf`` (a short CCD-bounded step is no
-sign of convergence); and the step is solved again while ``relag`` asks for another friction
+sign of convergence); and the step is solved again while ``advance`` moves a prescribed-motion
+obstacle on towards its place at the step's end, then while ``relag`` asks for another friction
 lagging iteration. ``keeps_contact = True`` declares it (the trait the other integrators lack).
 
 First order; unconditionally stable.
@@ -201,7 +203,7 @@ class NewtonImplicitEuler(Integrator):
         if bounded:  # start where the step began: y may lie past a contact
             x = xn.copy()
             for f in forces:
-                f.begin_step(state.x, h, gradient)
+                f.begin_step(state.x, h, gradient, t=state.t)
         gx, noise = g(x)
         residuals = []
         iterations = 0
@@ -243,8 +245,10 @@ class NewtonImplicitEuler(Integrator):
                     break
             else:
                 converged = False
-            if not (bounded and converged and any(
-                    [f.relag(state.x, x.reshape(shape), h) for f in forces])):
+            # moving obstacles first (their place at the step's end), then friction lagging
+            if not (bounded and converged and (
+                    any([f.advance(x.reshape(shape)) for f in forces])
+                    or any([f.relag(state.x, x.reshape(shape), h) for f in forces]))):
                 break
             gx, noise = g(x)
         if bounded:
