@@ -32,3 +32,25 @@ def pytest_collection_modifyitems(config, items):
         for marker, skip in skips.items():
             if marker in item.keywords or (marker == "cholmod" and item.name == "femkit.solvers.cholesky"):
                 item.add_marker(skip)
+
+
+import pytest  # noqa: E402
+
+
+@pytest.fixture(scope="session")
+def fresh_warmup(tmp_path_factory):
+    """``femkit warmup`` run once per session into an empty femkit cache directory: what a first
+    install's warm-up generates and compiles there (the case expressions' and the built-in
+    materials' modules), shared by the tests that check it (each marked
+    ``xdist_group("fresh_warmup")`` so that one worker runs them all and the warm-up once).
+    numba's cache of femkit's own kernels is its default one. Returns ``(cache directory, the
+    command's stdout, the environment in which a process sees that cache)``."""
+    import subprocess
+
+    cache = tmp_path_factory.mktemp("fresh-femkit-cache")
+    env = dict(os.environ, FEMKIT_CACHE_DIR=str(cache))
+    env.pop("NUMBA_CACHE_DIR", None)  # generated modules' machine code beside them, in `cache`
+    proc = subprocess.run([sys.executable, "-m", "femkit.cli", "warmup"], cwd=cache, env=env,
+                          capture_output=True, text=True, timeout=1500)
+    assert proc.returncode == 0, proc.stderr
+    return cache, proc.stdout, env
