@@ -95,3 +95,12 @@ def signal_inside(target: str, argv: list[str], sig, *, cwd=None,
         with open(stamp) as f:
             signalled = float(f.read())
     return proc.returncode, exited - signalled, err
+
+
+def slack(idle: float = 3.0) -> float:
+    """Seconds a stop may take from the signal to the exit: ``idle`` (the target is 1 s) on an
+    idle machine, scaled by the load per core now (the signal is answered by a process that
+    shares the cores: a stop that waited for the work to end would take the rest of the run,
+    tens of seconds). Read when asserting, not when the tests are collected (the load of a
+    test run changes as it goes)."""
+    return idle * max(1.0, os.getloadavg()[0] / (os.cpu_count() or 1))
