@@ -32,6 +32,11 @@ def pytest_collection_modifyitems(config, items):
         for marker, skip in skips.items():
             if marker in item.keywords or (marker == "cholmod" and item.name == "femkit.solvers.cholesky"):
                 item.add_marker(skip)
+    # the long tests first: pytest-xdist hands tests out in this order, and a long one handed out
+    # last keeps one worker busy while the others have finished (``slow``: tens of seconds; an
+    # ``xdist_group`` shares a fixture that compiles). A stable sort: the same order on every worker.
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None
+               and item.get_closest_marker("xdist_group") is None)
 
 
 import pytest  # noqa: E402

@@ -65,6 +65,7 @@ def test_designed_twins_stretch_energy_equals_the_builtins(name, rng):
                 np.testing.assert_allclose(b, a, rtol=0, atol=1e-12 * max(np.abs(a).max(), 1.0))
 
 
+@pytest.mark.xdist_group("designed_stable_neo_hookean")   # one compile of the module
 @pytest.mark.parametrize("d", [2, 3], ids=["triangles", "tetrahedra"])
 def test_designed_twin_equals_the_builtin_on_a_body(d, rng):
     """The stable neo-Hookean energy given as a user's energy evaluates a body (energy,
@@ -103,8 +104,12 @@ def test_user_stress_and_tangent_match_finite_differences(name, d, kind, rng):
 
 
 @pytest.mark.parametrize("d", [2, 3], ids=["triangles", "tetrahedra"])
-@pytest.mark.parametrize("name", list(USER))
+@pytest.mark.parametrize("name", ["separable_fgh", "full_W"])
 def test_user_assembled_gradient_and_hessian_match_finite_differences(name, d, rng):
+    """A designed module's element pass (the same generated code around every energy) assembles
+    the gradient and Hessian of its energy: one energy of each form (``f, g, h`` and ``W``); the
+    point functions of every user energy are checked above, the element pass of the built-ins
+    in test_derivatives.py (each designed module compiles its element pass anew, ~10 s)."""
     X, cells = mesh_by_dim(d)
     body = ElasticBody(X, cells, _user(name))
     x = X + 0.15 * rng.standard_normal(X.shape)
