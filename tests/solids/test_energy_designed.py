@@ -94,7 +94,14 @@ def test_rest_moduli_of_the_expression_are_the_materials(name):
     assert gen.lam == pytest.approx(hand.lam, rel=1e-12)
 
 
-POINT = [pytest.param(name, d, kind, id=f"{name}-{d}d-{kind}") for name in USER for d in (2, 3)
+def _module(name: str):
+    """The mark that runs every test of the user energy ``name`` on one worker: its module is
+    compiled once (~30 s on a cold cache), not by each worker that meets it first."""
+    return pytest.mark.xdist_group(f"designed_{name}")
+
+
+POINT = [pytest.param(name, d, kind, id=f"{name}-{d}d-{kind}", marks=_module(name))
+         for name in USER for d in (2, 3)
          for kind in ("random", "one_reflection", "repeated_two", "nearly_repeated")]
 
 
@@ -104,7 +111,7 @@ def test_user_stress_and_tangent_match_finite_differences(name, d, kind, rng):
 
 
 @pytest.mark.parametrize("d", [2, 3], ids=["triangles", "tetrahedra"])
-@pytest.mark.parametrize("name", ["separable_fgh", "full_W"])
+@pytest.mark.parametrize("name", [pytest.param(n, marks=_module(n)) for n in ("separable_fgh", "full_W")])
 def test_user_assembled_gradient_and_hessian_match_finite_differences(name, d, rng):
     """A designed module's element pass (the same generated code around every energy) assembles
     the gradient and Hessian of its energy: one energy of each form (``f, g, h`` and ``W``); the
