@@ -35,6 +35,11 @@ LOG_J = {
 }
 
 
+#: most tests here run the log(J) energy: one worker runs them all, so it is compiled once (~40 s
+#: on a cold cache), not once by each worker that meets it first
+pytestmark = pytest.mark.xdist_group("log_j_energy")
+
+
 def _write(tmp_path, data) -> Path:
     path = tmp_path / "case.yaml"
     path.write_text(yaml.safe_dump(data))

@@ -22,21 +22,38 @@ CASE = {
 }
 
 
-def _run(args, cwd, cache=None, generated=None):
-    env = dict(os.environ, **({} if cache is None else {"NUMBA_CACHE_DIR": str(cache)}),
-               **({} if generated is None else {"FEMKIT_CACHE_DIR": str(generated)}))
+def _run(args, cwd, cache=None):
+    env = dict(os.environ, **({} if cache is None else {"NUMBA_CACHE_DIR": str(cache)}))
     proc = subprocess.run([sys.executable, "-m", "femkit.cli", *args], cwd=cwd, env=env,
                           capture_output=True, text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr
     return proc.stdout
 
 
+@pytest.fixture(scope="module")
+def triangle_warmup(tmp_path_factory):
+    """An empty numba cache after a warm-up without multigrid on triangles (what a first pcg +
+    jacobi run compiles): ``(cache, the warm-up's output lines)``. Its tests (one worker:
+    ``xdist_group("triangle_warmup")``) share the compile; only the multigrid run adds to it."""
+    cache = tmp_path_factory.mktemp("numba-cache")
+    probe = ("from femkit.case.poisson.warmup import warm_up, kernels_cached, families; "
+             "warm_up(print, multigrid=False, dims=(2,)); "
+             "print(kernels_cached(families(False), (2,)), "
+             "kernels_cached(('geometric multigrid',), (2,)))")
+    res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         env=dict(os.environ, NUMBA_CACHE_DIR=str(cache)), timeout=900)
+    assert res.returncode == 0, res.stderr
+    return cache, res.stdout.strip().splitlines()
+
+
 @pytest.mark.slow
-def test_first_run_compiles_in_its_own_stage_then_never_again(tmp_path):
-    """An empty compile cache (a fresh install): the first fmg run says it compiles and books a
+@pytest.mark.xdist_group("triangle_warmup")
+def test_first_run_compiles_in_its_own_stage_then_never_again(tmp_path, triangle_warmup):
+    """A compile cache without the multigrid kernels (a fresh install, after a run without
+    multigrid: :func:`triangle_warmup`): the first fmg run says it compiles and books a
     ``compile`` stage; the second run of the same case has neither."""
     (tmp_path / "case.yaml").write_text(yaml.safe_dump(CASE))
-    cache = tmp_path / "numba-cache"
+    cache, _ = triangle_warmup
     first = _run(["solve", "case.yaml"], tmp_path, cache)
     timings = json.loads((tmp_path / "out" / "result.json").read_text())["timings"]
     assert ("compiling kernels (first run, cached afterwards): mesh passes, P1 assembly, "
@@ -54,46 +71,40 @@ def test_first_run_compiles_in_its_own_stage_then_never_again(tmp_path):
     assert res.stdout.strip() == "True False", res.stderr
 
 
-def test_warmup_fills_the_cache(tmp_path):
+@pytest.mark.xdist_group("fresh_warmup")
+def test_warmup_fills_the_cache(tmp_path, fresh_warmup):
     """``femkit warmup`` with the package's own cache (compiled once, loaded afterwards); an
-    empty cache directory is seen as empty."""
+    empty cache directory is seen as empty. (The session's one warm-up into an empty femkit
+    cache, :func:`fresh_warmup`: the expressions found there were compiled by it.)"""
     from femkit.case.poisson.warmup import COMPILE_MESSAGE
 
-    out = _run(["warmup"], tmp_path)
+    _, out, env = fresh_warmup
     assert COMPILE_MESSAGE in out and "kernels ready in" in out
     probe = ("from femkit.case.poisson.warmup import kernels_cached; "
              "print(kernels_cached())")
-    res = subprocess.run([sys.executable, "-c", probe], env=dict(os.environ), capture_output=True,
-                         text=True)
+    res = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True)
     assert res.stdout.strip() == "True"
     empty = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
-                           env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "other")))
+                           env=dict(env, NUMBA_CACHE_DIR=str(tmp_path / "other")))
     assert empty.stdout.strip() == "False"
     # the expressions of the bundled fmg case (the only bundled mesh large enough to compile them)
     fmg = ("from femkit.case import load_case; from femkit.case.compiled_expressions import "
            "case_kernels; from femkit.case.poisson.warmup import expressions_cached; "
            f"print(expressions_cached(case_kernels(load_case({str(FMG_CASE)!r})), 2))")
-    res = subprocess.run([sys.executable, "-c", fmg], env=dict(os.environ), capture_output=True,
-                         text=True)
+    res = subprocess.run([sys.executable, "-c", fmg], env=env, capture_output=True, text=True)
     assert res.stdout.strip() == "True", res.stderr
 
 
-def test_a_run_without_multigrid_compiles_no_multigrid_kernel(tmp_path):
-    """The families a run needs: pcg + jacobi compiles edges and assembly, not multigrid."""
+@pytest.mark.xdist_group("triangle_warmup")
+def test_a_run_without_multigrid_compiles_no_multigrid_kernel(triangle_warmup):
+    """The families a run needs: pcg + jacobi compiles edges and assembly, not multigrid (in an
+    empty numba cache: :func:`triangle_warmup`)."""
     from femkit.case.poisson.warmup import families
 
     assert families(True) == ("mesh passes", "P1 assembly", "solver checks", "geometric multigrid",
                               "error estimate")
     assert families(False) == ("mesh passes", "P1 assembly", "solver checks", "error estimate")
-    probe = ("from femkit.case.poisson.warmup import warm_up, kernels_cached, families; "
-             "warm_up(print, multigrid=False, dims=(2,)); "
-             "print(kernels_cached(families(False), (2,)), "
-             "kernels_cached(('geometric multigrid',), (2,)))")
-    res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
-                         env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache")),
-                         timeout=900)
-    assert res.returncode == 0, res.stderr
-    lines = res.stdout.strip().splitlines()
+    _, lines = triangle_warmup
     assert lines[0] == ("compiling kernels (first run, cached afterwards): mesh passes, "
                         "P1 assembly, solver checks, error estimate...")
     assert lines[-1] == "True False"
@@ -165,20 +176,20 @@ print("compiled:", missed)
 """
 
 
-def test_warmup_compiles_the_tetrahedral_kernels(tmp_path):
+@pytest.mark.xdist_group("fresh_warmup")
+def test_warmup_compiles_the_tetrahedral_kernels(tmp_path, fresh_warmup):
     """After ``femkit warmup`` a first run on tetrahedra (fmg, every compiled path taken) loads
     every kernel from the cache: none is compiled in the run, and none is missing from the
-    families the run checks before it starts. The generated expression modules go to a fresh
-    directory, so their passes are compiled by this warm-up, whatever the shared cache holds."""
+    families the run checks before it starts. The generated expression modules are in the
+    session's fresh femkit cache (:func:`fresh_warmup`), so their passes were compiled by that
+    warm-up, whatever the shared cache holds."""
     from femkit.case.poisson.warmup import _TINY_3D
 
-    generated = tmp_path / "generated"
-    _run(["warmup"], tmp_path, generated=generated)
+    _, _, env = fresh_warmup
     case = dict(_TINY_3D, mesh={"geometry": "kuhn_cube", "h": 0.5, "refine": 2},
                 solver={"method": "fmg"}, output={"vtu": False})
     proc = subprocess.run([sys.executable, "-c", FIRST_3D_RUN.format(case=case)], cwd=tmp_path,
-                          env=dict(os.environ, FEMKIT_CACHE_DIR=str(generated)),
-                          capture_output=True, text=True, timeout=900)
+                          env=env, capture_output=True, text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr
     assert "compile now: False" in proc.stdout
     assert "compiled: []" in proc.stdout, proc.stdout

@@ -1,8 +1,13 @@
-"""Send a signal to a femkit process once it has announced (a line on stderr) that it is inside
-the work under test; time how long it takes to exit."""
+"""Signal a femkit process inside the work under test; time how long it takes to exit.
 
+:func:`signal_inside` makes the run signal itself a set time after the work under test began
+(no race with the test's own scheduling on a loaded machine); :func:`signal_when_ready` sends
+the signal from the test once the process announces (a line on stderr) that it is inside."""
+
+import os
 import subprocess
 import sys
+import tempfile
 import time
 
 
@@ -28,24 +33,37 @@ def signal_when_ready(driver: str, args: list[str], ready: str, sig, *, cwd=None
             proc.wait()
 
 
-#: ``python -c SPY_DRIVER module:attr.path femkit-args...``: the command line as the console
-#: script runs it, with ``attr.path`` of ``module`` replaced by a spy that prints ``READY`` on
-#: stderr at its first call, so a test signals inside that piece of work.
+#: ``python -c SPY_DRIVER module:attr.path signum settle stamp femkit-args...``: the command line
+#: as the console script runs it, with ``attr.path`` of ``module`` replaced by a spy whose first
+#: call starts a timer: ``settle`` seconds later (by the run's own clock, whatever else the
+#: machine is doing) the process sends itself ``signum`` and writes the monotonic time it was due
+#: to the file ``stamp``, so the signal lands inside that piece of work however late the test's
+#: own process is scheduled.
 SPY_DRIVER = r"""
-import importlib, sys
-target, argv = sys.argv[1], sys.argv[2:]
+import importlib, os, sys, threading, time
+target, signum, settle, stamp, argv = (sys.argv[1], int(sys.argv[2]), float(sys.argv[3]),
+                                       sys.argv[4], sys.argv[5:])
 module, path = target.split(":")
 owner = importlib.import_module(module)
 *owners, name = path.split(".")
 for o in owners:
     owner = getattr(owner, o)
 real = getattr(owner, name)
-seen = []
+started = []
+
+def fire(due):
+    # the time the signal was due: a kernel holding the GIL delays this thread's kill exactly
+    # as long as it delays the handler of a signal sent from outside, so the wait counts
+    with open(stamp, "w") as f:
+        f.write(repr(due))
+    os.kill(os.getpid(), signum)
 
 def spy(*args, **kwargs):
-    if not seen:
-        seen.append(1)
-        print("READY", file=sys.stderr, flush=True)
+    if not started:
+        started.append(1)
+        timer = threading.Timer(settle, fire, (time.monotonic() + settle,))
+        timer.daemon = True
+        timer.start()
     return real(*args, **kwargs)
 
 setattr(owner, name, spy)
@@ -55,7 +73,34 @@ entry()
 """
 
 
-def signal_inside(target: str, argv: list[str], sig, **kwargs) -> tuple[int, float, str]:
-    """:func:`signal_when_ready` with :data:`SPY_DRIVER`: signal once ``target`` (``module:attr``)
-    has started, under ``femkit *argv``."""
-    return signal_when_ready(SPY_DRIVER, [target, *argv], "READY", sig, **kwargs)
+def signal_inside(target: str, argv: list[str], sig, *, cwd=None,
+                  settle: float = 0.3) -> tuple[int, float, str]:
+    """Run ``femkit *argv`` with :data:`SPY_DRIVER`: ``settle`` seconds after ``target``
+    (``module:attr``) has started, the run sends itself ``sig``. Returns (exit code, seconds
+    from the signal to the exit, stderr)."""
+    with tempfile.TemporaryDirectory() as scratch:
+        stamp = os.path.join(scratch, "signalled")
+        proc = subprocess.Popen([sys.executable, "-c", SPY_DRIVER, target, str(int(sig)),
+                                 str(settle), stamp, *argv], cwd=cwd, stderr=subprocess.PIPE,
+                                stdout=subprocess.DEVNULL, text=True)
+        try:
+            _, err = proc.communicate(timeout=600)
+            exited = time.monotonic()
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+        assert os.path.exists(stamp), (f"finished before the signal (exit {proc.returncode}): "
+                                       f"make the work under test longer\n{err[-2000:]}")
+        with open(stamp) as f:
+            signalled = float(f.read())
+    return proc.returncode, exited - signalled, err
+
+
+def slack(idle: float = 3.0) -> float:
+    """Seconds a stop may take from the signal to the exit: ``idle`` (the target is 1 s) on an
+    idle machine, scaled by the load per core now (the signal is answered by a process that
+    shares the cores: a stop that waited for the work to end would take the rest of the run,
+    tens of seconds). Read when asserting, not when the tests are collected (the load of a
+    test run changes as it goes)."""
+    return idle * max(1.0, os.getloadavg()[0] / (os.cpu_count() or 1))

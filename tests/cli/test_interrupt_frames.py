@@ -17,7 +17,7 @@ import pytest
 import yaml
 
 sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared helper
-from _signals import signal_inside  # noqa: E402
+from _signals import signal_inside, slack  # noqa: E402
 
 SCENE = {
     "problem": "mass_spring",
@@ -40,7 +40,7 @@ def test_signal_while_writing_frames_keeps_a_consistent_marked_output(tmp_path, 
     returncode, elapsed, err = signal_inside("femkit.mesh.vtk:VtuFrames.write",
                                              ["solve", str(case), "--quiet"], sig, cwd=tmp_path)
     assert returncode == code, err
-    assert elapsed < 3.0, elapsed  # target 1 s; slack for a loaded machine
+    assert elapsed < slack(), elapsed  # target 1 s; 3 s idle, scaled by the load
     assert f"interrupted by {sig.name}" in err and "Traceback" not in err
     out = tmp_path / "out"
     result = json.loads((out / "result.json").read_text())

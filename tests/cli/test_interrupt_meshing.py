@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared helper
-from _signals import signal_when_ready  # noqa: E402
+from _signals import signal_when_ready, slack  # noqa: E402
 
 # The command line as the console script runs it, with a spy announcing (on stderr) each piece
 # of compiled work started under run_interruptible, so the test signals during meshing itself.
@@ -48,7 +48,7 @@ def test_signal_during_meshing_exits_within_a_second(tmp_path, sig, code):
     # settle 1 s: well inside the mesher (a stop there used to crash 3 times in 5)
     returncode, elapsed, err = signal_when_ready(DRIVER, [str(case)], "STARTED meshing", sig, settle=1.0)
     assert returncode == code, err
-    assert elapsed < 3.0, elapsed  # target 1 s; slack for a loaded machine
+    assert elapsed < slack(), elapsed  # target 1 s; 3 s idle, scaled by the load
     assert f"interrupted by {sig.name} during meshing; nothing written" in err
     assert "Traceback" not in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["case.yaml"]

@@ -1,14 +1,14 @@
 """A stop request inside a run answers at once (issue 17: the cloth study's Liu reference ignored
 SIGINT for 657 s, the stress study waited 37 s for its current run): during a Poisson case's
-assembly, during its long iterative solve, and inside a study's run. Each test signals a
-``femkit`` subprocess once it has entered the work under test and measures signal-to-exit time
-(the target is 1 s; the assertion allows 3 s on an idle machine, scaled by the load per core
-when other processes share it: a stop that waited for the work to end would take the rest of the
-run, tens of seconds), the exit code, the one line
-saying what was kept, and the kept output."""
+assembly, during its long iterative solve, and inside a study's run. Each ``femkit`` subprocess
+signals itself a set time after it has entered the work under test (by its own clock, so the
+signal lands inside that work however the machine schedules the test) and the test measures
+signal-to-exit time (the target is 1 s; the assertion allows 3 s on an idle machine, scaled by
+the load per core when other processes share it: a stop that waited for the work to end would
+take the rest of the run, tens of seconds), the exit code, the one line saying what was kept,
+and the kept output."""
 
 import json
-import os
 import signal
 import sys
 from pathlib import Path
@@ -17,13 +17,11 @@ import pytest
 import yaml
 
 sys.path.insert(0, str(Path(__file__).parent))  # importlib mode: reach the shared helper
-from _signals import signal_inside  # noqa: E402
+from _signals import signal_inside, slack  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 SIGNALS = pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
                                   ids=["SIGINT", "SIGTERM"])
-# seconds from the signal to the exit (target 1 s), more when the machine is shared
-SLACK = 3.0 * max(1.0, os.getloadavg()[0] / (os.cpu_count() or 1))
 
 
 def _poisson(tmp_path, refine: int, rtol: float, method: str = "cg") -> Path:
@@ -47,7 +45,7 @@ def test_signal_during_assembly_stops_at_once_and_writes_nothing(tmp_path, sig, 
                                      ["solve", str(case), "--quiet"], sig, cwd=tmp_path,
                                      settle=0.1)
     assert rc == code, err
-    assert elapsed < SLACK, elapsed
+    assert elapsed < slack(), elapsed
     assert f"interrupted by {sig.name} during assembly; nothing written" in err
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "out").exists()
@@ -60,7 +58,7 @@ def test_signal_during_a_long_solve_writes_the_last_iterate_marked(tmp_path, sig
     rc, elapsed, err = signal_inside("femkit.interrupt:stopping_callback",
                                      ["solve", str(case), "--quiet"], sig, cwd=tmp_path)
     assert rc == code, err
-    assert elapsed < SLACK, elapsed
+    assert elapsed < slack(), elapsed
     assert f"interrupted by {sig.name}" in err and "Traceback" not in err
     result = json.loads((tmp_path / "out" / "result.json").read_text())
     assert result["interrupted"] is True
@@ -86,7 +84,7 @@ def test_signal_during_the_errors_stops_the_solution_writer_and_writes_nothing(t
                                      ["solve", str(case), "--quiet"], sig, cwd=tmp_path,
                                      settle=0.05)
     assert rc == code, err
-    assert elapsed < SLACK, elapsed
+    assert elapsed < slack(), elapsed
     assert f"interrupted by {sig.name}" in err and "nothing written" in err, err
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["case.yaml"]
@@ -102,7 +100,7 @@ def _earlier_report(out: Path) -> dict:
 
 def _check_study_stopped(rc, elapsed, err, sig, code, out, files):
     assert rc == code, err
-    assert elapsed < SLACK, elapsed
+    assert elapsed < slack(), elapsed
     lines = err.strip().splitlines()
     assert f"interrupted by {sig.name} during" in lines[-1], err
     assert "earlier report" in lines[-1] and "Traceback" not in err

@@ -36,6 +36,7 @@ def _run(data, tmp_path):
     return case.run(write=False, quiet=True)
 
 
+@pytest.mark.xdist_group("designed_stable_neo_hookean")   # test_energy_designed.py's module too
 def test_energy_of_a_builtin_in_a_case_gives_the_builtins_equilibrium(tmp_path):
     designed = dict(BASE, material={"energy": {"W": StableNeoHookean.energy_expression.W},
                                     "constants": {"mu": MU, "lam": LAM}, "density": 1.0})

@@ -6,7 +6,6 @@ SymPy is never imported; and a bundled solid case then runs through the command 
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -33,15 +32,14 @@ print(json.dumps(out))
 
 
 @pytest.mark.slow
-def test_warmup_compiles_the_builtin_materials_once(tmp_path):
+@pytest.mark.xdist_group("fresh_warmup")
+def test_warmup_compiles_the_builtin_materials_once(tmp_path, fresh_warmup):
+    """The session's one ``femkit warmup`` into an empty femkit cache (:func:`fresh_warmup`,
+    shared with the Poisson warm-up's tests)."""
     from femkit.solids.warmup import warm_up  # noqa: F401  (importable without side effects)
 
-    env = dict(os.environ, FEMKIT_CACHE_DIR=str(tmp_path / "cache"))
-    env.pop("NUMBA_CACHE_DIR", None)
-    run = subprocess.run([sys.executable, "-c", "from femkit.solids.warmup import warm_up; warm_up()"],
-                         env=env, capture_output=True, text=True, timeout=1500)
-    assert run.returncode == 0, run.stderr
-    assert list((tmp_path / "cache" / "energies").glob("femkit_energy_*.py"))
+    cache, _, env = fresh_warmup
+    assert list((cache / "energies").glob("femkit_energy_*.py"))
     probe = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True, text=True,
                            timeout=600)
     assert probe.returncode == 0, probe.stderr
