@@ -306,12 +306,16 @@ def test_a_bundled_study_renders(path, tmp_path, capsys):
 
 def test_a_study_view_picks_its_figures_and_refuses_a_bad_one_or_a_bad_directory(tmp_path,
                                                                                  capsys):
+    """``femkit view`` and ``StudyResult.plot`` draw the figure named, each its own picture."""
     out = tmp_path / "study"
     argv = ["study", str(ROOT / "studies" / "element_work_precision.yaml"), "--quick", "--quiet",
             "--output", str(out)]
     assert main(argv) == 0, capsys.readouterr().err
     figures = [Path(f).stem for f in json.loads((out / "results.json").read_text())["figures"]]
-    views = [open_view(out, field=f, size=SIZE) for f in figures[:2]]
+    from femkit.study import StudyResult
+
+    result = StudyResult(kind="element_work_precision", name="ewp", records=[], output_dir=out)
+    views = [result.plot(field=f, size=SIZE) for f in figures[:2]]
     assert [v.fields for v in views] == [tuple(figures)] * 2
     a, b = (v.image() for v in views)
     assert_figure(a), assert_figure(b)
