@@ -86,7 +86,7 @@ class StudyResult:
         if self.output_dir is None:
             raise InputError(f"study {self.name!r} wrote no report, so no figure to draw: run it "
                              "with write=True")
-        return view_of(self.output_dir, field=field, size=size)
+        return view_of(self, field=field, size=size)
 
     def to_dict(self) -> dict:
         return {"kind": self.kind, "name": self.name, "records": self.records,

@@ -317,6 +317,7 @@ def test_a_study_view_picks_its_figures_and_refuses_a_bad_one_or_a_bad_directory
     result = StudyResult(kind="element_work_precision", name="ewp", records=[], output_dir=out)
     views = [result.plot(field=f, size=SIZE) for f in figures[:2]]
     assert [v.fields for v in views] == [tuple(figures)] * 2
+    assert open_view(result).picture.field == figures[0]
     a, b = (v.image() for v in views)
     assert_figure(a), assert_figure(b)
     assert np.abs(a.astype(int) - b.astype(int)).mean() > 1  # two figures, two pictures

@@ -22,6 +22,8 @@ def picture_of(source: Any, field: str | None = None, **options) -> Picture:
     from ...kinds import KINDS
     from .study import is_study_dir, study_picture
 
+    if hasattr(source, "figures") and getattr(source, "output_dir", None) is not None:
+        source = source.output_dir  # a study's result: its report directory
     if isinstance(source, (str, Path)) and is_study_dir(Path(source)):
         if options:
             raise InputError(f"{source}: a study's figure takes no options (given: "
