@@ -275,15 +275,16 @@ def _run_list(args) -> int:
 _VIEW_EPILOG = """\
 exit codes:
   0  shown, or the files written
-  2  bad input (not a run directory, an unknown --field: the valid ones are named,
-     an unknown file type), or no pyvista (pip install femkit[view]), or neither a
-     display nor off-screen OpenGL (EGL/OSMesa: scripts/install-view.sh); one line,
-     nothing written
+  2  bad input (neither a run nor a study directory, an unknown --field: the valid
+     ones are named, an unknown file type), or no pyvista (pip install
+     femkit[view]), or neither a display nor off-screen OpenGL (EGL/OSMesa:
+     scripts/install-view.sh); one line, nothing written
 
 examples:
   femkit view runs/fichera
   femkit view runs/fichera --screenshot fichera.png
   femkit view runs/hanging_cloth --field stretch --movie cloth.gif
+  femkit view femkit-out/poisson_convergence --field work_precision --screenshot wp.png
 """
 
 
@@ -294,12 +295,15 @@ def _add_view(sub) -> None:
             "Draw the results of the run in RUN_DIR (the output directory of 'femkit solve') as "
             "its kind draws them: a Poisson solution (3D: clipped open), a solid warped by its "
             "displacement and coloured by its stress over its rest shape, a scene with its "
-            "obstacles; a time series frame by frame. In a window with a frame slider where a "
+            "obstacles; a time series frame by frame. A study's output directory (of 'femkit "
+            "study') is drawn as its report's first figure (--field: another, by name). In a window with a frame slider where a "
             "display exists; --screenshot and --movie render off screen (also where there is no "
             "display); with neither and no display, RUN_DIR's picture is written to "
             "<case>-<field>.png here. Files are written atomically."),
         epilog=_VIEW_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("run_dir", metavar="RUN_DIR", help="a run directory (holding result.json)")
+    p.add_argument("run_dir", metavar="RUN_DIR",
+                   help="a run directory (holding result.json) or a study's output directory "
+                   "(report.md, results.json)")
     p.add_argument("--field", metavar="NAME",
                    help="the field to colour by (default: the kind's; an unknown one lists them)")
     p.add_argument("--screenshot", metavar="FILE", help="write the last frame to FILE (.png)")

@@ -70,6 +70,24 @@ class StudyResult:
             raise KeyError(f"{len(rows)} fits match {where}")
         return rows[0]
 
+    def plot(self, field: str | None = None, size: tuple[int, int] = (960, 720)):
+        """The report's figure ``field`` (default: the first one the report shows) as a picture
+        (``femkit[view]``: pyvista, imported only now); a notebook shows it inline, as
+        ``femkit view OUTPUT_DIR`` draws it (docs/views.md).
+
+        Returns
+        -------
+        femkit.view.core.view.View
+            ``.screenshot(path)``, ``.show()``; ``.fields``: the figures' names.
+        """
+        from ..errors import InputError
+        from ..view.core import view_of
+
+        if self.output_dir is None:
+            raise InputError(f"study {self.name!r} wrote no report, so no figure to draw: run it "
+                             "with write=True")
+        return view_of(self, field=field, size=size)
+
     def to_dict(self) -> dict:
         return {"kind": self.kind, "name": self.name, "records": self.records,
                 "fits": [{k: v for k, v in f.items() if k != "fit"} for f in self.fits],

@@ -22,11 +22,12 @@ __all__ = ["open_view", "slider"]
 
 def open_view(source, field: str | None = None, size: tuple[int, int] = (960, 720), **options):
     """A :class:`~femkit.view.core.view.View` of ``source``: a result object (``RunResult``)
-    or the path of a run directory.
+    or the path of a run directory; a study's result (``StudyResult``) or output directory: its
+    report's figure (``field``: which one, by name; the first by default).
 
     Parameters
     ----------
-    source : RunResult or path
+    source : RunResult, StudyResult or path
         What to draw.
     field : str, optional
         The field to colour by (the kind's default when None); an unknown one is an

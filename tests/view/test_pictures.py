@@ -269,6 +269,67 @@ def test_a_bundled_file_renders(path, tmp_path):
     assert j["std"] > 15 and j["bar_colours"] >= 15 and 0.005 < j["covered"] < 0.95, j
 
 
+#: Every bundled study with FEMKIT_VIEW_ALL=1 (the same .ci/run step), each at its ``quick:``
+#: block; the default run draws the cheapest (about 1.5 s).
+STUDIES = sorted((ROOT / "studies").glob("*.yaml"))
+if os.environ.get("FEMKIT_VIEW_ALL") != "1":
+    STUDIES = [p for p in STUDIES if p.stem == "element_work_precision"]
+#: study -> further --set overrides where its quick: block alone is over ~20 s on 2 cores: the
+#: stiff heat study's finer quick mesh (h = 1/128, 32 runs: 23 s) is swapped for h = 1/64.
+SHRINK = {"heat_work_precision_stiff": ["--set", "quick.h=[0.03125, 0.015625]"]}
+
+
+def assert_figure(img: np.ndarray) -> None:
+    """A study's picture: not blank, the figure covering a sensible part, the plot's coloured
+    lines and markers there (a matplotlib figure on white; a blank or grey image has none)."""
+    j = judge(img)
+    coloured = np.ptp(img.astype(int), axis=2) > 80  # saturated pixels: the curves
+    assert img.shape == (SIZE[1], SIZE[0], 3)
+    assert j["std"] > 15 and 0.03 < j["covered"] < 0.95, j
+    assert coloured.sum() >= 40, int(coloured.sum())
+    assert (img[:int(0.08 * SIZE[1])] < 100).any()  # the title
+
+
+@pytest.mark.parametrize("path", STUDIES, ids=[p.stem for p in STUDIES])
+def test_a_bundled_study_renders(path, tmp_path, capsys):
+    out, png = tmp_path / "study", tmp_path / "study.png"
+    argv = ["study", str(path), "--quick", "--quiet", "--output", str(out)]
+    assert main(argv + SHRINK.get(path.stem, [])) == 0, capsys.readouterr().err
+    code = main(["view", str(out), "--screenshot", str(png), "--size", "400x300"])
+    assert code == 0, capsys.readouterr().err
+    from PIL import Image
+
+    assert_figure(np.asarray(Image.open(png).convert("RGB")))
+    first = json.loads((out / "results.json").read_text())["figures"][0]
+    assert open_view(out).picture.field == Path(first).stem  # the report's first figure
+
+
+def test_a_study_view_picks_its_figures_and_refuses_a_bad_one_or_a_bad_directory(tmp_path,
+                                                                                 capsys):
+    """``femkit view`` and ``StudyResult.plot`` draw the figure named, each its own picture."""
+    out = tmp_path / "study"
+    argv = ["study", str(ROOT / "studies" / "element_work_precision.yaml"), "--quick", "--quiet",
+            "--output", str(out)]
+    assert main(argv) == 0, capsys.readouterr().err
+    figures = [Path(f).stem for f in json.loads((out / "results.json").read_text())["figures"]]
+    from femkit.study import StudyResult
+
+    result = StudyResult(kind="element_work_precision", name="ewp", records=[], output_dir=out)
+    views = [result.plot(field=f, size=SIZE) for f in figures[:2]]
+    assert [v.fields for v in views] == [tuple(figures)] * 2
+    assert open_view(result).picture.field == figures[0]
+    a, b = (v.image() for v in views)
+    assert_figure(a), assert_figure(b)
+    assert np.abs(a.astype(int) - b.astype(int)).mean() > 1  # two figures, two pictures
+    png = tmp_path / "x.png"
+    _refused(capsys, ["view", str(out), "--field", "nope", "--screenshot", str(png)], "'nope'",
+             *figures)
+    (out / "report.md").unlink()  # neither a run nor a study directory now
+    _refused(capsys, ["view", str(out), "--screenshot", str(png)], "result.json", "results.json",
+             "report.md")
+    assert not png.exists()
+
+
 def test_the_window_slider_redraws_the_chosen_frame(runs):
     """:func:`render.show`'s slider callback, on an off-screen plotter: frame 0 (the cloth at
     rest, every node still) and the last frame (falling) differ; the colour bar stays."""

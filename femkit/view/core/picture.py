@@ -47,6 +47,9 @@ class Layer:
     lighting : bool, optional
         Shade by the lights (default: in 3D); False draws the colour map's own colours (a scalar
         field read by its colours).
+    rgb : bool
+        ``scalars`` are the colours themselves (RGB or RGBA bytes: an image, a study's figure),
+        drawn as they are, without a colour map or a colour bar.
     """
 
     mesh: Any
@@ -62,6 +65,7 @@ class Layer:
     line_width: float = 2.0
     tubes: bool = False
     lighting: bool | None = None
+    rgb: bool = False
 
 
 @dataclass
@@ -94,6 +98,9 @@ class Picture:
         The colour range; None: the range over every frame.
     time_label : str
         What a frame's time is called under the picture (``t``; a static solid: ``load factor``).
+    axes : bool
+        Draw the axes (2D: x and y rulers; 3D: the orientation triad); False for an image that
+        has its own (a study's figure).
     """
 
     frames: list[Frame]
@@ -104,6 +111,7 @@ class Picture:
     camera: tuple | None = None
     clim: tuple[float, float] | None = None
     time_label: str = "t"
+    axes: bool = True
 
     @property
     def times(self) -> list[float | None]:

@@ -97,7 +97,7 @@ def plotter(size: tuple[int, int], off_screen: bool = True) -> Any:
 def _main_layer(picture: Picture) -> int | None:
     """Index of the first layer coloured by an array (the one with the colour bar)."""
     for i, layer in enumerate(picture.frames[0].layers):
-        if layer.scalars is not None:
+        if layer.scalars is not None and not layer.rgb:
             return i
     return None
 
@@ -143,6 +143,9 @@ def draw(p: Any, picture: Picture, index: int = -1, *, clim=None, camera: bool =
         if layer.scalars is None:
             p.add_mesh(layer.mesh, color=layer.color, **kwargs)
             continue
+        if layer.rgb:  # an image: its own colours
+            p.add_mesh(layer.mesh, scalars=layer.scalars, rgb=True, show_scalar_bar=False, **kwargs)
+            continue
         title = layer.title or layer.scalars
         bar = dict(title=title, vertical=True, position_x=0.84, position_y=0.1, width=0.05,
                    height=0.75, color=FOREGROUND, fmt="%.3g",
@@ -187,15 +190,33 @@ def _camera(p: Any, picture: Picture, move: bool = True) -> None:
         elif picture.dim == 2:
             p.view_xy()
             p.reset_camera(bounds=bounds)
+            if not picture.axes:  # an image: fitted to the window, below the title
+                _fit_image(p, bounds)
+                return
         else:
             p.view_isometric()
         p.camera.zoom(0.95 if picture.dim == 3 else 0.9)
+    if not picture.axes:
+        return
     if picture.dim == 2:
         p.show_bounds(bounds=bounds, xtitle="x", ytitle="y", ztitle="", color=FOREGROUND,
                       location="outer", font_size=max(8, int(p.window_size[1] / 55)), n_zlabels=0,
                       grid=False, show_zaxis=False, show_zlabels=False)
     elif move:
         p.add_axes(color=FOREGROUND, line_width=2)
+
+
+def _fit_image(p: Any, bounds: list[float]) -> None:
+    """A parallel projection from +z in which the plane ``bounds`` fills the window's width or
+    91 % of its height, whichever binds (the top strip is the title's)."""
+    width, height = bounds[1] - bounds[0], bounds[3] - bounds[2]
+    aspect = p.window_size[0] / p.window_size[1]
+    p.enable_parallel_projection()
+    p.camera.parallel_scale = 0.5 * max(height / 0.91, width / aspect)
+    x, y = (bounds[0] + bounds[1]) / 2, (bounds[2] + bounds[3]) / 2
+    y += 0.09 * p.camera.parallel_scale  # the image's centre: the lower 91 %'s centre
+    p.camera.focal_point = (x, y, 0.0)
+    p.camera.position = (x, y, max(width, height))
 
 
 def frame_index(picture: Picture, frame: int) -> int:

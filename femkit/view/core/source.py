@@ -72,8 +72,9 @@ def open_run(source: Any) -> Run:
     path = Path(source)
     meta = path / "result.json"
     if not path.is_dir() or not meta.is_file():
-        raise InputError(f"{path}: not a femkit run directory (no result.json there); give the "
-                         "output directory of a 'femkit solve' run")
+        raise InputError(f"{path}: neither a femkit run directory (result.json, from 'femkit "
+                         "solve') nor a study's output (report.md and results.json, from "
+                         "'femkit study')")
     try:
         facts = json.loads(meta.read_text())
     except (OSError, ValueError) as exc:
