@@ -309,21 +309,6 @@ def test_default_step_solver_follows_the_size_rule_and_a_named_one_is_kept(tmp_p
     assert named.run(write=False, quiet=True).linear["method"] == "direct"
 
 
-def test_heat_on_the_petsc_backend_equals_femkit_step_by_step(tmp_path):
-    """``solver.backend: petsc`` (one process, one KSP kept for every step, warm-started):
-    the states equal femkit's kept factor's to 1e-8 (the PETSc solve's tolerance 1e-12)."""
-    pytest.importorskip("petsc4py")
-    base = {**MANUFACTURED, "integrator": "implicit_euler", "mesh": {"geometry": "unit_square", "h": 0.1}}
-    ref = load_case(_write(tmp_path, base)).run(write=False, quiet=True)
-    petsc = {**base, "solver": {"method": "pcg", "preconditioner": "jacobi", "backend": "petsc",
-                                "rtol": 1e-12}}
-    r = load_case(_write(tmp_path, petsc, "petsc.yaml")).run(write=False, quiet=True)
-    assert r.linear["method"] == "pcg" and r.linear["factorizations"] == 0
-    assert r.linear["preconditioner_setups"] == 1 and r.linear["backend"] == "petsc"
-    for (t, u, _), (s, v, _) in zip(r.march.frames, ref.march.frames):
-        assert t == s and np.abs(u - v).max() < 1e-8 * np.abs(v).max()
-
-
 def test_a_forced_unstable_run_reports_no_norm_for_overflowing_frames(tmp_path):
     """Explicit Euler forced far above its critical step grows by ~5x a step: frames past
     1e100 get no error norm (their squares overflow) instead of stopping the run."""

@@ -1,4 +1,5 @@
-"""``femkit solve`` of heat and wave cases on PETSc under ``mpirun -n 2`` against the serial run.
+"""``femkit solve`` of heat and wave cases on PETSc under ``mpirun -n 2`` (and in one process
+without mpirun) against the serial run.
 
 Both runs use the PETSc environment's interpreter, so the mesh is the same gmsh output; every
 frame of the distributed run (gathered on rank 0, written as frames/*.vtu) must equal the
@@ -38,20 +39,24 @@ def _frames_agree(serial, petsc, tol: float) -> int:
 
 
 @pytest.mark.usefixtures("needs_mpi")
-@pytest.mark.parametrize("name,changes,kept", [
-    ("heat_unit_square", {"mesh": {"geometry": "unit_square", "h": 0.06}, "t_end": 0.02}, 1),
+@pytest.mark.parametrize("name,changes,kept,ranks", [
+    ("heat_unit_square", {"mesh": {"geometry": "unit_square", "h": 0.06}, "t_end": 0.02}, 1, 2),
     ("heat_unit_square", {"mesh": {"geometry": "unit_square", "h": 0.06}, "t_end": 0.02,
-                          "solver": {"method": "pcg", "preconditioner": "amg", "rtol": 1e-12}}, 1),
-    ("wave_unit_square", {"mesh": {"geometry": "unit_square", "h": 0.08}, "t_end": 0.1}, 2),
-], ids=["heat-cn-direct", "heat-cn-pcg-amg", "wave-newmark"])
-def test_transient_on_two_ranks_equals_serial(name, changes, kept, tmp_path):
+                          "solver": {"method": "pcg", "preconditioner": "amg", "rtol": 1e-12}}, 1, 2),
+    ("wave_unit_square", {"mesh": {"geometry": "unit_square", "h": 0.08}, "t_end": 0.1}, 2, 2),
+    ("heat_unit_square", {"mesh": {"geometry": "unit_square", "h": 0.1}, "t_end": 0.02,
+                          "integrator": "implicit_euler",
+                          "solver": {"method": "pcg", "preconditioner": "jacobi", "rtol": 1e-12}}, 1, None),
+], ids=["heat-cn-direct-2ranks", "heat-cn-pcg-amg-2ranks", "wave-newmark-2ranks",
+        "heat-ie-pcg-jacobi-1rank-no-mpirun"])
+def test_transient_on_petsc_equals_serial(name, changes, kept, ranks, tmp_path):
     path = _case(tmp_path, name, **changes)
     femkit(["solve", path, "--quiet", "--output", tmp_path / "serial"])
-    femkit(["solve", path, "--quiet", "--backend", "petsc", "--output", tmp_path / "petsc"], ranks=2)
+    femkit(["solve", path, "--quiet", "--backend", "petsc", "--output", tmp_path / "petsc"], ranks=ranks)
     serial = json.loads((tmp_path / "serial" / "result.json").read_text())
     petsc = json.loads((tmp_path / "petsc" / "result.json").read_text())
     lin = petsc["linear_solver"]
-    assert (lin["backend"], lin["ranks"]) == ("petsc", 2)
+    assert (lin["backend"], lin["ranks"]) == ("petsc", ranks or 1)
     # one KSP per distinct step matrix, set up once and kept for every step
     assert lin["factorizations"] + lin["preconditioner_setups"] == kept
     assert lin["solves"] == serial["linear_solver"]["solves"] > 10
