@@ -12,7 +12,7 @@ def plan(study) -> Plan:
     """Each run priced by the heat kind's plan of the case it runs
     (:func:`femkit.case.heat.cost.plan_heat_case`), one stage per mesh size, times the repeats."""
     from ...kinds import KINDS
-    from .spec import base_case
+    from ..spec import load_base_case as base_case
 
     d = study.spec
     stages, assumptions = [], []

@@ -6,7 +6,7 @@ work). An explicit scheme above its critical step runs anyway (``force``) and is
 
 from __future__ import annotations
 
-from .spec import base_case
+from ..spec import load_base_case as base_case
 
 __all__ = ["run"]
 

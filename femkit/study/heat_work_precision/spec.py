@@ -8,18 +8,13 @@ from typing import Mapping
 from ...errors import CaseFileError
 from ..spec import StudySpec, load_base_case, plain
 
-__all__ = ["HeatStudySpec", "prepare", "base_case"]
-
-
-def base_case(study, **overrides):
-    """``(path, case)`` of the study's base case (:func:`femkit.study.spec.load_base_case`)."""
-    return load_base_case(study, **overrides)
+__all__ = ["HeatStudySpec", "prepare"]
 
 
 def prepare(study) -> None:
     """Build ``study.spec``; the base case must be a heat case with ``exact`` on a generated mesh."""
     study.spec = HeatStudySpec.from_data(study.data)
-    path, case = base_case(study)
+    path, case = load_base_case(study)
     if case.problem != "heat" or "exact.u" not in case.functions or case.spec.mesh.geometry is None:
         raise CaseFileError(f"base_case: {path.name} must be a heat case (problem: heat) with an "
                             "exact solution on a generated mesh (mesh.geometry)")

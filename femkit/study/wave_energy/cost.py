@@ -13,7 +13,7 @@ def plan(study) -> Plan:
     (:func:`femkit.case.wave.cost.plan_wave_case`), one stage per integrator."""
     from ...kinds import KINDS
     from .run import FRAMES
-    from .spec import base_case
+    from ..spec import load_base_case as base_case
 
     d = study.spec
     _, base = base_case(study)

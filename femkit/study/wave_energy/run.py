@@ -6,7 +6,7 @@ count whose dt is above an explicit scheme's critical step is run anyway and mar
 
 from __future__ import annotations
 
-from .spec import base_case
+from ..spec import load_base_case as base_case
 
 __all__ = ["run", "FRAMES"]
 

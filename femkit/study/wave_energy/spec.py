@@ -8,18 +8,13 @@ from typing import Mapping
 from ...errors import CaseFileError
 from ..spec import StudySpec, load_base_case, plain
 
-__all__ = ["WaveStudySpec", "prepare", "base_case"]
-
-
-def base_case(study, **overrides):
-    """``(path, case)`` of the study's base case (:func:`femkit.study.spec.load_base_case`)."""
-    return load_base_case(study, **overrides)
+__all__ = ["WaveStudySpec", "prepare"]
 
 
 def prepare(study) -> None:
     """Build ``study.spec``; the base case must be a wave case."""
     study.spec = WaveStudySpec.from_data(study.data)
-    path, case = base_case(study)
+    path, case = load_base_case(study)
     if case.problem != "wave":
         raise CaseFileError(f"base_case: {path.name} is not a wave case (problem: wave)")
     study.files.append(path)
