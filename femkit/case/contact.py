@@ -15,6 +15,9 @@ Shared by the ``mass_spring`` and ``solid`` kinds (docs/scenes.md, docs/solids.m
         - {type: plane, point: [0, 0, 0], normal: [0, 0, 1]}
         - {type: sphere, centre: [0, 0, 0.3], radius: 0.25}
         - {type: file, file: bowl.stl}
+        - {type: plane, point: [0, 0, 0.5], velocity: [0, 0, -0.1]}     # moving
+        - {type: file, file: paddle.stl, angular_velocity: [0, 0, 3.14],   # turning about
+           pivot: [0, 0, 0], path: [[0, 0, 0, 0], [1, 0.2, 0, 0]]}        # a travelling pivot
 
 Only integrators declaring ``keeps_contact`` run it (:func:`check_contact_integrator`, at load
 time); the initial state is checked for intersections before anything is written.
@@ -32,14 +35,28 @@ from .fragments import NONNEG, POS, VEC, closed
 __all__ = ["CONTACT_SCHEMA", "check_contact_integrator", "build_contact", "ContactRecorder",
            "contact_stage", "obstacle_facets", "CONTACT_ITERATIONS", "CONTACT_SECONDS_PER_FACET"]
 
+#: An obstacle's prescribed rigid motion (:class:`femkit.contact.Motion`): a constant
+#: ``velocity`` or a keyframed ``path`` of ``[t, ux, uy(, uz)]`` rows (displacements, linear
+#: between keys), and a constant ``angular_velocity`` (a rate in 2D, a vector in 3D) about a
+#: ``pivot`` (default: the centre of the obstacle's bounding box at time 0).
+MOTION = {"velocity": VEC,
+          "path": {"type": "array", "minItems": 1,
+                   "items": {"type": "array", "minItems": 3, "maxItems": 4,
+                             "items": {"type": "number"}}},
+          "angular_velocity": {"anyOf": [{"type": "number"},
+                                         {"type": "array", "minItems": 3, "maxItems": 3,
+                                          "items": {"type": "number"}}],
+                               "x-message": "expected a number (2D) or 3 numbers (3D)"},
+          "pivot": VEC}
+
 _OBSTACLES = {
     "plane": closed({"type": {"const": "plane"}, "point": VEC, "normal": VEC, "size": POS,
-                     "velocity": VEC}, ["type"]),
+                     **MOTION}, ["type"]),
     "sphere": closed({"type": {"const": "sphere"}, "centre": VEC, "radius": POS,
-                      "level": {"type": "integer", "minimum": 0, "maximum": 6}, "velocity": VEC},
+                      "level": {"type": "integer", "minimum": 0, "maximum": 6}, **MOTION},
                      ["type", "centre", "radius"]),
     "file": closed({"type": {"const": "file"}, "file": {"type": "string", "minLength": 1},
-                    "velocity": VEC}, ["type", "file"]),
+                    **MOTION}, ["type", "file"]),
 }
 
 #: The ``contact:`` mapping (closed; obstacles by ``type``).
@@ -95,22 +112,55 @@ def _obstacles(contact, x0: np.ndarray) -> list:
                 out.append(sphere_obstacle(ob["centre"], ob["radius"], dim, ob.get("level", 3)))
             else:
                 out.append(file_obstacle(ob["file"], dim))
-            if "velocity" in ob:
-                out[-1] = _moving(out[-1], ob["velocity"], dim)
+            if any(k in ob for k in MOTION):
+                out[-1] = _moving(out[-1], ob, dim)
         except (InputError, ValueError) as exc:
             raise with_prefix(InputError(str(exc).removeprefix("contact.obstacles: ")),
                               f"contact.obstacles[{i}]") from None
     return out
 
 
-def _moving(obstacle, velocity, dim: int):
-    """``obstacle`` moving at ``velocity`` (a vector of the scene's dimension)."""
+def _finite(value, shape: tuple, key: str, what: str) -> np.ndarray:
+    a = np.asarray(value, float)
+    if a.shape != shape or not np.all(np.isfinite(a)):
+        raise InputError(f"{key} must be {what}, got {value!r}")
+    return a
+
+
+def _path(path, dim: int) -> np.ndarray:
+    """A keyframed path's rows ``[t, u_1 .. u_dim]``, checked (times strictly increasing)."""
+    rows = [_finite(r, (dim + 1,), f"path[{i}]", f"[t, {dim} displacements] ({dim + 1} finite "
+                    "numbers)") for i, r in enumerate(path)]
+    a = np.array(rows)
+    if np.any(np.diff(a[:, 0]) <= 0.0):
+        raise InputError(f"path: the keyframe times must increase strictly, got "
+                         f"{a[:, 0].tolist()!r}")
+    return a
+
+
+def _moving(obstacle, ob: dict, dim: int):
+    """``obstacle`` in the rigid motion its mapping ``ob`` prescribes (:data:`MOTION`'s keys)."""
     from dataclasses import replace
 
-    v = np.asarray(velocity, float)
-    if v.shape != (dim,) or not np.all(np.isfinite(v)):
-        raise InputError(f"velocity must be {dim} finite numbers, got {list(velocity)!r}")
-    return replace(obstacle, velocity=v)
+    from ..contact import Motion
+
+    if "velocity" in ob and "path" in ob:
+        raise InputError("give a velocity or a path, not both (a path's rows are "
+                         "[t, displacement])")
+    v = (_finite(ob["velocity"], (dim,), "velocity", f"{dim} finite numbers")
+         if "velocity" in ob else None)
+    path = _path(ob["path"], dim) if "path" in ob else None
+    omega, pivot = ob.get("angular_velocity"), None
+    if omega is not None:
+        omega = _finite(omega, () if dim == 2 else (3,), "angular_velocity",
+                        "a number (a rate in 2D)" if dim == 2 else "3 finite numbers (3D)")
+        verts = obstacle.vertices
+        pivot = _finite(ob.get("pivot", 0.5 * (verts.min(axis=0) + verts.max(axis=0))), (dim,),
+                        "pivot", f"{dim} finite numbers")
+    elif "pivot" in ob:
+        raise InputError("pivot: only with an angular_velocity (the point it turns about)")
+    return replace(obstacle, motion=Motion(velocity=v, path=path, angular_velocity=omega,
+                                           pivot=pivot))
 
 
 def build_contact(contact, x0, cells):

@@ -18,10 +18,11 @@ are frozen ("lagged") at the start of a step, the friction force is ``-grad_v D(
 femkit's conventions: positions are node-major ``(n, d)``, the flat dof ``i*d + c``; the
 potential's gradient is ``(n, d)`` on every node of the body (zero off its surface), its Hessian a
 CSR matrix ``n d x n d``. Obstacles are part of the collision mesh but carry no dofs; a moving one
-(a prescribed constant velocity) is moved within each step towards its place at the step's end
-in moves each bounded by CCD against the bodies where the last solve left them
-(:meth:`BarrierModel.advance`; the step is solved again after every move), so it never passes
-through a body; friction sees its velocity.
+(a prescribed rigid motion: velocity or keyframed path, and rotation, :class:`~.surfaces.Motion`)
+is moved within each step towards its place at the step's end in straight moves each bounded by
+CCD against the bodies where the last solve left them (:meth:`BarrierModel.advance`; the step is
+solved again after every move), so it never passes through a body; friction sees each obstacle
+vertex's own velocity over the step.
 
 ipctk is the optional extra ``femkit[contact]`` (``pip install femkit[contact]``): importing this
 module never needs it; building a :class:`BarrierModel` without it is a one-line
@@ -73,8 +74,8 @@ def _positive(value, name: str) -> float:
 
 
 class BarrierModel:
-    """Barrier contact of one set of bodies (their surfaces) and obstacles, static or moving at
-    a prescribed velocity.
+    """Barrier contact of one set of bodies (their surfaces) and obstacles, static or in a
+    prescribed rigid motion.
 
     ``seconds`` sums the time of the broad phase, CCD and the Hessians by :attr:`clock`
     (wall time; a benchmark may set CPU time).
@@ -138,20 +139,20 @@ class BarrierModel:
         self.surface_nodes, local = np.unique(surface, return_inverse=True)
         self.nb = len(self.surface_nodes)
         faces = [local.reshape(surface.shape)]
-        verts, vels, offset = [np.zeros((0, self.dim))], [np.zeros((0, self.dim))], self.nb
+        verts, offset = [np.zeros((0, self.dim))], self.nb
         for ob in obstacles:
             if ob.dim != self.dim:
                 raise InputError(f"contact.obstacles: {ob.name} is {ob.dim}-D, the bodies "
                                  f"{self.dim}-D")
             verts.append(np.asarray(ob.vertices, float))
-            v = np.zeros(self.dim) if ob.velocity is None else np.asarray(ob.velocity, float)
-            vels.append(np.tile(v, (len(ob.vertices), 1)))
             faces.append(np.asarray(ob.faces, np.int64) + offset)
             offset += len(ob.vertices)
+        self.obstacles = tuple(obstacles)
         self.static = np.concatenate(verts)      # the obstacles' vertices now
         self.static0 = self.static.copy()        # ... at time 0
-        self.static_velocity = np.concatenate(vels)
-        self.moving = bool(np.any(self.static_velocity))
+        #: the obstacles' vertex velocities over the current step (friction's)
+        self.static_velocity = np.zeros_like(self.static)
+        self.moving = any(ob.moving for ob in obstacles)
         self._target = None                      # the obstacles' vertices at the step's end
         self.advances = 0                        # obstacle moves of the step
         self.faces = np.ascontiguousarray(np.concatenate(faces), dtype=np.int32)
@@ -357,14 +358,27 @@ class BarrierModel:
         return bool(changed)
 
     # ------------------------------------------------------------------ moving obstacles
+    def obstacles_at(self, t: float) -> np.ndarray:
+        """The obstacles' vertices at time ``t`` by their prescribed motions
+        (:meth:`~.surfaces.Obstacle.at`)."""
+        return np.concatenate([np.zeros((0, self.dim))] + [ob.at(t) for ob in self.obstacles])
+
     def start_motion(self, t: float, h: float) -> None:
         """A step from ``t`` to ``t + h``: the obstacles' place at ``t + h`` the target of
-        :meth:`advance` (they start where the last step left them, at ``t`` on the first)."""
+        :meth:`advance` (they start where the last step left them, at ``t`` on the first).
+
+        Friction sees each obstacle vertex's velocity over the step, ``(X(t + h) - X(t)) / h``:
+        measured as implicit Euler measures the bodies' (``(x - x_n) / h``), so a body carried
+        along with an obstacle -- a block on a turntable -- slides relative to it by nothing
+        (the instantaneous ``v + omega x (x - p)`` would differ from the chord's velocity by
+        ``|omega|^2 r h / 2`` at radius ``r``: a slip friction would fight every step).
+        """
         if not self.moving:
             return
         if self._target is None:
-            self.static = self.static0 + t * self.static_velocity
-        self._target = self.static0 + (t + h) * self.static_velocity
+            self.static = self.obstacles_at(t)
+        self._target = self.obstacles_at(t + h)
+        self.static_velocity = (self._target - self.static) / h
         self.advances = 0
 
     def advance(self, x) -> bool:

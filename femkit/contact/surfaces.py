@@ -4,27 +4,96 @@ Every surface is plain arrays: ``vertices`` ``(m, d)`` and ``faces`` ``(k, 3)`` 
 ``(k, 2)`` segments in 2D. A body's contact surface is made from its cells
 (:func:`body_surface`): the boundary triangles of tetrahedra, the boundary segments of triangles
 in the plane, or the triangles themselves of a surface (cloth) in 3D. Obstacles are surfaces,
-static or moving at a prescribed velocity: a plane (a square, or a segment in 2D, large enough
-for the scene), a sphere (a subdivided icosahedron, or a polygon in 2D) and a surface mesh read
-from a file by meshio
-(``.msh``, ``.stl``, ``.obj``; triangles, or lines in 2D).
+static or in a prescribed rigid motion (:class:`Motion`: a constant velocity or a keyframed
+path, and a constant angular velocity about a pivot): a plane (a square, or a segment in 2D,
+large enough for the scene), a sphere (a subdivided icosahedron, or a polygon in 2D) and a
+surface mesh read from a file by meshio (``.msh``, ``.stl``, ``.obj``; triangles, or lines in
+2D).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["Obstacle", "body_surface", "plane_obstacle", "sphere_obstacle", "file_obstacle"]
+__all__ = ["Obstacle", "Motion", "rotation", "body_surface", "plane_obstacle", "sphere_obstacle",
+           "file_obstacle"]
+
+
+def rotation(omega, t: float) -> np.ndarray:
+    """The rotation matrix of a constant angular velocity ``omega`` after time ``t``: in 2D
+    ``omega`` is a rate (rad/s, counter-clockwise), in 3D a vector (axis times rate; Rodrigues'
+    formula ``I + sin(a) K + (1 - cos(a)) K^2`` with ``a = |omega| t``, ``K`` the cross-product
+    matrix of the unit axis).
+
+    >>> np.round(rotation(np.pi / 2, 1.0) @ [1.0, 0.0], 12).tolist()
+    [0.0, 1.0]
+    >>> np.round(rotation([0.0, 0.0, np.pi], 0.5) @ [1.0, 0.0, 0.0], 12).tolist()
+    [0.0, 1.0, 0.0]
+    """
+    w = np.asarray(omega, dtype=float)
+    if w.ndim == 0:
+        a = float(w) * t
+        return np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+    rate = float(np.linalg.norm(w))
+    if rate == 0.0:
+        return np.eye(3)
+    k = w / rate
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    a = rate * t
+    return np.eye(3) + np.sin(a) * K + (1.0 - np.cos(a)) * (K @ K)
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A prescribed rigid motion: ``x(t) = p + u(t) + R(t) (x0 - p)``.
+
+    The translation ``u(t)`` is ``t velocity``, or the piecewise-linear interpolation of a
+    ``path`` of keyframes ``(t_k, u_k)`` (held at its first value before the first key and at
+    its last after the last); ``R(t)`` turns at the constant ``angular_velocity`` about the pivot
+    ``p`` (:func:`rotation`), which travels with the translation.
+
+    Attributes
+    ----------
+    velocity : (d,) float array, optional
+    path : (k, 1 + d) float array, optional
+        Rows ``[t, u_1, ..., u_d]``, times strictly increasing (not with ``velocity``).
+    angular_velocity : float (2D) or (3,) float array (3D), optional
+    pivot : (d,) float array
+        The point it turns about, at time 0.
+    """
+
+    velocity: np.ndarray | None = None
+    path: np.ndarray | None = None
+    angular_velocity: np.ndarray | float | None = None
+    pivot: np.ndarray | None = None
+
+    def translation(self, t: float, dim: int) -> np.ndarray:
+        """``u(t)``, the displacement of the pivot at time ``t``."""
+        if self.path is not None:
+            return np.array([np.interp(t, self.path[:, 0], self.path[:, 1 + c])
+                             for c in range(dim)])
+        if self.velocity is not None:
+            return t * np.asarray(self.velocity, float)
+        return np.zeros(dim)
+
+    def place(self, x0: np.ndarray, t: float) -> np.ndarray:
+        """The points ``x0`` (rows, at time 0) carried to time ``t``."""
+        x0 = np.asarray(x0, dtype=float)
+        u = self.translation(t, x0.shape[1])
+        if self.angular_velocity is None:
+            return x0 + u
+        p = np.asarray(self.pivot, float)
+        return p + u + (x0 - p) @ rotation(self.angular_velocity, t).T
 
 
 @dataclass(frozen=True)
 class Obstacle:
-    """A contact surface: static, or moving rigidly at a prescribed constant velocity.
+    """A contact surface: static, or in a prescribed rigid motion.
 
     Attributes
     ----------
@@ -34,18 +103,42 @@ class Obstacle:
         Its vertices at time 0.
     faces : (k, 3) triangles (3D) or (k, 2) segments (2D), int array
     velocity : (d,) float array, optional
-        Its prescribed velocity (the vertices at time ``t`` are ``vertices + t velocity``);
-        ``None``: static.
+        A prescribed constant velocity (the vertices at time ``t`` are ``vertices + t
+        velocity``), the short form of ``motion=Motion(velocity=...)``; ``None``: static.
+    motion : Motion, optional
+        A prescribed rigid motion (translation, keyframed path, rotation); with ``velocity``
+        given too, ``velocity`` is its translation (a ``path`` then is refused).
     """
 
     name: str
     vertices: np.ndarray
     faces: np.ndarray
     velocity: np.ndarray | None = None
+    motion: Motion | None = None
+
+    def __post_init__(self):
+        if self.velocity is not None and self.motion is not None and self.motion.path is not None:
+            raise InputError("contact.obstacles: give a velocity or a path, not both")
 
     @property
     def dim(self) -> int:
         return int(self.vertices.shape[1])
+
+    @property
+    def moving(self) -> bool:
+        """Whether it moves at all."""
+        m = self.motion
+        return bool((self.velocity is not None and np.any(self.velocity)) or (
+            m is not None and (m.path is not None or m.velocity is not None
+                               and np.any(m.velocity) or m.angular_velocity is not None
+                               and np.any(m.angular_velocity))))
+
+    def at(self, t: float) -> np.ndarray:
+        """Its vertices at time ``t``."""
+        m = self.motion or Motion()
+        if self.velocity is not None and m.path is None:
+            m = replace(m, velocity=np.asarray(self.velocity, float))
+        return m.place(self.vertices, t)
 
 
 def _boundary(cells: np.ndarray, local: np.ndarray) -> np.ndarray:

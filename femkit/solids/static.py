@@ -143,7 +143,8 @@ def solve_static(body: ElasticBody, dirichlet: Dirichlet | None = None, forces=N
     if load_steps < 1 or max_iterations < 1:
         raise InputError("solve_static: load_steps and max_iterations must be >= 1")
     if contact is not None and contact.moving:
-        raise InputError("contact.obstacles: a moving obstacle (velocity) needs dynamics; the "
+        raise InputError("contact.obstacles: a moving obstacle (velocity, path, "
+                         "angular_velocity) needs dynamics; the "
                          "static solver has no time to move it")
     if dirichlet is None or len(dirichlet.dofs) == 0:
         raise InputError("solve_static: prescribe some displacements (a free body has "

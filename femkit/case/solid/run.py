@@ -45,7 +45,8 @@ from ...errors import (CaseFileError, DegenerateMeshError, EquilibriumError, Inp
 from ...io.atomic import EARLIER_RUN, check_output_dir
 from ...kinds import KINDS
 from ...timing import StageTimer
-from ..contact import ContactRecorder, build_contact, check_contact_integrator, resolve_obstacle_files
+from ..contact import (MOTION, ContactRecorder, build_contact, check_contact_integrator,
+                       resolve_obstacle_files)
 from ..frozen import freeze
 from ..name_checks import check_geometry_spec, resolve_file
 from ..result import RunResult
@@ -206,9 +207,10 @@ def prepare_solid(case) -> None:
         if not dynamic and contact.get("friction"):
             raise CaseFileError("contact.friction: friction needs a time integration (it lives "
                                 "on the step's velocity); a static run is frictionless")
-        if not dynamic and any("velocity" in o for o in contact.get("obstacles") or []):
-            raise CaseFileError("contact.obstacles: a moving obstacle (velocity) needs a time "
-                                "integration; a static run keeps obstacles where they are")
+        if not dynamic and any(k in o for o in contact.get("obstacles") or [] for k in MOTION):
+            raise CaseFileError(f"contact.obstacles: a moving obstacle ({', '.join(MOTION)}) "
+                                "needs a time integration; a static run keeps obstacles where "
+                                "they are")
         contact["obstacles"] = [dict(o) for o in contact.get("obstacles") or []]
         resolve_obstacle_files(contact, case.base_dir)
     directory = str((case.base_dir / out.get("dir", os.path.join("runs", case.name))).resolve())
