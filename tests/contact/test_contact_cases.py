@@ -125,6 +125,12 @@ def test_a_stack_of_three_solids_rests_with_each_contact_carrying_the_weight_abo
     ("newton", "{obstacles: [{type: file, file: vol.msh}]}", ["not a surface", "tetra"]),
     ("newton", "{obstacles: [{type: plane, velocity: [0, 1]}]}", ["obstacles[0]", "velocity",
                                                                  "3 finite numbers"]),
+    ("newton", "{obstacles: [{type: plane, angular_velocity: 1.0}]}", ["obstacles[0]",
+                                                                     "angular_velocity", "3D"]),
+    ("newton", "{obstacles: [{type: plane, path: [[0, 0, 0, 0], [0, 1, 0, 0]]}]}",
+     ["obstacles[0]", "path", "increase strictly"]),
+    ("newton", "{obstacles: [{type: plane, velocity: [0, 0, 1], path: [[0, 0, 0, 0]]}]}",
+     ["obstacles[0]", "velocity or a path"]),
 ])
 def test_bad_contact_input_is_one_line_and_writes_nothing(tmp_path, capsys, integrator, contact,
                                                         words):
