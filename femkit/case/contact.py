@@ -32,8 +32,8 @@ import numpy as np
 from ..errors import CaseFileError, InputError, with_prefix
 from .fragments import NONNEG, POS, VEC, closed
 
-__all__ = ["CONTACT_SCHEMA", "check_contact_integrator", "build_contact", "ContactRecorder",
-           "contact_stage", "obstacle_facets", "CONTACT_ITERATIONS", "CONTACT_SECONDS_PER_FACET"]
+__all__ = ["CONTACT_SCHEMA", "MOTION", "check_contact_integrator", "build_contact",
+           "ContactRecorder", "obstacle_facets"]
 
 #: An obstacle's prescribed rigid motion (:class:`femkit.contact.Motion`): a constant
 #: ``velocity`` or a keyframed ``path`` of ``[t, ux, uy(, uz)]`` rows (displacements, linear
@@ -182,28 +182,10 @@ def build_contact(contact, x0, cells):
     return force
 
 
-#: Barrier contact's price: Newton iterations of a step in contact (IPC's line search bounded by
-#: CCD; 9.2 a contact step of the cloth_on_sphere at 21 x 21, 12.8 at 41 x 41 over 30 steps,
-#: benchmarks/bench_contact.py) and seconds per surface facet per iteration of the broad phase,
-#: CCD and barrier Hessian together (2.5e-5 s measured there on the shared 2-core machine).
-CONTACT_ITERATIONS = 12.0
-CONTACT_SECONDS_PER_FACET = 2.5e-5
-
-
-def contact_stage(steps: int, facets: float):
-    """The contact overhead of ``steps`` steps on ``facets`` surface facets (obstacles included),
-    priced from the numbers before the run (first steps are often contact-free, so a measured
-    first batch would miss it)."""
-    from ..cost.plan import Stage
-
-    sec = steps * CONTACT_ITERATIONS * facets * CONTACT_SECONDS_PER_FACET
-    return Stage("contact", sec, 0.0, detail=f"barrier contact: ~{facets:.3g} facets, "
-                 f"{CONTACT_ITERATIONS:g} CCD-bounded Newton iterations per step")
-
-
 def obstacle_facets(contact) -> float:
     """Facets of a ``contact:`` mapping's obstacles from its numbers (a sphere ``20 * 4^level``,
-    a plane 2; a file's counted as 2,000)."""
+    a plane 2; a file's counted as 2,000): what the plan's contact stage is priced on
+    (:func:`femkit.cost.contact_stage`) with the bodies' surface."""
     sizes = {"sphere": lambda o: 20 * 4 ** o.get("level", 3), "plane": lambda o: 2,
              "file": lambda o: 2000}
     return float(sum(sizes[o["type"]](o) for o in contact.get("obstacles") or []))

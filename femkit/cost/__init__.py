@@ -6,7 +6,8 @@ may use it and nothing in it runs a mesh generator, an assembly or a solver.
 
 * :func:`plan_poisson`, :func:`plan_mesh`, :func:`plan_scene` make a :class:`Plan` from plain
   numbers (a domain's area and line length and ``h``, or a triangle count; refinements,
-  solver; a scene's node and spring counts and time grid);
+  solver; a scene's node and spring counts and time grid); :func:`contact_stage` prices barrier
+  contact (facets, steps, the plan's own Newton iteration);
 * :func:`check_budget` refuses a plan that exceeds the available memory or a stated
   :class:`Limits` (``BudgetExceededError``, one line saying what to change);
 * the constants are calibrated by ``benchmarks/calibrate_cost.py`` and overridable per machine
@@ -31,6 +32,7 @@ from .budget import (
     with_default_time,
 )
 from .constants import load_constants
+from .contact import SCENE_FREE_ITERATIONS, contact_stage
 from .memory import available_memory, format_bytes, peak_rss
 from .meshfile import msh_has_volume, msh_triangle_count
 from .plan import Plan, Stage
@@ -41,4 +43,4 @@ from .speed import machine_speed
 __all__ = ["Plan", "Stage", "Limits", "LIMIT_KEYS", "DEFAULT_TIME_BUDGET", "with_default_time", "check_budget", "parse_bytes", "parse_seconds",
            "load_constants", "available_memory", "peak_rss", "format_bytes", "format_seconds",
            "msh_has_volume", "msh_triangle_count", "plan_mesh", "plan_poisson", "predict_triangles", "plan_scene",
-           "machine_speed"]
+           "machine_speed", "contact_stage", "SCENE_FREE_ITERATIONS"]

@@ -8,8 +8,9 @@ step are timed on a first batch (:func:`femkit.case.cost.measure_step_seconds`).
 
 from __future__ import annotations
 
-from ...cost import Plan, check_budget, plan_mesh, plan_scene
-from ..contact import contact_stage, obstacle_facets
+from ...cost import (SCENE_FREE_ITERATIONS, Plan, check_budget, contact_stage, machine_speed,
+                     plan_mesh, plan_scene)
+from ..contact import obstacle_facets
 from ..cost import OVERRIDE, measure_step_seconds
 
 __all__ = ["plan_scene_case", "check_scene_fits"]
@@ -48,15 +49,27 @@ def plan_scene_case(case, size, *, build=None, measure: bool = True) -> Plan:
         check_budget(plan, force=case.options.force, override=OVERRIDE)
         system, integrator, ctx = build()
     per_step = measure_step_seconds(system, integrator, spec.dt, ctx=ctx)
-    return _with_contact(_with_mesh(plan_scene(**common, step_seconds=per_step), mesh), spec, nodes)
+    speed = machine_speed(statistic="median") if getattr(spec, "contact", None) else 1.0
+    return _with_contact(_with_mesh(plan_scene(**common, step_seconds=per_step), mesh), spec,
+                         nodes, speed)
 
 
-def _with_contact(plan: Plan, spec, nodes: float) -> Plan:
+def _with_contact(plan: Plan, spec, nodes: float, speed: float = 1.0) -> Plan:
     """``plan`` with barrier contact's stage when the scene declares ``contact:`` (a surface of
-    ~2 triangles per node, a sphere obstacle's 20 * 4^level)."""
+    ~2 triangles per node, a sphere obstacle's 20 * 4^level; a Newton iteration of the
+    contact-free step the ``simulate`` stage priced, :func:`femkit.cost.contact_stage`; ``speed``
+    the machine's now, load included, when that step was measured)."""
     if getattr(spec, "contact", None) is None:
         return plan
-    plan.stages.append(contact_stage(spec.steps, 2.0 * nodes + obstacle_facets(spec.contact)))
+    simulate = next(s for s in plan.stages if s.name == "simulate")
+    step = simulate.seconds / max(spec.steps, 1)
+    plan.stages.append(contact_stage(spec.steps, 2.0 * nodes + obstacle_facets(spec.contact),
+                                     step / SCENE_FREE_ITERATIONS, SCENE_FREE_ITERATIONS, speed))
+    plan.assumptions.append(
+        f"contact: every step in contact, each a contact-free step's {SCENE_FREE_ITERATIONS:g} "
+        "Newton iterations and more (femkit/cost/contact.py)"
+        + (f"; contact's own work at this machine's speed now (x{speed:.2g})" if speed != 1.0
+           else ""))
     return plan
 
 

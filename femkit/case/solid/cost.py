@@ -26,8 +26,8 @@ from __future__ import annotations
 import functools
 import math
 
-from ..contact import contact_stage, obstacle_facets
-from ...cost import Plan, Stage, check_budget, load_constants
+from ..contact import obstacle_facets
+from ...cost import Plan, Stage, check_budget, contact_stage, load_constants
 from ...cost.plan import round_down, round_up
 from ..cost import OVERRIDE, geometry_domain
 
@@ -118,7 +118,8 @@ def plan_solid_case(case, *, measure: bool = True) -> Plan:
     ]
     if spec.contact is not None:   # boundary triangles ~ 12 n^(2/3) of n nodes (segments 4 sqrt n)
         surface = 12.0 * points ** (2.0 / 3.0) if dim == 3 else 4.0 * points ** 0.5
-        stages.append(contact_stage(steps, surface + obstacle_facets(spec.contact)))
+        stages.append(contact_stage(steps, surface + obstacle_facets(spec.contact),
+                                    pass_s + factor_s, per_step))
     title = (f"{case.name}: {spec.mesh.get('geometry', spec.mesh.get('file'))} "
              f"{'static' if spec.static else spec.integrator.method}")
     sizes = {what: cells, "points": points, "unknowns": dofs, "nonzeros": nnz,
