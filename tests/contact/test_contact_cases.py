@@ -3,6 +3,7 @@
 three solids, and the bad inputs (one line, exit 2, nothing written)."""
 
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -157,6 +158,12 @@ def test_the_plan_prices_contact_and_refuses_a_scene_past_its_time_budget(tmp_pa
     stages = {s.name: s for s in plan_scene_case(case, system_size(case.spec.system),
                                                  measure=False).stages}
     assert stages["contact"].seconds > 5.0
+    # contact's price is what refuses it: the same scene without contact: plans under the limit
+    free = tmp_path / "free.yaml"
+    free.write_text(re.sub(r"\ncontact:\n(  .*\n)+", "\n", text))
+    case = load_case(free)
+    assert case.spec.contact is None
+    assert plan_scene_case(case, system_size(case.spec.system), measure=False).seconds < 5.0
 
 
 BODIES = """problem: solid
