@@ -1,7 +1,9 @@
 """The mass-spring kind's picture (:attr:`femkit.kinds.Kind.view` of ``problem: mass_spring``):
 the cloth's triangles (a rope's springs as tubes, a mesh's springs as lines) coloured by the
 speed of the nodes or the springs by their stretch, the pinned nodes in red, the obstacles the
-scene declares (ground plane, spheres) in grey; one frame per recorded frame (``scene.pvd``).
+scene declares (penalty ground plane and spheres, barrier contact's obstacles where their
+prescribed motion puts them at each frame's time) in grey; one frame per recorded frame
+(``scene.pvd``).
 pyvista: ``femkit[view]``.
 
 The obstacles come from the result in memory, or, for a run directory, from its case file as it
@@ -19,10 +21,10 @@ from ...view.core.generic import flat, read_series
 from ...view.core.render import pyvista
 from ...view.core.source import Run, check_field
 
-__all__ = ["scene_view", "obstacle_layers"]
+__all__ = ["scene_view", "obstacle_layers", "barrier_obstacle_layers"]
 
 TITLES = {"speed": "speed (length units / s)", "stretch": "spring stretch (length / rest - 1)"}
-_CONTACTS = ("ground", "sphere")
+_CONTACTS = ("ground", "sphere", "barrier contact")
 
 
 def _forces(run: Run) -> list:
@@ -70,6 +72,35 @@ def obstacle_layers(forces, lo: np.ndarray, hi: np.ndarray, dim: int) -> list[La
     return layers
 
 
+def barrier_obstacle_layers(forces, t: float, lo: np.ndarray, hi: np.ndarray,
+                            dim: int) -> list[Layer]:
+    """Grey layers of barrier contact's obstacles among ``forces`` at time ``t``
+    (:meth:`femkit.contact.Obstacle.at`); a plane wider than the box ``lo``..``hi`` (3D points)
+    drawn shrunk about its centre to 1.5 times the box's size (the default plane is 10 times
+    the bodies' size: the camera would frame the plane, not the bodies). None in a picture of
+    flat frames (``dim`` 2) of a 3-D scene, drawn from above like a plane scene."""
+    from ...dynamics.forces.barrier import BarrierContact
+
+    pv = pyvista()
+    span = max(float(np.max(hi - lo)), 1e-9)
+    layers = []
+    for f in forces:
+        for ob in getattr(f, "obstacles", ()) if isinstance(f, BarrierContact) else ():
+            if ob.dim != dim:   # a 3-D scene whose frames are all flat, drawn from above
+                continue
+            V = np.zeros((len(ob.vertices), 3))
+            V[:, :ob.dim] = ob.at(t)
+            if ob.name == "plane":
+                c = V.mean(axis=0)
+                V = c + (V - c) * min(1.0, 1.5 * span / max(np.abs(V - c).max(), 1e-300))
+            k = ob.faces.shape[1]
+            cells = np.hstack([np.full((len(ob.faces), 1), k), ob.faces]).ravel()
+            mesh = pv.PolyData(V, faces=cells) if k == 3 else pv.PolyData(V, lines=cells)
+            layers.append(Layer(mesh, color="silver" if ob.name == "plane" else "lightsteelblue",
+                                opacity=0.6 if ob.name == "plane" else 0.9, line_width=4))
+    return layers
+
+
 def _body_layers(mesh, name: str) -> list[Layer]:
     """The body of one frame: triangles or springs coloured by ``name``, and the pins."""
     pv = pyvista()
@@ -107,8 +138,10 @@ def scene_view(run: Run, field: str | None = None, frames: int = 60) -> Picture:
     name = check_field(field, fields, "speed")
     dim = 2 if all(flat(m) for _, m in series) else 3
     points = np.concatenate([np.asarray(m.points) for _, m in series])
-    obstacles = obstacle_layers(_forces(run), points.min(axis=0), points.max(axis=0), dim)
-    out = [Frame(_body_layers(mesh, name) + obstacles, t) for t, mesh in series]
+    forces, lo, hi = _forces(run), points.min(axis=0), points.max(axis=0)
+    obstacles = obstacle_layers(forces, lo, hi, dim)
+    out = [Frame(_body_layers(mesh, name) + obstacles
+                 + barrier_obstacle_layers(forces, t, lo, hi, dim), t) for t, mesh in series]
     clim = None
     if name == "stretch":
         m = max(float(np.abs(np.asarray(f.layers[0].mesh["stretch"])).max(initial=0.0))
