@@ -137,7 +137,7 @@ class ElasticBody:
     def pattern(self):
         """The CSR pattern of the Hessian (built on first use, then kept)."""
         if self._pattern is None:
-            from .pattern import BlockPattern
+            from ..fem.sparsity import BlockPattern
 
             self._pattern = BlockPattern(self.rest.cells, self.n, self.dim)
         return self._pattern
