@@ -15,6 +15,15 @@ threshold on).
   so ``w = b * dofs per cell``); :func:`pattern_for` caches one per mesh, element and block
   (one component on a large mesh: built row by row from the dof map,
   :func:`femkit.fem._element_kernels.element_pattern_kernel`).
+- Node pairs as dense ``d x d`` blocks addressed by node-pair slots: :class:`BlockPattern` (an
+  elastic body's Hessian, :mod:`femkit.solids`), :func:`block_structure`, :func:`block_positions`.
+- The mass-spring matrices (:class:`femkit.dynamics.forces.jacobian.SpringPattern`,
+  :class:`femkit.dynamics.kernels.assembly.FreePattern`) from the same parts: the node pairs of
+  entry sets (springs as 2-node cells, :func:`cell_entries`; :func:`entry_pattern`) as blocks, a
+  force's fixed CSR structure joined by :func:`union_structures`, the held dofs dropped with a
+  slot map by :func:`restrict_structure` (the pattern of Dirichlet elimination's
+  ``K[free][:, free]``, whose values :func:`~femkit.fem.dirichlet.apply_dirichlet` moves in one
+  pass with the lifting).
 
 >>> import numpy as np
 >>> from femkit.mesh import Mesh
@@ -389,11 +398,12 @@ def block_positions(indptr: np.ndarray, node_slots: np.ndarray, node_rows: np.nd
 
 
 def union_structures(structures, n: int) -> tuple[np.ndarray, np.ndarray, list]:
-    """The union of CSR structures ``[(indptr, indices), ...]`` (each ``n x n``) and, for each,
-    the position of every one of its entries in the union's ``data``.
+    """The union of CSR structures ``[(indptr, indices), ...]`` (each ``n x n``, distinct columns
+    in each row) and, for each, the position of every one of its entries in the union's ``data``.
 
     The entries are merged by a stable sort of their ``(row, column)`` keys: linear for
-    structures with sorted columns, whose keys are sorted runs.
+    structures with sorted columns, whose keys are sorted runs; one structure (sorted) is its own
+    union.
 
     Returns
     -------

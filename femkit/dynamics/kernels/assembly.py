@@ -1,18 +1,20 @@
 """The implicit methods' matrices assembled by one compiled pass into a cached pattern.
 
-:class:`FreePattern` is built once per system (topology and pinned set): the CSR pattern of the
-spring matrices (every spring's four ``d x d`` blocks plus the full diagonal, as
-:class:`~femkit.dynamics.forces.jacobian.SpringPattern`) restricted to the free dofs, and for every
-spring block entry its slot in that CSR ``data`` array (``-1`` where the row or column is
-pinned). A step then only writes values: :meth:`FreePattern.assemble` fills ``data`` with the
-diagonal, adds every spring's Hessian (with the definiteness fix) and dashpot blocks in one
-pass (:func:`~femkit.dynamics.kernels.spring_kernels.hessian_values`), and adds the declared
-forces' own matrices (contact stiffness, viscous damping: nodal blocks, inside the pattern) by a
-sorted merge, or -- a force with a fixed structure, an elastic solid's Hessian -- by a slot map
-built with the pattern. The pattern never changes, so the Cholesky factorisation reuses one symbolic
-analysis for the whole run (:meth:`femkit.solvers.cholesky.CholeskyFactor.refactor`); a force
-matrix with an entry outside the pattern is reported (``None``), and the caller falls back to the
-general path.
+:class:`FreePattern` is built once per system (topology and pinned set) by femkit's one assembly
+stack, :mod:`femkit.fem.sparsity`: the CSR pattern of the spring matrices (every spring's four
+``d x d`` blocks plus every node's diagonal block,
+:class:`~femkit.dynamics.forces.jacobian.SpringPattern` with ``node_blocks``) joined to the declared
+forces' fixed structures (:func:`~femkit.fem.sparsity.union_structures`) and restricted to the free
+dofs (:func:`~femkit.fem.sparsity.restrict_structure`), and for every spring block entry its slot in
+that CSR ``data`` array (``-1`` where the row or column is pinned). A step then only writes
+values: :meth:`FreePattern.assemble` fills ``data`` with the diagonal, adds every spring's Hessian
+(with the definiteness fix) and dashpot blocks in one pass
+(:func:`~femkit.dynamics.kernels.spring_kernels.hessian_values`), and adds the declared forces' own
+matrices (contact stiffness, viscous damping: nodal blocks, inside the pattern) by a sorted merge,
+or -- a force with a fixed structure, an elastic solid's Hessian -- by a slot map built with the
+pattern. The pattern never changes, so the Cholesky factorisation reuses one symbolic analysis for
+the whole run (:meth:`femkit.solvers.cholesky.CholeskyFactor.refactor`); a force matrix with an
+entry outside the pattern is reported (``None``), and the caller falls back to the general path.
 """
 
 from __future__ import annotations
