@@ -171,7 +171,9 @@ class SparsityPattern:
         """
         if block < 1:
             raise InputError(f"block size must be a positive integer, got {block}")
-        cells = _blocked(cells, block)
+        if block > 1:
+            cells = np.asarray(cells, dtype=np.int64)
+            cells = (cells[:, :, None] * block + np.arange(block)).reshape(len(cells), -1)
         size = int(n) * block
         if backend == "auto":
             backend = "numba" if len(cells) >= NUMBA_THRESHOLD else "numpy"
@@ -294,24 +296,14 @@ def _normalise(pattern: SparsityPattern, elements):
     return select_elements(_Shape, elements)
 
 
-def _blocked(cells: np.ndarray, block: int) -> np.ndarray:
-    """``cells`` (m, k) of nodes as (m, k * block) cells of dofs ``block i + c`` (node-major)."""
-    if block == 1:
-        return cells
-    cells = np.asarray(cells, dtype=np.int64)
-    return (cells[:, :, None] * block + np.arange(block)).reshape(len(cells), -1)
+def cell_entries(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Row and column of every local entry of ``cells`` (m, w), in slot order: entry
+    ``(e, w a + b)`` at ``e w^2 + w a + b``, row ``cells[e, a]``, column ``cells[e, b]``; int64.
 
-
-def cell_entries(cells: np.ndarray, block: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """Row and column of every local entry of ``cells`` (m, k) with ``block`` components per
-    dof (node-major: dof ``block i + c``), in slot order: entry ``(e, w a + b)`` at
-    ``e w^2 + w a + b`` (``w = block k``), row ``cells[e, a]``, column ``cells[e, b]`` of the blocked
-    cells; int64.
-
-    >>> [r.tolist() for r in cell_entries(np.array([[2]]), block=2)]
-    [[4, 4, 5, 5], [4, 5, 4, 5]]
+    >>> [r.tolist() for r in cell_entries(np.array([[2, 0]]))]
+    [[2, 2, 0, 0], [2, 0, 2, 0]]
     """
-    cells = _blocked(np.asarray(cells, dtype=np.int64), block)
+    cells = np.asarray(cells, dtype=np.int64)
     w = cells.shape[1]
     return np.repeat(cells, w, axis=1).ravel(), np.tile(cells, (1, w)).ravel()
 
