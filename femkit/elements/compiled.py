@@ -15,7 +15,7 @@ For element ``e`` with rest volume ``vol`` and shape-function gradients ``g_n``:
 ``F = sum_n x_n g_n^T``, energy ``vol psi(F)``, gradient ``vol P g_n`` on vertex ``n`` and Hessian
 ``vol sum_k lam_k w_k w_k^T`` with ``w_k[n, a] = (Q_k g_n)_a`` from the eigenpairs of ``dP/dF``
 (``lam_k`` clamped at zero when projecting). The Hessian values go straight into the CSR
-``data`` of a :class:`~femkit.solids.pattern.BlockPattern` through its node-pair slots; no
+``data`` of a :class:`~femkit.fem.sparsity.BlockPattern` through its node-pair slots; no
 Python loop over elements, no per-element matrices kept.
 
 Signed SVD
@@ -436,7 +436,7 @@ def _mode_vectors(lam, work, h, nn, v, project, w, wl, d):  # pragma: no cover -
 @numba.njit(cache=True, inline="always")
 def _scatter_blocks(data, cells, e, node_slots, node_indptr, B, d):  # pragma: no cover - compiled
     """Add element ``e``'s Hessian ``B`` (``(nv d)^2``, node-major) into the CSR ``data`` of a
-    :class:`~femkit.solids.pattern.BlockPattern`: the ``nv^2`` blocks ``d x d``, entry ``(n, a),
+    :class:`~femkit.fem.sparsity.BlockPattern`: the ``nv^2`` blocks ``d x d``, entry ``(n, a),
     (m, c)`` at ``d^2 r0 + (slot - r0) d + a row + c`` (``r0`` the node row's start, ``row`` its
     dof width). Shared by both element passes."""
     nv = cells.shape[1]

@@ -15,6 +15,15 @@ threshold on).
   so ``w = b * dofs per cell``); :func:`pattern_for` caches one per mesh, element and block
   (one component on a large mesh: built row by row from the dof map,
   :func:`femkit.fem._element_kernels.element_pattern_kernel`).
+- Node pairs as dense ``d x d`` blocks addressed by node-pair slots: :class:`BlockPattern` (an
+  elastic body's Hessian, :mod:`femkit.solids`), :func:`block_structure`, :func:`block_positions`.
+- The mass-spring matrices (:class:`femkit.dynamics.forces.jacobian.SpringPattern`,
+  :class:`femkit.dynamics.kernels.assembly.FreePattern`) from the same parts: the node pairs of
+  entry sets (springs as 2-node cells, :func:`cell_entries`; :func:`entry_pattern`) as blocks, a
+  force's fixed CSR structure joined by :func:`union_structures`, the held dofs dropped with a
+  slot map by :func:`restrict_structure` (the pattern of Dirichlet elimination's
+  ``K[free][:, free]``, whose values :func:`~femkit.fem.dirichlet.apply_dirichlet` moves in one
+  pass with the lifting).
 
 >>> import numpy as np
 >>> from femkit.mesh import Mesh
@@ -211,6 +220,48 @@ class SparsityPattern:
         return mat
 
 
+class BlockPattern:
+    """Dof-level CSR pattern of a vector matrix (a ``d x d`` block per node pair sharing a cell:
+    an elastic body's Hessian) and the node-pair slots of each cell.
+
+    The node-level pattern is :meth:`SparsityPattern.from_cells`'s, expanded by
+    :func:`block_structure`: the element pass needs only the node-pair slot map
+    ``node_slots (m, k^2)``, not a dof-level one (16x smaller for tetrahedra).
+
+    Parameters
+    ----------
+    cells : (m, k) int array: each element's nodes (``k = d + 1`` for P1, 6 or 10 for P2).
+    n : number of nodes.
+    dim : ``d``.
+
+    Attributes
+    ----------
+    node_indptr : (n+1,) int64, node-level CSR row pointer.
+    node_slots : (m, k^2) int64, node-level data position of entry ``(cells[e,p], cells[e,q])``
+        at ``p k + q``.
+    indptr, indices : the dof-level CSR structure (sorted columns; int32 when it fits).
+
+    >>> pat = BlockPattern(np.array([[0, 1, 2]]), 3, 2)
+    >>> pat.nnz, pat.shape
+    (36, (6, 6))
+    """
+
+    def __init__(self, cells: np.ndarray, n: int, dim: int):
+        node = SparsityPattern.from_cells(np.asarray(cells, dtype=np.int64), n)
+        self.node_indptr = node.indptr.astype(np.int64)
+        self.node_slots = np.ascontiguousarray(node.slots, dtype=np.int64)
+        self.n, self.dim, self.ndof = n, dim, n * dim
+        self.nnz = int(node.nnz * dim * dim)
+        self.indptr, self.indices = block_structure(node.indptr, node.indices, dim)
+        self.shape = (n * dim, n * dim)
+
+    def matrix(self, data: np.ndarray) -> sp.csr_matrix:
+        """The CSR matrix with these values (index arrays copied, so it owns them)."""
+        mat = sp.csr_matrix((data, self.indices.copy(), self.indptr.copy()), shape=self.shape)
+        mat.has_sorted_indices = True
+        return mat
+
+
 def pattern_for(mesh, dofs, block: int = 1) -> SparsityPattern:
     """The pattern of a dof map ``dofs`` (:func:`femkit.fem.dofs.dof_map`) on ``mesh`` with
     ``block`` components per dof, built on first use and cached while the mesh lives (P1 with
@@ -245,14 +296,161 @@ def _normalise(pattern: SparsityPattern, elements):
     return select_elements(_Shape, elements)
 
 
-def _pattern_numpy(tri: np.ndarray, n: int):
-    m, w = tri.shape
-    rows = np.repeat(tri, w, axis=1).ravel()  # (e, a, b) -> tri[e, a]
-    cols = np.tile(tri, (1, w)).ravel()  # (e, a, b) -> tri[e, b]
-    keys = rows * np.int64(n) + cols
-    uniq, inv = np.unique(keys, return_inverse=True)
-    indices = uniq % n
-    counts = np.bincount(uniq // n, minlength=n)
+def cell_entries(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Row and column of every local entry of ``cells`` (m, w), in slot order: entry
+    ``(e, w a + b)`` at ``e w^2 + w a + b``, row ``cells[e, a]``, column ``cells[e, b]``; int64.
+
+    >>> [r.tolist() for r in cell_entries(np.array([[2, 0]]))]
+    [[2, 2, 0, 0], [2, 0, 2, 0]]
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    w = cells.shape[1]
+    return np.repeat(cells, w, axis=1).ravel(), np.tile(cells, (1, w)).ravel()
+
+
+def structure_entries(indptr: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Row and column of every stored entry of a CSR structure, in storage order; int64."""
+    indptr = np.asarray(indptr, dtype=np.int64)
+    rows = np.repeat(np.arange(len(indptr) - 1, dtype=np.int64), np.diff(indptr))
+    return rows, np.asarray(indices, dtype=np.int64)
+
+
+def entry_pattern(rows: np.ndarray, cols: np.ndarray,
+                  n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The CSR pattern of the entries ``(rows[k], cols[k])`` among ``n`` dofs (repeats allowed)
+    and the slot of each entry in its ``data``.
+
+    Several entry sets (cells of different widths, :func:`cell_entries`; a CSR structure,
+    :func:`structure_entries`) share one pattern when their rows and columns are concatenated;
+    each set's slots are then its part of ``slots``.
+
+    Returns
+    -------
+    indptr, indices : int64, sorted columns.
+    slots : (len(rows),) int64.
+
+    >>> indptr, indices, slots = entry_pattern(np.array([0, 2, 0, 1]), np.array([2, 0, 2, 1]), 3)
+    >>> indptr.tolist(), indices.tolist(), slots.tolist()
+    ([0, 1, 2, 3], [2, 1, 0], [0, 2, 0, 1])
+    """
+    rows = np.asarray(rows, dtype=np.int64)
+    cols = np.asarray(cols, dtype=np.int64)
+    n = int(n)
+    uniq, inv = np.unique(rows * np.int64(n) + cols, return_inverse=True)
     indptr = np.zeros(n + 1, dtype=np.int64)
-    np.cumsum(counts, out=indptr[1:])
-    return indptr, indices, inv.reshape(m, w * w).astype(np.intp, copy=False)
+    if n:
+        np.cumsum(np.bincount(uniq // n, minlength=n), out=indptr[1:])
+    return indptr, (uniq % n if n else uniq), inv.reshape(-1)
+
+
+def block_structure(indptr: np.ndarray, indices: np.ndarray,
+                    block: int) -> tuple[np.ndarray, np.ndarray]:
+    """The dof-level CSR structure of a node-level pattern whose every entry is a dense
+    ``block x block`` block (dof ``block i + c``, node-major; columns sorted).
+
+    Row ``block r + p`` starts at ``block^2 indptr[r] + p block w_r`` (``w_r``: node columns of node
+    row ``r``) and the block of the node entry at position ``t`` of row ``r`` occupies its columns
+    ``(t - indptr[r]) block ..`` (:func:`block_positions`), so a node-pair slot map addresses the
+    dof-level ``data`` without a dof-level map.
+
+    >>> ip, ix = block_structure(np.array([0, 1, 3]), np.array([1, 0, 1]), 2)
+    >>> ip.tolist(), ix.tolist()
+    ([0, 2, 4, 8, 12], [2, 3, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3])
+    """
+    ip = np.asarray(indptr, dtype=np.int64)
+    d, n = int(block), len(ip) - 1
+    # node row r's dof columns, ascending, are seg[d ip[r] : d ip[r + 1]]; each of its d dof rows
+    # holds them all
+    seg = (np.asarray(indices, dtype=np.int64)[:, None] * d + np.arange(d)).ravel()
+    row_len = np.repeat(np.diff(ip) * d, d)
+    out = np.zeros(n * d + 1, dtype=np.int64)
+    np.cumsum(row_len, out=out[1:])
+    nnz = int(out[-1])
+    cols = seg[np.arange(nnz) - np.repeat(out[:-1] - np.repeat(d * ip[:-1], d), row_len)]
+    itype = np.int32 if nnz < np.iinfo(np.int32).max else np.int64
+    return out.astype(itype), cols.astype(itype)
+
+
+def block_positions(indptr: np.ndarray, node_slots: np.ndarray, node_rows: np.ndarray,
+                    block: int) -> np.ndarray:
+    """``(k, block^2)`` positions in the :func:`block_structure` ``data`` of entry ``(p, q)`` (at
+    ``p block + q``) of the blocks of node entries: ``node_slots`` their slots in the node-level
+    pattern ``indptr``, ``node_rows`` their node rows.
+
+    >>> block_positions(np.array([0, 1, 3]), np.array([2]), np.array([1]), 2).tolist()
+    [[6, 7, 10, 11]]
+    """
+    ip = np.asarray(indptr, dtype=np.int64)
+    d = int(block)
+    rows = np.asarray(node_rows, dtype=np.int64)
+    start = ip[rows]
+    base = d * d * start + (np.asarray(node_slots, dtype=np.int64) - start) * d
+    e = np.arange(d * d)
+    return base[:, None] + (e // d) * (d * (ip[rows + 1] - start))[:, None] + e % d
+
+
+def union_structures(structures, n: int) -> tuple[np.ndarray, np.ndarray, list]:
+    """The union of CSR structures ``[(indptr, indices), ...]`` (each ``n x n``, distinct columns
+    in each row) and, for each, the position of every one of its entries in the union's ``data``.
+
+    The entries are merged by a stable sort of their ``(row, column)`` keys: linear for
+    structures with sorted columns, whose keys are sorted runs; one structure (sorted) is its own
+    union.
+
+    Returns
+    -------
+    indptr, indices : int64, sorted columns.
+    positions : list of int64 arrays, one per structure, in its storage order.
+
+    >>> ip, ix, (p, q) = union_structures([(np.array([0, 1, 2]), np.array([0, 1])),
+    ...                                    (np.array([0, 1, 1]), np.array([1]))], 2)
+    >>> ip.tolist(), ix.tolist(), p.tolist(), q.tolist()
+    ([0, 2, 3], [0, 1, 1], [0, 2], [1])
+    """
+    n = int(n)
+    if len(structures) == 1:
+        indptr, indices = (np.asarray(a, dtype=np.int64) for a in structures[0])
+        return indptr, indices, [np.arange(len(indices))]
+    keys = [rows * np.int64(n) + cols for rows, cols in (structure_entries(*st) for st in structures)]
+    every = np.concatenate(keys)
+    order = np.argsort(every, kind="stable")
+    ordered = every[order]
+    first = np.ones(len(every), dtype=bool)
+    first[1:] = ordered[1:] != ordered[:-1]
+    where = np.empty(len(every), dtype=np.int64)
+    where[order] = np.cumsum(first) - 1
+    uniq = ordered[first]
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    if n:
+        np.cumsum(np.bincount(uniq // n, minlength=n), out=indptr[1:])
+    return indptr, (uniq % n if n else uniq), np.split(where, np.cumsum([len(k) for k in keys])[:-1])
+
+
+def restrict_structure(indptr: np.ndarray, indices: np.ndarray,
+                       keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A CSR structure restricted to the rows and columns ``keep`` (sorted), renumbered in order
+    (``keep[r]`` becomes ``r``: the free-dof matrix of a system with held dofs, the pattern of
+    Dirichlet elimination's ``K[free][:, free]``), and ``moved``: each old entry's position in the
+    restricted ``data``, -1 for an entry left out.
+
+    >>> ip, ix, moved = restrict_structure(np.array([0, 2, 3, 5]), np.array([0, 2, 1, 0, 2]), np.array([0, 2]))
+    >>> ip.tolist(), ix.tolist(), moved.tolist()
+    ([0, 2, 4], [0, 1, 0, 1], [0, 1, -1, 2, 3])
+    """
+    ip = np.asarray(indptr, dtype=np.int64)
+    n, nk = len(ip) - 1, len(keep)
+    renumber = np.full(n, -1, dtype=np.int64)
+    renumber[keep] = np.arange(nk)
+    rows = renumber[np.repeat(np.arange(n), np.diff(ip))]
+    cols = renumber[np.asarray(indices, dtype=np.int64)]
+    inside = (rows >= 0) & (cols >= 0)
+    moved = np.full(len(cols), -1, dtype=np.int64)
+    moved[inside] = np.arange(int(inside.sum()))
+    out = np.zeros(nk + 1, dtype=np.int64)
+    np.cumsum(np.bincount(rows[inside], minlength=nk), out=out[1:])
+    return out, cols[inside], moved
+
+
+def _pattern_numpy(cells: np.ndarray, n: int):
+    indptr, indices, slots = entry_pattern(*cell_entries(cells), n)
+    return indptr, indices, slots.reshape(len(cells), -1).astype(np.intp, copy=False)

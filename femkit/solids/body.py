@@ -2,7 +2,7 @@
 
 ``ElasticBody(points, cells, material)`` precomputes the rest data once
 (:func:`~femkit.solids.kinematics.rest_shape`) and, on the first Hessian, the CSR pattern
-(:class:`~femkit.solids.pattern.BlockPattern`); each evaluation is one compiled pass per material
+(:class:`~femkit.fem.sparsity.BlockPattern`); each evaluation is one compiled pass per material
 group (:mod:`femkit.elements.compiled`). Positions are node-major ``(n, d)`` arrays, the flat
 dof index ``i*d + a`` as in :mod:`femkit.dynamics`. With ``element="P2"`` the nodes are the
 mesh's vertices followed by its edge midpoints and every cell is evaluated at the points of a
@@ -137,7 +137,7 @@ class ElasticBody:
     def pattern(self):
         """The CSR pattern of the Hessian (built on first use, then kept)."""
         if self._pattern is None:
-            from .pattern import BlockPattern
+            from ..fem.sparsity import BlockPattern
 
             self._pattern = BlockPattern(self.rest.cells, self.n, self.dim)
         return self._pattern

@@ -119,43 +119,56 @@ def regularization_shift(n: int, i, j, length, rest, k, extra=None) -> float:
 class SpringPattern:
     """Sparsity pattern and scatter map of the spring matrices, computed once per topology.
 
-    The pattern holds the four ``d x d`` blocks of every spring plus the full diagonal
-    (so that ``M + h^2 K`` and ``K + mu I`` keep the same structure).
+    The pattern holds the four ``d x d`` blocks of every spring plus the full diagonal (so that
+    ``M + h^2 K`` and ``K + mu I`` keep the same structure), or with ``node_blocks`` every node's
+    full ``d x d`` diagonal block (so that nodal force matrices fit too). It is built by femkit's
+    one assembly stack, :mod:`femkit.fem.sparsity`: a spring is a 2-node cell of the node-level
+    pattern (:func:`~femkit.fem.sparsity.entry_pattern`), each node pair a ``d x d`` block
+    (:func:`~femkit.fem.sparsity.block_structure`).
 
     Parameters
     ----------
     n, dim : number of nodes and space dimension.
     i, j : (s,) spring ends.
+    node_blocks : every node's diagonal block, not only the diagonal.
+
+    Attributes
+    ----------
+    indptr, indices : int32 arrays of the CSR structure (sorted columns).
+    slots : (4, s, d*d) int64, the ``data`` position of entry ``p*d + q`` of each spring's blocks
+        ``(i, i)``, ``(j, j)``, ``(i, j)``, ``(j, i)``.
+    diag : (n*d,) int64, the ``data`` position of each diagonal entry.
 
     >>> p = SpringPattern(2, 1, np.array([0]), np.array([1]))
     >>> p.assemble(np.array([[[3.0]]])).toarray().tolist()
     [[3.0, -3.0], [-3.0, 3.0]]
     """
 
-    def __init__(self, n: int, dim: int, i: np.ndarray, j: np.ndarray):
-        d = dim
-        self.n, self.dim, self.ndof = n, d, n * d
-        a = np.arange(d)
-        # block entry (p, q): row node*d + p, col node*d + q, laid out like H.reshape(s, d*d)
-        rp = np.repeat(a, d)           # p for each of the d*d entries
-        cq = np.tile(a, d)             # q
-        ri = (i[:, None] * d + rp).ravel()
-        rj = (j[:, None] * d + rp).ravel()
-        ci = (i[:, None] * d + cq).ravel()
-        cj = (j[:, None] * d + cq).ravel()
-        diag = np.arange(self.ndof)
-        rows = np.concatenate([ri, rj, ri, rj, diag])
-        cols = np.concatenate([ci, cj, cj, ci, diag])
-        keys = rows.astype(np.int64) * self.ndof + cols
-        uniq, inv = np.unique(keys, return_inverse=True)
-        self._inv = inv.astype(np.intp)
-        self._nblock = 4 * len(ri)
-        self.nnz = len(uniq)
-        urows = uniq // self.ndof
-        self.indices = (uniq % self.ndof).astype(np.int32)
-        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(urows, minlength=self.ndof))]).astype(np.int32)
-        self._diag_pos = self._inv[self._nblock:]
-        self._zero_tail = np.zeros(self.ndof)
+    def __init__(self, n: int, dim: int, i: np.ndarray, j: np.ndarray, *, node_blocks: bool = False):
+        from ...fem.sparsity import (block_positions, block_structure, cell_entries, entry_pattern,
+                                     union_structures)
+
+        d, s, ndof = dim, len(i), n * dim
+        self.n, self.dim, self.ndof = n, d, ndof
+        rows, cols = cell_entries(np.stack([np.asarray(i), np.asarray(j)], axis=1))
+        if node_blocks:
+            rows, cols = np.concatenate([rows, np.arange(n)]), np.concatenate([cols, np.arange(n)])
+        node_indptr, node_indices, node_slots = entry_pattern(rows, cols, n)
+        indptr, indices = block_structure(node_indptr, node_indices, d)
+        at = block_positions(node_indptr, node_slots, rows, d)    # (4 s [+ n], d*d)
+        if node_blocks:
+            self.diag = at[4 * s:, np.arange(d) * (d + 1)].reshape(-1)
+        else:  # the diagonal joined in (a node without springs has no block)
+            indptr, indices, (moved, self.diag) = union_structures(
+                [(indptr, indices), (np.arange(ndof + 1), np.arange(ndof))], ndof)
+            at = moved[at]
+        self.indptr, self.indices = indptr.astype(np.int32), indices.astype(np.int32)
+        self.nnz = len(indices)
+        # a spring's node entries (a, b) come in cell order (0,0), (0,1), (1,0), (1,1)
+        self.slots = np.ascontiguousarray(at[:4 * s].reshape(s, 4, d * d)[:, [0, 3, 1, 2]]
+                                          .transpose(1, 0, 2))
+        self._inv = np.concatenate([self.slots.reshape(-1), self.diag]).astype(np.intp)
+        self._zero_tail = np.zeros(ndof)
 
     def assemble(self, blocks: np.ndarray, diagonal: np.ndarray | float | None = None) -> sp.csr_matrix:
         """CSR matrix from per-spring blocks ``(s, d, d)`` (+ an optional added diagonal)."""

@@ -1,18 +1,20 @@
 """The implicit methods' matrices assembled by one compiled pass into a cached pattern.
 
-:class:`FreePattern` is built once per system (topology and pinned set): the CSR pattern of the
-spring matrices (every spring's four ``d x d`` blocks plus the full diagonal, as
-:class:`~femkit.dynamics.forces.jacobian.SpringPattern`) restricted to the free dofs, and for every
-spring block entry its slot in that CSR ``data`` array (``-1`` where the row or column is
-pinned). A step then only writes values: :meth:`FreePattern.assemble` fills ``data`` with the
-diagonal, adds every spring's Hessian (with the definiteness fix) and dashpot blocks in one
-pass (:func:`~femkit.dynamics.kernels.spring_kernels.hessian_values`), and adds the declared
-forces' own matrices (contact stiffness, viscous damping: nodal blocks, inside the pattern) by a
-sorted merge, or -- a force with a fixed structure, an elastic solid's Hessian -- by a slot map
-built with the pattern. The pattern never changes, so the Cholesky factorisation reuses one symbolic
-analysis for the whole run (:meth:`femkit.solvers.cholesky.CholeskyFactor.refactor`); a force
-matrix with an entry outside the pattern is reported (``None``), and the caller falls back to the
-general path.
+:class:`FreePattern` is built once per system (topology and pinned set) by femkit's one assembly
+stack, :mod:`femkit.fem.sparsity`: the CSR pattern of the spring matrices (every spring's four
+``d x d`` blocks plus every node's diagonal block,
+:class:`~femkit.dynamics.forces.jacobian.SpringPattern` with ``node_blocks``) joined to the declared
+forces' fixed structures (:func:`~femkit.fem.sparsity.union_structures`) and restricted to the free
+dofs (:func:`~femkit.fem.sparsity.restrict_structure`), and for every spring block entry its slot in
+that CSR ``data`` array (``-1`` where the row or column is pinned). A step then only writes
+values: :meth:`FreePattern.assemble` fills ``data`` with the diagonal, adds every spring's Hessian
+(with the definiteness fix) and dashpot blocks in one pass
+(:func:`~femkit.dynamics.kernels.spring_kernels.hessian_values`), and adds the declared forces' own
+matrices (contact stiffness, viscous damping: nodal blocks, inside the pattern) by a sorted merge,
+or -- a force with a fixed structure, an elastic solid's Hessian -- by a slot map built with the
+pattern. The pattern never changes, so the Cholesky factorisation reuses one symbolic analysis for
+the whole run (:meth:`femkit.solvers.cholesky.CholeskyFactor.refactor`); a force matrix with an
+entry outside the pattern is reported (``None``), and the caller falls back to the general path.
 """
 
 from __future__ import annotations
@@ -44,45 +46,33 @@ class FreePattern:
     """
 
     def __init__(self, system):
-        d = system.dim
-        s = system.n_springs
-        ndof = system.ndof
+        from ...fem.sparsity import restrict_structure, union_structures
+        from ..forces.jacobian import SpringPattern
+
         free = system.free_dofs
-        nf = len(free)
-        a = np.arange(d)
-        rp, cq = np.repeat(a, d), np.tile(a, d)       # entry p*d + q of a block
-        i, j = system.springs[:, 0], system.springs[:, 1]
-        ri, rj = (i[:, None] * d + rp).ravel(), (j[:, None] * d + rp).ravel()
-        ci, cj = (i[:, None] * d + cq).ravel(), (j[:, None] * d + cq).ravel()
-        nodes = np.arange(system.n)
-        nr, nc = (nodes[:, None] * d + rp).ravel(), (nodes[:, None] * d + cq).ravel()
-        # declared forces with a fixed matrix structure (an elastic body's CSR pattern)
+        # the spring blocks and every node's diagonal block
+        springs = SpringPattern(system.n, system.dim, system._i, system._j, node_blocks=True)
+        # declared forces with a fixed matrix structure (an elastic body's CSR pattern), joined
+        # to the springs' (a merge of sorted keys), then the pattern on the free dofs
         structured = [(k, f.structure()) for k, f in enumerate(system.forces)]
         structured = [(k, st) for k, st in structured if st is not None]
-        sr = [np.repeat(np.arange(ndof), np.diff(st[0])) for _, st in structured]
-        sc = [np.asarray(st[1], dtype=np.int64) for _, st in structured]
-        fmap = np.full(ndof, -1, dtype=np.int64)
-        fmap[free] = np.arange(nf)
-        fr = fmap[np.concatenate([ri, rj, ri, rj, nr, *sr])]
-        fc = fmap[np.concatenate([ci, cj, cj, ci, nc, *sc])]
-        ok = (fr >= 0) & (fc >= 0)
-        uniq, inv = np.unique(fr[ok] * nf + fc[ok], return_inverse=True)
-        slot = np.full(fr.size, -1, dtype=np.int64)
-        slot[ok] = inv
-        self.slots = np.ascontiguousarray(slot[:4 * s * d * d].reshape(4, s, d * d))
+        indptr, indices, (in_union, *own) = union_structures(
+            [(springs.indptr, springs.indices), *(st for _, st in structured)], system.ndof)
+        indptr, indices, moved = restrict_structure(indptr, indices, free)
+        spring_moved = moved[in_union]
+        self.slots = spring_moved[springs.slots]
+        self.diag = spring_moved[springs.diag[free]]
         #: force index -> (entries of its structure inside the free pattern, their data slots)
         self.force_slots = {}
-        start = 4 * s * d * d + len(nr)
-        for (k, _), rows in zip(structured, sr):
-            part = slot[start:start + len(rows)]
+        for (k, _), at in zip(structured, own):
+            part = moved[at]
             inside = np.flatnonzero(part >= 0)
             self.force_slots[k] = (inside, part[inside])
-            start += len(rows)
-        self.diag = np.searchsorted(uniq, np.arange(nf, dtype=np.int64) * (nf + 1))
-        self.indices = (uniq % nf).astype(np.int32) if nf else np.zeros(0, np.int32)
-        counts = np.bincount(uniq // nf, minlength=nf) if nf else np.zeros(0, np.int64)
-        self.indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
-        self.nnz = len(uniq)
+        nf = len(free)
+        d = system.dim
+        self.indices = indices.astype(np.int32)
+        self.indptr = indptr.astype(np.int32)
+        self.nnz = len(indices)
         # the coordinate pair (p, q) -> p*d + q an entry couples (see entry_group)
         coord = free % d
         rows = np.repeat(np.arange(nf), np.diff(self.indptr))
@@ -90,7 +80,7 @@ class FreePattern:
         self.dim = d
         self.free = free
         self.shape = (nf, nf)
-        self.ndof = ndof
+        self.ndof = system.ndof
 
     @property
     def entry_group(self) -> np.ndarray:
