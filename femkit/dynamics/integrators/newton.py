@@ -47,16 +47,23 @@ once per step on the same pattern) and refactorised by CHOLMOD on the symbolic a
 first iteration (:meth:`femkit.solvers.session.LinearSession.solve_on_pattern`).
 
 Barrier contact (:class:`~femkit.dynamics.forces.BarrierContact`, IPC: Li et al. 2020): a
-system with a force that ``requires_bounded_steps`` is run the IPC way -- each step starts from
-``x_n`` (``y`` may lie past a contact) after the forces' ``begin_step`` (the barrier stiffness,
-lagged friction, moving obstacles moved as far as CCD allows); every line search starts from
-``t_max = min(1, step_bound)``, the
-collision-free step size of CCD, so no iterate ever crosses a surface; after each iteration
+system with a force that ``requires_bounded_steps`` is run the IPC way -- after the forces'
+``begin_step`` (the barrier stiffness, lagged friction, moving obstacles moved as far as CCD
+allows) each step starts from ``x_n`` moved towards the inertial prediction ``y`` as far as CCD
+allows, when that lowers the objective (``y`` itself may lie past a contact), else from ``x_n``;
+every line search starts from ``t_max = min(1, step_bound)``, the
+collision-free step size of CCD, so no iterate ever crosses a surface; a full step along which
+the objective still falls almost linearly (a fold collapsing, which the clamped spring Hessian
+sees far too stiff) is extended to the minimum of the quadratic through the objective's value,
+slope and value at the full step, at most 8 steps and bounded by CCD again; after each iteration
 ``end_iteration`` may raise the barrier stiffness (the objective is then re-evaluated);
 convergence is judged on the Newton direction ``||dx||_inf`` (a short CCD-bounded step is no
 sign of convergence); and the step is solved again while ``advance`` moves a prescribed-motion
 obstacle on towards its place at the step's end, then while ``relag`` asks for another friction
-lagging iteration. ``keeps_contact = True`` declares it (the trait the other integrators lack).
+lagging iteration. ``keeps_contact = True`` declares it (the trait the other integrators lack). A contact Hessian
+couples any two surface nodes, outside the compiled pattern of the ``cholesky`` path, so a contact
+system's Newton matrix is assembled generally and factorised by the spec's method (``direct``, or
+``cholesky`` with any engine: symbolic analysis reused while the pattern holds, CHOLMOD's cache).
 
 First order; unconditionally stable.
 """
