@@ -46,8 +46,8 @@ def run(n: int, steps: int, contact: bool, tmp: Path, penalty: float = 0.0,
 
     data = yaml.safe_load(SCENE.read_text())
     data["system"].update(nx=n, ny=n)
-    if solver == "cholespy":
-        data["linear_solver"] = {"method": "cholesky", "options": {"engine": "cholespy"}}
+    if solver != "direct":
+        data["linear_solver"] = {"method": "cholesky", "options": {"engine": solver}}
     if not contact:
         data.pop("contact")
     else:
@@ -94,8 +94,8 @@ def main() -> None:
                     help="stiffness of the penalty run's sphere and ground")
     ap.add_argument("--ccd", default="tight_inclusion", choices=["tight_inclusion", "additive"],
                     help="the contact run's narrow-phase CCD (contact.ccd)")
-    ap.add_argument("--solver", default="direct", choices=["direct", "cholespy"],
-                    help="every run's Newton factorisation: SuperLU or CHOLMOD (cholespy wheel)")
+    ap.add_argument("--solver", default="direct", choices=["direct", "cholespy", "cholmod"],
+                    help="every run's Newton factorisation: SuperLU or CHOLMOD (the cholespy wheel, or scikit-sparse)")
     args = ap.parse_args()
     import ipctk
 

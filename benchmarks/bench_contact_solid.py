@@ -82,8 +82,8 @@ def run(cells, steps: int, contact: bool, solver: str = "direct") -> dict:
     system, force, n_cells = build(cells, contact)
     dt = 0.01
     integ = get_integrator("newton", tol=1e-2 * dt, max_iterations=60)
-    ctx = StepContext(SolverSpec("cholesky", options={"engine": "cholespy"}) if solver == "cholespy"
-                      else SolverSpec("direct"))
+    ctx = StepContext(SolverSpec("direct") if solver == "direct"
+                      else SolverSpec("cholesky", options={"engine": solver}))
     st = integ.start(system, system.x0, system.v0, 0.0, dt, ctx)
     cpu, wall, checked, active = [], [], 0, []
     with warnings.catch_warnings():
@@ -114,8 +114,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cells", type=int, nargs=3, default=[371, 3, 3], metavar=("NX", "NY", "NZ"))
     ap.add_argument("--steps", type=int, default=4)
-    ap.add_argument("--solver", default="direct", choices=["direct", "cholespy"],
-                    help="the Newton systems' factorisation: SuperLU or CHOLMOD (cholespy wheel)")
+    ap.add_argument("--solver", default="direct", choices=["direct", "cholespy", "cholmod"],
+                    help="the Newton systems' factorisation: SuperLU or CHOLMOD (the cholespy wheel, or scikit-sparse)")
     args = ap.parse_args()
     import ipctk
 
