@@ -35,7 +35,7 @@ SCENE = Path(__file__).resolve().parents[1] / "cases" / "scenes" / "cloth_on_sph
 
 
 def run(n: int, steps: int, contact: bool, tmp: Path, penalty: float = 0.0,
-        ccd: str = "tight_inclusion") -> dict:
+        ccd: str = "tight_inclusion", solver: str = "direct") -> dict:
     """Seconds per step after the first contact, Newton iterations and (contact) the split;
     ``penalty > 0`` (with ``contact=False``): the sphere and the ground as penalty forces of
     that stiffness instead (the same draping without barrier or CCD)."""
@@ -46,6 +46,8 @@ def run(n: int, steps: int, contact: bool, tmp: Path, penalty: float = 0.0,
 
     data = yaml.safe_load(SCENE.read_text())
     data["system"].update(nx=n, ny=n)
+    if solver != "direct":
+        data["linear_solver"] = {"method": "cholesky", "options": {"engine": solver}}
     if not contact:
         data.pop("contact")
     else:
@@ -92,6 +94,8 @@ def main() -> None:
                     help="stiffness of the penalty run's sphere and ground")
     ap.add_argument("--ccd", default="tight_inclusion", choices=["tight_inclusion", "additive"],
                     help="the contact run's narrow-phase CCD (contact.ccd)")
+    ap.add_argument("--solver", default="direct", choices=["direct", "cholespy", "cholmod"],
+                    help="every run's Newton factorisation: SuperLU or CHOLMOD (the cholespy wheel, or scikit-sparse)")
     args = ap.parse_args()
     import ipctk
 
@@ -100,11 +104,11 @@ def main() -> None:
     ipctk.set_num_threads(1)   # CPU seconds of one thread, as the contact-free step
     BarrierModel.clock = staticmethod(time.process_time)
     with tempfile.TemporaryDirectory() as tmp:
-        free = run(args.n, args.steps, False, Path(tmp))
-        pen = run(args.n, args.steps, False, Path(tmp), penalty=args.penalty)
-        con = run(args.n, args.steps, True, Path(tmp), ccd=args.ccd)
+        free = run(args.n, args.steps, False, Path(tmp), solver=args.solver)
+        pen = run(args.n, args.steps, False, Path(tmp), penalty=args.penalty, solver=args.solver)
+        con = run(args.n, args.steps, True, Path(tmp), ccd=args.ccd, solver=args.solver)
     print(f"cloth {args.n} x {args.n}, {args.steps} steps, measured from the first contact; "
-          f"CCD {args.ccd}")
+          f"CCD {args.ccd}, solver {args.solver}")
     for name, r in (("contact-free", free), ("penalty contact", pen), ("barrier contact", con)):
         print(f"  {name:16s} {1e3 * r['per_step']:9.1f} ms/step, {r['iterations']:5.1f} Newton "
               f"iterations/step ({r['steps_measured']} steps; wall {1e3 * r['wall']:.1f} ms/step)")

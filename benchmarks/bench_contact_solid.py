@@ -74,7 +74,7 @@ def build(cells, contact: bool):
     return system, force, len(T)
 
 
-def run(cells, steps: int, contact: bool) -> dict:
+def run(cells, steps: int, contact: bool, solver: str = "direct") -> dict:
     """CPU and wall seconds per step, Newton iterations, (contact) the split and the checks."""
     from femkit.dynamics.integrators import StepContext, get_integrator
     from femkit.solvers.spec import SolverSpec
@@ -82,7 +82,8 @@ def run(cells, steps: int, contact: bool) -> dict:
     system, force, n_cells = build(cells, contact)
     dt = 0.01
     integ = get_integrator("newton", tol=1e-2 * dt, max_iterations=60)
-    ctx = StepContext(SolverSpec("direct"))
+    ctx = StepContext(SolverSpec("direct") if solver == "direct"
+                      else SolverSpec("cholesky", options={"engine": solver}))
     st = integ.start(system, system.x0, system.v0, 0.0, dt, ctx)
     cpu, wall, checked, active = [], [], 0, []
     with warnings.catch_warnings():
@@ -113,6 +114,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cells", type=int, nargs=3, default=[371, 3, 3], metavar=("NX", "NY", "NZ"))
     ap.add_argument("--steps", type=int, default=4)
+    ap.add_argument("--solver", default="direct", choices=["direct", "cholespy", "cholmod"],
+                    help="the Newton systems' factorisation: SuperLU or CHOLMOD (the cholespy wheel, or scikit-sparse)")
     args = ap.parse_args()
     import ipctk
 
@@ -120,11 +123,12 @@ def main() -> None:
 
     ipctk.set_num_threads(1)   # CPU seconds of one thread, as the contact-free step
     BarrierModel.clock = staticmethod(time.process_time)
-    free = run(args.cells, args.steps, False)
-    con = run(args.cells, args.steps, True)
+    free = run(args.cells, args.steps, False, args.solver)
+    con = run(args.cells, args.steps, True, args.solver)
     print(f"coil of {' x '.join(map(str, args.cells))} cubes: {con['cells']:,} tetrahedra, "
           f"{con['dofs']:,} dofs, {con['surface']:,} surface triangles; {args.steps} steps of 0.01 "
-          "timed after an untimed first")
+          ""
+          f"timed after an untimed first; solver {args.solver}")
     for name, r in (("contact-free", free), ("barrier contact", con)):
         late = f", {r['unconverged']} unconverged" if r["unconverged"] else ""
         print(f"  {name:16s} {r['cpu']:7.2f} s/step CPU ({1 / r['cpu']:.3f} steps/s; wall "

@@ -241,3 +241,68 @@ def test_additive_ccd_keeps_a_fast_cube_off_the_plane():
     assert f.model.ccd_method == "additive"
     assert min(fr.x[:, 2].min() for fr in frames) > 0.0
     assert frames[-1].v[:, 2].mean() > -1.0          # stopped (or thrown back) by the plane
+
+
+def test_two_bodies_in_contact_run_on_the_cholesky_solver_as_on_superlu():
+    # their contact Hessian couples nodes of both bodies, outside the compiled pattern of the
+    # cholesky path (which refused it): a contact system assembles generally on every solver
+    pytest.importorskip("cholespy", reason="cholespy is not installed: pip install -e '.[fast]'")
+    from femkit.solvers.spec import SolverSpec
+
+    a, b = cube(1, 0.2, (0.0, 0.0, 0.0)), cube(1, 0.2, (0.21, 0.03, 0.02))
+    P, T, (ra, rb) = merged(a, b)
+    v0 = np.zeros_like(P)
+    v0[ra, 0], v0[rb, 0] = 1.0, -1.0
+    runs = []
+    for spec in (SolverSpec("direct"), SolverSpec("cholesky", options={"engine": "cholespy"})):
+        s = elastic_system(_body(P, T), forces=[BarrierContact(body_surface(T, 3))], v0=v0)
+        integ, ctx = INTEGRATORS.get("newton")(tol=1e-8), StepContext(spec)
+        st = integ.start(s, s.x0, s.v0, 0.0, 2e-3, ctx)
+        model = next(g for g in s.forces if isinstance(g, BarrierContact)).model
+        for _ in range(8):
+            st = integ.step(s, st, 2e-3, ctx)
+            assert model.intersections(st.x) == 0
+        assert model.active(st.x) > 0                              # they touch
+        runs.append(st.x)
+    assert np.abs(runs[1] - runs[0]).max() <= 1e-9
+
+
+class _Bound:
+    """A force whose CCD allows this fraction of any move (the newton step's only other input)."""
+
+    def __init__(self, fraction):
+        self.fraction, self.moves = fraction, []
+
+    def step_bound(self, x0, x1):
+        self.moves.append(np.abs(x1 - x0).max())
+        return self.fraction
+
+
+def test_a_full_contact_step_on_a_linear_stretch_is_extended_as_far_as_ccd_allows():
+    from femkit.dynamics.integrators.newton import EXTRAPOLATE_MAX
+
+    integ = INTEGRATORS.get("newton")()
+    x, dx = np.zeros(3), np.array([1.0, 0.0, 0.0])
+    g = lambda z: (-z[0], 0.0)                        # falls linearly along dx: no minimum near
+    slope, (g1, _) = -1.0, g(x + dx)
+    for fraction, far in ((1.0, EXTRAPOLATE_MAX), (0.25, 0.25 * EXTRAPOLATE_MAX)):
+        f = _Bound(fraction)
+        t, x_t, g_t, _ = integ._extrapolate(g, [f], (3,), x, dx, slope, 0.0, 1.0, x + dx, g1, 0.0)
+        assert t == pytest.approx(far) and x_t[0] == pytest.approx(far) and g_t < g1
+        assert f.moves == [pytest.approx(EXTRAPOLATE_MAX)]     # CCD over the extended move
+    # a quadratic the full step already minimises (decrease 1/2 of the linear model's): kept
+    q = lambda z: (0.5 * z[0] ** 2 - z[0], 0.0)
+    f = _Bound(1.0)
+    t, *_ = integ._extrapolate(q, [f], (3,), x, dx, -1.0, 0.0, 1.0, x + dx, -0.5, 0.0)
+    assert t == 1.0 and f.moves == []
+
+
+def test_a_contact_step_starts_towards_the_inertial_prediction_as_far_as_ccd_allows():
+    integ = INTEGRATORS.get("newton")()
+    xn, y = np.zeros(3), np.array([2.0, 0.0, 0.0])
+    down = lambda z: (-z[0], 0.0)                     # lower towards y: start at CCD's bound
+    x, gx, _ = integ._warm_start(down, [_Bound(0.25)], (3,), xn, y)
+    assert x[0] == pytest.approx(0.5) and gx == pytest.approx(-0.5)
+    up = lambda z: (z[0], 0.0)                        # higher there: start where the step began
+    x, gx, _ = integ._warm_start(up, [_Bound(1.0)], (3,), xn, y)
+    assert np.array_equal(x, xn) and gx == 0.0

@@ -47,16 +47,23 @@ once per step on the same pattern) and refactorised by CHOLMOD on the symbolic a
 first iteration (:meth:`femkit.solvers.session.LinearSession.solve_on_pattern`).
 
 Barrier contact (:class:`~femkit.dynamics.forces.BarrierContact`, IPC: Li et al. 2020): a
-system with a force that ``requires_bounded_steps`` is run the IPC way -- each step starts from
-``x_n`` (``y`` may lie past a contact) after the forces' ``begin_step`` (the barrier stiffness,
-lagged friction, moving obstacles moved as far as CCD allows); every line search starts from
-``t_max = min(1, step_bound)``, the
-collision-free step size of CCD, so no iterate ever crosses a surface; after each iteration
+system with a force that ``requires_bounded_steps`` is run the IPC way -- after the forces'
+``begin_step`` (the barrier stiffness, lagged friction, moving obstacles moved as far as CCD
+allows) each step starts from ``x_n`` moved towards the inertial prediction ``y`` as far as CCD
+allows, when that lowers the objective (``y`` itself may lie past a contact), else from ``x_n``;
+every line search starts from ``t_max = min(1, step_bound)``, the
+collision-free step size of CCD, so no iterate ever crosses a surface; a full step along which
+the objective still falls almost linearly (a fold collapsing, which the clamped spring Hessian
+sees far too stiff) is extended to the minimum of the quadratic through the objective's value,
+slope and value at the full step, at most 8 steps and bounded by CCD again; after each iteration
 ``end_iteration`` may raise the barrier stiffness (the objective is then re-evaluated);
 convergence is judged on the Newton direction ``||dx||_inf`` (a short CCD-bounded step is no
 sign of convergence); and the step is solved again while ``advance`` moves a prescribed-motion
 obstacle on towards its place at the step's end, then while ``relag`` asks for another friction
-lagging iteration. ``keeps_contact = True`` declares it (the trait the other integrators lack).
+lagging iteration. ``keeps_contact = True`` declares it (the trait the other integrators lack). A contact Hessian
+couples any two surface nodes, outside the compiled pattern of the ``cholesky`` path, so a contact
+system's Newton matrix is assembled generally and factorised by the spec's method (``direct``, or
+``cholesky`` with any engine: symbolic analysis reused while the pattern holds, CHOLMOD's cache).
 
 First order; unconditionally stable.
 """
@@ -142,7 +149,12 @@ class NewtonImplicitEuler(Integrator):
         xn = state.x.reshape(-1)
         M = system.mass_matrix()
         m = M.diagonal()
-        compiled = ctx.session.factors_on_pattern and not self.matrix_free
+        forces = system.forces
+        bounded = any(f.requires_bounded_steps for f in forces)
+        # the compiled pattern holds the springs' and nodal blocks; a contact Hessian couples
+        # any two surface nodes, so contact systems assemble generally (and factorise by the
+        # spec's method, the cholesky engines included)
+        compiled = ctx.session.factors_on_pattern and not self.matrix_free and not bounded
         if self.matrix_free:
             C = self.damping_operator(system, state.x)
             c_apply = C[0]
@@ -198,13 +210,12 @@ class NewtonImplicitEuler(Integrator):
 
         x = y.copy()
         x[~_free_mask(free, xn.size)] = xn[~_free_mask(free, xn.size)]
-        forces = system.forces
-        bounded = any(f.requires_bounded_steps for f in forces)
         if bounded:  # start where the step began: y may lie past a contact
-            x = xn.copy()
             for f in forces:
                 f.begin_step(state.x, h, gradient, t=state.t)
-        gx, noise = g(x)
+            x, gx, noise = self._warm_start(g, forces, shape, xn, x)
+        else:
+            gx, noise = g(x)
         residuals = []
         iterations = 0
         while True:  # once, or once per friction lagging iteration
@@ -234,6 +245,10 @@ class NewtonImplicitEuler(Integrator):
                 t, x_try, g_try, noise_try = self._line_search(
                     g, gradient, x, dx, grad, gx, noise, t_max, free, residuals, state, h,
                     iterations)
+                if bounded and t >= 1.0:
+                    t, x_try, g_try, noise_try = self._extrapolate(
+                        g, forces, shape, x, dx, grad[free] @ dx[free], gx, t, x_try, g_try,
+                        noise_try)
                 # with contact the Newton direction decides (IPC): a CCD-bounded t is no sign
                 # of convergence
                 step_size = (1.0 if bounded else t) * np.abs(dx).max(initial=0.0)
@@ -290,6 +305,42 @@ class NewtonImplicitEuler(Integrator):
             self._fail(state, h, iterations, residuals, "the objective is not finite")
         return t, x_try, g_try, noise_try
 
+    def _warm_start(self, g, forces, shape, xn, y):
+        """IPC's start of a contact step: from ``x_n`` towards the inertial prediction ``y``
+        (``x_n + h v_n`` on the free dofs) as far as CCD allows, when that lowers the
+        objective; else ``x_n``. Returns ``(x, g(x), its round-off level)``."""
+        gx, noise = g(xn)
+        t = min([1.0] + [f.step_bound(xn.reshape(shape), y.reshape(shape)) for f in forces])
+        if t <= 0.0:
+            return xn.copy(), gx, noise
+        x = xn + t * (y - xn)
+        g_try, noise_try = g(x)
+        if np.isfinite(g_try) and g_try < gx:
+            return x, g_try, noise_try
+        return xn.copy(), gx, noise
+
+    def _extrapolate(self, g, forces, shape, x, dx, slope, gx, t, x_try, g_try, noise_try):
+        """A full step accepted with the objective still falling almost linearly along ``dx``
+        (the decrease at least :data:`EXTRAPOLATE_RATIO` of ``t * slope``: the modified Newton
+        matrix, its spring blocks clamped, is far stiffer along ``dx`` than the objective -- a
+        fold collapsing) is extended to the minimum of the quadratic through ``g(x)``, the slope
+        and ``g(x + dx)``, at most :data:`EXTRAPOLATE_MAX` ``dx`` and bounded by CCD as every
+        step is; kept when it lowers the objective further and passes Armijo's test.
+        Returns ``(t, x_try, g_try, noise_try)``, the full step's when not extended."""
+        if not slope < 0.0 or (g_try - gx) > EXTRAPOLATE_RATIO * t * slope:
+            return t, x_try, g_try, noise_try
+        curvature = 2.0 * (g_try - gx - t * slope) / (t * t)   # of g(x + s dx) in s
+        far = EXTRAPOLATE_MAX if curvature <= 0.0 else min(-slope / curvature, EXTRAPOLATE_MAX)
+        far *= min([1.0] + [f.step_bound(x.reshape(shape), (x + far * dx).reshape(shape))
+                            for f in forces])
+        if far <= t:
+            return t, x_try, g_try, noise_try
+        x_far = x + far * dx
+        g_far, noise_far = g(x_far)
+        if np.isfinite(g_far) and g_far < g_try and g_far <= gx + self.armijo * far * slope:
+            return far, x_far, g_far, noise_far
+        return t, x_try, g_try, noise_try
+
     def _fail(self, state: StepperState, h: float, iterations: int, residuals: list,
               why: str) -> None:
         raise NewtonStepError(
@@ -306,6 +357,11 @@ class NewtonImplicitEuler(Integrator):
 #: :mod:`femkit.solids.static`): near the minimum the objective stops changing above its
 #: rounding while the gradient is still far from it.
 _ROUNDOFF = 64 * np.finfo(float).eps
+#: With contact, a full step whose objective decrease is at least this fraction of the linear
+#: model's (a quadratic model's would be 1/2) is extended (:meth:`NewtonImplicitEuler._extrapolate`).
+EXTRAPOLATE_RATIO = 0.75
+#: ... to at most this many Newton steps.
+EXTRAPOLATE_MAX = 8.0
 
 
 def _free_mask(free: np.ndarray, ndof: int) -> np.ndarray:
