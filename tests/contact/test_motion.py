@@ -84,6 +84,46 @@ def test_a_turning_paddle_sweeps_a_block_along_without_passing_through_it():
     assert frames[-1].v[:, 0].mean() > 0.15          # ... and moving with the paddle (0.3 m/s)
 
 
+def test_a_fast_paddle_strikes_a_resting_block_in_a_few_moves_a_step():
+    # the paddle of the test above at 3 rad/s (0.9 m/s at the block, 9 mm a step: ~50 dhat at
+    # the default dhat): moved alone, each CCD-bounded move gained only a fraction of the
+    # barrier's gap and the first step at the block took more than the 200-move cap; the block
+    # carried along with the paddle where it touches, the step takes a few moves
+    P, T = cube(1, 0.1, (0.01, -0.05, 0.05))
+    paddle = replace(plane_obstacle([0.0, 0.0, 0.1], [1, 0, 0], 0.3, 3),
+                     motion=Motion(angular_velocity=np.array([0.0, 0.0, -3.0]),
+                                   pivot=np.array([0.0, -0.3, 0.1])))
+    force = BarrierContact(body_surface(T, 3), [paddle])
+    s = elastic_system(_body(P, T), forces=[force])
+    frames, f = _run(s, 6, 0.01, tol=1e-6)    # _run: no intersection, distance > 0, each frame
+    assert f.model.stats["carries"] > 0
+    assert f.model.stats["obstacle_moves"] <= 4 * 6
+    for fr in frames[1:]:                     # on the paddle's front side
+        n = np.array([np.cos(3.0 * fr.t), -np.sin(3.0 * fr.t), 0.0])
+        assert ((fr.x - [0.0, -0.3, 0.1]) @ n).min() > 0.0
+    assert frames[-1].v[:, 0].mean() > 0.5       # swept along (0.9 m/s at the block)
+
+
+def test_a_rising_ball_lifts_a_cloth_lying_on_it_in_a_few_moves_a_step():
+    # a ball rising at 1 m/s under a 7 x 7 cloth (1 cm a step, ~35 dhat): the cloth is carried
+    # up with it, each step in a few obstacle moves (the ball alone: ~50 moves a step)
+    from femkit.contact import sphere_obstacle
+    from femkit.dynamics.topology import cloth_grid
+    from femkit.mesh import grid_triangles
+
+    ball = replace(sphere_obstacle([0.0, 0.0, -0.05], 0.05, 3, level=2),
+                   motion=Motion(velocity=np.array([0.0, 0.0, 1.0])))
+    force = BarrierContact(grid_triangles(7, 7), [ball])
+    s = cloth_grid(7, 7, 0.2, 0.2, k_structural=200.0, k_shear=50.0, k_bending=0.5,
+                   total_mass=0.02, pinned="none", plane="xy", origin=[-0.1, -0.1, 5e-4],
+                   forces=[Gravity(9.81), force])
+    frames, f = _run(s, 4, 0.01, tol=1e-6)
+    assert f.model.stats["obstacle_moves"] <= 4 * 4
+    for fr in frames[1:]:
+        top = fr.t * 1.0                          # the ball's top
+        assert top < fr.x[24, 2] < top + 0.01     # the cloth's centre node on it
+
+
 def test_friction_drags_a_block_on_a_turntable_to_its_velocity():
     # a block resting at radius r on a plane turning at omega about the z axis, mu 0.5: friction
     # (mu g = 4.9 m/s^2 > omega^2 r = 1.0 m/s^2 centripetal) brings it to omega r = 0.5 m/s

@@ -56,6 +56,7 @@ class BarrierContact(Force):
         self.model = BarrierModel(system.x0, self.surface, self.obstacles, **self.options)
         self._mask = ~system.pinned_dofs
         self._lags_left = 0
+        self._pieces = None
 
     def add_force(self, x, v, t, out) -> None:
         out -= self.model.gradient(x) * self._mask
@@ -95,8 +96,32 @@ class BarrierContact(Force):
 
     def advance(self, x) -> bool:
         """Moving obstacles moved on towards their step's end place (CCD-bounded, the bodies at
-        ``x``); True when they moved."""
-        return self.model.advance(x)
+        ``x``), the bodies' pieces touching one carried along with it when that goes farther
+        (``x``, the integrator's iterate ``(n, d)``, written in place; pinned pieces never);
+        True when they moved."""
+        return self.model.advance(x, self.pieces())
+
+    def pieces(self) -> np.ndarray:
+        """The connected piece of every node (springs and the other forces' stiffness
+        couplings at the rest place), ``-1`` on a piece with a pinned dof; computed once."""
+        if self._pieces is None:
+            import scipy.sparse as sp
+            from scipy.sparse.csgraph import connected_components
+
+            s = self._system
+            rows, cols = [s._i], [s._j]
+            for f in s.forces:
+                K = None if f is self else f.stiffness(s.x0)
+                if K is not None:
+                    K = sp.coo_matrix(K)
+                    rows.append(K.row // s.dim)
+                    cols.append(K.col // s.dim)
+            r, c = np.concatenate(rows), np.concatenate(cols)
+            graph = sp.coo_matrix((np.ones(len(r)), (r, c)), shape=(s.n, s.n))
+            pieces = connected_components(graph, directed=False)[1]
+            held = np.unique(pieces[(~self._mask).reshape(s.n, -1).any(axis=1)])
+            self._pieces = np.where(np.isin(pieces, held), -1, pieces)
+        return self._pieces
 
     def relag(self, x_start, x, h: float) -> bool:
         """Another lagging iteration: friction re-frozen at the step's solution ``x``; False
