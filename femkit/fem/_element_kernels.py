@@ -26,7 +26,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ._kernels import _cell_gradients, _insert_sorted, _vertex_starts
+from ._kernels import _cell_gradients, _element_scale, _insert_sorted, _vertex_starts
 from .cells.kernels import _tetrahedron, _triangle
 
 
@@ -187,20 +187,33 @@ def _cell_metric(cells, points, kappa, scalar_kappa):  # pragma: no cover - comp
     """The symmetric metric of every cell, ``k_ab = kappa |T| grad lambda_a . grad lambda_b`` for
     the vertices ``1 <= a <= b <= d`` (row by row: 3 products on a triangle, 6 on a tetrahedron;
     ``lambda_0 = 1 - sum`` needs none of its own), (m, P), and the number of degenerate cells
-    (their rows zero)."""
+    (their rows zero). A triangle's from its edges (``e_a`` opposite vertex ``a``:
+    ``k_ab = kappa e_a . e_b / (4 |T|)``), a tetrahedron's from its scaled face normals."""
     m = cells.shape[0]
-    nv = 3 if points.shape[1] == 2 else 4
-    k = np.zeros((m, ((nv - 1) * nv) // 2))
+    if points.shape[1] == 2:
+        k = np.zeros((m, 3))
+        bad = 0
+        for e in range(m):
+            _, _, _, _, _, ex1, ey1, ex2, ey2, area = _triangle(cells, points, e)
+            ok, s = _element_scale(area, 4.0, kappa, scalar_kappa, e)
+            if not ok:
+                bad += 1
+                continue
+            k[e, 0] = s * (ex1 * ex1 + ey1 * ey1)
+            k[e, 1] = s * (ex1 * ex2 + ey1 * ey2)
+            k[e, 2] = s * (ex2 * ex2 + ey2 * ey2)
+        return k, bad
+    k = np.zeros((m, 6))
     g = np.zeros((4, 3))
     bad = 0
     for e in range(m):
-        ok, s = _cell_gradients(cells, points, e, nv, kappa, scalar_kappa, g)
+        ok, s = _cell_gradients(cells, points, e, 4, kappa, scalar_kappa, g)
         if not ok:
             bad += 1
             continue
         p = 0
-        for a in range(1, nv):
-            for b in range(a, nv):
+        for a in range(1, 4):
+            for b in range(a, 4):
                 k[e, p] = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
                 p += 1
     return k, bad
@@ -262,17 +275,31 @@ def first_stiffness(mesh, dofs, kappa, table: np.ndarray):
 @numba.njit(cache=True)
 def _quadrature_coordinates(cells, points, bary):  # pragma: no cover - compiled
     """(d, m, q) coordinates of the barycentric points ``bary`` (q, d + 1) on each cell (its
-    first d + 1 columns the vertices), summed vertex by vertex in order."""
+    first d + 1 columns the vertices), summed vertex by vertex in order (compiled with the
+    vertex count a constant: 3, 4)."""
+    if bary.shape[1] == 3:
+        return _coordinates(cells, points, bary, 3)
+    if bary.shape[1] == 4:
+        return _coordinates(cells, points, bary, 4)
+    return _coordinates(cells, points, bary, bary.shape[1])
+
+
+@numba.njit(cache=True, inline="always")
+def _coordinates(cells, points, bary, nv):  # pragma: no cover - compiled
+    """The body of :func:`_quadrature_coordinates` for ``nv`` vertices per cell."""
     m = cells.shape[0]
     d = points.shape[1]
-    nq, nv = bary.shape
+    nq = bary.shape[0]
     out = np.empty((d, m, nq))
+    x = np.empty(nv)                        # one coordinate of the cell's vertices, read once
     for e in range(m):
         for c in range(d):
+            for a in range(nv):
+                x[a] = points[cells[e, a], c]
             for p in range(nq):
-                acc = points[cells[e, 0], c] * bary[p, 0]
+                acc = x[0] * bary[p, 0]
                 for a in range(1, nv):
-                    acc += points[cells[e, a], c] * bary[p, a]
+                    acc += x[a] * bary[p, a]
                 out[c, e, p] = acc
     return out
 
@@ -280,8 +307,19 @@ def _quadrature_coordinates(cells, points, bary):  # pragma: no cover - compiled
 @numba.njit(cache=True)
 def _element_load(cells, points, fq, wphi, F):  # pragma: no cover - compiled
     """``F_i += sum_cells |T| sum_q fq[e, q] wphi[q, a]`` over the dof map ``cells`` (m, w) (a
-    block of cells); returns the number of degenerate cells."""
-    m, w = cells.shape
+    block of cells); returns the number of degenerate cells (compiled with ``w`` a constant for
+    P2: 6, 10)."""
+    if cells.shape[1] == 6:
+        return _load_cells(cells, points, fq, wphi, F, 6)
+    if cells.shape[1] == 10:
+        return _load_cells(cells, points, fq, wphi, F, 10)
+    return _load_cells(cells, points, fq, wphi, F, cells.shape[1])
+
+
+@numba.njit(cache=True, inline="always")
+def _load_cells(cells, points, fq, wphi, F, w):  # pragma: no cover - compiled
+    """The body of :func:`_element_load` for ``w`` dofs per cell."""
+    m = cells.shape[0]
     nq = wphi.shape[0]
     g = np.zeros((4, 3))
     bad = 0
