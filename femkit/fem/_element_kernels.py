@@ -124,49 +124,57 @@ def _sort_pairs(idx, val, s, t):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, inline="always")
 def _value_rows(cells, n, split, indices, k, table, data, w):  # pragma: no cover - compiled
-    """The body of :func:`_stiffness_rows` for ``w`` dofs per cell: the columns below ``split``
-    go straight to ``indices``/``data``, the others to a buffer appended after the sorts."""
+    """The body of :func:`_stiffness_rows` for ``w`` dofs per cell. A row's columns below ``split``
+    and the others are gathered, with their sums, in two small buffers (in cache), each sorted,
+    then written out. ``mark[j]`` (one array, one read per column) holds ``(row << 32) |
+    position in its buffer`` of column ``j``'s last row."""
     start, inc = _incidence_lists(cells, n, w, indices)
     indptr = np.zeros(n + 1, indices.dtype)
-    stamp = np.full(n, -1, indices.dtype)
-    pos = np.empty(n, indices.dtype)
+    mark = np.full(n, -1, np.int64)
     most = 0
     for i in range(n):
         most = max(most, start[i + 1] - start[i])
-    upper = np.empty(w * most, indices.dtype)
-    upper_data = np.empty(w * most)
+    low, low_data = np.empty(w * most, indices.dtype), np.empty(w * most)
+    high, high_data = np.empty(w * most, indices.dtype), np.empty(w * most)
     row = np.zeros(w)
     nnz = 0
     for i in range(n):
-        s = nnz
-        u = 0
+        key = np.int64(i) << 32
+        nl = 0
+        nh = 0
         for q in range(start[i], start[i + 1]):
             e = inc[q] // w
             _local_row(k, table, e, inc[q] - w * e, row, w)
             for b in range(w):
                 j = cells[e, b]
-                if stamp[j] != i:
-                    stamp[j] = i
+                mk = mark[j]
+                if mk >> 32 == i:             # met before in this row: add
                     if j < split:
-                        pos[j] = nnz
-                        indices[nnz] = j
-                        data[nnz] = 0.0
-                        nnz += 1
+                        low_data[mk & 0xFFFFFFFF] += row[b]
                     else:
-                        pos[j] = u
-                        upper[u] = j
-                        upper_data[u] = 0.0
-                        u += 1
-                if j < split:
-                    data[pos[j]] += row[b]
+                        high_data[mk & 0xFFFFFFFF] += row[b]
+                elif j < split:
+                    mark[j] = key | nl
+                    low[nl] = j
+                    low_data[nl] = 0.0
+                    low_data[nl] += row[b]
+                    nl += 1
                 else:
-                    upper_data[pos[j]] += row[b]
-        _sort_pairs(indices, data, s, nnz)
-        _sort_pairs(upper, upper_data, 0, u)
-        for q in range(u):
-            indices[nnz + q] = upper[q]
-            data[nnz + q] = upper_data[q]
-        nnz += u
+                    mark[j] = key | nh
+                    high[nh] = j
+                    high_data[nh] = 0.0
+                    high_data[nh] += row[b]
+                    nh += 1
+        _sort_pairs(low, low_data, 0, nl)
+        _sort_pairs(high, high_data, 0, nh)
+        for q in range(nl):
+            indices[nnz + q] = low[q]
+            data[nnz + q] = low_data[q]
+        nnz += nl
+        for q in range(nh):
+            indices[nnz + q] = high[q]
+            data[nnz + q] = high_data[q]
+        nnz += nh
         indptr[i + 1] = nnz
     return indptr, nnz
 
