@@ -26,6 +26,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from ..mesh._edges_kernel import sort_pairs
 from ._kernels import _cell_gradients, _element_scale, _insert_sorted, _vertex_starts
 from .cells.kernels import _tetrahedron, _triangle
 
@@ -108,21 +109,6 @@ def _stiffness_rows(cells, n, split, indices, k, table, data):  # pragma: no cov
 
 
 @numba.njit(cache=True, inline="always")
-def _sort_pairs(idx, val, s, t):  # pragma: no cover - compiled
-    """Insertion sort of ``idx[s:t]`` with ``val[s:t]`` along (rows are short)."""
-    for q in range(s + 1, t):
-        j = idx[q]
-        v = val[q]
-        r = q
-        while r > s and idx[r - 1] > j:
-            idx[r] = idx[r - 1]
-            val[r] = val[r - 1]
-            r -= 1
-        idx[r] = j
-        val[r] = v
-
-
-@numba.njit(cache=True, inline="always")
 def _value_rows(cells, n, split, indices, k, table, data, w):  # pragma: no cover - compiled
     """The body of :func:`_stiffness_rows` for ``w`` dofs per cell. A row's columns below ``split``
     and the others are gathered, with their sums, in two small buffers (in cache), each sorted,
@@ -165,8 +151,8 @@ def _value_rows(cells, n, split, indices, k, table, data, w):  # pragma: no cove
                     high_data[nh] = 0.0
                     high_data[nh] += row[b]
                     nh += 1
-        _sort_pairs(low, low_data, 0, nl)
-        _sort_pairs(high, high_data, 0, nh)
+        sort_pairs(low, low_data, 0, nl)
+        sort_pairs(high, high_data, 0, nh)
         for q in range(nl):
             indices[nnz + q] = low[q]
             data[nnz + q] = low_data[q]

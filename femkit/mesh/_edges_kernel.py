@@ -43,19 +43,7 @@ def cell_edges(cells, local, n, node_type, edge_type):  # pragma: no cover - com
             q = fill[min(a, b)]
             fill[min(a, b)] = q + 1
             bucket[q] = (np.int64(max(a, b)) << 32) | (e * k + j)
-    count = 0
-    for v in range(n):
-        s, t = start[v], start[v + 1]
-        for a in range(s + 1, t):
-            h = bucket[a]
-            b = a
-            while b > s and bucket[b - 1] > h:
-                bucket[b] = bucket[b - 1]
-                b -= 1
-            bucket[b] = h
-        for a in range(s, t):
-            if a == s or bucket[a] >> 32 != bucket[a - 1] >> 32:
-                count += 1
+    count = sort_keys(start, bucket, 32)
     edge_nodes = np.empty((count, 2), node_type.dtype)  # exactly sized: no (m k, 2) buffer
     inverse = np.empty((m, k), edge_type.dtype)
     count = 0
@@ -78,19 +66,45 @@ def sort_buckets(start, key, ident):  # pragma: no cover - compiled
     count = 0
     for v in range(start.shape[0] - 1):
         s, t = start[v], start[v + 1]
-        for a in range(s + 1, t):
-            h, i = key[a], ident[a]
-            b = a
-            while b > s and key[b - 1] > h:
-                key[b] = key[b - 1]
-                ident[b] = ident[b - 1]
-                b -= 1
-            key[b] = h
-            ident[b] = i
+        sort_pairs(key, ident, s, t)
         for a in range(s, t):
             if a == s or key[a] != key[a - 1]:
                 count += 1
     return count
+
+
+@numba.njit(cache=True, inline="always")
+def sort_keys(start, key, shift):  # pragma: no cover - compiled
+    """Sort each bucket ``key[start[v]:start[v + 1]]`` by insertion (buckets are short); returns
+    the number of distinct ``key >> shift`` over all buckets (``shift = 0``: distinct keys)."""
+    count = 0
+    for v in range(start.shape[0] - 1):
+        s, t = start[v], start[v + 1]
+        for a in range(s + 1, t):
+            h = key[a]
+            b = a
+            while b > s and key[b - 1] > h:
+                key[b] = key[b - 1]
+                b -= 1
+            key[b] = h
+        for a in range(s, t):
+            if a == s or key[a] >> shift != key[a - 1] >> shift:
+                count += 1
+    return count
+
+
+@numba.njit(cache=True, inline="always")
+def sort_pairs(key, ident, s, t):  # pragma: no cover - compiled
+    """Insertion sort of ``key[s:t]`` with ``ident[s:t]`` along (runs are short)."""
+    for a in range(s + 1, t):
+        h, i = key[a], ident[a]
+        b = a
+        while b > s and key[b - 1] > h:
+            key[b] = key[b - 1]
+            ident[b] = ident[b - 1]
+            b -= 1
+        key[b] = h
+        ident[b] = i
 
 
 def warm_up() -> None:
