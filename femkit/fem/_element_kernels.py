@@ -16,9 +16,9 @@ pass (:func:`_stiffness_rows`), from each cell's metric computed once before it 
 2`` products ``kappa |T| grad lambda_a . grad lambda_b`` of the vertices ``a, b >= 1``,
 :func:`_cell_metric`, against a reference tensor folded for them, :func:`metric_table`: 3
 products per row entry on a triangle, 6 on a tetrahedron): each incidence adds its cell's local
-row into the row being built, whose vertex and edge columns are sorted apart at its end, so no slot map is written or read (72 MB on a 1M-dof square) and the matrix
-owns the new index arrays (no copy of a cached pattern's); the values are the separate pass's bit
-for bit.
+row into the row being built, whose vertex and edge columns are sorted apart at its end, so no
+slot map is written or read (72 MB on a 1M-dof square) and the matrix owns the new index arrays
+(no copy of a cached pattern's); the values are the separate pass's bit for bit.
 """
 
 from __future__ import annotations
