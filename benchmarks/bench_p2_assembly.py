@@ -107,10 +107,11 @@ def main() -> None:
     ap.add_argument("--n3", type=int, default=40, help="cubes per side of the 3D mesh")
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
-    from femkit.fem import _kernels
-    from femkit.mesh import structured_box, structured_mesh
+    from femkit.fem import _element_kernels, _kernels
+    from femkit.mesh import _edges_kernel, structured_box, structured_mesh
 
-    _kernels.warm_up()  # numba: loaded from the cache (or compiled once) before any timing
+    for module in (_kernels, _element_kernels, _edges_kernel):  # numba: loaded from the cache
+        module.warm_up()                                         # (or compiled once) before any timing
     rows = []
     if args.n2:
         rows.append(measure(f"square {args.n2}x{args.n2}", structured_mesh(args.n2, args.n2), args.repeat))

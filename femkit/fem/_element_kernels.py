@@ -12,11 +12,13 @@ incidence entries instead of ``w^2 m``: P2 has 6 or 10 dofs per cell). The same 
 entry for entry (tests/fem/test_p2_compiled_passes.py).
 
 A mesh's first stiffness (:func:`first_stiffness`, no pattern cached yet) is summed in such a row
-pass (:func:`_stiffness_rows`), from each cell's P1 products computed once before it
-(:func:`_cell_products`): each incidence adds its cell's local row into the row being built, which
-is sorted at its end, so no slot map is written or read (72 MB on a 1M-dof square) and the matrix
-owns the new index arrays (no copy of a cached pattern's); the values are the separate pass's bit
-for bit.
+pass (:func:`_stiffness_rows`), from each cell's metric computed once before it (the ``d (d + 1) /
+2`` products ``kappa |T| grad lambda_a . grad lambda_b`` of the vertices ``a, b >= 1``,
+:func:`_cell_metric`, against a reference tensor folded for them, :func:`metric_table`: 3
+products per row entry on a triangle, 6 on a tetrahedron): each incidence adds its cell's local
+row into the row being built, whose vertex and edge columns are sorted apart at its end, so no
+slot map is written or read (72 MB on a 1M-dof square) and the matrix owns the new index arrays
+(no copy of a cached pattern's); the values are the separate pass's bit for bit.
 """
 
 from __future__ import annotations
@@ -24,7 +26,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ._kernels import _cell_gradients, _insert_sorted, _vertex_starts
+from ..mesh._edges_kernel import sort_pairs
+from ._kernels import _cell_gradients, _element_scale, _insert_sorted, _vertex_starts
 from .cells.kernels import _tetrahedron, _triangle
 
 
@@ -87,100 +90,137 @@ def _pattern_rows(cells, n, indices, slots, w):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _stiffness_rows(cells, n, indices, k1, table, data):  # pragma: no cover - compiled
+def _stiffness_rows(cells, n, split, indices, k, table, data):  # pragma: no cover - compiled
     """The CSR pattern (as :func:`_element_pattern`, no slots) and the stiffness values of the dof
     map ``cells`` into ``indices`` and ``data`` (buffers of ``n + w (w - 1) m`` entries), row by
     row: each incidence (cell ``e``, local dof ``a``) of the row adds the cell's local row
-    ``sum_p k1[e, p] table[a, p, :]`` (``k1`` (m, P): the cells' symmetric P1 products,
-    :func:`_cell_products`; ``table`` (w, P, w): the folded reference tensor, :func:`symmetric_table`;
-    p in order, as :func:`_element_stiffness` sums it) at its columns, appended when new; the row
-    is then sorted with its values. Each entry sums its cells in increasing ``e`` (the
-    incidences' order), as the separate pass does: the same bits. Returns ``(indptr, nnz)``."""
+    ``sum_p k[e, p] table[a, p, :]`` (``k`` (m, P): the cells' metrics, :func:`_cell_metric`;
+    ``table`` (w, P, w): the folded reference tensor, :func:`metric_table`; p in order, as
+    :func:`_element_stiffness` sums it) at its columns, appended when new; the row is then sorted
+    with its values. Columns below ``split`` (the vertex dofs, which number below every edge dof)
+    and the others are gathered and sorted apart, then joined: two short sorts instead of one
+    of their sum's length. Each entry sums its cells in increasing ``e`` (the incidences'
+    order), as the separate pass does: the same bits. Returns ``(indptr, nnz)``."""
     if cells.shape[1] == 6:
-        return _value_rows(cells, n, indices, k1, table, data, 6)
+        return _value_rows(cells, n, split, indices, k, table, data, 6)
     if cells.shape[1] == 10:
-        return _value_rows(cells, n, indices, k1, table, data, 10)
-    return _value_rows(cells, n, indices, k1, table, data, cells.shape[1])
+        return _value_rows(cells, n, split, indices, k, table, data, 10)
+    return _value_rows(cells, n, split, indices, k, table, data, cells.shape[1])
 
 
 @numba.njit(cache=True, inline="always")
-def _value_rows(cells, n, indices, k1, table, data, w):  # pragma: no cover - compiled
-    """The body of :func:`_stiffness_rows` for ``w`` dofs per cell."""
+def _value_rows(cells, n, split, indices, k, table, data, w):  # pragma: no cover - compiled
+    """The body of :func:`_stiffness_rows` for ``w`` dofs per cell. A row's columns below ``split``
+    and the others are gathered, with their sums, in two small buffers (in cache), each sorted,
+    then written out. ``mark[j]`` (one array, one read per column) holds ``(row << 32) |
+    position in its buffer`` of column ``j``'s last row."""
     start, inc = _incidence_lists(cells, n, w, indices)
     indptr = np.zeros(n + 1, indices.dtype)
-    stamp = np.full(n, -1, indices.dtype)
-    pos = np.empty(n, indices.dtype)
+    mark = np.full(n, -1, np.int64)
+    most = 0
+    for i in range(n):
+        most = max(most, start[i + 1] - start[i])
+    low, low_data = np.empty(w * most, indices.dtype), np.empty(w * most)
+    high, high_data = np.empty(w * most, indices.dtype), np.empty(w * most)
     row = np.zeros(w)
     nnz = 0
     for i in range(n):
-        s = nnz
-        for k in range(start[i], start[i + 1]):
-            e = inc[k] // w
-            _local_row(k1, table, e, inc[k] - w * e, row, w)
+        key = np.int64(i) << 32
+        nl = 0
+        nh = 0
+        for q in range(start[i], start[i + 1]):
+            e = inc[q] // w
+            _local_row(k, table, e, inc[q] - w * e, row, w)
             for b in range(w):
                 j = cells[e, b]
-                if stamp[j] != i:
-                    stamp[j] = i
-                    pos[j] = nnz
-                    indices[nnz] = j
-                    data[nnz] = 0.0
-                    nnz += 1
-                data[pos[j]] += row[b]
-        for q in range(s + 1, nnz):       # insertion sort of the row, its values along
-            j = indices[q]
-            v = data[q]
-            r = q
-            while r > s and indices[r - 1] > j:
-                indices[r] = indices[r - 1]
-                data[r] = data[r - 1]
-                r -= 1
-            indices[r] = j
-            data[r] = v
+                mk = mark[j]
+                if mk >> 32 == i:             # met before in this row: add
+                    if j < split:
+                        low_data[mk & 0xFFFFFFFF] += row[b]
+                    else:
+                        high_data[mk & 0xFFFFFFFF] += row[b]
+                elif j < split:
+                    mark[j] = key | nl
+                    low[nl] = j
+                    low_data[nl] = 0.0
+                    low_data[nl] += row[b]
+                    nl += 1
+                else:
+                    mark[j] = key | nh
+                    high[nh] = j
+                    high_data[nh] = 0.0
+                    high_data[nh] += row[b]
+                    nh += 1
+        sort_pairs(low, low_data, 0, nl)
+        sort_pairs(high, high_data, 0, nh)
+        for q in range(nl):
+            indices[nnz + q] = low[q]
+            data[nnz + q] = low_data[q]
+        nnz += nl
+        for q in range(nh):
+            indices[nnz + q] = high[q]
+            data[nnz + q] = high_data[q]
+        nnz += nh
         indptr[i + 1] = nnz
     return indptr, nnz
 
 
 @numba.njit(cache=True, inline="always")
-def _local_row(k1, table, e, a, row, w):  # pragma: no cover - compiled
-    """Row ``a`` of cell ``e``'s stiffness into ``row``: ``sum_p k1[e, p] table[a, p, :]``."""
+def _local_row(k, table, e, a, row, w):  # pragma: no cover - compiled
+    """Row ``a`` of cell ``e``'s stiffness into ``row``: ``sum_p k[e, p] table[a, p, :]``."""
     for b in range(w):
         row[b] = 0.0
-    for p in range(k1.shape[1]):
-        c = k1[e, p]
+    for p in range(k.shape[1]):
+        c = k[e, p]
         for b in range(w):
             row[b] += c * table[a, p, b]
 
 
 @numba.njit(cache=True)
-def _cell_products(cells, points, kappa, scalar_kappa):  # pragma: no cover - compiled
-    """The symmetric P1 products ``k1_ab = kappa |T| grad lambda_a . grad lambda_b`` (``a <= b``,
-    row by row) of every cell, (m, P), and the number of degenerate cells (their rows zero)."""
+def _cell_metric(cells, points, kappa, scalar_kappa):  # pragma: no cover - compiled
+    """The symmetric metric of every cell, ``k_ab = kappa |T| grad lambda_a . grad lambda_b`` for
+    the vertices ``1 <= a <= b <= d`` (row by row: 3 products on a triangle, 6 on a tetrahedron;
+    ``lambda_0 = 1 - sum`` needs none of its own), (m, P), and the number of degenerate cells
+    (their rows zero). A triangle's from its edges (``e_a`` opposite vertex ``a``:
+    ``k_ab = kappa e_a . e_b / (4 |T|)``), a tetrahedron's from its scaled face normals."""
     m = cells.shape[0]
-    nv = 3 if points.shape[1] == 2 else 4
-    k1 = np.zeros((m, (nv * (nv + 1)) // 2))
+    if points.shape[1] == 2:
+        k = np.zeros((m, 3))
+        bad = 0
+        for e in range(m):
+            _, _, _, _, _, ex1, ey1, ex2, ey2, area = _triangle(cells, points, e)
+            ok, s = _element_scale(area, 4.0, kappa, scalar_kappa, e)
+            if not ok:
+                bad += 1
+                continue
+            k[e, 0] = s * (ex1 * ex1 + ey1 * ey1)
+            k[e, 1] = s * (ex1 * ex2 + ey1 * ey2)
+            k[e, 2] = s * (ex2 * ex2 + ey2 * ey2)
+        return k, bad
+    k = np.zeros((m, 6))
     g = np.zeros((4, 3))
     bad = 0
     for e in range(m):
-        ok, s = _cell_gradients(cells, points, e, nv, kappa, scalar_kappa, g)
+        ok, s = _cell_gradients(cells, points, e, 4, kappa, scalar_kappa, g)
         if not ok:
             bad += 1
             continue
         p = 0
-        for a in range(nv):
-            for b in range(a, nv):
-                k1[e, p] = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
+        for a in range(1, 4):
+            for b in range(a, 4):
+                k[e, p] = s * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
                 p += 1
-    return k1, bad
+    return k, bad
 
 
-def cell_products(mesh, kappa) -> np.ndarray | None:
-    """The cells' symmetric P1 products (m, P) (:func:`_cell_products`) for ``kappa`` (a float or
-    one per cell); None if a cell is degenerate."""
+def cell_metric(mesh, kappa) -> np.ndarray | None:
+    """The cells' symmetric metrics (m, P) (:func:`_cell_metric`) for ``kappa`` (a float or one
+    per cell); None if a cell is degenerate."""
     from ._kernels import _values
 
-    k1, bad = _cell_products(np.ascontiguousarray(mesh.cells, dtype=np.int64),
-                             np.ascontiguousarray(mesh.points, dtype=np.float64), *_values(kappa))
-    return None if bad else k1
+    k, bad = _cell_metric(np.ascontiguousarray(mesh.cells, dtype=np.int64),
+                          np.ascontiguousarray(mesh.points, dtype=np.float64), *_values(kappa))
+    return None if bad else k
 
 
 def _pattern_buffers(cells: np.ndarray, n: int, *, with_slots: bool = True):
@@ -209,15 +249,16 @@ def first_stiffness(mesh, dofs, kappa, table: np.ndarray):
     cell. None if a cell is degenerate (the caller's numpy path then names it)."""
     import scipy.sparse as sp
 
-    k1 = cell_products(mesh, kappa)
-    if k1 is None:
+    k = cell_metric(mesh, kappa)
+    if k is None:
         return None
     cells, indices, _ = _pattern_buffers(dofs.cells, dofs.n_dofs, with_slots=False)
     data = np.empty(len(indices))
     w = cells.shape[1]
-    folded = symmetric_table(table, mesh.dim + 1).reshape(-1, w, w)        # (P, a, b)
+    folded = metric_table(table, mesh.dim + 1).reshape(-1, w, w)           # (P, a, b)
     folded = np.ascontiguousarray(folded.transpose(1, 0, 2))                # (a, P, b)
-    indptr, nnz = _stiffness_rows(cells, int(dofs.n_dofs), indices, k1, folded, data)
+    split = int(getattr(dofs, "n_vertices", dofs.n_dofs))
+    indptr, nnz = _stiffness_rows(cells, int(dofs.n_dofs), split, indices, k, folded, data)
     indices.resize(nnz, refcheck=False)   # shrink in place: the untouched tails were never paged in
     data.resize(nnz, refcheck=False)
     K = sp.csr_matrix((data, indices, indptr), shape=(dofs.n_dofs, dofs.n_dofs), copy=False)
@@ -228,17 +269,31 @@ def first_stiffness(mesh, dofs, kappa, table: np.ndarray):
 @numba.njit(cache=True)
 def _quadrature_coordinates(cells, points, bary):  # pragma: no cover - compiled
     """(d, m, q) coordinates of the barycentric points ``bary`` (q, d + 1) on each cell (its
-    first d + 1 columns the vertices), summed vertex by vertex in order."""
+    first d + 1 columns the vertices), summed vertex by vertex in order (compiled with the
+    vertex count a constant: 3, 4)."""
+    if bary.shape[1] == 3:
+        return _coordinates(cells, points, bary, 3)
+    if bary.shape[1] == 4:
+        return _coordinates(cells, points, bary, 4)
+    return _coordinates(cells, points, bary, bary.shape[1])
+
+
+@numba.njit(cache=True, inline="always")
+def _coordinates(cells, points, bary, nv):  # pragma: no cover - compiled
+    """The body of :func:`_quadrature_coordinates` for ``nv`` vertices per cell."""
     m = cells.shape[0]
     d = points.shape[1]
-    nq, nv = bary.shape
+    nq = bary.shape[0]
     out = np.empty((d, m, nq))
+    x = np.empty(nv)                        # one coordinate of the cell's vertices, read once
     for e in range(m):
         for c in range(d):
+            for a in range(nv):
+                x[a] = points[cells[e, a], c]
             for p in range(nq):
-                acc = points[cells[e, 0], c] * bary[p, 0]
+                acc = x[0] * bary[p, 0]
                 for a in range(1, nv):
-                    acc += points[cells[e, a], c] * bary[p, a]
+                    acc += x[a] * bary[p, a]
                 out[c, e, p] = acc
     return out
 
@@ -246,8 +301,19 @@ def _quadrature_coordinates(cells, points, bary):  # pragma: no cover - compiled
 @numba.njit(cache=True)
 def _element_load(cells, points, fq, wphi, F):  # pragma: no cover - compiled
     """``F_i += sum_cells |T| sum_q fq[e, q] wphi[q, a]`` over the dof map ``cells`` (m, w) (a
-    block of cells); returns the number of degenerate cells."""
-    m, w = cells.shape
+    block of cells); returns the number of degenerate cells (compiled with ``w`` a constant for
+    P2: 6, 10)."""
+    if cells.shape[1] == 6:
+        return _load_cells(cells, points, fq, wphi, F, 6)
+    if cells.shape[1] == 10:
+        return _load_cells(cells, points, fq, wphi, F, 10)
+    return _load_cells(cells, points, fq, wphi, F, cells.shape[1])
+
+
+@numba.njit(cache=True, inline="always")
+def _load_cells(cells, points, fq, wphi, F, w):  # pragma: no cover - compiled
+    """The body of :func:`_element_load` for ``w`` dofs per cell."""
+    m = cells.shape[0]
     nq = wphi.shape[0]
     g = np.zeros((4, 3))
     bad = 0
@@ -302,8 +368,8 @@ def warm_up() -> None:
         element_pattern_kernel(cells, w)
         first_stiffness(SimpleNamespace(cells=cells[:, :nv], points=pts, dim=dim),
                         SimpleNamespace(cells=cells, n_dofs=w), 1.0, np.ones(((dim + 1) ** 2, w * w)))
-        k1, _ = _cell_products(cells, pts, np.ones(1), True)
-        _element_stiffness(k1, np.ones((k1.shape[1], w * w)), np.arange(w * w, dtype=np.int32).reshape(1, -1),
+        k, _ = _cell_metric(cells, pts, np.ones(1), True)
+        _element_stiffness(k, np.ones((k.shape[1], w * w)), np.arange(w * w, dtype=np.int32).reshape(1, -1),
                            w * w)
         quadrature_coordinates(cells, pts, np.full((1, nv), 1.0 / nv))
         fq = np.ones((1, 1))
@@ -312,14 +378,12 @@ def warm_up() -> None:
 
 
 @numba.njit(cache=True)
-def _element_stiffness(k1, table, slots, nnz):  # pragma: no cover - compiled
-    """Stiffness of an element other than P1 on affine cells into CSR data: per cell its P1
-    products ``k1`` (symmetric: the ``a <= b`` ones, :func:`_cell_products`; ``table`` row ``p``
-    for pair ``p`` holding ``S_ab + S_ba``, or ``S_aa``), then ``local += k1_ab table[p]`` row by
-    row (independent sums over the ``w^2`` entries, which the compiler vectorises; the P1
-    kernel's order, :func:`femkit.fem._kernels._element_stiffness`, sums each entry's products in
-    one chain), then scattered through ``slots``."""
-    m, npair = k1.shape
+def _element_stiffness(metric, table, slots, nnz):  # pragma: no cover - compiled
+    """Stiffness of an element other than P1 on affine cells into CSR data: per cell its metric
+    ``metric`` (the ``1 <= a <= b`` products of :func:`_cell_metric`; ``table`` row ``p`` for
+    pair ``p``, :func:`metric_table`), then ``local += metric_ab table[p]`` row by row (independent sums
+    over the ``w^2`` entries, which the compiler vectorises), then scattered through ``slots``."""
+    m, npair = metric.shape
     n2 = table.shape[1]
     data = np.zeros(nnz)
     local = np.empty(n2)
@@ -327,7 +391,7 @@ def _element_stiffness(k1, table, slots, nnz):  # pragma: no cover - compiled
         for j in range(n2):
             local[j] = 0.0
         for p in range(npair):
-            k = k1[e, p]
+            k = metric[e, p]
             for j in range(n2):
                 local[j] += k * table[p, j]
         for j in range(n2):
@@ -335,19 +399,25 @@ def _element_stiffness(k1, table, slots, nnz):  # pragma: no cover - compiled
     return data
 
 
-def symmetric_table(table: np.ndarray, nv: int) -> np.ndarray:
-    """The reference tensor ``table`` ((nv^2, n^2), row ``nv a + b``) folded for the symmetric
-    P1 products: row ``p`` of pair ``a <= b`` is ``S_ab + S_ba`` (``S_aa`` on the diagonal)."""
-    T = np.asarray(table, dtype=np.float64).reshape(nv, nv, -1)
-    rows = [T[a, a] if a == b else T[a, b] + T[b, a] for a in range(nv) for b in range(a, nv)]
-    return np.ascontiguousarray(np.array(rows))
+def metric_table(table: np.ndarray, nv: int) -> np.ndarray:
+    """The reference tensor ``table`` ((nv^2, n^2), row ``nv a + b``: ``S_ab``) folded for the cell
+    metric of :func:`_cell_metric`: with ``grad lambda_0 = -sum_a grad lambda_a``, ``sum_ab G_ab
+    S_ab = sum_{1 <= a, b} G_ab T_ab``, ``T_ab = S_ab - S_a0 - S_0b + S_00``; row ``p`` of pair
+    ``1 <= a <= b`` is ``T_ab + T_ba`` (``T_aa`` on the diagonal), each made exactly symmetric in
+    its two dof indices (so is every local matrix, and the global one). (P, n^2)."""
+    S = np.asarray(table, dtype=np.float64).reshape(nv, nv, -1)
+    n = int(round(np.sqrt(S.shape[2])))
+    T = S - S[:, :1] - S[:1, :] + S[:1, :1]
+    rows = [T[a, a] if a == b else T[a, b] + T[b, a] for a in range(1, nv) for b in range(a, nv)]
+    R = np.array(rows).reshape(-1, n, n)
+    return np.ascontiguousarray((0.5 * (R + R.transpose(0, 2, 1))).reshape(len(rows), -1))
 
 
 def element_stiffness_kernel(mesh, kappa, table: np.ndarray, pattern):
     """CSR data of the stiffness of every cell of ``mesh`` for the reference tensor ``table``
     ((d+1)^2, n^2) into ``pattern``, or None if a cell is degenerate (the caller's numpy path
     then names it). ``kappa``: a float or one per cell."""
-    k1 = cell_products(mesh, kappa)
-    if k1 is None:
+    k = cell_metric(mesh, kappa)
+    if k is None:
         return None
-    return _element_stiffness(k1, symmetric_table(table, mesh.dim + 1), pattern.slots, pattern.nnz)
+    return _element_stiffness(k, metric_table(table, mesh.dim + 1), pattern.slots, pattern.nnz)

@@ -95,6 +95,10 @@ def _build(mesh, elem: Element) -> DofMap:
     if not elem.dofs_per_edge:
         return DofMap(elem, cells, n, n, np.zeros((0, 2), dtype=np.int64))
     edge_nodes, cell_edges = edges(mesh)
-    edge_dofs = n + np.asarray(cell_edges, dtype=np.int64)[:, local_edge_order(mesh.dim, elem)]
-    dofs = np.ascontiguousarray(np.concatenate([cells, edge_dofs], axis=1))
+    order = local_edge_order(mesh.dim, elem)
+    m, nv = cells.shape
+    dofs = np.empty((m, nv + len(order)), dtype=np.int64)   # filled column by column: no temporaries
+    dofs[:, :nv] = cells
+    for k, col in enumerate(order):
+        np.add(cell_edges[:, col], n, out=dofs[:, nv + k], dtype=np.int64)
     return DofMap(elem, dofs, n + len(edge_nodes), n, np.asarray(edge_nodes, dtype=np.int64))

@@ -56,7 +56,7 @@ register_kernels("P1 assembly", "femkit.fem._kernels", "_incidences", "_pattern"
 # declared with the stack's pattern so that the warm-up, which compiles them, knows them)
 register_kernels("P1 assembly", "femkit.fem._kernels", "_scatter", "_element_stiffness", rank=1)
 register_kernels("P1 assembly", "femkit.fem._element_kernels", "_element_pattern", "_stiffness_rows",
-                 "_cell_products", "_element_stiffness", "_quadrature_coordinates", "_element_load", rank=1)
+                 "_cell_metric", "_element_stiffness", "_quadrature_coordinates", "_element_load", rank=1)
 
 def compiled_from(count: int, element) -> bool:
     """True when ``count`` cells of ``element`` (an :class:`~femkit.elements.base.Element`) go

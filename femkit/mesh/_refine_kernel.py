@@ -10,7 +10,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ._edges_kernel import sort_buckets
+from ._edges_kernel import sort_buckets, sort_keys
 
 
 @numba.njit(cache=True)
@@ -215,19 +215,7 @@ def interleaved_edges(n, below, inv, bstart, b_hi, children, local, node_type, e
     at a coarse node are its edges' midpoints in order. Each child's local edge ``local[k]``
     is then looked up in the bucket of its lower node (a few entries)."""
     n_edges = bstart.shape[0] - 1
-    count = 0
-    for e in range(n_edges):                     # each bucket by key, counting distinct keys
-        s, u = bstart[e], bstart[e + 1]
-        for a in range(s + 1, u):
-            h = b_hi[a]
-            b = a
-            while b > s and b_hi[b - 1] > h:
-                b_hi[b] = b_hi[b - 1]
-                b -= 1
-            b_hi[b] = h
-        for a in range(s, u):
-            if a == s or b_hi[a] != b_hi[a - 1]:
-                count += 1
+    count = sort_keys(bstart, b_hi, 0)           # each bucket by key, counting distinct keys
     fine_edges = np.empty((n_edges + count, 2), node_type.dtype)
     node_start = np.empty(n + n_edges + 1, np.int64)
     count = 0

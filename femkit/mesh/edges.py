@@ -107,7 +107,7 @@ def _edges(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
     k = 3 if mesh.dim == 2 else 6
     node_type = index_dtype(n)
     edge_type = index_dtype(mesh.n_cells * k)  # at most one edge per local edge
-    if mesh.n_cells >= NUMBA_THRESHOLD:
+    if NUMBA_THRESHOLD <= mesh.n_cells and mesh.n_cells * k < 2 ** 32:  # the kernel packs e k + j in 32 bits
         from ._edges_kernel import cell_edges
 
         return cell_edges(mesh.cells, LOCAL_EDGES[mesh.cells.shape[1]], n,
