@@ -204,3 +204,25 @@ def test_two_bodies_of_one_file_meet_head_on_without_crossing(tmp_path, capsys):
     v_last = frames[-1].point_data["velocity"]
     assert np.abs(mass @ v_last - p0).max() <= 1e-8 * (mass @ np.abs(m0.point_data["velocity"])).sum()
     assert v_last[a, 0].mean() < 2.0                          # they pushed each other
+
+
+class _Forces:
+    def __init__(self, bounded: bool):
+        self.requires_bounded_steps = bounded
+
+
+@pytest.mark.parametrize("bounded, expected, absent", [
+    (True, "CHOLMOD", "cholespy"),
+    (False, "cholespy", "CHOLMOD"),
+], ids=["contact-scene-points-at-cholmod", "spring-scene-points-at-cholespy"])
+def test_fast_path_hint_names_the_engine_measured_faster_for_the_scene(bounded, expected, absent):
+    from types import SimpleNamespace
+
+    from femkit.case.scene.run import FAST_PATH_DOFS, fast_path_hint
+
+    case = SimpleNamespace(solver=SimpleNamespace(method="direct"))
+    system = SimpleNamespace(ndof=FAST_PATH_DOFS, forces=[_Forces(bounded)])
+    hint = fast_path_hint(case, system, SimpleNamespace(implicit=True))
+    assert expected in hint and absent not in hint
+    small = SimpleNamespace(ndof=FAST_PATH_DOFS - 1, forces=system.forces)
+    assert fast_path_hint(case, small, SimpleNamespace(implicit=True)) is None
