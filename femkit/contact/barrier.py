@@ -21,8 +21,10 @@ CSR matrix ``n d x n d``. Obstacles are part of the collision mesh but carry no 
 (a prescribed rigid motion: velocity or keyframed path, and rotation, :class:`~.surfaces.Motion`)
 is moved within each step towards its place at the step's end in straight moves each bounded by
 CCD against the bodies where the last solve left them (:meth:`BarrierModel.advance`; the step is
-solved again after every move), so it never passes through a body; friction sees each obstacle
-vertex's own velocity over the step.
+solved again after every move), so it never passes through a body; the bodies' pieces touching
+it are carried along with its rigid move in the same CCD-bounded move when that goes farther (a
+few moves a step instead of one per fraction of ``dhat``); friction sees each obstacle vertex's
+own velocity over the step.
 
 ipctk is the optional extra ``femkit[contact]`` (``pip install femkit[contact]``): importing this
 module never needs it; building a :class:`BarrierModel` without it is a one-line
