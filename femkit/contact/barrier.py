@@ -21,8 +21,10 @@ CSR matrix ``n d x n d``. Obstacles are part of the collision mesh but carry no 
 (a prescribed rigid motion: velocity or keyframed path, and rotation, :class:`~.surfaces.Motion`)
 is moved within each step towards its place at the step's end in straight moves each bounded by
 CCD against the bodies where the last solve left them (:meth:`BarrierModel.advance`; the step is
-solved again after every move), so it never passes through a body; friction sees each obstacle
-vertex's own velocity over the step.
+solved again after every move), so it never passes through a body; the bodies' pieces touching
+it are carried along with its rigid move in the same CCD-bounded move when that goes farther (a
+few moves a step instead of one per fraction of ``dhat``); friction sees each obstacle vertex's
+own velocity over the step.
 
 ipctk is the optional extra ``femkit[contact]`` (``pip install femkit[contact]``): importing this
 module never needs it; building a :class:`BarrierModel` without it is a one-line
@@ -50,6 +52,8 @@ CCD_METHODS = ("tight_inclusion", "additive")
 #: Moves of a moving obstacle within one step, each bounded by CCD with the bodies where the
 #: last solve left them (:meth:`BarrierModel.advance`).
 MAX_ADVANCES = 200
+#: ... and fewer when this many moves together gained under 1% of the way left: stuck.
+STALL_MOVES = 20
 #: Tight-Inclusion CCD's iteration cap per primitive pair (ipctk's default, 1e7, let one nearly
 #: parallel face pair at a tiny gap -- a cube resting on a cube -- cost tens of seconds; at the
 #: cap the root finder returns its conservative lower bound, so the guarantee stands).
@@ -157,6 +161,7 @@ class BarrierModel:
         self.moving = any(ob.moving for ob in obstacles)
         self._target = None                      # the obstacles' vertices at the step's end
         self.advances = 0                        # obstacle moves of the step
+        self._left = []                          # the way left before each move of the step
         self.faces = np.ascontiguousarray(np.concatenate(faces), dtype=np.int32)
         self.n_obstacle_faces = len(self.faces) - len(surface)
         self.component = self._components()
@@ -383,6 +388,7 @@ class BarrierModel:
         self._target = self.obstacles_at(t + h)
         self.static_velocity = (self._target - self.static) / h
         self.advances = 0
+        self._left = []                          # the way left before each move of the step
 
     def advance(self, x, pieces=None) -> bool:
         """Move the obstacles towards their step's end place as far as CCD allows with the
@@ -407,20 +413,24 @@ class BarrierModel:
         Raises
         ------
         SolverError
-            After :data:`MAX_ADVANCES` moves in one step without reaching the place (the bodies
-            cannot get out of the way: caught between obstacles, held, or a step too long).
+            After :data:`MAX_ADVANCES` moves in one step without reaching the place, or when the
+            last :data:`STALL_MOVES` moves gained under 1% of the way left (the bodies cannot
+            get out of the way: caught between obstacles, held, or a step too long).
         """
         from ..errors import SolverError
 
         if self._target is None or np.array_equal(self.static, self._target):
             return False
-        if self.advances >= MAX_ADVANCES:
-            left = float(np.abs(self._target - self.static).max())
-            raise SolverError(f"contact: a moving obstacle did not reach its place in "
-                              f"{MAX_ADVANCES} moves within one step ({left:.3g} short of it): "
-                              "the bodies cannot make way for it (caught between obstacles, "
-                              "held, or too slow to follow); use a smaller dt or a path that "
-                              "leaves them room")
+        left = float(np.abs(self._target - self.static).max())
+        self._left.append(left)
+        stalled = self.advances >= STALL_MOVES and left > 0.99 * self._left[-1 - STALL_MOVES]
+        if self.advances >= MAX_ADVANCES or stalled:
+            why = f"{MAX_ADVANCES} moves" if not stalled else \
+                f"{self.advances} moves, the last {STALL_MOVES} gaining under 1% of the way"
+            raise SolverError(f"contact: a moving obstacle did not reach its place within one "
+                              f"step ({why}; {left:.3g} short of it): the bodies cannot make "
+                              "way for it (caught between obstacles, held, or too slow to "
+                              "follow); use a smaller dt or a path that leaves them room")
         V0 = self.vertices(x)
         t, u = self._move_fraction(V0, None), None
         if t < 1.0 and pieces is not None:

@@ -226,3 +226,36 @@ def test_fast_path_hint_names_the_engine_measured_faster_for_the_scene(bounded, 
     assert expected in hint and absent not in hint
     small = SimpleNamespace(ndof=FAST_PATH_DOFS - 1, forces=system.forces)
     assert fast_path_hint(case, small, SimpleNamespace(implicit=True)) is None
+
+
+LID = """problem: mass_spring
+name: lid
+system: {type: cloth, nx: 5, ny: 5, width: 0.1, height: 0.1, plane: xy, origin: [0.0, 0.0, 0.001],
+         k_structural: 200.0, total_mass: 0.01, pinned: none}
+forces: {gravity: 9.81}
+contact:
+  obstacles:
+    - {type: plane, point: [0.05, 0.05, 0.0], normal: [0, 0, 1], size: 0.2}
+    - {type: plane, point: [0.05, 0.05, 0.01], normal: [0, 0, -1], size: 0.2,
+       path: [[0.02, 0, 0, 0], [0.03, 0, 0, -0.05]]}
+integrator: {method: newton, options: {tol: 1.0e-6}}
+dt: 0.01
+t_end: 0.05
+stability: {check: false}
+output: {frames: 5}
+"""
+
+
+def test_a_scene_whose_step_fails_keeps_its_frames_and_says_why(tmp_path, capsys):
+    # a lid driven through the table onto a cloth lying on it (third step): no way there
+    # without a crossing; the run stops at that step, exit 1, the frames before it written
+    # and result.json marked solver_failed with the reason
+    p, out = _solve(tmp_path, LID, capsys)
+    assert p.returncode == 1
+    assert "cannot make way" in p.stderr
+    res = json.loads((out / "result.json").read_text())
+    assert res["converged"] is False and res["steps"] == 2
+    st = res["stability"]
+    assert st["verdict"] == "solver_failed" and st["step"] == 3
+    assert "cannot make way" in st["message"]
+    assert res["contact"]["intersections"] == 0 and len(_frames(out)) == 3

@@ -124,6 +124,25 @@ def test_a_rising_ball_lifts_a_cloth_lying_on_it_in_a_few_moves_a_step():
         assert top < fr.x[24, 2] < top + 0.01     # the cloth's centre node on it
 
 
+def test_a_lid_pressing_a_block_through_the_table_fails_with_its_reason():
+    # a lid driven down at 15 m/s onto a block resting on a static table: its place at the
+    # first step's end (z = -0.05) lies past the table with the block between them -- no way
+    # there without a crossing; the step fails as soon as the moves stall, saying why
+    from femkit.errors import SolverError
+
+    P, T = cube(1, 0.1, (0.01, 0.02, 1e-3))
+    lid = replace(plane_obstacle([0.0, 0.0, 0.102], [0, 0, -1], 0.3, 3),
+                  motion=Motion(velocity=np.array([0.0, 0.0, -15.0])))
+    force = BarrierContact(body_surface(T, 3), [plane_obstacle([0.0, 0.0, 0.0], [0, 0, 1], 0.3, 3),
+                                                lid])
+    s = elastic_system(_body(P, T), forces=[force])
+    with pytest.raises(SolverError, match="cannot make way for it .*use a smaller dt") as err:
+        _run(s, 1, 0.01, tol=1e-6)
+    assert "the last 20 gaining under 1%" in str(err.value)
+    f = next(g for g in s.forces if isinstance(g, BarrierContact))
+    assert f.model.advances < 200
+
+
 def test_friction_drags_a_block_on_a_turntable_to_its_velocity():
     # a block resting at radius r on a plane turning at omega about the z axis, mu 0.5: friction
     # (mu g = 4.9 m/s^2 > omega^2 r = 1.0 m/s^2 centripetal) brings it to omega r = 0.5 m/s

@@ -13,7 +13,10 @@ after it, all into the output directory's temporary place, moved into place at t
 Stability: an :class:`~femkit.errors.InstabilityError` does not escape :func:`run_scene`. The
 trajectory up to the last good step is written, ``result.json`` says ``"verdict":
 "unstable"`` with the error's facts, and :attr:`SceneResult.converged` is false, so
-``femkit solve`` exits with code 1 ("ran, but did not reach its goal").
+``femkit solve`` exits with code 1 ("ran, but did not reach its goal"). A step that fails
+(:class:`~femkit.errors.SolverError`: Newton, a linear solve, a moving obstacle that cannot get
+to its place) is kept the same way, ``"verdict": "newton_failed"`` or ``"solver_failed"`` with
+its step and message, as a solid's run keeps it.
 
 Each stage is a public function (:func:`build_system`, :func:`build_integrator`,
 :func:`build_context`, :func:`output_every`), so a Python user can reuse one of them::
@@ -45,8 +48,10 @@ from ...dynamics.stability import estimate_omega_max
 from ...errors import (
     CaseFileError,
     ExpressionError,
+    EquilibriumError,
     InputError,
     InstabilityError,
+    SolverError,
     UnknownNameError,
     with_prefix,
 )
@@ -332,11 +337,13 @@ class SceneResult(RunResult):
     files: list = field(default_factory=list)
     output_stop: str | None = None      # signal that stopped the frame writing, if one did
     frames_written: int | None = None   # frames written before it (None: all)
+    failed_step: SolverError | None = None  # the step that failed (Newton, a linear solve)
 
     @property
     def converged(self) -> bool:
-        """False when the run stopped on an instability (``femkit solve`` then exits 1)."""
-        return self.instability is None
+        """False when the run stopped on an instability or a failed step (``femkit solve`` then
+        exits 1)."""
+        return self.instability is None and self.failed_step is None
 
     @property
     def interrupted(self) -> str | None:
@@ -351,13 +358,20 @@ class SceneResult(RunResult):
 
     @property
     def verdict(self) -> str:
-        """``unstable`` when the run stopped on an instability, else the base verdict."""
-        return "unstable" if self.instability is not None else super().verdict
+        """``unstable`` when the run stopped on an instability, ``newton_failed`` /
+        ``solver_failed`` on a failed step, else the base verdict."""
+        if self.instability is not None:
+            return "unstable"
+        if self.failed_step is not None:
+            return "newton_failed" if isinstance(self.failed_step, EquilibriumError) \
+                else "solver_failed"
+        return super().verdict
 
     @property
     def failure(self) -> str | None:
         """One-line reason of the failure (None when stable)."""
-        return None if self.instability is None else " ".join(str(self.instability).split())
+        e = self.instability if self.instability is not None else self.failed_step
+        return None if e is None else " ".join(str(e).split())
 
     def stability(self) -> dict:
         tr = self.trajectory
@@ -377,6 +391,9 @@ class SceneResult(RunResult):
             out.update(method=e.method, step=int(e.step), time=float(e.time),
                        energy_ratio=float(e.energy_ratio), dt=float(e.dt), reason=e.reason,
                        dt_crit=e.dt_crit, message=self.failure)
+        if self.failed_step is not None:
+            out.update(verdict=self.verdict, step=getattr(self.failed_step, "step", None),
+                       message=self.failure)
         return out
 
     def facts(self) -> dict:
@@ -459,6 +476,8 @@ class SceneResult(RunResult):
         if st["dt_crit"] is not None:
             stab += f", critical dt {st['dt_crit']:.4g}"
         verdict = st["verdict"] if self.instability is None else f"UNSTABLE: {self.failure}"
+        if self.failed_step is not None:
+            verdict = f"FAILED: {self.failure}"
         if st["dt_exceeds_critical"] and self.instability is None:
             verdict += " (but dt exceeds the critical step: growth may not have shown yet)"
         lines.append(f"verdict   {verdict}" + (f" ({stab})" if stab else ""))
@@ -490,8 +509,9 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     Returns
     -------
     SceneResult
-        ``converged`` is false when the run became unstable; the results up to the last good
-        step are still written, marked ``"verdict": "unstable"``.
+        ``converged`` is false when the run became unstable or a step failed; the results up
+        to the last good step are still written, marked ``"verdict": "unstable"`` (or
+        ``"newton_failed"``, ``"solver_failed"``).
     """
     final = Path(output_dir or case.spec.output.dir).resolve()
     if write:  # refuse a bad output location before any work (never replaces user files)
@@ -511,7 +531,7 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
     progress = Progress(n_steps(case), f"scene {case.name}", unit="step", quiet=quiet)
 
     caught: list[str] = []
-    instability = None
+    instability = failed_step = None
     with contextlib.ExitStack() as outputs:
         # the output directory is built under a temporary name while the run goes on: frames
         # are written by a writer thread as they are recorded, the rest after the run; an
@@ -539,6 +559,10 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
             except InstabilityError as exc:
                 instability = exc
                 traj = exc.partial
+            except SolverError as exc:   # a failed step: the frames before it are kept
+                if getattr(exc, "partial", None) is None:
+                    raise
+                failed_step, traj = exc, exc.partial
             for w in wlist:
                 if issubclass(w.category, StabilityWarning):
                     caught.append(" ".join(str(w.message).split()))
@@ -551,7 +575,8 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
         result = SceneResult(case=case, system=system, integrator=integrator, trajectory=traj,
                              triangles=triangles, instability=instability, every=every,
                              wall_time=time.perf_counter() - t0, timings=timer.times,
-                             omega_max=omega, warnings=caught, contact=recorder)
+                             omega_max=omega, warnings=caught, contact=recorder,
+                             failed_step=failed_step)
         if not quiet:
             for w in caught:
                 print(f"femkit: warning: {w}", file=sys.stderr)
@@ -562,6 +587,8 @@ def run_scene(case: Case, output_dir: str | os.PathLike | None = None, quiet: bo
                 write_scene_outputs(result, final, into=tmp, frames=frames)
     if instability is not None:
         print(f"femkit: unstable: {result.failure}", file=sys.stderr)
+    elif failed_step is not None:
+        print(f"femkit: failed: {result.failure}", file=sys.stderr)
     if not quiet:
         for line in result.summary_lines():
             out(line)

@@ -13,8 +13,8 @@ with this force when the run starts (:attr:`requires_bounded_steps`).
 The step protocol the ``newton`` integrator calls (no-ops on every other force,
 :class:`~.base.Force`): :meth:`begin_step` (the stiffness initialised on the first step, IPC's
 rule; friction lagged at ``x_n``; moving obstacles started), :meth:`step_bound`,
-:meth:`end_iteration` (IPC's stiffness update), :meth:`advance` (moving obstacles moved on:
-solve again), :meth:`relag` (another friction lagging iteration) and :meth:`end_step`.
+:meth:`end_iteration` (IPC's stiffness update), :meth:`advance` (moving obstacles moved on,
+the bodies touching one carried along in the integrator's iterate: solve again), :meth:`relag` (another friction lagging iteration) and :meth:`end_step`.
 """
 
 from __future__ import annotations

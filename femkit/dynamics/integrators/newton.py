@@ -9,7 +9,8 @@ constant damping). Then ``v+ = (x+ - x_n) / h``.
 
 Each iteration solves ``(M + h^2 K_fix(x) + h C) dx = -grad g(x)`` on the free dofs (``K_fix``
 with the per-spring eigenvalue clamp ``fix="clamp"`` by default, or ``"regularize"``, so ``dx``
-is a descent direction), then backtracks (Armijo, Nocedal & Wright, Numerical Optimization, section 3.1: ``g(x + t dx) <= g(x) + c t grad.dx``,
+is a descent direction; to the linear solver's ``rtol``, or up to :data:`FORCING` where rounding
+keeps ``rtol`` out of reach), then backtracks (Armijo, Nocedal & Wright, Numerical Optimization, section 3.1: ``g(x + t dx) <= g(x) + c t grad.dx``,
 ``t *= shrink``). It stops when ``||dx||_inf <= tol * L`` (``L`` = bounding-box diagonal of
 ``x_n``) or after ``max_iterations``; the iteration count of every step is appended to
 ``ctx.stats["newton_iterations"]``, and a step stopped by ``max_iterations`` is counted in
@@ -59,7 +60,8 @@ slope and value at the full step, at most 8 steps and bounded by CCD again; afte
 ``end_iteration`` may raise the barrier stiffness (the objective is then re-evaluated);
 convergence is judged on the Newton direction ``||dx||_inf`` (a short CCD-bounded step is no
 sign of convergence); and the step is solved again while ``advance`` moves a prescribed-motion
-obstacle on towards its place at the step's end, then while ``relag`` asks for another friction
+obstacle on towards its place at the step's end (carrying the bodies touching it: ``advance``
+writes the iterate in place), then while ``relag`` asks for another friction
 lagging iteration. ``keeps_contact = True`` declares it (the trait the other integrators lack). A contact Hessian
 couples any two surface nodes, outside the compiled pattern of the ``cholesky`` path, so a contact
 system's Newton matrix is assembled generally and factorised by the spec's method (``direct``, or
