@@ -18,7 +18,10 @@ step is (on a shared machine wall time follows the load; the wall seconds are pr
 Newton iterations per step, and for the contact run the split of its time among
 the collision broad phase (``NormalCollisions.build``), CCD (``compute_collision_free_stepsize``)
 and the barrier/friction Hessian (``BarrierModel.seconds``); the rest is the Newton step itself
-(springs, the linear solves). The issue's bar is a contact step at most 3x the contact-free one.
+(springs, the linear solves), and per Newton iteration the cost of each run, the barrier's Newton
+rest, and the evaluations of the step's objective (``system.energies`` calls) and the CCD calls. All
+counters are read before the first step in contact, which is measured whole. The issue's bar is a
+contact step at most 3x the contact-free one.
 """
 
 from __future__ import annotations
@@ -64,26 +67,45 @@ def run(n: int, steps: int, contact: bool, tmp: Path, penalty: float = 0.0,
     integ, ctx = build_integrator(case), build_context(case)
     f = contact_force(system)
     st = integ.start(system, system.x0, system.v0, 0.0, case.spec.dt, ctx)
+    calls = _count_calls(system, "energies")   # one per evaluation of newton's objective
     times, walls, split0, first = [], [], None, None
     for k in range(steps):
+        # the counters before the step: the first step in contact is measured whole
+        before = (None if f is None else dict(f.model.seconds),
+                  (calls[0], 0 if f is None else f.model.stats["ccd_calls"]))
         t0, w0 = time.process_time(), time.perf_counter()
         st = integ.step(system, st, case.spec.dt, ctx)
         times.append(time.process_time() - t0)
         walls.append(time.perf_counter() - w0)
         touching = st.x[:, 2].min() < 0.51 if f is None else f.model.active(st.x) > 0
         if first is None and touching:
-            first = k
-            split0 = None if f is None else dict(f.model.seconds)
+            first, (split0, counts0) = k, before
     if first is None:   # no contact in these steps: all of them measured
         first, split0 = 0, None if f is None else {k: 0.0 for k in f.model.seconds}
+        counts0 = (0, 0)
     after = np.array(times[first:])
     its = ctx.stats["newton_iterations"][first:]
     out = {"per_step": float(after.mean()), "wall": float(np.mean(walls[first:] or walls)), "iterations": float(np.mean(its)) if its else 0.0,
            "steps_measured": len(after), "first_contact_step": first}
+    n_its = max(sum(its), 1)
+    out["objective_per_iteration"] = (calls[0] - counts0[0]) / n_its
     if f is not None:
+        out["ccd_per_iteration"] = (f.model.stats["ccd_calls"] - counts0[1]) / n_its
         sec = f.model.seconds
         out["split"] = {k: (sec[k] - split0[k]) / max(len(after), 1) for k in sec}
     return out
+
+
+def _count_calls(obj, name: str) -> list:
+    """Count the calls of ``obj.name`` from now on (``[count]``, updated in place)."""
+    calls, method = [0], getattr(obj, name)
+
+    def counted(*args, **kwargs):
+        calls[0] += 1
+        return method(*args, **kwargs)
+
+    setattr(obj, name, counted)
+    return calls
 
 
 def main() -> None:
@@ -117,6 +139,12 @@ def main() -> None:
     rest = con["per_step"] - sum(con["split"].values())
     print("  split of a contact step: " + ", ".join(
         f"{k} {1e3 * v:.1f} ms" for k, v in con["split"].items()) + f", Newton rest {1e3 * rest:.1f} ms")
+    print(f"  per Newton iteration: contact-free {1e3 * free['per_step'] / free['iterations']:.1f} ms, "
+          f"penalty {1e3 * pen['per_step'] / pen['iterations']:.1f} ms, barrier {1e3 * con['per_step'] / con['iterations']:.1f} ms "
+          f"(its Newton rest {1e3 * rest / con['iterations']:.1f} ms); objective evaluations per "
+          f"iteration: free {free['objective_per_iteration']:.2f}, penalty "
+          f"{pen['objective_per_iteration']:.2f}, barrier {con['objective_per_iteration']:.2f} "
+          f"(CCD calls {con['ccd_per_iteration']:.2f})")
 
 
 if __name__ == "__main__":

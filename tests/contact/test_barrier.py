@@ -244,8 +244,9 @@ def test_additive_ccd_keeps_a_fast_cube_off_the_plane():
 
 
 def test_two_bodies_in_contact_run_on_the_cholesky_solver_as_on_superlu():
-    # their contact Hessian couples nodes of both bodies, outside the compiled pattern of the
-    # cholesky path (which refused it): a contact system assembles generally on every solver
+    # their contact Hessian couples nodes of both bodies, outside the springs' and elements'
+    # compiled pattern of the cholesky path (which refused it): it goes on the run's
+    # ContactPattern, the iterates those of SuperLU on the generally assembled matrix
     pytest.importorskip("cholespy", reason="cholespy is not installed: pip install -e '.[fast]'")
     from femkit.solvers.spec import SolverSpec
 
@@ -263,6 +264,7 @@ def test_two_bodies_in_contact_run_on_the_cholesky_solver_as_on_superlu():
             st = integ.step(s, st, 2e-3, ctx)
             assert model.intersections(st.x) == 0
         assert model.active(st.x) > 0                              # they touch
+        assert ("contact_pattern" in ctx.cache) == (spec.method == "cholesky")
         runs.append(st.x)
     assert np.abs(runs[1] - runs[0]).max() <= 1e-9
 

@@ -13,7 +13,7 @@ import scipy.sparse as sp
 from femkit.dynamics.forces import Gravity, GroundContact
 from femkit.dynamics.forces.elastic import ElasticForce
 from femkit.dynamics.forces.jacobian import SpringPattern
-from femkit.dynamics.kernels.assembly import FreePattern, assemble_with_forces
+from femkit.dynamics.kernels.assembly import FreePattern, assemble_with_forces, contact_values
 from femkit.dynamics.system import MassSpringSystem
 from femkit.dynamics.topology import cloth_grid
 from femkit.fem.sparsity import BlockPattern, restrict_structure, union_structures
@@ -107,6 +107,46 @@ def test_free_pattern_is_the_unique_construction(build):
     K = sp.csr_matrix(system.mass_matrix() + 0.01 * system.stiffness_matrix(x, fix="clamp"))
     ref = K[system.free_dofs][:, system.free_dofs].toarray()
     assert np.abs(pat.matrix(data).toarray() - ref).max() <= 1e-12 * np.abs(ref).max()
+
+
+def _pair_matrix(system, pairs, seed):
+    """A symmetric ``nd x nd`` matrix with a random dense ``d x d`` block on every node pair
+    ``(a, b)`` of ``pairs`` and its transpose on ``(b, a)`` (a contact Hessian's couplings)."""
+    d, rng = system.dim, np.random.default_rng(seed)
+    B = np.zeros((system.ndof, system.ndof))
+    for a, b in pairs:
+        blk = rng.standard_normal((d, d))
+        B[a * d:a * d + d, b * d:b * d + d] += blk
+        B[b * d:b * d + d, a * d:a * d + d] += blk.T
+    return sp.csr_matrix(B)
+
+
+def test_contact_pattern_holds_the_newton_matrix_and_follows_the_contact_set():
+    """Far node pairs (a pinned node's and the roller's among them) join the free pattern; the
+    values are the free rows and columns of the sum; a pattern that holds a call's couplings is
+    kept (the same object: the factor's analysis reused), one that does not is rebuilt from them
+    and the pairs used since the last build, so a pair out of contact since then leaves it."""
+    system = _cloth()
+    pat, free, cache = FreePattern(system), system.free_dofs, {}
+    x = system.x0 + 0.01 * np.random.default_rng(5).standard_normal(system.x0.shape)
+    m = np.repeat(system.mass, system.dim)
+    base, _, _ = assemble_with_forces(pat, system, x, np.zeros_like(x), 0.0, diagonal=m,
+                                      kcoef=0.01, dcoef=0.0, fix="clamp")
+    K = sp.csr_matrix(system.mass_matrix() + 0.01 * system.stiffness_matrix(x, fix="clamp"))
+    A, P, Q, R = (0, 40), (6, 24), (3, 45), (10, 38)   # node 6: a pinned corner; 24: the roller
+    seen = []
+    for k, pairs in enumerate(([A, P], [A], [Q], [R])):
+        B = _pair_matrix(system, pairs, k)
+        cp, data = contact_values(pat, base, [None, B], 0.5, cache)
+        ref = (K + 0.5 * B)[free][:, free].toarray()
+        assert np.abs(cp.matrix(data).toarray() - ref).max() <= 1e-12 * np.abs(ref).max()
+        seen.append(cp)
+    n = system.n
+    key = lambda a, b: a * n + b
+    assert seen[1] is seen[0] and seen[2] is not seen[1] and seen[3] is not seen[2]
+    assert {key(*A), key(*P), key(*Q)} <= set(seen[2].pairs)          # A, P used since build 1
+    assert key(*A) not in set(seen[3].pairs) and key(*Q) in set(seen[3].pairs)
+    assert not np.isin(seen[3].extra_pairs, [key(*A), key(*A[::-1])]).any()
 
 
 def test_spring_pattern_is_the_unique_construction():

@@ -63,9 +63,12 @@ sign of convergence); and the step is solved again while ``advance`` moves a pre
 obstacle on towards its place at the step's end (carrying the bodies touching it: ``advance``
 writes the iterate in place), then while ``relag`` asks for another friction
 lagging iteration. ``keeps_contact = True`` declares it (the trait the other integrators lack). A contact Hessian
-couples any two surface nodes, outside the compiled pattern of the ``cholesky`` path, so a contact
-system's Newton matrix is assembled generally and factorised by the spec's method (``direct``, or
-``cholesky`` with any engine: symbolic analysis reused while the pattern holds, CHOLMOD's cache).
+couples any two surface nodes, outside the compiled pattern of the ``cholesky`` path: there the
+springs (and any other force) are written by the compiled pass and the contact Hessian is added on
+the run's :class:`~femkit.dynamics.kernels.assembly.ContactPattern` (the compiled pattern joined to
+the blocks of the node pairs in contact), rebuilt only when a new pair couples outside it -- so the
+factorisation is refactorised in place on one symbolic analysis for most iterations; with
+``direct`` (or Rayleigh's ``r_K`` with contact) the Newton matrix is assembled generally.
 
 First order; unconditionally stable.
 """
@@ -152,16 +155,19 @@ class NewtonImplicitEuler(Integrator):
         M = system.mass_matrix()
         m = M.diagonal()
         forces = system.forces
-        bounded = any(f.requires_bounded_steps for f in forces)
-        # the compiled pattern holds the springs' and nodal blocks; a contact Hessian couples
-        # any two surface nodes, so contact systems assemble generally (and factorise by the
-        # spec's method, the cholesky engines included)
-        compiled = ctx.session.factors_on_pattern and not self.matrix_free and not bounded
+        contact = [f for f in forces if f.requires_bounded_steps]
+        bounded = bool(contact)
+        # the compiled pattern holds the springs' and nodal blocks; a contact Hessian, which
+        # couples any two surface nodes, goes on the run's ContactPattern (that pattern joined
+        # to the contact pairs' blocks); Rayleigh damping's K(x_n) with contact assembles
+        # generally
+        compiled = ctx.session.factors_on_pattern and not self.matrix_free and not (
+            bounded and rk != 0.0)
         if self.matrix_free:
             C = self.damping_operator(system, state.x)
             c_apply = C[0]
         elif compiled:  # C on the cached pattern, the springs in one compiled pass
-            from ..kernels.assembly import assemble_with_forces, free_pattern
+            from ..kernels.assembly import assemble_with_forces, contact_values, free_pattern
 
             pat = free_pattern(system, ctx.cache)
             zero_v = np.zeros(shape)
@@ -169,7 +175,8 @@ class NewtonImplicitEuler(Integrator):
                 f.damping(state.x) is not None for f in system.forces)
             if damped:
                 c_data = assemble_with_forces(pat, system, state.x, zero_v, state.t,
-                                              diagonal=rm * m, kcoef=rk, dcoef=1.0, fix=None)[0]
+                                              diagonal=rm * m, kcoef=rk, dcoef=1.0, fix=None,
+                                              skip=contact)[0]
                 Cf = pat.matrix(c_data)
 
                 def c_apply(e):
@@ -225,8 +232,14 @@ class NewtonImplicitEuler(Integrator):
                 iterations += 1
                 if compiled:  # the matrix first: an elastic body's element pass then serves the gradient
                     data = assemble_with_forces(pat, system, x.reshape(shape), zero_v, state.t,
-                                                diagonal=m, kcoef=h * h, dcoef=0.0, fix=self.fix)[0]
+                                                diagonal=m, kcoef=h * h, dcoef=0.0, fix=self.fix,
+                                                skip=contact)[0]
                     data += h * c_data
+                    on = pat
+                    if contact:
+                        on, data = contact_values(pat, data, [
+                            f.stiffness(x.reshape(shape), "clamp" if self.fix == "clamp" else None)
+                            for f in contact], h * h, ctx.cache)
                 grad = gradient(x)
                 residuals.append(float(np.linalg.norm(grad[free])))
                 dx = np.zeros_like(x)
@@ -236,7 +249,7 @@ class NewtonImplicitEuler(Integrator):
                                                  accept=FORCING)
                 elif compiled:
                     dx[free] = ctx.session.solve_on_pattern(
-                        pat.matrix(data), -grad[free], pat,
+                        on.matrix(data), -grad[free], on,
                         "newton_factor" if self.reuse_factorization else None, accept=FORCING)
                 else:
                     H = M + (h * h) * system.stiffness_matrix(x.reshape(shape), fix=self.fix) + h * C

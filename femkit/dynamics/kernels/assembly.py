@@ -22,10 +22,56 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["FreePattern", "free_pattern"]
+__all__ = ["FreePattern", "free_pattern", "ContactPattern", "contact_values"]
 
 
-class FreePattern:
+class _FreeDofPattern:
+    """The interface :meth:`femkit.solvers.session.LinearSession.solve_on_pattern` and the
+    assembly read of a CSR pattern on the free dofs: ``indptr``, ``indices``, ``free``, ``shape``,
+    ``dim`` and ``coordinate_pair`` set by the subclass."""
+
+    @property
+    def entry_group(self) -> np.ndarray:
+        """The group of each entry for :meth:`femkit.solvers.session.LinearSession.solve_on_pattern`:
+        its coordinate pair (groups that stay all zero, e.g. the out-of-plane couplings of a
+        planar cloth, are left out of the factor)."""
+        return self.coordinate_pair
+
+    @property
+    def n_groups(self) -> int:
+        """Number of coordinate pairs, ``d * d``."""
+        return self.dim * self.dim
+
+    @property
+    def kept_groups(self) -> np.ndarray:
+        """The same-coordinate pairs ``(p, p)``, always factorised (the clamp zeroes and restores
+        them spring by spring)."""
+        return np.arange(self.dim) * (self.dim + 1)
+
+    def matrix(self, data: np.ndarray) -> sp.csr_matrix:
+        """The CSR matrix with these values (the pattern arrays are shared, not copied)."""
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape)
+
+    def add(self, data: np.ndarray, B, scale: float = 1.0) -> bool:
+        """``data += scale * B[free][:, free]`` for a full ``ndof x ndof`` sparse ``B`` inside the
+        pattern; False when ``B`` has an entry outside it (``data`` is then unusable)."""
+        from .spring_kernels import add_csr_into
+
+        Bf = sp.csr_matrix(B)[self.free][:, self.free].tocsr()
+        Bf.sort_indices()
+        return bool(add_csr_into(self.indptr, self.indices, data, Bf.indptr.astype(np.int32),
+                                 Bf.indices.astype(np.int32), Bf.data, float(scale)))
+
+
+def _coordinate_pairs(free: np.ndarray, indptr: np.ndarray, indices: np.ndarray,
+                      d: int) -> np.ndarray:
+    """``p*d + q`` of every entry of a free-dof CSR pattern: the coordinates it couples."""
+    coord = free % d
+    rows = np.repeat(np.arange(len(free)), np.diff(indptr))
+    return (coord[rows] * d + coord[indices]).astype(np.int8)
+
+
+class FreePattern(_FreeDofPattern):
     """CSR pattern of the implicit methods' matrices on the free dofs, with the scatter slots.
 
     The pattern holds every spring's four ``d x d`` blocks, every node's full ``d x d``
@@ -74,45 +120,11 @@ class FreePattern:
         self.indptr = indptr.astype(np.int32)
         self.nnz = len(indices)
         # the coordinate pair (p, q) -> p*d + q an entry couples (see entry_group)
-        coord = free % d
-        rows = np.repeat(np.arange(nf), np.diff(self.indptr))
-        self.coordinate_pair = (coord[rows] * d + coord[self.indices]).astype(np.int8)
+        self.coordinate_pair = _coordinate_pairs(free, self.indptr, self.indices, d)
         self.dim = d
         self.free = free
         self.shape = (nf, nf)
         self.ndof = system.ndof
-
-    @property
-    def entry_group(self) -> np.ndarray:
-        """The group of each entry for :meth:`femkit.solvers.session.LinearSession.solve_on_pattern`:
-        its coordinate pair (groups that stay all zero, e.g. the out-of-plane couplings of a
-        planar cloth, are left out of the factor)."""
-        return self.coordinate_pair
-
-    @property
-    def n_groups(self) -> int:
-        """Number of coordinate pairs, ``d * d``."""
-        return self.dim * self.dim
-
-    @property
-    def kept_groups(self) -> np.ndarray:
-        """The same-coordinate pairs ``(p, p)``, always factorised (the clamp zeroes and restores
-        them spring by spring)."""
-        return np.arange(self.dim) * (self.dim + 1)
-
-    def matrix(self, data: np.ndarray) -> sp.csr_matrix:
-        """The CSR matrix with these values (the pattern arrays are shared, not copied)."""
-        return sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape)
-
-    def add(self, data: np.ndarray, B, scale: float = 1.0) -> bool:
-        """``data += scale * B[free][:, free]`` for a full ``ndof x ndof`` sparse ``B`` inside the
-        pattern; False when ``B`` has an entry outside it (``data`` is then unusable)."""
-        from .spring_kernels import add_csr_into
-
-        Bf = sp.csr_matrix(B)[self.free][:, self.free].tocsr()
-        Bf.sort_indices()
-        return bool(add_csr_into(self.indptr, self.indices, data, Bf.indptr.astype(np.int32),
-                                 Bf.indices.astype(np.int32), Bf.data, float(scale)))
 
     def assemble(self, system, x, *, diagonal, kcoef: float, ccoef: float = 0.0,
                  clamp: bool = False, v=None, want_force: bool = False,
@@ -153,8 +165,100 @@ def free_pattern(system, cache: dict) -> FreePattern:
     return pat
 
 
+class ContactPattern(_FreeDofPattern):
+    """A :class:`FreePattern` joined to the ``d x d`` blocks of node pairs a contact Hessian
+    couples (any two surface nodes, outside the springs' pattern), on the free dofs.
+
+    Kept for a run and rebuilt -- a new object, so the factorisation's symbolic analysis is
+    redone only then -- when a contact Hessian couples a pair outside it (:func:`contact_values`).
+
+    Attributes
+    ----------
+    base : FreePattern
+    pairs : int64 array, the node pairs ``a n + b`` (both orders) joined to ``base``.
+    base_slots : (base.nnz,) int64, the position of each ``base`` entry in this pattern's ``data``.
+    extra : int64 array, the positions of the entries outside ``base``.
+    extra_pairs : int64 array, the node pair ``a n + b`` of each of them.
+    """
+
+    def __init__(self, base: FreePattern, pairs: np.ndarray):
+        from ...fem.sparsity import entry_pattern, structure_entries, union_structures
+
+        d, free = base.dim, base.free
+        n, nf = base.ndof // d, len(free)
+        self.base, self.pairs = base, np.asarray(pairs, dtype=np.int64)
+        renumber = np.full(base.ndof, -1, dtype=np.int64)
+        renumber[free] = np.arange(nf)
+        e, shape = np.arange(d), (len(self.pairs), d, d)
+        # entry (p, q) of the block of pair (a, b): row a d + p, column b d + q
+        rows = renumber[np.broadcast_to((self.pairs // n)[:, None, None] * d + e[:, None], shape)]
+        cols = renumber[np.broadcast_to((self.pairs % n)[:, None, None] * d + e, shape)]
+        rows, cols = rows.ravel(), cols.ravel()
+        inside = (rows >= 0) & (cols >= 0)
+        ip, ix, _ = entry_pattern(rows[inside], cols[inside], nf)
+        indptr, indices, (self.base_slots, _) = union_structures(
+            [(base.indptr, base.indices), (ip, ix)], nf)
+        outside = np.ones(len(indices), dtype=bool)
+        outside[self.base_slots] = False
+        self.extra = np.flatnonzero(outside)
+        r, c = structure_entries(indptr, indices)
+        self.extra_pairs = free[r[self.extra]] // d * n + free[c[self.extra]] // d
+        self.indptr, self.indices = indptr.astype(np.int32), indices.astype(np.int32)
+        self.nnz = len(indices)
+        self.coordinate_pair = _coordinate_pairs(free, self.indptr, self.indices, d)
+        self.dim, self.free, self.shape, self.ndof = d, free, (nf, nf), base.ndof
+
+    def values(self, base_data: np.ndarray, matrices, scale: float):
+        """``data`` of ``base_data`` (on :attr:`base`) plus ``scale`` times the full
+        ``ndof x ndof`` ``matrices`` (``None`` skipped) on the free dofs, or ``None`` when one of
+        them has an entry outside this pattern."""
+        data = np.zeros(self.nnz)
+        data[self.base_slots] = base_data
+        for B in matrices:
+            if B is not None and not self.add(data, B, scale):
+                return None
+        return data
+
+
+def node_pairs(matrices, n: int, d: int) -> np.ndarray:
+    """The node pairs ``a n + b`` the entries of sparse ``nd x nd`` ``matrices`` couple (``None``
+    skipped), unique."""
+    keys = [np.zeros(0, dtype=np.int64)]
+    for B in matrices:
+        if B is not None:
+            C = sp.coo_matrix(B)
+            keys.append(C.row.astype(np.int64) // d * n + C.col.astype(np.int64) // d)
+    return np.unique(np.concatenate(keys))
+
+
+def contact_values(base: FreePattern, base_data: np.ndarray, matrices, scale: float,
+                   cache: dict) -> tuple[ContactPattern, np.ndarray]:
+    """``(pattern, data)``: ``base_data + scale * sum(matrices)`` (a contact Hessian's
+    couplings) on the :class:`ContactPattern` kept in ``cache`` (a run's ``ctx.cache``).
+
+    The kept pattern serves while every coupling fits; otherwise a new one is built from the
+    couplings of ``matrices`` and those outside ``base`` that were nonzero since the last
+    build (pairs that left contact since then are dropped, so the pattern follows the contact
+    set instead of growing with every pair a run ever touched).
+    """
+    kept = cache.get("contact_pattern")
+    pat, used = kept if kept is not None and kept[0].base is base else (None, None)
+    data = None if pat is None else pat.values(base_data, matrices, scale)
+    if data is None:
+        n = base.ndof // base.dim
+        pairs = node_pairs(matrices, n, base.dim)
+        if pat is not None:
+            pairs = np.union1d(pairs, pat.extra_pairs[used])
+        pat = ContactPattern(base, pairs)
+        used = np.zeros(len(pat.extra), dtype=bool)
+        data = pat.values(base_data, matrices, scale)
+    used |= data[pat.extra] != 0.0
+    cache["contact_pattern"] = (pat, used)
+    return pat, data
+
+
 def assemble_with_forces(pat: FreePattern, system, x, v, t: float, *, diagonal, kcoef: float,
-                         dcoef: float, fix: str | None):
+                         dcoef: float, fix: str | None, skip=()):
     """One implicit step's matrix and vectors, the springs in one compiled pass.
 
     Returns ``(data, f, kv)``: the values (on ``pat``) of
@@ -163,7 +267,9 @@ def assemble_with_forces(pat: FreePattern, system, x, v, t: float, *, diagonal, 
     damping, e.g. viscous, not Rayleigh), the force ``system.force(x, v, t, rayleigh=False)``
     ``(n, d)`` and the product ``K_fix(x) v`` ``(n, d)`` -- the same three objects as
     ``stiffness_matrix`` / ``damping_matrix`` / ``force`` of the system
-    (:class:`~femkit.dynamics.system.MassSpringSystem`), tested equal to them.
+    (:class:`~femkit.dynamics.system.MassSpringSystem`), tested equal to them. The forces in
+    ``skip`` are left out of all three (a contact force, whose Hessian the caller puts on a
+    :class:`ContactPattern`).
     """
     from ...errors import SolverError
     from ..forces.rayleigh import RayleighDamping
@@ -177,6 +283,8 @@ def assemble_with_forces(pat: FreePattern, system, x, v, t: float, *, diagonal, 
     force_fix = "clamp" if clamp else None
     moving = bool(v.any())
     for k, force in enumerate(system.forces):
+        if any(force is f for f in skip):
+            continue
         Kf = force.stiffness(x, force_fix)    # first: an elastic body's pass keeps its gradient
         if not isinstance(force, RayleighDamping):
             force.add_force(x, v, t, f)
