@@ -610,7 +610,7 @@ def fast_path_hint(case, system, integrator) -> str | None:
     :data:`FAST_PATH_DOFS` unknowns factorises with SuperLU (``method: direct``); else None.
 
     A barrier-contact scene is pointed at CHOLMOD (scikit-sparse, ``femkit[cholesky]``), which
-    cuts its step (81 x 81 cloth on a sphere: 3.4 against 4.6 s), not at cholespy, which is no
+    cuts its step (81 x 81 cloth on a sphere: 2.7 against 4.0 s CPU), not at cholespy, which is no
     faster there (docs/benchmarks.md, "Barrier contact")."""
     if (case.solver.method != "direct" or not getattr(integrator, "implicit", False)
             or system.ndof < FAST_PATH_DOFS):
