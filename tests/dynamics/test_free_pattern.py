@@ -109,10 +109,10 @@ def test_free_pattern_is_the_unique_construction(build):
     assert np.abs(pat.matrix(data).toarray() - ref).max() <= 1e-12 * np.abs(ref).max()
 
 
-def _pair_matrix(system, pairs, seed):
+def _pair_matrix(system, pairs, stream):
     """A symmetric ``nd x nd`` matrix with a random dense ``d x d`` block on every node pair
     ``(a, b)`` of ``pairs`` and its transpose on ``(b, a)`` (a contact Hessian's couplings)."""
-    d, rng = system.dim, np.random.default_rng(seed)
+    d, rng = system.dim, np.random.default_rng(stream)
     B = np.zeros((system.ndof, system.ndof))
     for a, b in pairs:
         blk = rng.standard_normal((d, d))
