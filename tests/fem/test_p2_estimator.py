@@ -60,3 +60,28 @@ def test_zz_is_refused_for_p2():
     prob = PoissonProblem(unit_square(2), 1.0, 1.0, element="P2")
     with pytest.raises(InputError, match="estimator 'zz' is not available for element P2; valid: residual"):
         estimate(prob, prob.solve("direct")[0], "zz")
+
+
+@pytest.mark.parametrize("a", [0.0, 3.0, -0.5], ids=["no-kink", "kink-3", "kink-minus-half"])
+def test_jump_term_of_a_known_kink_across_one_edge(a):
+    # u = x^2 + 2y on T1 and that plus a (x + y - 1) on T2: continuous across their shared edge
+    # x + y = 1, both pieces quadratic (so their P2 interpolants are exact), the normal-derivative
+    # jump -a sqrt(2) along the whole edge; jump part of each cell
+    # 0.5 c_J^2 / p * h_F |F| |jump|^2 = 0.5 / 24 * sqrt(2) sqrt(2) 2 a^2 = a^2 / 12
+    from femkit.elements import get_element
+    from femkit.fem.dofs import dof_map
+    from femkit.fem.estimators.residual_p2 import residual_estimator_p2
+    from femkit.mesh import Mesh
+
+    mesh = Mesh(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]),
+                np.array([[0, 1, 2], [1, 3, 2]]))
+    elem = get_element("P2", 2)
+    dofs = dof_map(mesh, elem)
+    pieces = [lambda x, y: x * x + 2 * y, lambda x, y: x * x + 2 * y + a * (x + y - 1)]
+    u = np.zeros(dofs.n_dofs)
+    for e, q in enumerate(pieces):
+        verts = mesh.points[mesh.cells[e]]
+        where = np.vstack([verts] + [(verts[i] + verts[j]) / 2 for i, j in elem.local_edges])
+        u[dofs.cells[e]] = q(*where.T)
+    est = residual_estimator_p2(mesh, u, kappa=1.0, f=0.0)
+    np.testing.assert_allclose(est.parts["jump"], [a * a / 12] * 2, rtol=1e-12, atol=1e-14)

@@ -111,28 +111,33 @@ def residual_estimator_p2(mesh, u: np.ndarray, *, kappa=1.0, f=0.0, neumann: Seq
     r = fq + (kap * lap)[:, None]
     h_t = _longest(mesh.points, cells)
     volume = c_volume ** 2 * h_t ** 2 / (p * p * kap) * vol * ((r * r) @ rule.weights)
-    jump, neumann_part = _facet_terms(mesh, elem, ue, G, vol, cells, kap, neumann, dirichlet_nodes,
-                                      c_jump ** 2 / p)
+    jump, neumann_part = _facet_terms(mesh, hess, ue[:, :nv], G, vol, cells, kap, neumann,
+                                      dirichlet_nodes, c_jump ** 2 / p)
     parts = {"volume": volume, "jump": jump, "neumann": neumann_part}
     return ErrorEstimate("residual", np.sqrt(volume + jump + neumann_part), parts)
 
 
-def _facet_terms(mesh, elem, ue, G, vol, cells, kap, neumann, dirichlet_nodes, weight):
-    """The jump and the Neumann parts (each (m,), squared, times ``weight = c_J^2 / p``)."""
+def _facet_terms(mesh, hess, uv, G, vol, cells, kap, neumann, dirichlet_nodes, weight):
+    """The jump and the Neumann parts (each (m,), squared, times ``weight = c_J^2 / p``).
+
+    ``hess`` (m, d+1, d+1): the second derivatives of ``u_h`` in the barycentric coordinates;
+    ``uv`` (m, d+1): its vertex values. The gradient of a P2 field is linear in the cell:
+    ``du/dlambda_a = sum_b hess[a, b] lambda_b - u_a`` (from ``sum_b lambda_b = 1``), so the flux
+    at a facet point is that row times ``G_a . n``, with no basis evaluation."""
     fbary, fw = _facet_rule(mesh.dim)
     ids, count = _facets(mesh)
     m, nv = cells.shape
     n_f, q = len(count), len(fw)
     flux = np.empty((m, nv, q))                                      # outward kappa du/dn
-    pts = np.empty((m, nv, q, mesh.dim))
-    area = mesh.dim * vol[:, None] * np.linalg.norm(G, axis=2)       # |F_k| = d |T| |grad lambda_k|
+    lams = []
+    gnorm = np.linalg.norm(G, axis=2)                                # (m, d+1)
+    area = mesh.dim * vol[:, None] * gnorm                           # |F_k| = d |T| |grad lambda_k|
     for k in range(nv):
         lam = _facet_points(cells, k, fbary)                         # (m, q, d+1)
-        dl = np.einsum("mn,mqna->mqa", ue, elem.lambda_gradients(lam.reshape(-1, nv)).reshape(m, q, -1, nv))
-        grad = np.einsum("mqa,mad->mqd", dl, G)
-        normal = -G[:, k] / np.linalg.norm(G[:, k], axis=1)[:, None]
-        flux[:, k] = kap[:, None] * np.einsum("mqd,md->mq", grad, normal)
-        pts[:, k] = np.einsum("mqa,mad->mqd", lam, mesh.points[cells])
+        lams.append(lam)
+        dl = np.matmul(lam, hess) - uv[:, None, :]                   # (m, q, d+1); hess symmetric
+        gn = -np.einsum("mad,md->ma", G, G[:, k]) / gnorm[:, k][:, None]   # G_a . n_k
+        flux[:, k] = kap[:, None] * np.einsum("mqa,ma->mq", dl, gn)
     jump_sum = np.zeros((n_f, q))
     for j in range(q):
         jump_sum[:, j] = np.bincount(ids.ravel(), weights=flux[:, :, j].ravel(), minlength=n_f)
@@ -168,7 +173,11 @@ def _facet_terms(mesh, elem, ue, G, vol, cells, kap, neumann, dirichlet_nodes, w
         if not hit.any():
             continue
         if callable(h):
-            xyz = pts[elem_i[hit], k_i[hit]]                         # (k, q, d)
+            e_h, k_h = elem_i[hit], k_i[hit]
+            xyz = np.empty((len(e_h), q, mesh.dim))                  # (k, q, d)
+            for k in range(nv):
+                sel = k_h == k
+                xyz[sel] = np.einsum("kqa,kad->kqd", lams[k][e_h[sel]], mesh.points[cells[e_h[sel]]])
             hq[hit] = evaluate_callable(h, *np.moveaxis(xyz, 2, 0), name="h")
         else:
             hq[hit] = float(h)
