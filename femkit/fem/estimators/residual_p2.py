@@ -129,12 +129,10 @@ def _facet_terms(mesh, hess, uv, G, vol, cells, kap, neumann, dirichlet_nodes, w
     m, nv = cells.shape
     n_f, q = len(count), len(fw)
     flux = np.empty((m, nv, q))                                      # outward kappa du/dn
-    lams = []
     gnorm = np.linalg.norm(G, axis=2)                                # (m, d+1)
     area = mesh.dim * vol[:, None] * gnorm                           # |F_k| = d |T| |grad lambda_k|
     for k in range(nv):
         lam = _facet_points(cells, k, fbary)                         # (m, q, d+1)
-        lams.append(lam)
         dl = np.matmul(lam, hess) - uv[:, None, :]                   # (m, q, d+1); hess symmetric
         gn = -np.einsum("mad,md->ma", G, G[:, k]) / gnorm[:, k][:, None]   # G_a . n_k
         flux[:, k] = kap[:, None] * np.einsum("mqa,ma->mq", dl, gn)
@@ -177,7 +175,8 @@ def _facet_terms(mesh, hess, uv, G, vol, cells, kap, neumann, dirichlet_nodes, w
             xyz = np.empty((len(e_h), q, mesh.dim))                  # (k, q, d)
             for k in range(nv):
                 sel = k_h == k
-                xyz[sel] = np.einsum("kqa,kad->kqd", lams[k][e_h[sel]], mesh.points[cells[e_h[sel]]])
+                own = cells[e_h[sel]]
+                xyz[sel] = np.einsum("kqa,kad->kqd", _facet_points(own, k, fbary), mesh.points[own])
             hq[hit] = evaluate_callable(h, *np.moveaxis(xyz, 2, 0), name="h")
         else:
             hq[hit] = float(h)
